@@ -1,0 +1,18 @@
+//! # spectral-remesh
+//!
+//! Spectral sampling and remeshing of triangle meshes, after *Spectral Sampling of Manifolds*
+//! (A. C. Öztireli, M. Alexa, M. Gross, ACM Trans. Graph. 29(6), SIGGRAPH Asia 2010,
+//! doi:10.1145/1882261.1866190).
+//!
+//! The pipeline (see `ARCHITECTURE.md`): read → normalize (bbox 100) → candidates → linear scan →
+//! gradient ascent + projection → triangulate → clean up → report → write.
+
+pub mod error;
+pub mod io;
+pub mod mesh;
+pub mod quality;
+pub mod surface;
+
+pub use error::{Error, Result};
+pub use mesh::{Aabb, Normalization, TriMesh};
+pub use surface::{MeshSurface, SurfacePoint};

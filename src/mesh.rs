@@ -1,0 +1,322 @@
+//! The indexed triangle mesh used throughout the pipeline, with the bounding-box normalization of
+//! Sec. 7 of the paper (longest side scaled to 100).
+
+use glam::DVec3;
+
+/// An indexed triangle mesh: `positions` is `V × 3` (model units, or bbox-100 units after
+/// [`Normalization::apply`]), `triangles` is `F × 3` indices into `positions`, counter-clockwise
+/// seen from the outside (the side the face normal points to).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Triangles as vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Axis-aligned bounding box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    /// Lower corner.
+    pub min: DVec3,
+    /// Upper corner.
+    pub max: DVec3,
+}
+
+impl Aabb {
+    /// The bounding box of `points`; `None` when `points` is empty.
+    pub fn of(points: &[DVec3]) -> Option<Self> {
+        let first = *points.first()?;
+        let (min, max) = points
+            .iter()
+            .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        Some(Aabb { min, max })
+    }
+
+    /// The length of the longest side.
+    pub fn longest_side(&self) -> f64 {
+        (self.max - self.min).max_element()
+    }
+
+    /// The length of the diagonal.
+    pub fn diagonal(&self) -> f64 {
+        (self.max - self.min).length()
+    }
+
+    /// The centre.
+    pub fn center(&self) -> DVec3 {
+        0.5 * (self.min + self.max)
+    }
+}
+
+impl TriMesh {
+    /// A mesh from positions and triangles, taken as they are (see [`TriMesh::check_indices`]).
+    pub fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Self {
+        TriMesh {
+            positions,
+            triangles,
+        }
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of triangles.
+    pub fn face_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The three corner positions of triangle `f`.
+    #[inline]
+    pub fn corners(&self, f: usize) -> [DVec3; 3] {
+        let [a, b, c] = self.triangles[f];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    /// Twice the area vector of triangle `f` ((b-a)×(c-a)): its direction is the face normal,
+    /// its length twice the area.
+    #[inline]
+    pub fn face_cross(&self, f: usize) -> DVec3 {
+        let [a, b, c] = self.corners(f);
+        (b - a).cross(c - a)
+    }
+
+    /// Unit normal of triangle `f` (zero for a degenerate triangle).
+    #[inline]
+    pub fn face_normal(&self, f: usize) -> DVec3 {
+        self.face_cross(f).normalize_or_zero()
+    }
+
+    /// Area of triangle `f`.
+    #[inline]
+    pub fn face_area(&self, f: usize) -> f64 {
+        0.5 * self.face_cross(f).length()
+    }
+
+    /// Total surface area.
+    pub fn area(&self) -> f64 {
+        (0..self.face_count()).map(|f| self.face_area(f)).sum()
+    }
+
+    /// Bounding box of the vertices; `None` for an empty mesh.
+    pub fn bbox(&self) -> Option<Aabb> {
+        Aabb::of(&self.positions)
+    }
+
+    /// Unit vertex normals, `V × 3`: the angle-weighted average of the incident face normals
+    /// (Thürmer & Wüthrich 1998). A vertex in no triangle, or only in degenerate ones, gets zero.
+    pub fn vertex_normals(&self) -> Vec<DVec3> {
+        let mut normals = vec![DVec3::ZERO; self.positions.len()];
+        for (f, tri) in self.triangles.iter().enumerate() {
+            let n = self.face_normal(f);
+            if n == DVec3::ZERO {
+                continue;
+            }
+            let p = self.corners(f);
+            for k in 0..3 {
+                let e1 = p[(k + 1) % 3] - p[k];
+                let e2 = p[(k + 2) % 3] - p[k];
+                let angle = e1.angle_between(e2);
+                if angle.is_finite() {
+                    normals[tri[k] as usize] += angle * n;
+                }
+            }
+        }
+        for n in &mut normals {
+            *n = n.normalize_or_zero();
+        }
+        normals
+    }
+
+    /// The first triangle that names a vertex index `>= V`, as `(face, index)`.
+    pub fn check_indices(&self) -> Option<(usize, u32)> {
+        let n = self.positions.len() as u64;
+        self.triangles.iter().enumerate().find_map(|(f, t)| {
+            t.iter()
+                .find(|&&i| u64::from(i) >= n)
+                .map(|&i| (f, i))
+        })
+    }
+
+    /// The first vertex with a NaN or infinite coordinate.
+    pub fn first_non_finite_vertex(&self) -> Option<usize> {
+        self.positions.iter().position(|p| !p.is_finite())
+    }
+
+    /// Removes the vertices no triangle uses, renumbering the triangles. Returns how many were
+    /// removed.
+    pub fn remove_unreferenced_vertices(&mut self) -> usize {
+        let mut new_index = vec![u32::MAX; self.positions.len()];
+        for t in &self.triangles {
+            for &i in t {
+                new_index[i as usize] = 0;
+            }
+        }
+        let mut kept = Vec::with_capacity(self.positions.len());
+        for (i, slot) in new_index.iter_mut().enumerate() {
+            if *slot == 0 {
+                *slot = kept.len() as u32;
+                kept.push(self.positions[i]);
+            }
+        }
+        let removed = self.positions.len() - kept.len();
+        for t in &mut self.triangles {
+            for i in t.iter_mut() {
+                *i = new_index[*i as usize];
+            }
+        }
+        self.positions = kept;
+        removed
+    }
+
+    /// Merges vertices with bit-identical positions (as glTF files split vertices at texture
+    /// seams), renumbering the triangles, and drops triangles that then repeat a vertex. Returns
+    /// how many vertices were merged away.
+    pub fn weld_identical_positions(&mut self) -> usize {
+        let mut first: rustc_hash::FxHashMap<[u64; 3], u32> = Default::default();
+        let mut remap = Vec::with_capacity(self.positions.len());
+        let mut kept = Vec::with_capacity(self.positions.len());
+        for p in &self.positions {
+            // +0.0 and -0.0 are the same point.
+            let key = [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
+            let idx = *first.entry(key).or_insert_with(|| {
+                kept.push(*p);
+                (kept.len() - 1) as u32
+            });
+            remap.push(idx);
+        }
+        let merged = self.positions.len() - kept.len();
+        self.positions = kept;
+        for t in &mut self.triangles {
+            for i in t.iter_mut() {
+                *i = remap[*i as usize];
+            }
+        }
+        self.triangles
+            .retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+        merged
+    }
+}
+
+/// The similarity transform that maps a model into the bbox-100 frame of Sec. 7: centred on its
+/// bounding box, longest side 100. All sigma_p, distances and tolerances of the pipeline are in
+/// that frame; outputs are mapped back to model units with [`Normalization::invert`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Normalization {
+    /// The model-space centre of the bounding box.
+    pub center: DVec3,
+    /// Model units to bbox-100 units (100 / longest side).
+    pub scale: f64,
+}
+
+impl Normalization {
+    /// The longest side of the bounding box after normalization.
+    pub const TARGET_SIZE: f64 = 100.0;
+
+    /// The normalization of `bbox`; `None` when its longest side is zero or not finite.
+    pub fn for_bbox(bbox: &Aabb) -> Option<Self> {
+        let side = bbox.longest_side();
+        if !(side.is_finite() && side > 0.0) {
+            return None;
+        }
+        let scale = Self::TARGET_SIZE / side;
+        if !scale.is_finite() {
+            return None;
+        }
+        Some(Normalization {
+            center: bbox.center(),
+            scale,
+        })
+    }
+
+    /// The identity transform.
+    pub fn identity() -> Self {
+        Normalization {
+            center: DVec3::ZERO,
+            scale: 1.0,
+        }
+    }
+
+    /// Model units to bbox-100 units.
+    #[inline]
+    pub fn apply(&self, p: DVec3) -> DVec3 {
+        (p - self.center) * self.scale
+    }
+
+    /// bbox-100 units back to model units.
+    #[inline]
+    pub fn invert(&self, p: DVec3) -> DVec3 {
+        p / self.scale + self.center
+    }
+
+    /// A copy of `mesh` in bbox-100 units.
+    pub fn apply_mesh(&self, mesh: &TriMesh) -> TriMesh {
+        TriMesh {
+            positions: mesh.positions.iter().map(|&p| self.apply(p)).collect(),
+            triangles: mesh.triangles.clone(),
+        }
+    }
+
+    /// A copy of `mesh` back in model units.
+    pub fn invert_mesh(&self, mesh: &TriMesh) -> TriMesh {
+        TriMesh {
+            positions: mesh.positions.iter().map(|&p| self.invert(p)).collect(),
+            triangles: mesh.triangles.clone(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normalization_round_trips_and_scales_longest_side_to_100() {
+        let pts = vec![DVec3::new(1.0, 2.0, 3.0), DVec3::new(3.0, 7.0, 4.0)];
+        let bbox = Aabb::of(&pts).unwrap();
+        let n = Normalization::for_bbox(&bbox).unwrap();
+        let q: Vec<_> = pts.iter().map(|&p| n.apply(p)).collect();
+        let nb = Aabb::of(&q).unwrap();
+        assert!((nb.longest_side() - 100.0).abs() < 1e-12);
+        assert!(nb.center().length() < 1e-12);
+        for (p, q) in pts.iter().zip(&q) {
+            assert!((n.invert(*q) - *p).length() < 1e-12);
+        }
+        let flat = Aabb::of(&[DVec3::ONE, DVec3::ONE]).unwrap();
+        assert!(Normalization::for_bbox(&flat).is_none());
+    }
+
+    #[test]
+    fn weld_merges_identical_positions_and_drops_collapsed_faces() {
+        let mut m = TriMesh::new(
+            vec![
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::Y,
+                DVec3::X, // duplicate of 1
+                DVec3::new(1.0, 1.0, 0.0),
+            ],
+            vec![[0, 1, 2], [3, 4, 2], [1, 3, 2]],
+        );
+        assert_eq!(m.weld_identical_positions(), 1);
+        assert_eq!(m.positions.len(), 4);
+        assert_eq!(m.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+    }
+
+    #[test]
+    fn unreferenced_vertices_are_removed() {
+        let mut m = TriMesh::new(
+            vec![DVec3::ZERO, DVec3::Z, DVec3::X, DVec3::Y],
+            vec![[0, 2, 3]],
+        );
+        assert_eq!(m.remove_unreferenced_vertices(), 1);
+        assert_eq!(m.triangles, vec![[0, 1, 2]]);
+        assert_eq!(m.positions[1], DVec3::X);
+    }
+}

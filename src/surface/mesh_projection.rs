@@ -1,0 +1,203 @@
+//! Closest-point projection onto a triangle mesh, through the bounding-volume hierarchy of
+//! `parry3d-f64`. Used to project gradient-ascent moves back onto the input surface (Sec. 6.2) and
+//! to measure the distance between two surfaces (Hausdorff, RMS).
+
+use glam::DVec3;
+use parry3d_f64::query::PointQueryWithLocation;
+use parry3d_f64::shape::{TriMesh as ParryTriMesh, TrianglePointLocation};
+
+use crate::error::{Error, Result};
+use crate::mesh::TriMesh;
+
+/// A point on the surface: where it is, on which triangle, with which barycentric coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// Position on the surface (units of the mesh).
+    pub position: DVec3,
+    /// Index of the triangle of the source mesh it lies on.
+    pub face: u32,
+    /// Barycentric coordinates in that triangle (sum 1).
+    pub barycentric: [f64; 3],
+    /// Distance from the query point to `position`.
+    pub distance: f64,
+}
+
+/// A triangle mesh prepared for closest-point queries and normal look-ups.
+///
+/// Degenerate triangles (zero area) are left out of the search structure; every other triangle
+/// keeps its index in the source mesh.
+pub struct MeshSurface {
+    mesh: TriMesh,
+    bvh: ParryTriMesh,
+    /// parry triangle index -> source face index.
+    face_of_part: Vec<u32>,
+    face_normals: Vec<DVec3>,
+    vertex_normals: Vec<DVec3>,
+}
+
+impl MeshSurface {
+    /// Builds the search structure over `mesh` (copied).
+    ///
+    /// # Errors
+    /// [`Error::InvalidMesh`] when the mesh has no triangle of non-zero area, an index out of
+    /// range, or a non-finite coordinate.
+    pub fn new(mesh: &TriMesh) -> Result<Self> {
+        if let Some((f, i)) = mesh.check_indices() {
+            return Err(Error::invalid_mesh(
+                "",
+                format!("face {f} refers to vertex {i}, but there are {} vertices", mesh.vertex_count()),
+            ));
+        }
+        if let Some(v) = mesh.first_non_finite_vertex() {
+            return Err(Error::invalid_mesh("", format!("vertex {v} has a non-finite coordinate")));
+        }
+        let face_normals: Vec<DVec3> = (0..mesh.face_count()).map(|f| mesh.face_normal(f)).collect();
+        let face_of_part: Vec<u32> = (0..mesh.face_count() as u32)
+            .filter(|&f| face_normals[f as usize] != DVec3::ZERO)
+            .collect();
+        let indices: Vec<[u32; 3]> = face_of_part.iter().map(|&f| mesh.triangles[f as usize]).collect();
+        let bvh = ParryTriMesh::new(mesh.positions.clone(), indices).map_err(|e| {
+            Error::invalid_mesh("", format!("no triangle of non-zero area ({e})"))
+        })?;
+        Ok(MeshSurface {
+            vertex_normals: mesh.vertex_normals(),
+            mesh: mesh.clone(),
+            bvh,
+            face_of_part,
+            face_normals,
+        })
+    }
+
+    /// The source mesh.
+    pub fn mesh(&self) -> &TriMesh {
+        &self.mesh
+    }
+
+    /// The closest point of the surface to `p`. `None` only when `p` is not finite.
+    pub fn closest_point(&self, p: DVec3) -> Option<SurfacePoint> {
+        self.closest_point_within(p, f64::MAX)
+    }
+
+    /// The closest point of the surface to `p` if it is within `max_dist` of `p`.
+    pub fn closest_point_within(&self, p: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        if !p.is_finite() {
+            return None;
+        }
+        let (proj, (part, location)) = self
+            .bvh
+            .project_local_point_and_get_location_with_max_dist(p, false, max_dist)?;
+        let barycentric = match location {
+            TrianglePointLocation::OnSolid => [1.0 / 3.0; 3],
+            loc => loc.barycentric_coordinates().unwrap_or([1.0 / 3.0; 3]),
+        };
+        Some(SurfacePoint {
+            position: proj.point,
+            face: self.face_of_part[part as usize],
+            barycentric,
+            distance: (proj.point - p).length(),
+        })
+    }
+
+    /// Unit normal of face `f` of the source mesh.
+    #[inline]
+    pub fn face_normal(&self, f: u32) -> DVec3 {
+        self.face_normals[f as usize]
+    }
+
+    /// The smooth normal at a surface point: the angle-weighted vertex normals interpolated with
+    /// its barycentric coordinates (falls back to the face normal where they cancel).
+    pub fn smooth_normal(&self, sp: &SurfacePoint) -> DVec3 {
+        let t = self.mesh.triangles[sp.face as usize];
+        let n = (0..3)
+            .map(|k| sp.barycentric[k] * self.vertex_normals[t[k] as usize])
+            .fold(DVec3::ZERO, |a, b| a + b);
+        let n = n.normalize_or_zero();
+        if n == DVec3::ZERO {
+            self.face_normal(sp.face)
+        } else {
+            n
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_square() -> TriMesh {
+        TriMesh::new(
+            vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+    }
+
+    #[test]
+    fn projects_onto_the_plane_and_reports_the_face() {
+        let s = MeshSurface::new(&unit_square()).unwrap();
+        let sp = s.closest_point(DVec3::new(0.8, 0.2, 0.5)).unwrap();
+        assert!((sp.position - DVec3::new(0.8, 0.2, 0.0)).length() < 1e-12);
+        assert_eq!(sp.face, 0);
+        assert!((sp.distance - 0.5).abs() < 1e-12);
+        let b = sp.barycentric;
+        let rebuilt = b[0] * s.mesh().positions[0] + b[1] * s.mesh().positions[1] + b[2] * s.mesh().positions[2];
+        assert!((rebuilt - sp.position).length() < 1e-12);
+        assert!((s.smooth_normal(&sp) - DVec3::Z).length() < 1e-12);
+        // Outside the square: the closest point is on its border.
+        let sp = s.closest_point(DVec3::new(2.0, 0.5, 0.0)).unwrap();
+        assert!((sp.position - DVec3::new(1.0, 0.5, 0.0)).length() < 1e-12);
+    }
+
+    #[test]
+    fn closest_point_agrees_with_brute_force() {
+        use rand::{RngExt, SeedableRng};
+        // A bumpy grid surface.
+        let n = 12;
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                positions.push(DVec3::new(x, y, 0.1 * (7.0 * x).sin() * (5.0 * y).cos()));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = (j * (n + 1) + i) as u32;
+                let w = v + n as u32 + 1;
+                triangles.push([v, v + 1, w + 1]);
+                triangles.push([v, w + 1, w]);
+            }
+        }
+        let mesh = TriMesh::new(positions, triangles);
+        let s = MeshSurface::new(&mesh).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..200 {
+            let p = DVec3::new(
+                rng.random_range(-0.2..1.2),
+                rng.random_range(-0.2..1.2),
+                rng.random_range(-0.3..0.3),
+            );
+            let sp = s.closest_point(p).unwrap();
+            let brute = (0..mesh.face_count())
+                .map(|f| {
+                    let [a, b, c] = mesh.corners(f);
+                    let t = parry3d_f64::shape::Triangle::new(a, b, c);
+                    use parry3d_f64::query::PointQuery;
+                    (t.project_local_point(p, false).point - p).length()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((sp.distance - brute).abs() < 1e-12, "{} vs {}", sp.distance, brute);
+        }
+    }
+
+    #[test]
+    fn rejects_a_mesh_without_area() {
+        let m = TriMesh::new(vec![DVec3::ZERO, DVec3::X, 2.0 * DVec3::X], vec![[0, 1, 2]]);
+        assert!(MeshSurface::new(&m).is_err());
+    }
+}
