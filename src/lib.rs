@@ -9,9 +9,15 @@
 
 pub mod error;
 pub mod io;
+pub mod kernel;
+pub mod measure;
 pub mod mesh;
+pub mod pipeline;
 pub mod quality;
+pub mod sampling;
+pub mod spatial;
 pub mod surface;
+pub mod triangulate;
 
 pub use error::{Error, Result};
 pub use mesh::{Aabb, Normalization, TriMesh};

@@ -137,11 +137,10 @@ impl TriMesh {
     /// The first triangle that names a vertex index `>= V`, as `(face, index)`.
     pub fn check_indices(&self) -> Option<(usize, u32)> {
         let n = self.positions.len() as u64;
-        self.triangles.iter().enumerate().find_map(|(f, t)| {
-            t.iter()
-                .find(|&&i| u64::from(i) >= n)
-                .map(|&i| (f, i))
-        })
+        self.triangles
+            .iter()
+            .enumerate()
+            .find_map(|(f, t)| t.iter().find(|&&i| u64::from(i) >= n).map(|&i| (f, i)))
     }
 
     /// The first vertex with a NaN or infinite coordinate.

@@ -45,20 +45,30 @@ impl MeshSurface {
         if let Some((f, i)) = mesh.check_indices() {
             return Err(Error::invalid_mesh(
                 "",
-                format!("face {f} refers to vertex {i}, but there are {} vertices", mesh.vertex_count()),
+                format!(
+                    "face {f} refers to vertex {i}, but there are {} vertices",
+                    mesh.vertex_count()
+                ),
             ));
         }
         if let Some(v) = mesh.first_non_finite_vertex() {
-            return Err(Error::invalid_mesh("", format!("vertex {v} has a non-finite coordinate")));
+            return Err(Error::invalid_mesh(
+                "",
+                format!("vertex {v} has a non-finite coordinate"),
+            ));
         }
-        let face_normals: Vec<DVec3> = (0..mesh.face_count()).map(|f| mesh.face_normal(f)).collect();
+        let face_normals: Vec<DVec3> = (0..mesh.face_count())
+            .map(|f| mesh.face_normal(f))
+            .collect();
         let face_of_part: Vec<u32> = (0..mesh.face_count() as u32)
             .filter(|&f| face_normals[f as usize] != DVec3::ZERO)
             .collect();
-        let indices: Vec<[u32; 3]> = face_of_part.iter().map(|&f| mesh.triangles[f as usize]).collect();
-        let bvh = ParryTriMesh::new(mesh.positions.clone(), indices).map_err(|e| {
-            Error::invalid_mesh("", format!("no triangle of non-zero area ({e})"))
-        })?;
+        let indices: Vec<[u32; 3]> = face_of_part
+            .iter()
+            .map(|&f| mesh.triangles[f as usize])
+            .collect();
+        let bvh = ParryTriMesh::new(mesh.positions.clone(), indices)
+            .map_err(|e| Error::invalid_mesh("", format!("no triangle of non-zero area ({e})")))?;
         Ok(MeshSurface {
             vertex_normals: mesh.vertex_normals(),
             mesh: mesh.clone(),
@@ -144,7 +154,9 @@ mod tests {
         assert_eq!(sp.face, 0);
         assert!((sp.distance - 0.5).abs() < 1e-12);
         let b = sp.barycentric;
-        let rebuilt = b[0] * s.mesh().positions[0] + b[1] * s.mesh().positions[1] + b[2] * s.mesh().positions[2];
+        let rebuilt = b[0] * s.mesh().positions[0]
+            + b[1] * s.mesh().positions[1]
+            + b[2] * s.mesh().positions[2];
         assert!((rebuilt - sp.position).length() < 1e-12);
         assert!((s.smooth_normal(&sp) - DVec3::Z).length() < 1e-12);
         // Outside the square: the closest point is on its border.
@@ -191,7 +203,12 @@ mod tests {
                     (t.project_local_point(p, false).point - p).length()
                 })
                 .fold(f64::INFINITY, f64::min);
-            assert!((sp.distance - brute).abs() < 1e-12, "{} vs {}", sp.distance, brute);
+            assert!(
+                (sp.distance - brute).abs() < 1e-12,
+                "{} vs {}",
+                sp.distance,
+                brute
+            );
         }
     }
 

@@ -1,0 +1,546 @@
+//! The spectral measure s(x) = 1 - k^T K^-1 k / k(x, x) (Sec. 4.3, eq. 9), computed from the
+//! neighbours of x only, and its gradient (Sec. 6.2).
+//!
+//! s(x) is the squared norm of the part of the feature vector φ(x) orthogonal to the span of the
+//! φ(x_i), relative to |φ(x)|^2 (Appendix B): 1 for a point far from every other, 0 for a point
+//! that duplicates one. Adding neighbours can only lower it, so the linear scan stops adding them
+//! as soon as s <= epsilon (Sec. 6.1).
+
+use crate::kernel::{Kernel, KernelPoint};
+
+/// The acceptance threshold of the linear scan (Sec. 6.3: epsilon = 0.5 for all the paper's
+/// results).
+pub const DEFAULT_EPSILON: f64 = 0.5;
+
+/// A neighbour x_{n+1} whose g_n^-1 = k(x_{n+1}, x_{n+1}) - k_n^T K_n^-1 k_n falls below this is
+/// skipped: φ(x_{n+1}) is then (numerically) in the span of the neighbours already taken and adds
+/// nothing to the projection (Sec. 6.1). Dimensionless (k(x, x) = 1).
+pub const SINGULAR_TOLERANCE: f64 = 1e-9;
+
+/// The outcome of one evaluation of the measure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measure {
+    /// s(x) over the neighbours taken (in [0, 1]); an upper bound of s over all of them when
+    /// `stopped_early` is set.
+    pub s: f64,
+    /// Neighbours taken into K.
+    pub used: usize,
+    /// Neighbours skipped as (numerically) in the span of the others.
+    pub skipped: usize,
+    /// The evaluation stopped once s fell to the stop value, before the last neighbour.
+    pub stopped_early: bool,
+}
+
+/// The inverse of the kernel matrix of a growing set of points, updated one point at a time with
+/// the block inversion formula of eq. 10 (Sec. 6.1; Moghaddam et al. 2008):
+///
+/// K_{n+1}^-1 = [[K_n^-1 + g a a^T, -g a], [-g a^T, g]],
+/// a = K_n^-1 k_n(x_{n+1}), g = (k(x_{n+1}, x_{n+1}) - k_n(x_{n+1})^T a)^-1.
+///
+/// Costs O(n^2) per point. Reuse one value across evaluations to avoid allocation.
+#[derive(Debug, Clone, Default)]
+pub struct IncrementalInverse {
+    points: Vec<KernelPoint>,
+    /// K^-1, row-major, n × n.
+    inv: Vec<f64>,
+    scratch: Vec<f64>,
+    b: Vec<f64>,
+    a: Vec<f64>,
+}
+
+/// What [`IncrementalInverse::push`] did with a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Push {
+    /// The point was added; `g` as in eq. 10.
+    Added {
+        /// g = 1 / (k(y, y) - k^T K^-1 k).
+        g: f64,
+    },
+    /// The point was skipped: g^-1 below [`SINGULAR_TOLERANCE`].
+    Skipped,
+}
+
+impl IncrementalInverse {
+    /// An empty set (K is 0 × 0).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Empties the set, keeping the allocations.
+    pub fn clear(&mut self) {
+        self.points.clear();
+        self.inv.clear();
+    }
+
+    /// Number of points in K.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether K is empty.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// The points of K, in the order they were added.
+    pub fn points(&self) -> &[KernelPoint] {
+        &self.points
+    }
+
+    /// K^-1 as a row-major `n × n` slice.
+    pub fn inverse(&self) -> &[f64] {
+        &self.inv
+    }
+
+    /// The vector a = K^-1 k(y) of the last successful or skipped [`IncrementalInverse::push`].
+    pub fn last_a(&self) -> &[f64] {
+        &self.a
+    }
+
+    /// Adds y to the set with eq. 10, or skips it when it is numerically in the span.
+    pub fn push(&mut self, kernel: &Kernel, y: KernelPoint) -> Push {
+        let n = self.points.len();
+        self.b.clear();
+        self.b
+            .extend(self.points.iter().map(|p| kernel.eval(p, &y)));
+        self.a.clear();
+        self.a.resize(n, 0.0);
+        for i in 0..n {
+            let row = &self.inv[i * n..(i + 1) * n];
+            self.a[i] = row.iter().zip(&self.b).map(|(m, b)| m * b).sum();
+        }
+        let g_inv = 1.0 - self.b.iter().zip(&self.a).map(|(b, a)| b * a).sum::<f64>();
+        if !(g_inv > SINGULAR_TOLERANCE) {
+            return Push::Skipped;
+        }
+        let g = 1.0 / g_inv;
+        let m = n + 1;
+        self.scratch.clear();
+        self.scratch.resize(m * m, 0.0);
+        for i in 0..n {
+            let gai = g * self.a[i];
+            for j in 0..n {
+                self.scratch[i * m + j] = self.inv[i * n + j] + gai * self.a[j];
+            }
+            self.scratch[i * m + n] = -gai;
+            self.scratch[n * m + i] = -gai;
+        }
+        self.scratch[n * m + n] = g;
+        std::mem::swap(&mut self.inv, &mut self.scratch);
+        self.points.push(y);
+        Push::Added { g }
+    }
+}
+
+/// Reusable buffers for [`spectral_measure`] and [`measure_and_gradient`]; one per thread.
+#[derive(Debug, Clone, Default)]
+pub struct MeasureWorkspace {
+    inverse: IncrementalInverse,
+    k: Vec<f64>,
+    chol: Vec<f64>,
+    z: Vec<f64>,
+    kept: Vec<usize>,
+}
+
+impl MeasureWorkspace {
+    /// Empty buffers.
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
+/// s(x) (eq. 9) from the neighbours `neighbors` of x, taken in the order given (nearest first, as
+/// Sec. 6.1 prescribes), each added to K with the block inversion of eq. 10; stops as soon as
+/// s <= `stop_at` (pass a negative value to take every neighbour). Neighbours whose g^-1 falls
+/// below [`SINGULAR_TOLERANCE`] are skipped.
+///
+/// With no neighbour s = 1. k(x, x) = 1 for this kernel, so s = 1 - k^T K^-1 k. The update of
+/// q = k^T K^-1 k per added neighbour y is q += g (k(x, y) - a^T k)^2 (the Schur complement of
+/// eq. 10), O(n^2) per neighbour.
+pub fn spectral_measure(
+    kernel: &Kernel,
+    x: &KernelPoint,
+    neighbors: impl IntoIterator<Item = KernelPoint>,
+    stop_at: f64,
+    ws: &mut MeasureWorkspace,
+) -> Measure {
+    ws.inverse.clear();
+    ws.k.clear();
+    let mut q = 0.0;
+    let mut skipped = 0;
+    let mut iter = neighbors.into_iter().peekable();
+    while let Some(y) = iter.next() {
+        match ws.inverse.push(kernel, y) {
+            Push::Skipped => skipped += 1,
+            Push::Added { g } => {
+                let c = kernel.eval(x, &y);
+                let t = c - ws
+                    .inverse
+                    .last_a()
+                    .iter()
+                    .zip(&ws.k)
+                    .map(|(a, k)| a * k)
+                    .sum::<f64>();
+                q += g * t * t;
+                ws.k.push(c);
+                let s = (1.0 - q).clamp(0.0, 1.0);
+                if s <= stop_at && iter.peek().is_some() {
+                    return Measure {
+                        s,
+                        used: ws.inverse.len(),
+                        skipped,
+                        stopped_early: true,
+                    };
+                }
+            }
+        }
+    }
+    Measure {
+        s: (1.0 - q).clamp(0.0, 1.0),
+        used: ws.inverse.len(),
+        skipped,
+        stopped_early: false,
+    }
+}
+
+/// s(x) and its gradient with respect to the position part of x, in kernel units (multiply by
+/// 1/sigma_p for the gradient in bbox-100 units), from all of `neighbors`.
+///
+/// With α = K^-1 k, s = 1 - k·α and, since ∂k_i/∂x = -2 (x - x_i) k_i,
+///
+/// ∇s = 4 Σ_i α_i k_i (x - x_i) = 2 Σ_ij K^-1_ij k_i k_j (2x - x_i - x_j).
+///
+/// Sec. 6.2 prints this with the factor -2/σ^2, in position units: the sign there is reversed
+/// (the expression as printed is -∇s; the step of eq. 11 must go along +∇s to raise s), which a
+/// finite-difference test of this function checks. α is found by a Cholesky factorization built
+/// row by row in the same nearest-first order as eq. 10: the squared pivot of row n+1 is exactly
+/// g_n^-1, so skipping rows whose squared pivot is below [`SINGULAR_TOLERANCE`] skips the same
+/// neighbours as eq. 10 does.
+pub fn measure_and_gradient(
+    kernel: &Kernel,
+    x: &KernelPoint,
+    neighbors: &[KernelPoint],
+    ws: &mut MeasureWorkspace,
+) -> (f64, [f64; 3]) {
+    let n = neighbors.len();
+    // Lower-triangular L with stride n over the kept rows; kept[r] = neighbour index of row r.
+    ws.chol.clear();
+    ws.chol.resize(n * n, 0.0);
+    ws.kept.clear();
+    ws.z.clear();
+    ws.k.clear();
+    let mut q = 0.0;
+    for (j, y) in neighbors.iter().enumerate() {
+        let r = ws.kept.len();
+        // Row r: solve L[0..r, 0..r] l = b with b_i = k(x_kept[i], y).
+        let mut dot = 0.0;
+        for i in 0..r {
+            let b = kernel.eval(&neighbors[ws.kept[i]], y);
+            let row = &ws.chol[i * n..i * n + i];
+            let s: f64 = row
+                .iter()
+                .zip(&ws.chol[r * n..r * n + i])
+                .map(|(a, b)| a * b)
+                .sum();
+            let l = (b - s) / ws.chol[i * n + i];
+            ws.chol[r * n + i] = l;
+            dot += l * l;
+        }
+        let pivot2 = 1.0 - dot;
+        if !(pivot2 > SINGULAR_TOLERANCE) {
+            // Clear the partial row; it will be overwritten by the next kept neighbour anyway.
+            continue;
+        }
+        let d = pivot2.sqrt();
+        ws.chol[r * n + r] = d;
+        let kj = kernel.eval(x, y);
+        let s: f64 = ws.chol[r * n..r * n + r]
+            .iter()
+            .zip(&ws.z)
+            .map(|(a, b)| a * b)
+            .sum();
+        let zr = (kj - s) / d;
+        q += zr * zr;
+        ws.z.push(zr);
+        ws.k.push(kj);
+        ws.kept.push(j);
+    }
+    // α = L^-T z (back substitution, in place in z).
+    let m = ws.kept.len();
+    for r in (0..m).rev() {
+        let mut s = ws.z[r];
+        for i in r + 1..m {
+            s -= ws.chol[i * n + r] * ws.z[i];
+        }
+        ws.z[r] = s / ws.chol[r * n + r];
+    }
+    let mut grad = [0.0; 3];
+    for r in 0..m {
+        let y = &neighbors[ws.kept[r]];
+        let w = 4.0 * ws.z[r] * ws.k[r];
+        for c in 0..3 {
+            grad[c] += w * (x.0[c] - y.0[c]);
+        }
+    }
+    ((1.0 - q).clamp(0.0, 1.0), grad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+    use nalgebra::{DMatrix, DVector};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn iso(sigma: f64) -> Kernel {
+        Kernel::new(sigma, f64::INFINITY).unwrap()
+    }
+
+    /// A jittered hexagonal grid in the plane z = 0 with spacing `h`, `n × n` points.
+    fn jittered_plane(n: usize, h: f64, jitter: f64, seed: u64) -> Vec<DVec3> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut pts = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let x =
+                    (i as f64 + 0.5 * (j % 2) as f64) * h + jitter * rng.random_range(-1.0..1.0);
+                let y = j as f64 * h * 3f64.sqrt() / 2.0 + jitter * rng.random_range(-1.0..1.0);
+                pts.push(DVec3::new(x, y, 0.0));
+            }
+        }
+        pts
+    }
+
+    /// s(x) with the global K over all `pts` by a direct inverse (nalgebra LU).
+    fn global_measure(kernel: &Kernel, x: &KernelPoint, pts: &[KernelPoint]) -> f64 {
+        let n = pts.len();
+        let kmat = DMatrix::from_fn(n, n, |i, j| kernel.eval(&pts[i], &pts[j]));
+        let kvec = DVector::from_fn(n, |i, _| kernel.eval(x, &pts[i]));
+        let alpha = kmat.lu().solve(&kvec).unwrap();
+        1.0 - kvec.dot(&alpha)
+    }
+
+    fn sorted_neighbors(
+        kernel: &Kernel,
+        x: &KernelPoint,
+        pts: &[KernelPoint],
+        r: f64,
+    ) -> Vec<KernelPoint> {
+        let mut v: Vec<_> = pts
+            .iter()
+            .copied()
+            .filter(|p| p.dist2(x) <= r * r)
+            .collect();
+        v.sort_by(|a, b| a.dist2(x).total_cmp(&b.dist2(x)));
+        let _ = kernel;
+        v
+    }
+
+    #[test]
+    fn local_measure_agrees_with_the_global_kernel_matrix() {
+        let k = iso(1.0);
+        let pts: Vec<_> = jittered_plane(16, 0.9, 0.15, 1)
+            .into_iter()
+            .map(|p| k.embed(p, DVec3::Z))
+            .collect();
+        let mut ws = MeasureWorkspace::new();
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        for _ in 0..40 {
+            // Query points well inside the patch, so the local neighbourhood is complete.
+            let x = k.embed(
+                DVec3::new(rng.random_range(4.0..9.0), rng.random_range(3.5..8.0), 0.0),
+                DVec3::Z,
+            );
+            let local =
+                spectral_measure(&k, &x, sorted_neighbors(&k, &x, &pts, 2.5), -1.0, &mut ws);
+            let global = global_measure(&k, &x, &pts);
+            assert!(
+                (local.s - global).abs() < 1e-3,
+                "local {} global {}",
+                local.s,
+                global
+            );
+            assert!((0.0..=1.0).contains(&local.s));
+        }
+    }
+
+    #[test]
+    fn measure_is_one_alone_zero_on_a_duplicate_and_in_unit_range() {
+        let k = iso(1.0);
+        let mut ws = MeasureWorkspace::new();
+        let x = k.embed(DVec3::new(0.3, 0.2, 0.0), DVec3::Z);
+        assert_eq!(spectral_measure(&k, &x, [], -1.0, &mut ws).s, 1.0);
+        let pts: Vec<_> = jittered_plane(6, 0.7, 0.2, 3)
+            .into_iter()
+            .map(|p| k.embed(p, DVec3::Z))
+            .collect();
+        for p in &pts {
+            let m = spectral_measure(&k, p, sorted_neighbors(&k, p, &pts, 2.5), -1.0, &mut ws);
+            assert!(m.s.abs() < 1e-6, "duplicate point has s = {}", m.s);
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        for _ in 0..100 {
+            let x = k.embed(
+                DVec3::new(
+                    rng.random_range(-1.0..5.0),
+                    rng.random_range(-1.0..5.0),
+                    rng.random_range(-1.0..1.0),
+                ),
+                DVec3::Z,
+            );
+            let m = spectral_measure(&k, &x, sorted_neighbors(&k, &x, &pts, 2.5), -1.0, &mut ws);
+            assert!((0.0..=1.0).contains(&m.s));
+        }
+    }
+
+    #[test]
+    fn block_inversion_matches_a_direct_inverse() {
+        let k = Kernel::new(1.0, 0.75).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let pts: Vec<_> = (0..30)
+            .map(|_| {
+                let p = DVec3::new(
+                    rng.random_range(0.0..4.0),
+                    rng.random_range(0.0..4.0),
+                    rng.random_range(-0.3..0.3),
+                );
+                let n = DVec3::new(
+                    rng.random_range(-0.3..0.3),
+                    rng.random_range(-0.3..0.3),
+                    1.0,
+                )
+                .normalize();
+                k.embed(p, n)
+            })
+            .collect();
+        let mut inc = IncrementalInverse::new();
+        for p in &pts {
+            assert!(matches!(inc.push(&k, *p), Push::Added { .. }));
+        }
+        let n = pts.len();
+        let direct = DMatrix::from_fn(n, n, |i, j| k.eval(&pts[i], &pts[j]))
+            .try_inverse()
+            .unwrap();
+        let mut max_err: f64 = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                max_err = max_err.max((inc.inverse()[i * n + j] - direct[(i, j)]).abs());
+            }
+        }
+        let scale = direct.abs().max();
+        assert!(
+            max_err <= 1e-9 * scale.max(1.0),
+            "max error {max_err} (scale {scale})"
+        );
+    }
+
+    #[test]
+    fn near_singular_neighbours_are_skipped() {
+        let k = iso(1.0);
+        let a = k.embed(DVec3::ZERO, DVec3::Z);
+        let b = k.embed(DVec3::new(1e-7, 0.0, 0.0), DVec3::Z);
+        let c = k.embed(DVec3::new(0.8, 0.0, 0.0), DVec3::Z);
+        let mut ws = MeasureWorkspace::new();
+        let x = k.embed(DVec3::new(0.5, 0.5, 0.0), DVec3::Z);
+        let m = spectral_measure(&k, &x, [a, b, c], -1.0, &mut ws);
+        assert_eq!(m.skipped, 1);
+        assert_eq!(m.used, 2);
+        let reference = spectral_measure(&k, &x, [a, c], -1.0, &mut ws);
+        assert!((m.s - reference.s).abs() < 1e-9);
+    }
+
+    #[test]
+    fn early_stop_gives_an_upper_bound_at_or_below_the_threshold() {
+        let k = iso(1.0);
+        let pts: Vec<_> = jittered_plane(8, 0.8, 0.1, 6)
+            .into_iter()
+            .map(|p| k.embed(p, DVec3::Z))
+            .collect();
+        let x = k.embed(DVec3::new(2.9, 2.1, 0.0), DVec3::Z);
+        let mut ws = MeasureWorkspace::new();
+        let nb = sorted_neighbors(&k, &x, &pts, 2.5);
+        let full = spectral_measure(&k, &x, nb.clone(), -1.0, &mut ws);
+        let early = spectral_measure(&k, &x, nb.clone(), 0.5, &mut ws);
+        assert!(early.stopped_early);
+        assert!(early.s <= 0.5);
+        assert!(early.s >= full.s - 1e-12);
+        assert!(early.used < full.used);
+    }
+
+    #[test]
+    fn cholesky_measure_matches_block_inversion() {
+        let k = Kernel::new(1.2, 0.6).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        let mut ws = MeasureWorkspace::new();
+        for _ in 0..20 {
+            let pts: Vec<_> = (0..25)
+                .map(|_| {
+                    let p = DVec3::new(
+                        rng.random_range(-3.0..3.0),
+                        rng.random_range(-3.0..3.0),
+                        rng.random_range(-0.5..0.5),
+                    );
+                    let n = DVec3::new(
+                        rng.random_range(-0.5..0.5),
+                        rng.random_range(-0.5..0.5),
+                        1.0,
+                    )
+                    .normalize();
+                    k.embed(p, n)
+                })
+                .collect();
+            let x = k.embed(DVec3::new(0.1, -0.2, 0.05), DVec3::Z);
+            let s_eq10 = spectral_measure(&k, &x, pts.clone(), -1.0, &mut ws).s;
+            let (s_chol, _) = measure_and_gradient(&k, &x, &pts, &mut ws);
+            assert!((s_eq10 - s_chol).abs() < 1e-9, "{s_eq10} vs {s_chol}");
+        }
+    }
+
+    #[test]
+    fn gradient_matches_finite_differences_of_the_measure() {
+        let k = Kernel::new(1.5, 0.8).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let mut ws = MeasureWorkspace::new();
+        for trial in 0..25 {
+            let pts: Vec<_> = (0..18)
+                .map(|_| {
+                    let p = DVec3::new(
+                        rng.random_range(-3.0..3.0),
+                        rng.random_range(-3.0..3.0),
+                        rng.random_range(-0.5..0.5),
+                    );
+                    let n = DVec3::new(
+                        rng.random_range(-0.5..0.5),
+                        rng.random_range(-0.5..0.5),
+                        1.0,
+                    )
+                    .normalize();
+                    k.embed(p, n)
+                })
+                .collect();
+            let p0 = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                0.0,
+            );
+            let x = k.embed(p0, DVec3::Z);
+            let (_, g) = measure_and_gradient(&k, &x, &pts, &mut ws);
+            let h = 1e-6;
+            for c in 0..3 {
+                let mut xp = x;
+                let mut xm = x;
+                xp.0[c] += h;
+                xm.0[c] -= h;
+                let fd = (spectral_measure(&k, &xp, pts.clone(), -1.0, &mut ws).s
+                    - spectral_measure(&k, &xm, pts.clone(), -1.0, &mut ws).s)
+                    / (2.0 * h);
+                assert!(
+                    (fd - g[c]).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "trial {trial} axis {c}: analytic {} finite difference {fd}",
+                    g[c]
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,340 @@
+//! The remeshing pipeline: normalize (bbox 100) → candidates → linear scan (with the sigma_p
+//! search for a target count) → gradient ascent + projection → triangulate → clean up → back to
+//! model units.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::kernel::Kernel;
+use crate::mesh::{Normalization, TriMesh};
+use crate::sampling::boundary::{boundary_curves, sample_boundary};
+use crate::sampling::candidates::surface_candidates;
+use crate::sampling::gradient_ascent::{
+    gradient_ascent, GradientAscentParams, GradientAscentResult,
+};
+use crate::sampling::linear_scan::{linear_scan, LinearScanParams, LinearScanResult};
+use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
+use crate::sampling::SurfaceSample;
+use crate::surface::MeshSurface;
+use crate::triangulate::{triangulate, AssemblyStats, SampleSet, TriangulateParams};
+
+/// How dense the output is: a vertex count, or sigma_p directly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Density {
+    /// About this many output vertices (sigma_p is searched for; Sec. 6.3 and the `--points`
+    /// option).
+    Points(usize),
+    /// This sigma_p, bbox-100 units.
+    SigmaP(f64),
+}
+
+/// Output samples per unit of sigma_p^-2 area: a linear scan with epsilon = 0.5 followed by
+/// gradient ascent leaves about `SAMPLES_PER_SIGMA2 · A / sigma_p^2` samples on a surface of area
+/// A. Measured on the shared models (horse, spot, fandisk); used for the first guess of the
+/// sigma_p search and to size the candidate pool when sigma_p is given.
+pub const SAMPLES_PER_SIGMA2: f64 = 1.0;
+
+/// Spacing of the boundary samples in units of sigma_p: the mean edge length the interior
+/// sampling reaches (measured), so boundary triangles match interior ones.
+pub const BOUNDARY_SPACING_PER_SIGMA: f64 = 1.0;
+
+/// Parameters of [`remesh`]. `Default` is the command line's default.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RemeshParams {
+    /// Output density.
+    pub density: Density,
+    /// sigma_n (bbox-100 units of the normal part; infinity = isotropic sampling).
+    pub sigma_n: f64,
+    /// Candidates per expected output sample in the linear scan's pool (default 10).
+    pub candidates_per_sample: f64,
+    /// The linear scan.
+    pub linear_scan: LinearScanParams,
+    /// The gradient ascent.
+    pub gradient_ascent: GradientAscentParams,
+    /// The triangulation.
+    pub triangulate: TriangulateParams,
+    /// Relative tolerance of the count search (default 0.005).
+    pub count_tolerance: f64,
+    /// Seed of every random choice.
+    pub seed: u64,
+}
+
+impl Default for RemeshParams {
+    fn default() -> Self {
+        RemeshParams {
+            density: Density::Points(10_000),
+            sigma_n: f64::INFINITY,
+            candidates_per_sample: 10.0,
+            linear_scan: LinearScanParams::default(),
+            gradient_ascent: GradientAscentParams::default(),
+            triangulate: TriangulateParams::default(),
+            count_tolerance: 0.005,
+            seed: 1,
+        }
+    }
+}
+
+/// One timed stage.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Stage {
+    /// Stage name.
+    pub name: &'static str,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// The output of [`remesh`].
+#[derive(Debug, Clone)]
+pub struct RemeshOutput {
+    /// The remeshed surface in model units.
+    pub mesh: TriMesh,
+    /// The same in bbox-100 units.
+    pub mesh_normalized: TriMesh,
+    /// The input in bbox-100 units.
+    pub input_normalized: TriMesh,
+    /// Model units ↔ bbox-100 units.
+    pub normalization: Normalization,
+    /// The sigma_p used (bbox-100 units).
+    pub sigma_p: f64,
+    /// The target count, when one was asked for.
+    pub target: Option<usize>,
+    /// Whether the sample count of the search came within its tolerance of the target.
+    pub target_reached: bool,
+    /// The search's evaluations as (sigma_p, samples).
+    pub search_history: Vec<(f64, usize)>,
+    /// Samples produced by the sampler (before triangulation).
+    pub samples: usize,
+    /// Of those, samples on the input's boundary curves.
+    pub boundary_samples: usize,
+    /// Size of the candidate pool.
+    pub candidates: usize,
+    /// The final linear scan's statistics.
+    pub rejected_by_nearest: usize,
+    /// Candidates whose measure was evaluated.
+    pub measured: usize,
+    /// The gradient ascent's convergence record.
+    pub gradient_ascent: GradientAscentResult,
+    /// The triangulation's statistics.
+    pub assembly: AssemblyStats,
+    /// How each face of `mesh` came in.
+    pub face_sources: Vec<crate::triangulate::FaceSource>,
+    /// Samples that ended in no triangle and were dropped.
+    pub dropped_samples: usize,
+    /// Timed stages in order.
+    pub stages: Vec<Stage>,
+}
+
+/// Checks `mesh` and returns its normalization to bbox 100.
+///
+/// # Errors
+/// [`Error::InvalidMesh`] for no faces, an index out of range, a non-finite coordinate, or a
+/// bounding box of zero size.
+pub fn validate_input(mesh: &TriMesh) -> Result<Normalization> {
+    if mesh.triangles.is_empty() {
+        return Err(Error::invalid_mesh("", "the mesh has no faces"));
+    }
+    if let Some((f, i)) = mesh.check_indices() {
+        return Err(Error::invalid_mesh(
+            "",
+            format!(
+                "face {f} refers to vertex {i}, but there are {} vertices",
+                mesh.vertex_count()
+            ),
+        ));
+    }
+    if let Some(v) = mesh.first_non_finite_vertex() {
+        return Err(Error::invalid_mesh(
+            "",
+            format!("vertex {v} has a non-finite coordinate"),
+        ));
+    }
+    let bbox = mesh
+        .bbox()
+        .ok_or_else(|| Error::invalid_mesh("", "the mesh has no vertices"))?;
+    Normalization::for_bbox(&bbox)
+        .ok_or_else(|| Error::invalid_mesh("", "the bounding box has zero size"))
+}
+
+struct Timer {
+    stages: Vec<Stage>,
+    last: Instant,
+}
+
+impl Timer {
+    fn new() -> Self {
+        Timer {
+            stages: Vec::new(),
+            last: Instant::now(),
+        }
+    }
+    fn lap(&mut self, name: &'static str) {
+        let now = Instant::now();
+        self.stages.push(Stage {
+            name,
+            seconds: (now - self.last).as_secs_f64(),
+        });
+        self.last = now;
+    }
+}
+
+/// Remeshes `input` (model units): samples its surface with the spectral sampler and
+/// triangulates the samples. `on_stage` is called with each stage's name as it starts (for
+/// progress display).
+///
+/// # Errors
+/// [`Error::InvalidMesh`] for an unusable input (see [`validate_input`]);
+/// [`Error::InvalidParameter`] for a density or sigma out of range.
+pub fn remesh(
+    input: &TriMesh,
+    params: &RemeshParams,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<RemeshOutput> {
+    let mut timer = Timer::new();
+    let normalization = validate_input(input)?;
+    match params.density {
+        Density::Points(n) if n < 4 => {
+            return Err(Error::InvalidParameter {
+                name: "--points",
+                message: format!("at least 4 points are needed for a closed surface, got {n}"),
+            })
+        }
+        Density::SigmaP(s) if !(s.is_finite() && s > 0.0) => {
+            return Err(Error::InvalidParameter {
+                name: "--sigma-p",
+                message: format!("must be a positive number, got {s}"),
+            })
+        }
+        _ => {}
+    }
+    // Validate sigma_n early.
+    Kernel::new(1.0, params.sigma_n)?;
+    on_stage("normalize");
+    let normalized = normalization.apply_mesh(input);
+    let surface = MeshSurface::new(&normalized)?;
+    let area = normalized.area();
+    let curves = boundary_curves(&normalized);
+    timer.lap("normalize");
+
+    on_stage("candidates");
+    let expected = match params.density {
+        Density::Points(n) => n as f64,
+        Density::SigmaP(s) => SAMPLES_PER_SIGMA2 * area / (s * s),
+    };
+    let pool_size = (params.candidates_per_sample * expected)
+        .ceil()
+        .clamp(16.0, 2e8) as usize;
+    let pool = surface_candidates(&normalized, pool_size, params.seed);
+    timer.lap("candidates");
+
+    on_stage("linear scan");
+    let scan = |sigma_p: f64| -> Result<(usize, (LinearScanResult, Vec<[u32; 2]>))> {
+        let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+        let b = sample_boundary(&normalized, &curves, BOUNDARY_SPACING_PER_SIGMA * sigma_p);
+        let r = linear_scan(&kernel, &pool, &b.samples, &params.linear_scan);
+        Ok((r.samples.len(), (r, b.edges)))
+    };
+    let (sigma_p, target_reached, search_history, (scan_result, boundary_edges)) =
+        match params.density {
+            Density::SigmaP(s) => {
+                let (count, value) = scan(s)?;
+                (s, true, vec![(s, count)], value)
+            }
+            Density::Points(n) => {
+                let search = TargetCountParams {
+                    tolerance: params.count_tolerance,
+                    ..TargetCountParams::new(n)
+                };
+                let start = (SAMPLES_PER_SIGMA2 * area / n as f64).sqrt();
+                let mut failure = None;
+                let r = find_sigma_p(&search, start, |s| match scan(s) {
+                    Ok(v) => v,
+                    Err(e) => {
+                        failure = Some(e);
+                        (
+                            0,
+                            (
+                                LinearScanResult {
+                                    samples: vec![],
+                                    initial: 0,
+                                    rejected_by_nearest: 0,
+                                    measured: 0,
+                                },
+                                vec![],
+                            ),
+                        )
+                    }
+                });
+                if let Some(e) = failure {
+                    return Err(e);
+                }
+                (r.sigma_p, r.reached, r.history, r.value)
+            }
+        };
+    timer.lap("linear scan");
+
+    on_stage("gradient ascent");
+    let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+    let LinearScanResult {
+        mut samples,
+        initial: boundary_count,
+        rejected_by_nearest,
+        measured,
+    } = scan_result;
+    let ga = gradient_ascent(
+        &kernel,
+        &surface,
+        &mut samples,
+        boundary_count,
+        &params.gradient_ascent,
+    );
+    timer.lap("gradient ascent");
+
+    on_stage("triangulate");
+    let positions: Vec<DVec3> = samples.iter().map(|s| s.position).collect();
+    let normals: Vec<DVec3> = samples
+        .par_iter()
+        .map(
+            |s: &SurfaceSample| match surface.closest_point(s.position) {
+                Some(sp) => surface.smooth_normal(&sp),
+                None => s.normal,
+            },
+        )
+        .collect();
+    let set = SampleSet {
+        positions: &positions,
+        normals: &normals,
+        boundary_edges: &boundary_edges,
+    };
+    let (faces, face_sources, assembly) = triangulate(&set, &params.triangulate);
+    let mut mesh_normalized = TriMesh::new(positions, faces);
+    let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
+    timer.lap("triangulate");
+
+    let mesh = normalization.invert_mesh(&mesh_normalized);
+    Ok(RemeshOutput {
+        mesh,
+        mesh_normalized,
+        input_normalized: normalized,
+        normalization,
+        sigma_p,
+        target: match params.density {
+            Density::Points(n) => Some(n),
+            Density::SigmaP(_) => None,
+        },
+        target_reached,
+        search_history,
+        samples: samples.len(),
+        boundary_samples: boundary_count,
+        candidates: pool.len(),
+        rejected_by_nearest,
+        measured,
+        gradient_ascent: ga,
+        assembly,
+        face_sources,
+        dropped_samples,
+        stages: timer.stages,
+    })
+}

@@ -1,0 +1,90 @@
+//! The candidate pool of the linear scan: a dense, uniform random sampling of the input surface.
+//!
+//! A mesh's own vertices are a poor pool: too sparse where the mesh is coarse (the scan can only
+//! choose among them) and uneven where it is not. The pool is instead drawn uniformly by area,
+//! stratified per triangle (each triangle gets ⌊A_f ρ⌋ points plus one more with probability
+//! equal to the fraction), at a density set relative to the expected output count; the visit
+//! order is a seeded random permutation (Algorithm 1 takes points in random order).
+
+use rand::seq::SliceRandom;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::SurfaceSample;
+use crate::mesh::TriMesh;
+
+/// Draws about `count` points uniformly by area on `mesh` (bbox-100 units), each with its face's
+/// unit normal, in a random visit order; deterministic for a given `seed`. Degenerate (zero-area)
+/// triangles get none.
+pub fn surface_candidates(mesh: &TriMesh, count: usize, seed: u64) -> Vec<SurfaceSample> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let area = mesh.area();
+    let mut out = Vec::with_capacity(count + count / 16 + 16);
+    if !(area > 0.0) || count == 0 {
+        return out;
+    }
+    let density = count as f64 / area;
+    for f in 0..mesh.face_count() {
+        let cross = mesh.face_cross(f);
+        let a = 0.5 * cross.length();
+        if !(a > 0.0) {
+            continue;
+        }
+        let normal = cross / (2.0 * a);
+        let expected = a * density;
+        let mut m = expected.floor() as usize;
+        if rng.random::<f64>() < expected - m as f64 {
+            m += 1;
+        }
+        let [p0, p1, p2] = mesh.corners(f);
+        for _ in 0..m {
+            // Uniform on the triangle: reflect the unit square's upper half.
+            let (mut u, mut v): (f64, f64) = (rng.random(), rng.random());
+            if u + v > 1.0 {
+                u = 1.0 - u;
+                v = 1.0 - v;
+            }
+            out.push(SurfaceSample {
+                position: p0 + u * (p1 - p0) + v * (p2 - p0),
+                normal,
+                face: f as u32,
+            });
+        }
+    }
+    out.shuffle(&mut rng);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn candidates_are_on_the_surface_uniform_by_area_and_seeded() {
+        // Two triangles, areas 1 and 3.
+        let mesh = TriMesh::new(
+            vec![
+                DVec3::ZERO,
+                DVec3::new(2.0, 0.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(0.0, 0.0, 5.0),
+                DVec3::new(2.0, 0.0, 5.0),
+                DVec3::new(0.0, 3.0, 5.0),
+            ],
+            vec![[0, 1, 2], [3, 4, 5]],
+        );
+        let c = surface_candidates(&mesh, 40_000, 1);
+        assert!((c.len() as f64 - 40_000.0).abs() < 200.0, "{}", c.len());
+        let on_second = c.iter().filter(|s| s.face == 1).count() as f64 / c.len() as f64;
+        assert!((on_second - 0.75).abs() < 0.01, "{on_second}");
+        for s in &c {
+            let z = if s.face == 0 { 0.0 } else { 5.0 };
+            assert!((s.position.z - z).abs() < 1e-12);
+            assert!(s.position.x >= -1e-12 && s.position.y >= -1e-12);
+            assert_eq!(s.normal, DVec3::Z);
+        }
+        assert_eq!(c, surface_candidates(&mesh, 40_000, 1));
+        assert_ne!(c, surface_candidates(&mesh, 40_000, 2));
+    }
+}

@@ -1,0 +1,144 @@
+//! The search for the sigma_p that gives a target number of samples.
+//!
+//! On a surface the count of a linear scan grows like sigma_p^-2, so the search works on
+//! log sigma_p against log count: a first step with slope -2, then secant steps on the two
+//! closest evaluations, kept inside the bracket found so far (bisection in log space when a
+//! secant step leaves it).
+
+/// Parameters of the search.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TargetCountParams {
+    /// The count wanted.
+    pub target: usize,
+    /// Relative tolerance: the search stops once |count - target| <= tolerance · target
+    /// (default 0.005, half of the 1% the command line promises, so that the few samples the
+    /// triangulation may set aside keep the result within 1%).
+    pub tolerance: f64,
+    /// Most evaluations (default 16).
+    pub max_evaluations: usize,
+}
+
+impl TargetCountParams {
+    /// Default tolerance and evaluation budget for `target`.
+    pub fn new(target: usize) -> Self {
+        TargetCountParams {
+            target,
+            tolerance: 0.005,
+            max_evaluations: 16,
+        }
+    }
+}
+
+/// The outcome of the search.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetCountResult<T> {
+    /// The sigma_p whose count is closest to the target.
+    pub sigma_p: f64,
+    /// That count.
+    pub count: usize,
+    /// Whatever the evaluation returned for that sigma_p.
+    pub value: T,
+    /// Whether the count is within the tolerance; when false, `sigma_p` is the best found.
+    pub reached: bool,
+    /// Every evaluation as (sigma_p, count), in order.
+    pub history: Vec<(f64, usize)>,
+}
+
+/// Finds sigma_p with `evaluate(sigma_p).0` (a count that decreases with sigma_p) within the
+/// tolerance of the target, starting from `sigma_start` (> 0). `evaluate` returns the count and
+/// any value the caller wants back for the chosen sigma_p (for example the samples).
+pub fn find_sigma_p<T>(
+    params: &TargetCountParams,
+    sigma_start: f64,
+    mut evaluate: impl FnMut(f64) -> (usize, T),
+) -> TargetCountResult<T> {
+    let target = params.target.max(1) as f64;
+    let ln_target = target.ln();
+    let within = |c: usize| (c as f64 - target).abs() <= params.tolerance * target;
+    let mut history: Vec<(f64, usize)> = Vec::new();
+    let mut best: Option<(f64, usize, T)> = None;
+    // Bracket in log sigma: lo has count > target, hi has count < target.
+    let mut lo: Option<(f64, f64)> = None; // (ln sigma, ln count)
+    let mut hi: Option<(f64, f64)> = None;
+    let mut ln_sigma = sigma_start.ln();
+    for _ in 0..params.max_evaluations.max(1) {
+        let sigma = ln_sigma.exp();
+        let (count, value) = evaluate(sigma);
+        history.push((sigma, count));
+        let better = best
+            .as_ref()
+            .is_none_or(|b| (count as f64 - target).abs() < (b.1 as f64 - target).abs());
+        if better {
+            best = Some((sigma, count, value));
+        }
+        if within(count) {
+            break;
+        }
+        let ln_count = (count.max(1) as f64).ln();
+        if (count as f64) > target {
+            if lo.is_none_or(|l| ln_sigma > l.0) {
+                lo = Some((ln_sigma, ln_count));
+            }
+        } else if hi.is_none_or(|h| ln_sigma < h.0) {
+            hi = Some((ln_sigma, ln_count));
+        }
+        // Next guess: secant across the bracket, or slope -2 from the last point.
+        let mut next = match (lo, hi) {
+            (Some(l), Some(h)) if (h.1 - l.1).abs() > 1e-12 => {
+                l.0 + (ln_target - l.1) * (h.0 - l.0) / (h.1 - l.1)
+            }
+            _ => ln_sigma + 0.5 * (ln_count - ln_target),
+        };
+        if let (Some(l), Some(h)) = (lo, hi) {
+            // Stay strictly inside the bracket; bisect when the secant lands near its ends.
+            let width = h.0 - l.0;
+            if !(next > l.0 + 0.05 * width && next < h.0 - 0.05 * width) {
+                next = 0.5 * (l.0 + h.0);
+            }
+            if width.abs() < 1e-9 {
+                break;
+            }
+        }
+        ln_sigma = next;
+    }
+    let (sigma_p, count, value) = best.expect("at least one evaluation");
+    TargetCountResult {
+        sigma_p,
+        count,
+        value,
+        reached: within(count),
+        history,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn finds_sigma_for_an_inverse_square_law_with_noise() {
+        // count = A / sigma^2 with a deterministic wobble of ±0.4%.
+        for &target in &[100usize, 3000, 8600, 100_000] {
+            let f = |s: f64| {
+                let base = 12_345.0 / (s * s);
+                let wobble = 1.0 + 0.004 * ((s * 1e4).sin());
+                ((base * wobble).round() as usize, s)
+            };
+            let r = find_sigma_p(&TargetCountParams::new(target), 1.0, f);
+            assert!(r.reached, "target {target}: {:?}", r.history);
+            assert!((r.count as f64 - target as f64).abs() <= 0.005 * target as f64);
+            assert_eq!(r.value, r.sigma_p);
+            assert!(r.history.len() <= 8, "{} evaluations", r.history.len());
+        }
+    }
+
+    #[test]
+    fn reports_the_best_when_the_target_cannot_be_reached() {
+        // A step function that jumps over the target.
+        let f = |s: f64| (if s < 2.0 { 1000 } else { 10 }, ());
+        let r = find_sigma_p(&TargetCountParams::new(500), 1.0, f);
+        assert!(!r.reached);
+        assert!(r.count == 1000 || r.count == 10);
+        assert!(r.history.len() <= 16);
+    }
+}

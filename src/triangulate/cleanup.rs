@@ -1,0 +1,419 @@
+//! From voted umbrella triangles to a manifold mesh: accept the triangles every corner agrees on,
+//! add the best of the others where they fit, fill the holes that remain, and repair vertices
+//! whose faces do not form one fan.
+//!
+//! Every accepted face must use each directed edge at most once. That single rule keeps every
+//! edge in at most two faces and the orientation consistent. Boundary edges of an open input are
+//! usable in their own direction only, so they stay boundary edges.
+
+use glam::DVec3;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+use super::tangent_delaunay::VotedTriangle;
+
+/// Parameters of the assembly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AssemblyParams {
+    /// Holes with more edges than this are left open (default 100).
+    pub max_hole_edges: usize,
+    /// Accept two-vote triangles greedily before filling holes (default false: the hole filler
+    /// chooses better triangles where the umbrellas disagree).
+    pub two_vote_phase: bool,
+}
+
+impl Default for AssemblyParams {
+    fn default() -> Self {
+        AssemblyParams {
+            max_hole_edges: 100,
+            two_vote_phase: std::env::var("SR_TWO").is_ok(),
+        }
+    }
+}
+
+/// What the assembly did.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct AssemblyStats {
+    /// Candidate triangles from all umbrellas.
+    pub candidates: usize,
+    /// Triangles with three votes accepted.
+    pub accepted_three_votes: usize,
+    /// Triangles with two votes accepted.
+    pub accepted_two_votes: usize,
+    /// Holes closed by the clean-up.
+    pub holes_filled: usize,
+    /// Triangles added to close them.
+    pub hole_triangles: usize,
+    /// Holes that could not be closed (too large, or no valid triangulation).
+    pub holes_left: usize,
+    /// Faces removed to repair vertices whose faces formed several fans.
+    pub faces_removed_at_pinched_vertices: usize,
+}
+
+struct Builder<'a> {
+    positions: &'a [DVec3],
+    normals: &'a [DVec3],
+    faces: Vec<Option<[u32; 3]>>,
+    /// How each face came in (see [`FaceSource`]).
+    sources: Vec<FaceSource>,
+    /// Directed edge → face using it (`u32::MAX` for a blocked direction).
+    directed: FxHashMap<(u32, u32), u32>,
+}
+
+const BLOCKED: u32 = u32::MAX;
+
+impl<'a> Builder<'a> {
+    fn fits(&self, t: [u32; 3]) -> bool {
+        (0..3).all(|k| !self.directed.contains_key(&(t[k], t[(k + 1) % 3])))
+    }
+
+    fn add(&mut self, t: [u32; 3], source: FaceSource) -> bool {
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !self.fits(t) {
+            return false;
+        }
+        let f = self.faces.len() as u32;
+        for k in 0..3 {
+            self.directed.insert((t[k], t[(k + 1) % 3]), f);
+        }
+        self.faces.push(Some(t));
+        self.sources.push(source);
+        true
+    }
+
+    fn remove(&mut self, f: u32) {
+        if let Some(t) = self.faces[f as usize].take() {
+            for k in 0..3 {
+                self.directed.remove(&(t[k], t[(k + 1) % 3]));
+            }
+        }
+    }
+
+    fn has_edge(&self, a: u32, b: u32) -> bool {
+        let used = |x: &(u32, u32)| self.directed.get(x).is_some_and(|&f| f != BLOCKED);
+        used(&(a, b)) || used(&(b, a))
+    }
+
+    /// Quality Q = 6S/(√3 p h) of a triangle, or -1 when its normal opposes the corners'
+    /// normals (a fold).
+    fn quality(&self, t: [u32; 3]) -> f64 {
+        let [a, b, c] = t.map(|i| self.positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        let avg = t.iter().map(|&i| self.normals[i as usize]).sum::<DVec3>();
+        if n.dot(avg) <= 0.0 {
+            return -1.0;
+        }
+        triangle_q(a, b, c)
+    }
+
+    /// Half-edges bordering holes: `b → a` for every face edge `a → b` with no face on `b → a`
+    /// and `b → a` not blocked (blocked directions are the outside of input boundaries).
+    fn hole_half_edges(&self) -> Vec<(u32, u32)> {
+        let mut out: Vec<(u32, u32)> = self
+            .directed
+            .iter()
+            .filter(|(_, &f)| f != BLOCKED)
+            .map(|(&(a, b), _)| (b, a))
+            .filter(|e| !self.directed.contains_key(e))
+            .collect();
+        out.sort_unstable();
+        out
+    }
+}
+
+/// How a face of the assembled mesh came in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum FaceSource {
+    /// In the umbrellas of all three corners.
+    ThreeVotes,
+    /// In the umbrellas of two corners.
+    TwoVotes,
+    /// Added to close a hole.
+    HoleFill,
+}
+
+/// Q = 6S/(√3 p h) (S area, p half-perimeter, h longest edge): 1 for an equilateral triangle.
+pub fn triangle_q(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let s = 0.5 * (b - a).cross(c - a).length();
+    let (l0, l1, l2) = (a.distance(b), b.distance(c), c.distance(a));
+    let p = 0.5 * (l0 + l1 + l2);
+    let h = l0.max(l1).max(l2);
+    if p * h > 0.0 {
+        6.0 * s / (3f64.sqrt() * p * h)
+    } else {
+        0.0
+    }
+}
+
+/// Assembles a mesh from voted triangles. `boundary_edges` (directed, surface on the left) may
+/// only be used in their own direction. Returns the faces, how each came in, and what was done.
+pub fn assemble(
+    positions: &[DVec3],
+    normals: &[DVec3],
+    voted: &[VotedTriangle],
+    boundary_edges: &[[u32; 2]],
+    params: &AssemblyParams,
+) -> (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats) {
+    let mut b = Builder {
+        positions,
+        normals,
+        faces: Vec::with_capacity(2 * positions.len() + 16),
+        sources: Vec::with_capacity(2 * positions.len() + 16),
+        directed: FxHashMap::default(),
+    };
+    let mut stats = AssemblyStats {
+        candidates: voted.len(),
+        ..Default::default()
+    };
+    for &[x, y] in boundary_edges {
+        b.directed.insert((y, x), BLOCKED);
+    }
+    for t in voted
+        .iter()
+        .filter(|t| t.votes >= 3 && !t.orientation_conflict)
+    {
+        if b.add(t.corners, FaceSource::ThreeVotes) {
+            stats.accepted_three_votes += 1;
+        }
+    }
+    let mut two: Vec<(f64, [u32; 3])> = voted
+        .iter()
+        .filter(|t| params.two_vote_phase && t.votes == 2 && !t.orientation_conflict)
+        .map(|t| (b.quality(t.corners), t.corners))
+        .filter(|x| x.0 > 0.0)
+        .collect();
+    two.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+    for (_, t) in two {
+        if b.add(t, FaceSource::TwoVotes) {
+            stats.accepted_two_votes += 1;
+        }
+    }
+    for _round in 0..4 {
+        let (filled, tris, left) = fill_holes(&mut b, params);
+        stats.holes_filled += filled;
+        stats.hole_triangles += tris;
+        stats.holes_left = left;
+        let removed = repair_pinched_vertices(&mut b);
+        stats.faces_removed_at_pinched_vertices += removed;
+        if removed == 0 && left == 0 {
+            break;
+        }
+    }
+    let (faces, sources) = b
+        .faces
+        .into_iter()
+        .zip(b.sources)
+        .filter_map(|(f, s)| f.map(|f| (f, s)))
+        .unzip();
+    (faces, sources, stats)
+}
+
+/// Splits a closed walk at repeated vertices into simple loops.
+fn simple_loops(walk: &[u32]) -> Vec<Vec<u32>> {
+    let mut out = Vec::new();
+    let mut stack: Vec<u32> = Vec::new();
+    let mut pos: FxHashMap<u32, usize> = FxHashMap::default();
+    for &v in walk {
+        if let Some(&k) = pos.get(&v) {
+            let cycle: Vec<u32> = stack.drain(k..).collect();
+            for x in &cycle {
+                pos.remove(x);
+            }
+            out.push(cycle);
+        }
+        pos.insert(v, stack.len());
+        stack.push(v);
+    }
+    if !stack.is_empty() {
+        out.push(stack);
+    }
+    out
+}
+
+fn fill_holes(b: &mut Builder, params: &AssemblyParams) -> (usize, usize, usize) {
+    let edges = b.hole_half_edges();
+    let mut from: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    for &(x, y) in &edges {
+        from.entry(x).or_default().push(y);
+    }
+    let mut used: FxHashSet<(u32, u32)> = FxHashSet::default();
+    let (mut filled, mut added, mut left) = (0, 0, 0);
+    for &(x0, y0) in &edges {
+        if used.contains(&(x0, y0)) {
+            continue;
+        }
+        // Walk the hole.
+        let mut walk = vec![x0];
+        let (mut x, mut y) = (x0, y0);
+        loop {
+            used.insert((x, y));
+            if y == x0 {
+                break;
+            }
+            walk.push(y);
+            let next = from
+                .get(&y)
+                .and_then(|v| v.iter().copied().find(|&z| !used.contains(&(y, z))));
+            match next {
+                Some(z) => {
+                    x = y;
+                    y = z;
+                }
+                None => break,
+            }
+            if walk.len() > 100_000 {
+                break;
+            }
+        }
+        for lp in simple_loops(&walk) {
+            if lp.len() < 3 {
+                continue;
+            }
+            if lp.len() > params.max_hole_edges {
+                left += 1;
+                continue;
+            }
+            match triangulate_polygon(b, &lp) {
+                Some(tris) => {
+                    let mut ok = true;
+                    let mut done = Vec::new();
+                    for t in tris {
+                        if b.add(t, FaceSource::HoleFill) {
+                            done.push(b.faces.len() as u32 - 1);
+                        } else {
+                            ok = false;
+                            break;
+                        }
+                    }
+                    if ok {
+                        filled += 1;
+                        added += done.len();
+                    } else {
+                        for f in done {
+                            b.remove(f);
+                        }
+                        left += 1;
+                    }
+                }
+                None => left += 1,
+            }
+        }
+    }
+    (filled, added, left)
+}
+
+/// The triangulation of the polygon `lp` (a hole's vertices in the order of its half-edges) that
+/// maximizes the smallest triangle quality, with no diagonal that is already a mesh edge.
+fn triangulate_polygon(b: &Builder, lp: &[u32]) -> Option<Vec<[u32; 3]>> {
+    let m = lp.len();
+    if m == 3 {
+        let t = [lp[0], lp[1], lp[2]];
+        return if b.fits(t) { Some(vec![t]) } else { None };
+    }
+    // best[i][k]: max-min quality of triangulating the sub-polygon i..=k; choice[i][k] = j.
+    let idx = |i: usize, k: usize| i * m + k;
+    let mut best = vec![f64::NEG_INFINITY; m * m];
+    let mut choice = vec![usize::MAX; m * m];
+    let diagonal_ok = |i: usize, k: usize| -> bool {
+        if k == i + 1 || (i == 0 && k == m - 1) {
+            return true;
+        }
+        !b.has_edge(lp[i], lp[k])
+    };
+    for i in 0..m - 1 {
+        best[idx(i, i + 1)] = f64::INFINITY;
+    }
+    for len in 2..m {
+        for i in 0..m - len {
+            let k = i + len;
+            if !diagonal_ok(i, k) {
+                continue;
+            }
+            for j in i + 1..k {
+                let q = b.quality([lp[i], lp[j], lp[k]]);
+                if q <= 0.0 {
+                    continue;
+                }
+                let v = best[idx(i, j)].min(best[idx(j, k)]).min(q);
+                if v > best[idx(i, k)] {
+                    best[idx(i, k)] = v;
+                    choice[idx(i, k)] = j;
+                }
+            }
+        }
+    }
+    if !(best[idx(0, m - 1)] > 0.0) {
+        return None;
+    }
+    let mut out = Vec::with_capacity(m - 2);
+    let mut stack = vec![(0usize, m - 1)];
+    while let Some((i, k)) = stack.pop() {
+        if k < i + 2 {
+            continue;
+        }
+        let j = choice[idx(i, k)];
+        out.push([lp[i], lp[j], lp[k]]);
+        stack.push((i, j));
+        stack.push((j, k));
+    }
+    Some(out)
+}
+
+/// Finds vertices whose faces form more than one edge-connected fan and removes the faces of
+/// all fans but the largest, so that hole filling can rebuild them as one. Returns how many faces
+/// were removed.
+fn repair_pinched_vertices(b: &mut Builder) -> usize {
+    let mut around: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    for (f, t) in b.faces.iter().enumerate() {
+        if let Some(t) = t {
+            for &v in t {
+                around.entry(v).or_default().push(f as u32);
+            }
+        }
+    }
+    let mut vertices: Vec<u32> = around.keys().copied().collect();
+    vertices.sort_unstable();
+    let mut removed = 0;
+    for v in vertices {
+        let faces = &around[&v];
+        // Fans: faces around v joined through the edges at v.
+        let mut fan_of: FxHashMap<u32, usize> = FxHashMap::default();
+        let mut fans: Vec<Vec<u32>> = Vec::new();
+        for &f in faces {
+            if fan_of.contains_key(&f) || b.faces[f as usize].is_none() {
+                continue;
+            }
+            let id = fans.len();
+            let mut fan = vec![f];
+            fan_of.insert(f, id);
+            let mut k = 0;
+            while k < fan.len() {
+                let t = b.faces[fan[k] as usize].unwrap();
+                for &w in t.iter().filter(|&&w| w != v) {
+                    for e in [(v, w), (w, v)] {
+                        if let Some(&g) = b.directed.get(&e) {
+                            if g != BLOCKED && !fan_of.contains_key(&g) {
+                                fan_of.insert(g, id);
+                                fan.push(g);
+                            }
+                        }
+                    }
+                }
+                k += 1;
+            }
+            fans.push(fan);
+        }
+        if fans.len() > 1 {
+            let keep = (0..fans.len())
+                .max_by_key(|&i| (fans[i].len(), usize::MAX - i))
+                .unwrap();
+            for (i, fan) in fans.iter().enumerate() {
+                if i != keep {
+                    for &f in fan {
+                        b.remove(f);
+                        removed += 1;
+                    }
+                }
+            }
+        }
+    }
+    removed
+}

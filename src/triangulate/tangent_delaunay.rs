@@ -1,0 +1,240 @@
+//! Local tangent-plane Delaunay triangulation of surface samples.
+//!
+//! For each sample its nearest samples are projected onto its tangent plane and triangulated
+//! (2D Delaunay with spade, constrained by the boundary edges that fall among them); the
+//! triangles incident to the sample form its umbrella. A triangle that is Delaunay in the tangent
+//! planes of all three of its corners gets three votes; these form an edge-manifold, consistently
+//! oriented mesh by themselves (each umbrella is a planar star). Triangles with two votes fill in
+//! where the local views disagree (near-cocircular quads), when they fit; `cleanup` closes what
+//! is left. (The approach of Gopi, Krishnan, Silva 2000, "Surface reconstruction based on lower
+//! dimensional localized Delaunay triangulation", and of Boissonnat's tangent-plane methods.)
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+use spade::handles::FixedVertexHandle;
+use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
+
+use crate::spatial::StaticTree;
+
+/// Parameters of the local triangulation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TangentDelaunayParams {
+    /// Neighbours projected into each tangent plane (default 18).
+    pub neighbors: usize,
+    /// Neighbours whose normal differs from the centre's by more than this are left out (they
+    /// are on another sheet of the surface), degrees (default 75).
+    pub max_normal_angle_deg: f64,
+}
+
+impl Default for TangentDelaunayParams {
+    fn default() -> Self {
+        TangentDelaunayParams {
+            neighbors: 18,
+            max_normal_angle_deg: 75.0,
+        }
+    }
+}
+
+/// Samples to triangulate.
+#[derive(Debug, Clone, Copy)]
+pub struct SampleSet<'a> {
+    /// Positions (bbox-100 units).
+    pub positions: &'a [DVec3],
+    /// Unit normals of the surface at the samples (smooth normals: they define tangent planes).
+    pub normals: &'a [DVec3],
+    /// Boundary edges `[from, to]`, directed with the surface on the left; they become boundary
+    /// edges of the output.
+    pub boundary_edges: &'a [[u32; 2]],
+}
+
+/// A candidate triangle with its votes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VotedTriangle {
+    /// Corners, counter-clockwise about the normals (the orientation of the first umbrella that
+    /// produced it).
+    pub corners: [u32; 3],
+    /// How many of its corners' umbrellas contain it (1 to 3).
+    pub votes: u8,
+    /// Whether two umbrellas gave it opposite orientations.
+    pub orientation_conflict: bool,
+}
+
+#[derive(Clone, Copy)]
+struct LocalVertex {
+    p: Point2<f64>,
+    index: u32,
+}
+
+impl HasPosition for LocalVertex {
+    type Scalar = f64;
+    fn position(&self) -> Point2<f64> {
+        self.p
+    }
+}
+
+/// An orthonormal basis (u, v) of the plane orthogonal to unit `n`, with u × v = n.
+pub fn tangent_basis(n: DVec3) -> (DVec3, DVec3) {
+    let a = if n.x.abs() < 0.6 { DVec3::X } else { DVec3::Y };
+    let u = (a - n * n.dot(a)).normalize();
+    let v = n.cross(u);
+    (u, v)
+}
+
+/// The umbrella of sample `i`: the triangles incident to it in the Delaunay triangulation of its
+/// neighbours projected on its tangent plane, as `[i, a, b]` counter-clockwise about n_i.
+fn umbrella(
+    i: usize,
+    set: &SampleSet,
+    neighbors: &[(u32, f64)],
+    params: &TangentDelaunayParams,
+    chain: &FxHashMap<u32, (Option<u32>, Option<u32>)>,
+    out: &mut Vec<[u32; 3]>,
+) {
+    out.clear();
+    let pi = set.positions[i];
+    let ni = set.normals[i];
+    let (u, v) = tangent_basis(ni);
+    let cos_max = params.max_normal_angle_deg.to_radians().cos();
+    let mut cdt: ConstrainedDelaunayTriangulation<LocalVertex> =
+        ConstrainedDelaunayTriangulation::new();
+    let Ok(center) = cdt.insert(LocalVertex {
+        p: Point2::new(0.0, 0.0),
+        index: i as u32,
+    }) else {
+        return;
+    };
+    let mut handles: Vec<(u32, FixedVertexHandle)> = Vec::with_capacity(neighbors.len());
+    for &(j, _) in neighbors {
+        if j as usize == i || set.normals[j as usize].dot(ni) < cos_max {
+            continue;
+        }
+        // Projection onto the tangent plane, rescaled to keep the 3D distance (a first-order
+        // log map): neighbours far out on a curved surface keep their spacing.
+        let d = set.positions[j as usize] - pi;
+        let mut q = DVec2::new(d.dot(u), d.dot(v));
+        if std::env::var("SR_LOGMAP").is_ok() {
+            let l = q.length();
+            if l > 0.0 {
+                q *= d.length() / l;
+            }
+        }
+        if let Ok(h) = cdt.insert(LocalVertex {
+            p: Point2::new(q.x, q.y),
+            index: j,
+        }) {
+            if h != center && cdt.vertex(h).data().index == j {
+                handles.push((j, h));
+            }
+        }
+    }
+    // Boundary edges among the local points are constraints.
+    if !chain.is_empty() {
+        let local: FxHashMap<u32, FixedVertexHandle> = handles
+            .iter()
+            .copied()
+            .chain(std::iter::once((i as u32, center)))
+            .collect();
+        for (&a, &(_, next)) in chain.iter() {
+            if let (Some(b), Some(&ha)) = (next, local.get(&a)) {
+                if let Some(&hb) = local.get(&b) {
+                    if cdt.can_add_constraint(ha, hb) {
+                        cdt.add_constraint(ha, hb);
+                    }
+                }
+            }
+        }
+    }
+    // The wedge of a boundary sample: from the direction of its next boundary neighbour
+    // counter-clockwise to the previous one (the surface is on the left of prev → i → next).
+    let wedge = chain.get(&(i as u32)).and_then(|&(prev, next)| {
+        let dir = |j: u32| {
+            let d = set.positions[j as usize] - pi;
+            d.dot(v).atan2(d.dot(u))
+        };
+        Some((dir(next?), dir(prev?)))
+    });
+    let c = cdt.vertex(center);
+    for e in c.out_edges() {
+        let Some(face) = e.face().as_inner() else {
+            continue;
+        };
+        let [a, b, cc] = face.vertices().map(|h| h.data().index);
+        let tri = if a == i as u32 {
+            [a, b, cc]
+        } else if b == i as u32 {
+            [b, cc, a]
+        } else {
+            [cc, a, b]
+        };
+        if let Some((start, end)) = wedge {
+            let span = |j: u32| {
+                let d = set.positions[j as usize] - pi;
+                (d.dot(v).atan2(d.dot(u)) - start).rem_euclid(std::f64::consts::TAU)
+            };
+            let limit = (end - start).rem_euclid(std::f64::consts::TAU) + 1e-9;
+            let (s1, s2) = (span(tri[1]), span(tri[2]));
+            // Both edges within the wedge, and the triangle turning counter-clockwise in it.
+            let s1 = if s1 > std::f64::consts::TAU - 1e-9 {
+                0.0
+            } else {
+                s1
+            };
+            if !(s1 <= limit && s2 <= limit && s2 > s1) {
+                continue;
+            }
+        }
+        out.push(tri);
+    }
+}
+
+/// Computes every sample's umbrella and counts the votes of each triangle. The result is sorted
+/// by corner indices (deterministic).
+pub fn vote_triangles(set: &SampleSet, params: &TangentDelaunayParams) -> Vec<VotedTriangle> {
+    let n = set.positions.len();
+    let tree = StaticTree::new(set.positions);
+    let mut chain: FxHashMap<u32, (Option<u32>, Option<u32>)> = FxHashMap::default();
+    for &[a, b] in set.boundary_edges {
+        chain.entry(a).or_insert((None, None)).1 = Some(b);
+        chain.entry(b).or_insert((None, None)).0 = Some(a);
+    }
+    let umbrellas: Vec<Vec<[u32; 3]>> = (0..n)
+        .into_par_iter()
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |(found, tris), i| {
+                tree.nearest_n(set.positions[i], params.neighbors + 1, found);
+                umbrella(i, set, found, params, &chain, tris);
+                tris.clone()
+            },
+        )
+        .collect();
+    let mut votes: FxHashMap<[u32; 3], VotedTriangle> = FxHashMap::default();
+    for tris in &umbrellas {
+        for &t in tris {
+            let mut key = t;
+            key.sort_unstable();
+            let e = votes.entry(key).or_insert(VotedTriangle {
+                corners: t,
+                votes: 0,
+                orientation_conflict: false,
+            });
+            e.votes = e.votes.saturating_add(1);
+            if !same_orientation(e.corners, t) {
+                e.orientation_conflict = true;
+            }
+        }
+    }
+    let mut all: Vec<([u32; 3], VotedTriangle)> = votes.into_iter().collect();
+    all.sort_unstable_by_key(|x| x.0);
+    all.into_iter().map(|x| x.1).collect()
+}
+
+/// Whether two triangles on the same three vertices have the same cyclic order.
+pub fn same_orientation(a: [u32; 3], b: [u32; 3]) -> bool {
+    let k = b.iter().position(|&x| x == a[0]);
+    match k {
+        Some(k) => b[(k + 1) % 3] == a[1],
+        None => false,
+    }
+}
