@@ -7,6 +7,7 @@
 //! The pipeline (see `ARCHITECTURE.md`): read → normalize (bbox 100) → candidates → linear scan →
 //! gradient ascent + projection → triangulate → clean up → report → write.
 
+pub mod app;
 pub mod error;
 pub mod io;
 pub mod kernel;

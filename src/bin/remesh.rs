@@ -1,1 +1,190 @@
-fn main() {}
+//! `remesh`: the command line. Parses flags into a validated job, calls the library, prints the
+//! report, and maps errors to exit codes (2 usage, 3 input, 4 output, 1 internal).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use spectral_remesh::app::{run_quality, run_remesh, RemeshJob};
+use spectral_remesh::pipeline::{Density, RemeshParams};
+use spectral_remesh::Error;
+
+const EXAMPLES: &str = "\
+Examples:
+  remesh data/spot.obj spot-3k.obj --points 3000
+  remesh horse.ply horse.glb --points 8600 --report horse.json
+  remesh fandisk.obj fandisk.obj.ply --points 6000 --sigma-n 0.75
+  remesh quality out.obj --ref in.obj";
+
+/// Spectral remeshing of triangle meshes (Öztireli, Alexa, Gross 2010: Spectral Sampling of
+/// Manifolds): samples the input surface with the spectral measure, triangulates the samples,
+/// writes the mesh and prints a quality report.
+#[derive(Parser, Debug)]
+#[command(name = "remesh", version, after_help = EXAMPLES)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+
+    /// Input mesh: .obj, .ply, .gltf or .glb.
+    #[arg(required = true)]
+    input: Option<PathBuf>,
+
+    /// Output mesh: .obj, .ply or .glb (format by extension).
+    #[arg(required = true)]
+    output: Option<PathBuf>,
+
+    /// Number of output vertices (within 1%); sigma_p is searched for and printed. Default: the
+    /// input's vertex count.
+    #[arg(long, conflicts_with = "sigma_p")]
+    points: Option<usize>,
+
+    /// Kernel width sigma_p in bbox-100 units (the model is scaled so its longest side is 100),
+    /// instead of --points.
+    #[arg(long)]
+    sigma_p: Option<f64>,
+
+    /// Normal width sigma_n: finite values turn on feature-adaptive sampling (more samples where
+    /// normals vary; 0.5 to 1 is typical). Default: infinity (isotropic).
+    #[arg(long)]
+    sigma_n: Option<f64>,
+
+    /// Gradient-ascent sweeps (Sec. 6.2).
+    #[arg(long, default_value_t = 10)]
+    iterations: usize,
+
+    /// Seed of every random choice: the same seed gives the same output, byte for byte.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+
+    /// Write the quality report as JSON to this file.
+    #[arg(long, value_name = "FILE.json")]
+    report: Option<PathBuf>,
+
+    /// Skip the distance to the input (Hausdorff, RMS) in the report.
+    #[arg(long)]
+    no_distance: bool,
+
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Report on any mesh: Table 1 triangle measures, topology, and with --ref the distance to a
+    /// reference surface.
+    Quality {
+        /// The mesh to measure.
+        mesh: PathBuf,
+        /// The reference (usually the input of a remesher); sets the bbox-100 frame.
+        #[arg(long = "ref")]
+        reference: Option<PathBuf>,
+        /// Print the report as JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Also write the JSON report to this file.
+        #[arg(long, value_name = "FILE.json")]
+        report: Option<PathBuf>,
+        /// Seed of the distance sampling.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+}
+
+fn write_report(path: &PathBuf, json: &str) -> Result<(), Error> {
+    std::fs::write(path, json).map_err(|e| Error::Write {
+        path: path.clone(),
+        message: e.to_string(),
+    })
+}
+
+fn run(cli: Cli) -> Result<(), Error> {
+    if let Some(Command::Quality {
+        mesh,
+        reference,
+        json,
+        report,
+        seed,
+    }) = cli.command
+    {
+        let r = run_quality(&mesh, reference.as_deref(), seed)?;
+        if json {
+            println!("{}", r.to_json());
+        } else {
+            print!("{r}");
+        }
+        if let Some(p) = report {
+            write_report(&p, &r.to_json())?;
+        }
+        return Ok(());
+    }
+    let (Some(input), Some(output)) = (cli.input, cli.output) else {
+        return Err(Error::InvalidParameter {
+            name: "INPUT OUTPUT",
+            message: "both are required (see --help)".into(),
+        });
+    };
+    let density = match (cli.points, cli.sigma_p) {
+        (Some(n), None) => Density::Points(n),
+        (None, Some(s)) => Density::SigmaP(s),
+        _ => Density::Points(0),
+    };
+    if cli.points == Some(0) {
+        return Err(Error::InvalidParameter {
+            name: "--points",
+            message: "must be at least 4".into(),
+        });
+    }
+    let mut params = RemeshParams {
+        density,
+        seed: cli.seed,
+        ..Default::default()
+    };
+    params.gradient_ascent.iterations = cli.iterations;
+    params.gradient_ascent.seed = cli.seed;
+    if let Some(s) = cli.sigma_n {
+        params.sigma_n = s;
+    }
+    let job = RemeshJob {
+        input,
+        output,
+        params,
+        measure_distance: !cli.no_distance,
+    };
+    let bar = if cli.quiet {
+        ProgressBar::hidden()
+    } else {
+        let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template("{spinner} {msg} {elapsed}")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        b.enable_steady_tick(Duration::from_millis(120));
+        b
+    };
+    let result = run_remesh(&job, &|stage: &str| bar.set_message(stage.to_string()));
+    bar.finish_and_clear();
+    let report = result?;
+    if !cli.quiet {
+        println!("{} -> {}", job.input.display(), job.output.display());
+        print!("{report}");
+    }
+    if let Some(p) = cli.report {
+        write_report(&p, &report.to_json())?;
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("remesh: error: {e}");
+            ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}

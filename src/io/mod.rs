@@ -1,1 +1,347 @@
 //! Reading and writing meshes: OBJ, PLY, glTF 2.0 (`.gltf`/`.glb`), chosen by extension.
+//!
+//! [`read_mesh`] parses a file into a [`TriMesh`] in the file's own units, then cleans it the same
+//! way for every format: it checks the indices and the coordinates, welds vertices with identical
+//! positions (glTF splits vertices at texture seams, OBJ files keep them shared, so welding makes
+//! the OBJ and glTF versions of a model the same mesh) and drops vertices no triangle uses.
+//!
+//! [`write_mesh`] writes a mesh with angle-weighted vertex normals, atomically: the target is
+//! either replaced by the complete new file or left as it was.
+//!
+//! No function here panics on a file's content; every failure is an [`Error`] naming the file.
+
+mod gltf;
+mod obj;
+mod ply;
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::mesh::TriMesh;
+
+/// A mesh file format, chosen by the file's extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MeshFormat {
+    /// Wavefront OBJ (`.obj`), text.
+    Obj,
+    /// Stanford PLY (`.ply`): ascii, binary little endian or binary big endian.
+    Ply,
+    /// glTF 2.0 as JSON (`.gltf`), with its buffers embedded as data URIs or in external files.
+    Gltf,
+    /// glTF 2.0 binary container (`.glb`).
+    Glb,
+}
+
+impl MeshFormat {
+    /// The format a file's extension names, compared case-insensitively (`.obj`, `.ply`,
+    /// `.gltf`, `.glb`).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::UnsupportedFormat`] naming `path` when it has no extension or another one.
+    pub fn from_path(path: &Path) -> Result<MeshFormat> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("obj") => Ok(MeshFormat::Obj),
+            Some("ply") => Ok(MeshFormat::Ply),
+            Some("gltf") => Ok(MeshFormat::Gltf),
+            Some("glb") => Ok(MeshFormat::Glb),
+            _ => Err(Error::UnsupportedFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+
+    /// The usual lower-case extension of the format, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            MeshFormat::Obj => "obj",
+            MeshFormat::Ply => "ply",
+            MeshFormat::Gltf => "gltf",
+            MeshFormat::Glb => "glb",
+        }
+    }
+}
+
+/// What [`read_mesh`] found in a file and what its clean-up changed. All counts are plain
+/// numbers of elements (no units).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct ReadStats {
+    /// The format the file was read as.
+    pub format: MeshFormat,
+    /// Vertices in the file: OBJ `v` lines, the PLY `vertex` element count, or for glTF the sum
+    /// of the POSITION accessor counts over every primitive instance placed in the scene.
+    pub vertices_read: usize,
+    /// Faces as the file stores them: OBJ `f` statements and PLY `face` elements with at least
+    /// three corners (polygons count once each), or for glTF the triangles its triangle,
+    /// strip and fan primitives describe.
+    pub faces_read: usize,
+    /// Faces with more than three corners, fan-triangulated into `corners - 2` triangles each
+    /// (OBJ and PLY; always 0 for glTF).
+    pub polygons_triangulated: usize,
+    /// Vertices merged into another one with a bit-identical position
+    /// ([`TriMesh::weld_identical_positions`]).
+    pub welded_vertices: usize,
+    /// Vertices dropped because no triangle uses them
+    /// ([`TriMesh::remove_unreferenced_vertices`]).
+    pub unreferenced_vertices_removed: usize,
+    /// glTF primitive instances skipped because they hold points or lines rather than
+    /// triangles (always 0 for OBJ and PLY, whose point and line statements are ignored).
+    pub skipped_primitives: usize,
+}
+
+impl ReadStats {
+    fn new(format: MeshFormat) -> Self {
+        ReadStats {
+            format,
+            vertices_read: 0,
+            faces_read: 0,
+            polygons_triangulated: 0,
+            welded_vertices: 0,
+            unreferenced_vertices_removed: 0,
+            skipped_primitives: 0,
+        }
+    }
+}
+
+/// Reads a triangle mesh from an OBJ, PLY, glTF or GLB file (format by extension), in the
+/// file's units (glTF positions are placed by the scene's node transforms).
+///
+/// Polygons are fan-triangulated; points and lines are ignored. After parsing, the mesh is
+/// checked (every index in range, every coordinate finite), vertices with bit-identical
+/// positions are welded (triangles that collapse are dropped) and vertices no triangle uses are
+/// removed; [`ReadStats`] reports what was found and changed.
+///
+/// - OBJ: `v` and `f` statements (`f` corners as `v`, `v/vt`, `v//vn`, `v/vt/vn`, negative
+///   indices relative to the vertices read so far). Vertices are shared by position index even
+///   where texture or normal indices differ; all objects and groups are merged; materials are
+///   not read, so a missing `.mtl` file does not matter. Coordinates are parsed as `f64`.
+/// - PLY: ascii or binary of either byte order; element `vertex` with scalar properties `x`,
+///   `y`, `z` of any type, element `face` with an integer list property `vertex_indices` (or
+///   `vertex_index`). Other elements and properties are ignored.
+/// - glTF 2.0: the default scene (else the first scene; with no scene, every mesh
+///   untransformed), nodes walked recursively with their world transforms applied (winding
+///   reversed under a negative determinant), meshes instanced once per node using them.
+///   Triangle, strip and fan primitives are read; point and line primitives are counted in
+///   [`ReadStats::skipped_primitives`]. Buffers may be the GLB binary chunk, data URIs or
+///   external files beside the `.gltf`. Images are not loaded.
+///
+/// # Errors
+///
+/// Every error names `path`:
+/// - [`Error::UnsupportedFormat`] for an extension other than the four above;
+/// - [`Error::Io`] when the file (or an external glTF buffer) cannot be read;
+/// - [`Error::Parse`] when the content does not match the format (with the line, for OBJ and
+///   ascii PLY header problems where known);
+/// - [`Error::InvalidMesh`] for an index out of range (naming the face and the index), a
+///   non-finite coordinate (naming the vertex), or a file with no triangles ("no faces").
+pub fn read_mesh(path: &Path) -> Result<(TriMesh, ReadStats)> {
+    let format = MeshFormat::from_path(path)?;
+    let mut stats = ReadStats::new(format);
+    let raw = match format {
+        MeshFormat::Obj => obj::read(path, &mut stats)?,
+        MeshFormat::Ply => ply::read(path, &mut stats)?,
+        MeshFormat::Gltf | MeshFormat::Glb => gltf::read(path, &mut stats)?,
+    };
+    let mesh = finish(path, raw, &mut stats)?;
+    Ok((mesh, stats))
+}
+
+/// Writes `mesh` to `path` in the format its extension names, in the mesh's own units, with
+/// unit vertex normals from [`TriMesh::vertex_normals`] (a vertex whose normal is undefined, such
+/// as an isolated vertex, gets +Z).
+///
+/// - `.obj`: a comment header, `v x y z` and `vn nx ny nz` lines with Rust's shortest
+///   round-trip formatting of `f64` (reading the file back gives the same coordinates), and
+///   `f a//a b//b c//c` faces (1-based).
+/// - `.ply`: `binary_little_endian 1.0`, vertex `x y z nx ny nz` as `float` (`f32`), face
+///   `list uchar int vertex_indices`.
+/// - `.glb`: binary glTF 2.0 with one scene, one node, one mesh of one triangle primitive:
+///   POSITION and NORMAL (`f32` VEC3) and `u32` indices.
+/// - `.gltf`: the same glTF 2.0 asset as JSON, its buffer embedded as a base64 data URI.
+///
+/// The file is written to a temporary file in the target's directory (`.NAME.tmp-PID-N`),
+/// flushed and synced, then renamed onto the target, which an existing file is replaced by.
+///
+/// # Errors
+///
+/// - [`Error::UnsupportedFormat`] for another extension;
+/// - [`Error::Write`] naming `path` when the mesh cannot be written as it is (an index out of
+///   range, a non-finite coordinate, more than `u32::MAX` elements; for glTF, no triangles) or
+///   the file cannot be written (missing directory, no permission, disk full, ...). Nothing is
+///   left behind at the target or the temporary path when an error is returned.
+pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
+    let format = MeshFormat::from_path(path)?;
+    let write_err = |message: String| Error::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    if let Some((f, i)) = mesh.check_indices() {
+        return Err(write_err(format!(
+            "triangle {f} names vertex {i}, but the mesh has {} vertices",
+            mesh.positions.len()
+        )));
+    }
+    if let Some(v) = mesh.first_non_finite_vertex() {
+        return Err(write_err(format!(
+            "vertex {v} has a non-finite coordinate {:?}",
+            mesh.positions[v].to_array()
+        )));
+    }
+    if u32::try_from(mesh.positions.len()).is_err() || i32::try_from(mesh.positions.len()).is_err()
+    {
+        return Err(write_err(format!(
+            "too many vertices ({}) for a 32-bit index",
+            mesh.positions.len()
+        )));
+    }
+    let normals = output_normals(mesh);
+    let bytes = match format {
+        MeshFormat::Obj => obj::encode(mesh, &normals),
+        MeshFormat::Ply => ply::encode(mesh, &normals),
+        MeshFormat::Glb => gltf::encode_glb(mesh, &normals).map_err(write_err)?,
+        MeshFormat::Gltf => gltf::encode_gltf(mesh, &normals).map_err(write_err)?,
+    };
+    write_atomically(path, &bytes)
+}
+
+/// Unit vertex normals for output: [`TriMesh::vertex_normals`], with +Z where that is zero.
+fn output_normals(mesh: &TriMesh) -> Vec<DVec3> {
+    mesh.vertex_normals()
+        .into_iter()
+        .map(|n| {
+            if n.is_finite() && n.length_squared() > 0.5 {
+                n
+            } else {
+                DVec3::Z
+            }
+        })
+        .collect()
+}
+
+/// The checks and clean-up every reader shares, on the mesh as parsed (indices as in the file,
+/// before any welding). The readers check their indices themselves first where they can name
+/// the face better (OBJ line, PLY face element, glTF primitive); this is the catch-all.
+fn finish(path: &Path, mut mesh: TriMesh, stats: &mut ReadStats) -> Result<TriMesh> {
+    if mesh.triangles.is_empty() {
+        return Err(Error::invalid_mesh(path, "no faces"));
+    }
+    if u32::try_from(mesh.positions.len()).is_err() {
+        return Err(Error::invalid_mesh(
+            path,
+            format!(
+                "too many vertices ({}) for 32-bit indices",
+                mesh.positions.len()
+            ),
+        ));
+    }
+    if let Some((f, i)) = mesh.check_indices() {
+        return Err(Error::invalid_mesh(
+            path,
+            format!(
+                "triangle {f} names vertex index {i} (0-based), but there are only {} vertices",
+                mesh.positions.len()
+            ),
+        ));
+    }
+    if let Some(v) = mesh.first_non_finite_vertex() {
+        return Err(Error::invalid_mesh(
+            path,
+            format!(
+                "vertex {v} (0-based) has a non-finite coordinate {:?}",
+                mesh.positions[v].to_array()
+            ),
+        ));
+    }
+    stats.welded_vertices = mesh.weld_identical_positions();
+    stats.unreferenced_vertices_removed = mesh.remove_unreferenced_vertices();
+    if mesh.triangles.is_empty() {
+        return Err(Error::invalid_mesh(
+            path,
+            "no faces (every triangle is degenerate: it repeats a vertex)",
+        ));
+    }
+    Ok(mesh)
+}
+
+/// Reads a whole file, mapping failure to [`Error::Io`] naming `path`.
+fn read_file(path: &Path) -> Result<Vec<u8>> {
+    fs::read(path).map_err(|e| Error::io(path, e))
+}
+
+/// Collapses a third-party error message onto one line and bounds its length (some parsers
+/// quote whole input lines, which may be arbitrary bytes).
+fn one_line(message: &str) -> String {
+    const MAX: usize = 300;
+    let mut out = String::with_capacity(message.len().min(MAX + 3));
+    let mut last_space = false;
+    for c in message.chars() {
+        let c = if c.is_whitespace() || c.is_control() {
+            ' '
+        } else {
+            c
+        };
+        if c == ' ' && (last_space || out.is_empty()) {
+            continue;
+        }
+        last_space = c == ' ';
+        if out.len() + c.len_utf8() > MAX {
+            out.push_str("...");
+            return out;
+        }
+        out.push(c);
+    }
+    out.trim_end().to_string()
+}
+
+/// Writes `bytes` to a temporary file beside `path`, syncs it and renames it onto `path`. On
+/// failure the temporary file is removed and [`Error::Write`] names `path`.
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let write_err = |message: String| Error::Write {
+        path: path.to_path_buf(),
+        message,
+    };
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| write_err("the path names no file".to_string()))?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(file_name);
+    // The process id keeps concurrent processes apart, the counter concurrent threads.
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    tmp_name.push(format!(
+        ".tmp-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let tmp = dir.join(tmp_name);
+
+    let result = (|| -> std::result::Result<(), String> {
+        let mut file = fs::File::create(&tmp)
+            .map_err(|e| format!("cannot create a temporary file in {}: {e}", dir.display()))?;
+        file.write_all(bytes)
+            .and_then(|()| file.flush())
+            .and_then(|()| file.sync_all())
+            .map_err(|e| format!("cannot write {}: {e}", tmp.display()))?;
+        drop(file);
+        fs::rename(&tmp, path).map_err(|e| format!("cannot rename {} onto it: {e}", tmp.display()))
+    })();
+    result.map_err(|message| {
+        // The temporary file may or may not exist, depending on where it failed.
+        let _ = fs::remove_file(&tmp);
+        write_err(message)
+    })
+}

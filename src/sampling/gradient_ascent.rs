@@ -21,8 +21,10 @@ pub struct GradientAscentParams {
     pub max_move: f64,
     /// Neighbourhood radius in kernel units (default 2.5, Sec. 6.3).
     pub support_radius: f64,
-    /// Move samples one at a time in a seeded random order (Sec. 6.2 as printed), each seeing
-    /// the moves before it, instead of all at once (default false).
+    /// Move samples one at a time in a seeded random order, each seeing the moves before it
+    /// (Sec. 6.2; default true). When false, all samples move at once from the positions at
+    /// the start of the sweep, in parallel; that form needs a smaller step (0.25) to converge and
+    /// converges more slowly (horse at 8600, 10 sweeps: θmin,ave 50.5 against 52.6).
     pub sequential: bool,
     /// Seed of the sequential order.
     pub seed: u64,
@@ -35,7 +37,7 @@ impl Default for GradientAscentParams {
             step: 0.5,
             max_move: 0.25,
             support_radius: SUPPORT_RADIUS,
-            sequential: false,
+            sequential: true,
             seed: 1,
         }
     }
@@ -56,12 +58,10 @@ pub struct GradientAscentResult {
 /// projects it onto `surface` (closest point), for `params.iterations` sweeps. `samples[..fixed]`
 /// (for example samples on the input's boundary curves) act as neighbours but do not move.
 ///
-/// Neighbourhoods are found once with a kd-tree and kept for all sweeps (Sec. 6.3). The sweeps
-/// are Jacobi-style: every sample's move is computed from the positions at the start of the
-/// sweep, in parallel, then all moves are applied; the result does not depend on the thread
-/// count or on a visiting order. (Sec. 6.2 moves samples one at a time in random order; with the
-/// fixed neighbourhoods of Sec. 6.3 and the bounded step both converge to the same kind of
-/// configuration, and the simultaneous form parallelizes.)
+/// Neighbourhoods are found once with a kd-tree and kept for all sweeps (Sec. 6.3). By default
+/// each sweep visits the samples one at a time in a seeded random order, each move seeing the
+/// ones before it (Sec. 6.2); with `sequential = false` all moves of a sweep are computed in
+/// parallel from the positions at its start. Either way the result depends only on the seed.
 ///
 /// The gradient is taken with respect to the position part of x with the sample's normal held
 /// fixed; the projection then gives the new position and the normal of the input triangle it

@@ -6,7 +6,7 @@
 //! edge in at most two faces and the orientation consistent. Boundary edges of an open input are
 //! usable in their own direction only, so they stay boundary edges.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::tangent_delaunay::VotedTriangle;
@@ -25,7 +25,7 @@ impl Default for AssemblyParams {
     fn default() -> Self {
         AssemblyParams {
             max_hole_edges: 100,
-            two_vote_phase: std::env::var("SR_TWO").is_ok(),
+            two_vote_phase: false,
         }
     }
 }
@@ -230,6 +230,15 @@ fn simple_loops(walk: &[u32]) -> Vec<Vec<u32>> {
 
 fn fill_holes(b: &mut Builder, params: &AssemblyParams) -> (usize, usize, usize) {
     let edges = b.hole_half_edges();
+    let mut referenced = vec![false; b.positions.len()];
+    for t in b.faces.iter().flatten() {
+        for &v in t {
+            referenced[v as usize] = true;
+        }
+    }
+    let mut loose: Vec<u32> = (0..b.positions.len() as u32)
+        .filter(|&v| !referenced[v as usize])
+        .collect();
     let mut from: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     for &(x, y) in &edges {
         from.entry(x).or_default().push(y);
@@ -271,7 +280,9 @@ fn fill_holes(b: &mut Builder, params: &AssemblyParams) -> (usize, usize, usize)
                 left += 1;
                 continue;
             }
-            match triangulate_polygon(b, &lp) {
+            let tris = triangulate_hole_with_interior(b, &lp, &loose)
+                .or_else(|| triangulate_polygon(b, &lp));
+            match tris {
                 Some(tris) => {
                     let mut ok = true;
                     let mut done = Vec::new();
@@ -286,6 +297,12 @@ fn fill_holes(b: &mut Builder, params: &AssemblyParams) -> (usize, usize, usize)
                     if ok {
                         filled += 1;
                         added += done.len();
+                        for &f in &done {
+                            for v in b.faces[f as usize].unwrap() {
+                                referenced[v as usize] = true;
+                            }
+                        }
+                        loose.retain(|&v| !referenced[v as usize]);
                     } else {
                         for f in done {
                             b.remove(f);
@@ -298,6 +315,132 @@ fn fill_holes(b: &mut Builder, params: &AssemblyParams) -> (usize, usize, usize)
         }
     }
     (filled, added, left)
+}
+
+/// Whether segments p1-p2 and q1-q2 properly cross (shared endpoints do not count).
+fn segments_cross(p1: DVec2, p2: DVec2, q1: DVec2, q2: DVec2) -> bool {
+    let orient = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
+    let (d1, d2) = (orient(q1, q2, p1), orient(q1, q2, p2));
+    let (d3, d4) = (orient(p1, p2, q1), orient(p1, p2, q2));
+    d1 * d2 < 0.0 && d3 * d4 < 0.0
+}
+
+/// Whether `p` is inside the polygon `poly` (even-odd rule).
+fn inside_polygon(p: DVec2, poly: &[DVec2]) -> bool {
+    let mut inside = false;
+    let m = poly.len();
+    for i in 0..m {
+        let (a, c) = (poly[i], poly[(i + 1) % m]);
+        if (a.y > p.y) != (c.y > p.y) && p.x < a.x + (p.y - a.y) * (c.x - a.x) / (c.y - a.y) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// Fills the hole `lp` with a constrained Delaunay triangulation, in the plane of the hole's
+/// Newell normal, of its boundary and of the samples that no face uses yet and that lie inside
+/// it. `None` when the hole does not project to a simple polygon, faces away from its corners'
+/// normals, or a triangle would not fit.
+fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Option<Vec<[u32; 3]>> {
+    use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+    let m = lp.len();
+    let pts: Vec<DVec3> = lp.iter().map(|&v| b.positions[v as usize]).collect();
+    let newell = (0..m)
+        .map(|i| pts[i].cross(pts[(i + 1) % m]))
+        .sum::<DVec3>();
+    let n = newell.try_normalize()?;
+    let avg_normal = lp.iter().map(|&v| b.normals[v as usize]).sum::<DVec3>();
+    if n.dot(avg_normal) <= 0.0 {
+        return None;
+    }
+    let (u, w) = super::tangent_delaunay::tangent_basis(n);
+    let center = pts.iter().sum::<DVec3>() / m as f64;
+    let to2 = |p: DVec3| DVec2::new((p - center).dot(u), (p - center).dot(w));
+    let poly: Vec<DVec2> = pts.iter().map(|&p| to2(p)).collect();
+    for i in 0..m {
+        for j in i + 2..m {
+            if i == 0 && j == m - 1 {
+                continue;
+            }
+            if segments_cross(poly[i], poly[(i + 1) % m], poly[j], poly[(j + 1) % m]) {
+                return None;
+            }
+        }
+    }
+    let radius2 = pts
+        .iter()
+        .map(|p| p.distance_squared(center))
+        .fold(0.0, f64::max);
+    let interior: Vec<u32> = loose
+        .iter()
+        .copied()
+        .filter(|&v| {
+            let p = b.positions[v as usize];
+            p.distance_squared(center) <= radius2
+                && b.normals[v as usize].dot(n) > 0.3
+                && inside_polygon(to2(p), &poly)
+        })
+        .collect();
+    #[derive(Clone, Copy)]
+    struct V {
+        p: Point2<f64>,
+        index: u32,
+    }
+    impl spade::HasPosition for V {
+        type Scalar = f64;
+        fn position(&self) -> Point2<f64> {
+            self.p
+        }
+    }
+    let mut cdt: ConstrainedDelaunayTriangulation<V> = ConstrainedDelaunayTriangulation::new();
+    let mut handles = Vec::with_capacity(m);
+    for (k, &v) in lp.iter().enumerate() {
+        let h = cdt
+            .insert(V {
+                p: Point2::new(poly[k].x, poly[k].y),
+                index: v,
+            })
+            .ok()?;
+        if cdt.vertex(h).data().index != v {
+            return None;
+        }
+        handles.push(h);
+    }
+    for &v in &interior {
+        let q = to2(b.positions[v as usize]);
+        let _ = cdt.insert(V {
+            p: Point2::new(q.x, q.y),
+            index: v,
+        });
+    }
+    for k in 0..m {
+        let (a, c) = (handles[k], handles[(k + 1) % m]);
+        if !cdt.can_add_constraint(a, c) {
+            return None;
+        }
+        cdt.add_constraint(a, c);
+    }
+    let mut out = Vec::new();
+    for f in cdt.inner_faces() {
+        let vs = f.vertices();
+        let c2 = vs
+            .iter()
+            .map(|h| DVec2::new(h.position().x, h.position().y))
+            .sum::<DVec2>()
+            / 3.0;
+        if inside_polygon(c2, &poly) {
+            let t = vs.map(|h| h.data().index);
+            if !b.fits(t) || b.quality(t) <= 0.0 {
+                return None;
+            }
+            out.push(t);
+        }
+    }
+    if out.len() != m - 2 + 2 * interior.len() {
+        return None;
+    }
+    Some(out)
 }
 
 /// The triangulation of the polygon `lp` (a hole's vertices in the order of its half-edges) that

@@ -20,18 +20,18 @@ use crate::spatial::StaticTree;
 /// Parameters of the local triangulation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TangentDelaunayParams {
-    /// Neighbours projected into each tangent plane (default 18).
+    /// Neighbours projected into each tangent plane (default 14).
     pub neighbors: usize,
     /// Neighbours whose normal differs from the centre's by more than this are left out (they
-    /// are on another sheet of the surface), degrees (default 75).
+    /// are on another sheet of the surface), degrees (default 90).
     pub max_normal_angle_deg: f64,
 }
 
 impl Default for TangentDelaunayParams {
     fn default() -> Self {
         TangentDelaunayParams {
-            neighbors: 18,
-            max_normal_angle_deg: 75.0,
+            neighbors: 14,
+            max_normal_angle_deg: 90.0,
         }
     }
 }
@@ -113,11 +113,9 @@ fn umbrella(
         // log map): neighbours far out on a curved surface keep their spacing.
         let d = set.positions[j as usize] - pi;
         let mut q = DVec2::new(d.dot(u), d.dot(v));
-        if std::env::var("SR_LOGMAP").is_ok() {
-            let l = q.length();
-            if l > 0.0 {
-                q *= d.length() / l;
-            }
+        let l = q.length();
+        if l > 0.0 {
+            q *= d.length() / l;
         }
         if let Ok(h) = cdt.insert(LocalVertex {
             p: Point2::new(q.x, q.y),

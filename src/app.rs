@@ -1,0 +1,192 @@
+//! The jobs behind the `remesh` command line, as library functions: remesh a file and report on
+//! it, or report on any mesh against a reference.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::error::{Error, Result};
+use crate::io::{read_mesh, write_mesh};
+use crate::pipeline::{remesh, Density, RemeshParams};
+use crate::quality::{surface_distance, surface_distance_with, QualityReport};
+use crate::surface::MeshSurface;
+
+/// Samples per side for the Hausdorff and RMS distances of the report (Metro-style, on top of
+/// every vertex).
+pub const DISTANCE_SAMPLES: usize = 200_000;
+
+/// A remeshing job: input and output files and the pipeline's parameters.
+#[derive(Debug, Clone)]
+pub struct RemeshJob {
+    /// Input mesh (.obj, .ply, .gltf, .glb).
+    pub input: PathBuf,
+    /// Output mesh (.obj, .ply, .glb), format by extension.
+    pub output: PathBuf,
+    /// Pipeline parameters; `Density::Points(0)` means "as many as the input has vertices".
+    pub params: RemeshParams,
+    /// Whether to measure the distance to the input (Hausdorff, RMS).
+    pub measure_distance: bool,
+}
+
+/// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
+///
+/// # Errors
+/// Whatever reading, the pipeline or writing return, each naming the file concerned; an
+/// [`Error::InvalidParameter`] when the output path is the input path.
+pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<QualityReport> {
+    if same_file(&job.input, &job.output) {
+        return Err(Error::InvalidParameter {
+            name: "OUTPUT",
+            message: format!(
+                "{} is the input file; choose another output path",
+                job.output.display()
+            ),
+        });
+    }
+    on_stage("read");
+    let t = Instant::now();
+    let (input, stats) = read_mesh(&job.input)?;
+    let read_seconds = t.elapsed().as_secs_f64();
+    let mut params = job.params;
+    if params.density == Density::Points(0) {
+        params.density = Density::Points(input.vertex_count());
+    }
+    let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
+    on_stage("write");
+    let t = Instant::now();
+    write_mesh(&job.output, &out.mesh)?;
+    let write_seconds = t.elapsed().as_secs_f64();
+
+    let mut report = QualityReport::new(&out.mesh_normalized);
+    report.push_stage("read", read_seconds);
+    for s in &out.stages {
+        report.push_stage(s.name, s.seconds);
+    }
+    report.push_stage("write", write_seconds);
+    let input_topology = crate::quality::topology(&out.input_normalized);
+    if input_topology.non_manifold_vertices > 0 || input_topology.non_manifold_edges > 0 {
+        report.notes.push(format!(
+            "the input has {} non-manifold vertices and {} non-manifold edges; the sampler works on \
+             the surface as a point set and the output is rebuilt manifold",
+            input_topology.non_manifold_vertices, input_topology.non_manifold_edges
+        ));
+    }
+    report.input_topology = Some(input_topology);
+    if job.measure_distance {
+        on_stage("distance");
+        let t = Instant::now();
+        let a = MeshSurface::new(&out.mesh_normalized)?;
+        let b = MeshSurface::new(&out.input_normalized)?;
+        report.distance = Some(surface_distance_with(
+            &out.mesh_normalized,
+            &a,
+            &out.input_normalized,
+            &b,
+            DISTANCE_SAMPLES,
+            params.seed,
+        ));
+        report.push_stage("distance (report)", t.elapsed().as_secs_f64());
+    }
+    let extra = &mut report.extra;
+    extra.insert("sigma_p".into(), out.sigma_p.into());
+    extra.insert(
+        "sigma_n".into(),
+        if params.sigma_n.is_finite() {
+            params.sigma_n.into()
+        } else {
+            "infinity".into()
+        },
+    );
+    if let Some(n) = out.target {
+        extra.insert("target_points".into(), n.into());
+    }
+    extra.insert("samples".into(), out.samples.into());
+    extra.insert("boundary_samples".into(), out.boundary_samples.into());
+    extra.insert("candidates".into(), out.candidates.into());
+    extra.insert("seed".into(), params.seed.into());
+    extra.insert(
+        "sigma_p_search".into(),
+        serde_json::to_value(&out.search_history).unwrap_or_default(),
+    );
+    extra.insert(
+        "assembly".into(),
+        serde_json::to_value(&out.assembly).unwrap_or_default(),
+    );
+    extra.insert("input_vertices".into(), input.vertex_count().into());
+    extra.insert("input_faces".into(), input.face_count().into());
+    if stats.welded_vertices > 0 {
+        report.notes.push(format!(
+            "{} input vertices at identical positions were merged",
+            stats.welded_vertices
+        ));
+    }
+    if let Some(n) = out.target {
+        let v = out.mesh.vertex_count();
+        if (v as f64 - n as f64).abs() > 0.01 * n as f64 {
+            report.notes.push(format!(
+                "target not reached: {v} vertices for --points {n} (more than 1% off)"
+            ));
+        }
+    }
+    if out.dropped_samples > 0 {
+        report.notes.push(format!(
+            "{} samples ended in no triangle and were left out",
+            out.dropped_samples
+        ));
+    }
+    if out.assembly.holes_left > 0 {
+        report.notes.push(format!(
+            "{} holes of the triangulation could not be closed",
+            out.assembly.holes_left
+        ));
+    }
+    Ok(report)
+}
+
+/// Reports on the mesh in `path`; with `reference`, also the distance to it. Both are scaled by
+/// the reference's bbox-100 normalization (or the mesh's own without a reference).
+///
+/// # Errors
+/// Reading errors naming the file; [`Error::InvalidMesh`] for a mesh without area.
+pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<QualityReport> {
+    let t = Instant::now();
+    let (mesh, _) = read_mesh(path)?;
+    let reference = reference.map(read_mesh).transpose()?.map(|r| r.0);
+    let frame = reference.as_ref().unwrap_or(&mesh);
+    let bbox = frame
+        .bbox()
+        .ok_or_else(|| Error::invalid_mesh(path, "the mesh has no vertices"))?;
+    let normalization = crate::mesh::Normalization::for_bbox(&bbox)
+        .ok_or_else(|| Error::invalid_mesh(path, "the bounding box has zero size"))?;
+    let m = normalization.apply_mesh(&mesh);
+    let mut report = QualityReport::new(&m);
+    report.push_stage("read and measure", t.elapsed().as_secs_f64());
+    if let Some(r) = &reference {
+        let t = Instant::now();
+        let rn = normalization.apply_mesh(r);
+        report.input_topology = Some(crate::quality::topology(&rn));
+        report.distance = Some(
+            surface_distance(&m, &rn, DISTANCE_SAMPLES, seed).map_err(|e| with_path(e, path))?,
+        );
+        report.push_stage("distance", t.elapsed().as_secs_f64());
+    }
+    Ok(report)
+}
+
+/// Fills in the file of an [`Error::InvalidMesh`] that was raised without one.
+fn with_path(e: Error, path: &Path) -> Error {
+    match e {
+        Error::InvalidMesh { path: p, message } if p.as_os_str().is_empty() => Error::InvalidMesh {
+            path: path.to_path_buf(),
+            message,
+        },
+        other => other,
+    }
+}
+
+/// Whether two paths name the same existing file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}

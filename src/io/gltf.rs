@@ -1,0 +1,704 @@
+//! glTF 2.0 (`.gltf` and `.glb`): reading the triangles of a scene with the `gltf` crate, and
+//! writing one mesh as a binary or embedded glTF asset.
+//!
+//! Reading parses and validates the document with `gltf`, loads only its buffers (not its
+//! images), and decodes accessors with our own bounds-checked code: the `gltf` crate's accessor
+//! iterators and importer can panic on some malformed files (a GLB header length below 12, an
+//! accessor of count 0, a buffer URI that is not UTF-8 once percent-decoded).
+
+use std::path::{Path, PathBuf};
+
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::buffer::Source;
+use ::gltf::json::validation::{Error as ValidationError, Validate};
+use ::gltf::mesh::Mode;
+use glam::{DMat3, DMat4, DVec3};
+use serde_json::json;
+
+use super::{one_line, read_file, ReadStats};
+use crate::error::{Error, Result};
+use crate::mesh::TriMesh;
+
+/// Largest number of node instances visited in a scene walk: a guard against node graphs that
+/// are not trees (a node listed as the child of several parents can multiply instances
+/// exponentially).
+const MAX_NODE_VISITS: usize = 1 << 20;
+
+/// Largest number of components (elements × components per element) of an accessor without a
+/// buffer view (all zeros plus sparse substitutes), which costs memory without costing file
+/// size.
+const MAX_VIEWLESS_COMPONENTS: usize = 1 << 24;
+
+/// Parses the glTF or GLB file at `path` into the triangles of its scene, in world
+/// coordinates.
+pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
+    let data = read_file(path)?;
+    let parse_err = |message: String| Error::parse(path, None, message);
+    check_glb_header(&data).map_err(parse_err)?;
+    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_slice_without_validation(&data)
+        .map_err(|e| {
+            parse_err(format!(
+                "not a valid glTF 2.0 file: {}",
+                one_line(&e.to_string())
+            ))
+        })?;
+    validate(&document).map_err(parse_err)?;
+    let buffers = load_buffers(path, &document, blob)?;
+
+    let mut walk = Walk {
+        path,
+        buffers: &buffers,
+        positions: Vec::new(),
+        triangles: Vec::new(),
+        stats,
+    };
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next());
+    match scene {
+        Some(scene) => {
+            let mut on_path = vec![false; document.as_json().nodes.len()];
+            let mut visits = 0usize;
+            // Depth-first with an explicit stack: deep hierarchies cannot overflow the call
+            // stack, and `on_path` finds cycles.
+            enum Step<'a> {
+                Enter(::gltf::Node<'a>, DMat4),
+                Leave(usize),
+            }
+            let mut stack: Vec<Step> = scene
+                .nodes()
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+                .map(|n| Step::Enter(n, DMat4::IDENTITY))
+                .collect();
+            while let Some(step) = stack.pop() {
+                match step {
+                    Step::Leave(i) => on_path[i] = false,
+                    Step::Enter(node, parent) => {
+                        let i = node.index();
+                        if on_path[i] {
+                            return Err(parse_err(format!(
+                                "node {i} is its own ancestor (the node hierarchy has a cycle)"
+                            )));
+                        }
+                        visits += 1;
+                        if visits > MAX_NODE_VISITS {
+                            return Err(parse_err(format!(
+                                "the node hierarchy places more than {MAX_NODE_VISITS} nodes \
+                                 (nodes with several parents?)"
+                            )));
+                        }
+                        on_path[i] = true;
+                        let local = node.transform().matrix().map(|c| c.map(f64::from));
+                        let world = parent * DMat4::from_cols_array_2d(&local);
+                        if let Some(mesh) = node.mesh() {
+                            walk.add_mesh(&mesh, &world)?;
+                        }
+                        stack.push(Step::Leave(i));
+                        let children: Vec<_> = node.children().collect();
+                        for child in children.into_iter().rev() {
+                            stack.push(Step::Enter(child, world));
+                        }
+                    }
+                }
+            }
+        }
+        None => {
+            for mesh in document.meshes() {
+                walk.add_mesh(&mesh, &DMat4::IDENTITY)?;
+            }
+        }
+    }
+    Ok(TriMesh::new(walk.positions, walk.triangles))
+}
+
+/// Checks a GLB header's length field before `gltf` computes with it (it subtracts 12 from it
+/// unchecked). Text glTF passes unchanged.
+fn check_glb_header(data: &[u8]) -> std::result::Result<(), String> {
+    if !data.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let word = |k: usize| {
+        data.get(k..k + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        return Err("truncated GLB header".to_string());
+    };
+    if version != 2 {
+        return Err(format!("GLB version {version}, expected 2"));
+    }
+    if (length as usize) < 20 || length as usize > data.len() {
+        return Err(format!(
+            "GLB header gives a length of {length} bytes, but the file has {} bytes",
+            data.len()
+        ));
+    }
+    Ok(())
+}
+
+/// Required extensions that do not change how positions and indices are stored (or, for
+/// `KHR_mesh_quantization`, only allow integer positions, which [`read_accessor`] decodes).
+const HARMLESS_EXTENSIONS: [&str; 3] = ["KHR_mesh_quantization", "KHR_materials_", "KHR_texture_"];
+
+/// The `gltf` crate's validation, except that a POSITION accessor without `min`/`max` (required
+/// by the specification, but often missing in practice, and not needed here) is accepted, and so
+/// are required extensions that do not affect geometry (materials, textures, lights,
+/// quantization). Geometry compression (Draco, meshopt) is refused by name.
+fn validate(document: &::gltf::Document) -> std::result::Result<(), String> {
+    let root = document.as_json();
+    for ext in &root.extensions_required {
+        let harmless = HARMLESS_EXTENSIONS.iter().any(|h| ext.starts_with(h))
+            || matches!(
+                ext.as_str(),
+                "KHR_lights_punctual" | "EXT_texture_webp" | "MSFT_texture_dds"
+            );
+        if !harmless {
+            return Err(format!(
+                "the file requires the glTF extension {}, which is not supported",
+                one_line(ext)
+            ));
+        }
+    }
+    let mut errors: Vec<(String, ValidationError)> = Vec::new();
+    root.validate(root, ::gltf::json::Path::new, &mut |path, error| {
+        errors.push((path().to_string(), error))
+    });
+    errors.retain(|(path, error)| match error {
+        ValidationError::Missing => !(path.ends_with(".min") || path.ends_with(".max")),
+        ValidationError::Unsupported => !path.starts_with("extensionsRequired"),
+        _ => true,
+    });
+    match errors.first() {
+        None => Ok(()),
+        Some((path, error)) => Err(format!(
+            "invalid glTF: {path}: {error}{}",
+            if errors.len() > 1 {
+                format!(" (and {} more problems)", errors.len() - 1)
+            } else {
+                String::new()
+            }
+        )),
+    }
+}
+
+/// Loads every buffer: the GLB binary chunk, data URIs, or files relative to the glTF file.
+fn load_buffers(
+    path: &Path,
+    document: &::gltf::Document,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<::gltf::buffer::Data>> {
+    let base = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut out = Vec::new();
+    for buffer in document.buffers() {
+        let i = buffer.index();
+        let uri = match buffer.source() {
+            Source::Uri(uri) => {
+                // `gltf` unwraps the percent-decoding of relative URIs into UTF-8.
+                if !uri.contains(':') && std::str::from_utf8(&percent_decode(uri)).is_err() {
+                    return Err(Error::parse(
+                        path,
+                        None,
+                        format!("buffer {i}: URI is not UTF-8 once percent-decoded"),
+                    ));
+                }
+                Some(uri)
+            }
+            Source::Bin => None,
+        };
+        let data =
+            ::gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(&base), &mut blob)
+                .map_err(|e| {
+                    let what = match uri {
+                        Some(u) if u.starts_with("data:") => "embedded data URI".to_string(),
+                        Some(u) => format!("'{}'", one_line(u)),
+                        None => "GLB binary chunk".to_string(),
+                    };
+                    match e {
+                        ::gltf::Error::Io(io) => Error::io(
+                            path,
+                            std::io::Error::new(io.kind(), format!("buffer {i} ({what}): {io}")),
+                        ),
+                        other => Error::parse(
+                            path,
+                            None,
+                            format!("buffer {i} ({what}): {}", one_line(&other.to_string())),
+                        ),
+                    }
+                })?;
+        if data.len() < buffer.length() {
+            return Err(Error::parse(
+                path,
+                None,
+                format!(
+                    "buffer {i} holds {} bytes, but the file declares {}",
+                    data.len(),
+                    buffer.length()
+                ),
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// Percent-decoding as the `urlencoding` crate does it (`%` not followed by two hex digits is
+/// kept as it is).
+fn percent_decode(s: &str) -> Vec<u8> {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut k = 0;
+    while k < b.len() {
+        if b[k] == b'%' && k + 2 < b.len() {
+            let hex = |c: u8| (c as char).to_digit(16);
+            if let (Some(h), Some(l)) = (hex(b[k + 1]), hex(b[k + 2])) {
+                out.push((h * 16 + l) as u8);
+                k += 3;
+                continue;
+            }
+        }
+        out.push(b[k]);
+        k += 1;
+    }
+    out
+}
+
+/// The triangles gathered so far in a scene walk.
+struct Walk<'a, 's> {
+    path: &'a Path,
+    buffers: &'a [::gltf::buffer::Data],
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    stats: &'s mut ReadStats,
+}
+
+impl Walk<'_, '_> {
+    /// Adds the triangle primitives of `mesh`, placed by `world`.
+    fn add_mesh(&mut self, mesh: &::gltf::Mesh, world: &DMat4) -> Result<()> {
+        let flip = DMat3::from_mat4(*world).determinant() < 0.0;
+        for primitive in mesh.primitives() {
+            let mode = primitive.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                self.stats.skipped_primitives += 1;
+                continue;
+            }
+            let what = format!("mesh {} primitive {}", mesh.index(), primitive.index());
+            let err = |message: String| Error::parse(self.path, None, format!("{what}: {message}"));
+            let accessor = primitive
+                .get(&::gltf::Semantic::Positions)
+                .ok_or_else(|| err("no POSITION attribute".to_string()))?;
+            if accessor.dimensions() != Dimensions::Vec3 {
+                return Err(err(format!(
+                    "POSITION accessor {} is {:?}, expected VEC3",
+                    accessor.index(),
+                    accessor.dimensions()
+                )));
+            }
+            let coords = read_accessor(&accessor, self.buffers).map_err(err)?;
+            let count = accessor.count();
+            let indices: Vec<u32> = match primitive.indices() {
+                Some(ia) => {
+                    if ia.dimensions() != Dimensions::Scalar
+                        || ia.normalized()
+                        || !matches!(ia.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+                    {
+                        return Err(err(format!(
+                            "index accessor {} is {:?} {:?}, expected unsigned integer SCALAR",
+                            ia.index(),
+                            ia.data_type(),
+                            ia.dimensions()
+                        )));
+                    }
+                    let values = read_accessor(&ia, self.buffers).map_err(err)?;
+                    let mut out = Vec::with_capacity(values.len());
+                    for v in values {
+                        // Unsigned 32-bit values read as f64 are exact integers.
+                        let v = v as u64;
+                        if v >= count as u64 {
+                            return Err(Error::invalid_mesh(
+                                self.path,
+                                format!("{what}: index {v} is out of range for {count} vertices"),
+                            ));
+                        }
+                        out.push(v as u32);
+                    }
+                    out
+                }
+                None => {
+                    let n = u32::try_from(count)
+                        .map_err(|_| err(format!("{count} vertices do not fit 32-bit indices")))?;
+                    (0..n).collect()
+                }
+            };
+            let base = self.positions.len();
+            let total = base + count;
+            if u32::try_from(total).is_err() {
+                return Err(err(format!(
+                    "the scene has more than {} vertices",
+                    u32::MAX
+                )));
+            }
+            self.positions.extend(
+                coords
+                    .chunks_exact(3)
+                    .map(|c| world.transform_point3(DVec3::new(c[0], c[1], c[2]))),
+            );
+            self.stats.vertices_read += count;
+
+            let base = base as u32;
+            let before = self.triangles.len();
+            let mut push = |a: u32, b: u32, c: u32| {
+                let (b, c) = if flip { (c, b) } else { (b, c) };
+                self.triangles.push([base + a, base + b, base + c]);
+            };
+            match mode {
+                Mode::Triangles => {
+                    for t in indices.chunks_exact(3) {
+                        push(t[0], t[1], t[2]);
+                    }
+                }
+                Mode::TriangleStrip => {
+                    for k in 0..indices.len().saturating_sub(2) {
+                        if k % 2 == 0 {
+                            push(indices[k], indices[k + 1], indices[k + 2]);
+                        } else {
+                            push(indices[k], indices[k + 2], indices[k + 1]);
+                        }
+                    }
+                }
+                Mode::TriangleFan => {
+                    for k in 1..indices.len().saturating_sub(1) {
+                        push(indices[k], indices[k + 1], indices[0]);
+                    }
+                }
+                _ => {}
+            }
+            self.stats.faces_read += self.triangles.len() - before;
+        }
+        Ok(())
+    }
+}
+
+/// The components of `accessor` as `f64`, `count × components` flat, with bounds checked
+/// against the buffers, byte strides followed, normalized integers mapped to [0, 1] or [-1, 1]
+/// and sparse substitutions applied.
+fn read_accessor(
+    accessor: &::gltf::Accessor,
+    buffers: &[::gltf::buffer::Data],
+) -> std::result::Result<Vec<f64>, String> {
+    let a = accessor.index();
+    let ty = accessor.data_type();
+    let csize = ty.size();
+    let dims = accessor.dimensions().multiplicity();
+    let elem = csize * dims;
+    let count = accessor.count();
+    let normalized = accessor.normalized();
+    let too_big = || format!("accessor {a} is larger than its buffer");
+
+    let mut out = match accessor.view() {
+        Some(view) => {
+            let data = view_bytes(&view, buffers)?;
+            let stride = view.stride().unwrap_or(elem);
+            if stride < elem {
+                return Err(format!(
+                    "accessor {a}: buffer view {} has a byte stride of {stride}, less than \
+                     the element size {elem}",
+                    view.index()
+                ));
+            }
+            let offset = accessor.offset();
+            if count > 0 {
+                let end = stride
+                    .checked_mul(count - 1)
+                    .and_then(|x| x.checked_add(offset))
+                    .and_then(|x| x.checked_add(elem))
+                    .ok_or_else(too_big)?;
+                if end > data.len() {
+                    return Err(format!(
+                        "accessor {a} reads bytes {offset}..{end} of buffer view {}, which has \
+                         {} bytes",
+                        view.index(),
+                        data.len()
+                    ));
+                }
+            }
+            let mut out = Vec::with_capacity(count * dims);
+            for i in 0..count {
+                let start = offset + i * stride;
+                for c in 0..dims {
+                    out.push(component(&data[start + c * csize..], ty, normalized));
+                }
+            }
+            out
+        }
+        None => {
+            if count.saturating_mul(dims) > MAX_VIEWLESS_COMPONENTS {
+                return Err(format!(
+                    "accessor {a} has no buffer view and {count} elements"
+                ));
+            }
+            vec![0.0; count * dims]
+        }
+    };
+
+    if let Some(sparse) = accessor.sparse() {
+        let n = sparse.count();
+        let indices = sparse.indices();
+        let isize = indices.index_type().size();
+        let idata = view_bytes(&indices.view(), buffers)?;
+        let ioff = indices.offset();
+        let values = sparse.values();
+        let vdata = view_bytes(&values.view(), buffers)?;
+        let voff = values.offset();
+        let fits = |off: usize, size: usize, len: usize| {
+            n.checked_mul(size)
+                .and_then(|x| x.checked_add(off))
+                .is_some_and(|end| end <= len)
+        };
+        if !fits(ioff, isize, idata.len()) || !fits(voff, elem, vdata.len()) {
+            return Err(format!(
+                "accessor {a}: sparse data is larger than its buffer views"
+            ));
+        }
+        for k in 0..n {
+            let at = &idata[ioff + k * isize..];
+            let i = match isize {
+                1 => usize::from(at[0]),
+                2 => usize::from(u16::from_le_bytes([at[0], at[1]])),
+                _ => u32::from_le_bytes([at[0], at[1], at[2], at[3]]) as usize,
+            };
+            if i >= count {
+                return Err(format!(
+                    "accessor {a}: sparse index {i} is out of range for {count} elements"
+                ));
+            }
+            for c in 0..dims {
+                out[i * dims + c] =
+                    component(&vdata[voff + k * elem + c * csize..], ty, normalized);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The bytes of a buffer view, bounds-checked against its buffer.
+fn view_bytes<'b>(
+    view: &::gltf::buffer::View,
+    buffers: &'b [::gltf::buffer::Data],
+) -> std::result::Result<&'b [u8], String> {
+    let buffer = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| format!("buffer view {} names a missing buffer", view.index()))?;
+    view.offset()
+        .checked_add(view.length())
+        .and_then(|end| buffer.get(view.offset()..end))
+        .ok_or_else(|| {
+            format!(
+                "buffer view {} (bytes {}..+{}) lies outside buffer {} ({} bytes)",
+                view.index(),
+                view.offset(),
+                view.length(),
+                view.buffer().index(),
+                buffer.len()
+            )
+        })
+}
+
+/// One component at the start of `b` (which holds at least its size), little endian.
+fn component(b: &[u8], ty: DataType, normalized: bool) -> f64 {
+    match ty {
+        DataType::F32 => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        DataType::U32 => {
+            let v = f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+            if normalized {
+                v / f64::from(u32::MAX)
+            } else {
+                v
+            }
+        }
+        DataType::U16 => {
+            let v = f64::from(u16::from_le_bytes([b[0], b[1]]));
+            if normalized {
+                v / 65535.0
+            } else {
+                v
+            }
+        }
+        DataType::I16 => {
+            let v = f64::from(i16::from_le_bytes([b[0], b[1]]));
+            if normalized {
+                (v / 32767.0).max(-1.0)
+            } else {
+                v
+            }
+        }
+        DataType::U8 => {
+            let v = f64::from(b[0]);
+            if normalized {
+                v / 255.0
+            } else {
+                v
+            }
+        }
+        DataType::I8 => {
+            let v = f64::from(b[0] as i8);
+            if normalized {
+                (v / 127.0).max(-1.0)
+            } else {
+                v
+            }
+        }
+    }
+}
+
+/// The glTF JSON (without the buffer's `uri`) and binary buffer of `mesh` with `normals`.
+fn build(
+    mesh: &TriMesh,
+    normals: &[DVec3],
+) -> std::result::Result<(serde_json::Value, Vec<u8>), String> {
+    if mesh.positions.is_empty() || mesh.triangles.is_empty() {
+        return Err(format!(
+            "glTF cannot hold an empty mesh ({} vertices, {} triangles)",
+            mesh.positions.len(),
+            mesh.triangles.len()
+        ));
+    }
+    let v = mesh.positions.len();
+    let f = mesh.triangles.len();
+    let pos_bytes = v * 12;
+    let idx_bytes = f * 12;
+    let total = 2 * pos_bytes + idx_bytes;
+    if u32::try_from(total + 4096).is_err() {
+        return Err(format!(
+            "{total} bytes of vertex and index data is too much for glTF"
+        ));
+    }
+    let mut bin = Vec::with_capacity(total);
+    let mut min = glam::Vec3::splat(f32::INFINITY);
+    let mut max = glam::Vec3::splat(f32::NEG_INFINITY);
+    for p in &mesh.positions {
+        let p = p.as_vec3();
+        if !p.is_finite() {
+            return Err(format!("position {p} does not fit in f32"));
+        }
+        min = min.min(p);
+        max = max.max(p);
+        for c in p.to_array() {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for n in normals {
+        let n = n.as_vec3().normalize_or(glam::Vec3::Z);
+        for c in n.to_array() {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for t in &mesh.triangles {
+        for i in t {
+            bin.extend_from_slice(&i.to_le_bytes());
+        }
+    }
+    // f32 bounds written as the f64 of the same value, so they match the data exactly.
+    let bound = |b: glam::Vec3| b.to_array().map(f64::from).to_vec();
+    let json = json!({
+        "asset": { "version": "2.0", "generator": "spectral-remesh" },
+        "scene": 0,
+        "scenes": [ { "nodes": [0] } ],
+        "nodes": [ { "mesh": 0 } ],
+        "meshes": [ {
+            "primitives": [ {
+                "attributes": { "POSITION": 0, "NORMAL": 1 },
+                "indices": 2,
+                "mode": 4
+            } ]
+        } ],
+        "accessors": [
+            { "bufferView": 0, "componentType": 5126, "count": v, "type": "VEC3",
+              "min": bound(min), "max": bound(max) },
+            { "bufferView": 1, "componentType": 5126, "count": v, "type": "VEC3" },
+            { "bufferView": 2, "componentType": 5125, "count": 3 * f, "type": "SCALAR" }
+        ],
+        "bufferViews": [
+            { "buffer": 0, "byteOffset": 0, "byteLength": pos_bytes, "target": 34962 },
+            { "buffer": 0, "byteOffset": pos_bytes, "byteLength": pos_bytes, "target": 34962 },
+            { "buffer": 0, "byteOffset": 2 * pos_bytes, "byteLength": idx_bytes,
+              "target": 34963 }
+        ],
+        "buffers": [ { "byteLength": total } ]
+    });
+    Ok((json, bin))
+}
+
+/// The `.glb` bytes of `mesh`: header, JSON chunk padded with spaces, BIN chunk padded with
+/// zeros.
+pub(super) fn encode_glb(
+    mesh: &TriMesh,
+    normals: &[DVec3],
+) -> std::result::Result<Vec<u8>, String> {
+    let (json, bin) = build(mesh, normals)?;
+    let mut json = serde_json::to_vec(&json).map_err(|e| e.to_string())?;
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let mut bin = bin;
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let total32 = u32::try_from(total).map_err(|_| format!("{total} bytes is too much for GLB"))?;
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&total32.to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    Ok(out)
+}
+
+/// The `.gltf` (JSON) bytes of `mesh`, its buffer embedded as a base64 data URI.
+pub(super) fn encode_gltf(
+    mesh: &TriMesh,
+    normals: &[DVec3],
+) -> std::result::Result<Vec<u8>, String> {
+    let (mut json, bin) = build(mesh, normals)?;
+    json["buffers"][0]["uri"] = serde_json::Value::String(format!(
+        "data:application/octet-stream;base64,{}",
+        base64(&bin)
+    ));
+    let mut out = serde_json::to_vec_pretty(&json).map_err(|e| e.to_string())?;
+    out.push(b'\n');
+    Ok(out)
+}
+
+/// Standard base64 with padding.
+fn base64(data: &[u8]) -> String {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(data.len().div_ceil(3) * 4);
+    for chunk in data.chunks(3) {
+        let b = [
+            chunk[0],
+            chunk.get(1).copied().unwrap_or(0),
+            chunk.get(2).copied().unwrap_or(0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,258 @@
+//! Stanford PLY: reading with `ply-rs-bw` (ascii and binary of either byte order), writing
+//! binary little endian by hand.
+
+use std::io::{BufReader, Cursor};
+use std::path::Path;
+
+use glam::DVec3;
+use ply_rs_bw::parser::{Parser, Reader};
+use ply_rs_bw::ply::{
+    Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
+};
+
+use super::{one_line, read_file, ReadStats};
+use crate::error::{Error, Result};
+use crate::mesh::TriMesh;
+
+/// The names a face element's index list may have.
+const INDEX_LISTS: [&str; 2] = ["vertex_indices", "vertex_index"];
+
+/// One element of the payload, whatever its kind: the parser uses one type for all elements,
+/// so this holds what a vertex (`x y z`) or a face (an index list) needs.
+#[derive(Default)]
+struct Element {
+    xyz: [f64; 3],
+    indices: Vec<i64>,
+}
+
+impl Element {
+    fn coordinate(&mut self, name: &str, value: f64) -> PropertyAccessResult {
+        let k = match name {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => return PropertyAccessResult::Ignored,
+        };
+        self.xyz[k] = value;
+        PropertyAccessResult::Set
+    }
+
+    fn index_list<T: Into<i64>>(&mut self, name: &str, values: Vec<T>) -> PropertyAccessResult {
+        if INDEX_LISTS.contains(&name) {
+            self.indices = values.into_iter().map(Into::into).collect();
+            PropertyAccessResult::Set
+        } else {
+            PropertyAccessResult::Ignored
+        }
+    }
+}
+
+impl PropertyAccess for Element {
+    fn new() -> Self {
+        Element::default()
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        let value = match property {
+            Property::Char(v) => f64::from(v),
+            Property::UChar(v) => f64::from(v),
+            Property::Short(v) => f64::from(v),
+            Property::UShort(v) => f64::from(v),
+            Property::Int(v) => f64::from(v),
+            Property::UInt(v) => f64::from(v),
+            Property::Float(v) => f64::from(v),
+            Property::Double(v) => v,
+            // Other lists (texture coordinates, ...) are not ours; float index lists are
+            // refused by the header check before the payload is read.
+            _ => return PropertyAccessResult::Ignored,
+        };
+        self.coordinate(name, value)
+    }
+
+    fn set_float(&mut self, name: &str, value: f32) -> PropertyAccessResult {
+        self.coordinate(name, f64::from(value))
+    }
+
+    fn set_double(&mut self, name: &str, value: f64) -> PropertyAccessResult {
+        self.coordinate(name, value)
+    }
+
+    fn set_list_char(&mut self, name: &str, value: Vec<i8>) -> PropertyAccessResult {
+        self.index_list(name, value)
+    }
+
+    fn set_list_uchar(&mut self, name: &str, value: Vec<u8>) -> PropertyAccessResult {
+        self.index_list(name, value)
+    }
+
+    fn set_list_short(&mut self, name: &str, value: Vec<i16>) -> PropertyAccessResult {
+        self.index_list(name, value)
+    }
+
+    fn set_list_ushort(&mut self, name: &str, value: Vec<u16>) -> PropertyAccessResult {
+        self.index_list(name, value)
+    }
+
+    fn set_list_int(&mut self, name: &str, value: Vec<i32>) -> PropertyAccessResult {
+        self.index_list(name, value)
+    }
+
+    fn set_list_uint(&mut self, name: &str, value: Vec<u32>) -> PropertyAccessResult {
+        self.index_list(name, value)
+    }
+}
+
+/// Checks that the header has what we read, before reading the payload: `vertex` with scalar
+/// `x y z`, and `face` (if present) with an integer index list. Returns the name of the face
+/// element's index list, `None` when there is no face element.
+fn check_header(path: &Path, header: &Header) -> Result<Option<&'static str>> {
+    let parse_err = |message: String| Error::parse(path, None, message);
+    let vertex = header
+        .elements
+        .get("vertex")
+        .ok_or_else(|| parse_err("the header declares no 'vertex' element".to_string()))?;
+    for axis in ["x", "y", "z"] {
+        match vertex.properties.get(axis).map(|p| &p.data_type) {
+            Some(PropertyType::Scalar(_)) => {}
+            Some(PropertyType::List(..)) => {
+                return Err(parse_err(format!(
+                    "vertex property '{axis}' is a list, expected a number"
+                )))
+            }
+            None => {
+                return Err(parse_err(format!(
+                    "the 'vertex' element has no '{axis}' property"
+                )))
+            }
+        }
+    }
+    let Some(face) = header.elements.get("face") else {
+        return Ok(None);
+    };
+    for name in INDEX_LISTS {
+        match face.properties.get(name).map(|p| &p.data_type) {
+            Some(PropertyType::List(_, ScalarType::Float | ScalarType::Double)) => {
+                return Err(parse_err(format!(
+                    "face property '{name}' holds floating-point numbers, expected integers"
+                )))
+            }
+            Some(PropertyType::List(..)) => return Ok(Some(name)),
+            Some(PropertyType::Scalar(_)) => {
+                return Err(parse_err(format!(
+                    "face property '{name}' is a single number, expected a list"
+                )))
+            }
+            None => {}
+        }
+    }
+    Err(parse_err(
+        "the 'face' element has no 'vertex_indices' (or 'vertex_index') list".to_string(),
+    ))
+}
+
+/// Parses the PLY file at `path`; faces are fan-triangulated, indices checked (naming the face
+/// element).
+pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
+    let data = read_file(path)?;
+    let parser = Parser::<Element>::new();
+    let mut reader = Reader::new(BufReader::new(Cursor::new(&data[..])));
+    let header = parser
+        .read_header(&mut reader)
+        .map_err(|e| Error::parse(path, e.line(), one_line(&strip_line_prefix(&e.to_string()))))?;
+    let face_list = check_header(path, &header)?;
+    let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
+        // Line numbers mean something only in ascii files.
+        let line = match header.encoding {
+            Encoding::Ascii => e.line(),
+            _ => None,
+        };
+        Error::parse(path, line, one_line(&strip_line_prefix(&e.to_string())))
+    })?;
+
+    let vertices = payload.get("vertex").map_or(&[][..], |v| &v[..]);
+    let faces = payload.get("face").map_or(&[][..], |f| &f[..]);
+    stats.vertices_read = vertices.len();
+    let positions: Vec<DVec3> = vertices.iter().map(|v| DVec3::from_array(v.xyz)).collect();
+    let n = positions.len() as i64;
+
+    let mut triangles = Vec::with_capacity(faces.len());
+    if face_list.is_some() {
+        for (f, face) in faces.iter().enumerate() {
+            let idx = &face.indices;
+            if let Some(&bad) = idx
+                .iter()
+                .find(|&&i| i < 0 || i >= n || i > i64::from(u32::MAX))
+            {
+                return Err(Error::invalid_mesh(
+                    path,
+                    format!("face {f} (0-based) names vertex {bad}, but the file has {n} vertices"),
+                ));
+            }
+            if idx.len() < 3 {
+                continue;
+            }
+            stats.faces_read += 1;
+            if idx.len() > 3 {
+                stats.polygons_triangulated += 1;
+            }
+            // Checked above: 0 <= index <= u32::MAX.
+            let at = |k: usize| idx[k] as u32;
+            for k in 1..idx.len() - 1 {
+                triangles.push([at(0), at(k), at(k + 1)]);
+            }
+        }
+    }
+    Ok(TriMesh::new(positions, triangles))
+}
+
+/// `ply-rs-bw` prefixes messages with "Line N: "; we carry the line separately.
+fn strip_line_prefix(message: &str) -> String {
+    if let Some(rest) = message.strip_prefix("Line ") {
+        if let Some((num, tail)) = rest.split_once(": ") {
+            if num.chars().all(|c| c.is_ascii_digit()) {
+                return tail.to_string();
+            }
+        }
+    }
+    message.to_string()
+}
+
+/// The binary little-endian PLY bytes of `mesh` with `normals`: vertex `x y z nx ny nz` as
+/// `float`, face `list uchar int vertex_indices`. The caller has checked that vertex indices
+/// fit in `i32`.
+pub(super) fn encode(mesh: &TriMesh, normals: &[DVec3]) -> Vec<u8> {
+    let header = format!(
+        "ply\n\
+         format binary_little_endian 1.0\n\
+         comment written by spectral-remesh {}\n\
+         element vertex {}\n\
+         property float x\n\
+         property float y\n\
+         property float z\n\
+         property float nx\n\
+         property float ny\n\
+         property float nz\n\
+         element face {}\n\
+         property list uchar int vertex_indices\n\
+         end_header\n",
+        env!("CARGO_PKG_VERSION"),
+        mesh.positions.len(),
+        mesh.triangles.len()
+    );
+    let mut out =
+        Vec::with_capacity(header.len() + mesh.positions.len() * 24 + mesh.triangles.len() * 13);
+    out.extend_from_slice(header.as_bytes());
+    for (p, n) in mesh.positions.iter().zip(normals) {
+        let n = n.as_vec3().normalize_or(glam::Vec3::Z);
+        for c in p.as_vec3().to_array().into_iter().chain(n.to_array()) {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for t in &mesh.triangles {
+        out.push(3);
+        for &i in t {
+            out.extend_from_slice(&(i as i32).to_le_bytes());
+        }
+    }
+    out
+}
