@@ -1,0 +1,179 @@
+//! Runs the `remesh` binary on the shared models and checks the guarantees of issue 2 on its JSON
+//! report: vertex count within 1% of --points, manifold, closed where the input is closed, the
+//! input's boundary loops kept where it is open.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::Value;
+
+fn shared(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data").join(name)
+}
+
+/// Runs `remesh INPUT OUT --points N --report R` plus `extra`, returns the parsed report and the
+/// output path.
+fn run(input: &str, out_name: &str, points: usize, extra: &[&str], dir: &Path) -> (Value, PathBuf) {
+    let out = dir.join(out_name);
+    let report = dir.join(format!("{out_name}.json"));
+    let status = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .arg(shared(input))
+        .arg(&out)
+        .args(["--points", &points.to_string(), "-q", "--report"])
+        .arg(&report)
+        .args(extra)
+        .status()
+        .expect("run remesh");
+    assert!(status.success(), "remesh {input} failed: {status}");
+    let json: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    (json, out)
+}
+
+fn int(v: &Value, path: &[&str]) -> i64 {
+    let mut x = v;
+    for p in path {
+        x = &x[*p];
+    }
+    x.as_i64().unwrap_or_else(|| panic!("{path:?} is not an integer: {x}"))
+}
+
+fn float(v: &Value, path: &[&str]) -> f64 {
+    let mut x = v;
+    for p in path {
+        x = &x[*p];
+    }
+    x.as_f64().unwrap_or_else(|| panic!("{path:?} is not a number: {x}"))
+}
+
+/// Count within 1%, no non-manifold edge or vertex, consistently oriented.
+fn assert_manifold_with_count(r: &Value, target: usize, name: &str) {
+    let v = int(r, &["topology", "vertices"]);
+    assert!(
+        (v as f64 - target as f64).abs() <= 0.01 * target as f64,
+        "{name}: {v} vertices for --points {target}"
+    );
+    assert_eq!(int(r, &["topology", "non_manifold_edges"]), 0, "{name}");
+    assert_eq!(int(r, &["topology", "non_manifold_vertices"]), 0, "{name}");
+    assert_eq!(int(r, &["topology", "inconsistent_orientation_edges"]), 0, "{name}");
+    assert_eq!(int(r, &["topology", "degenerate_faces"]), 0, "{name}");
+    assert_eq!(int(r, &["topology", "duplicate_faces"]), 0, "{name}");
+}
+
+fn assert_closed_genus_0(r: &Value, name: &str) {
+    assert_eq!(int(r, &["topology", "boundary_edges"]), 0, "{name}");
+    assert_eq!(int(r, &["topology", "euler_characteristic"]), 2, "{name}");
+    assert_eq!(int(r, &["topology", "components"]), 1, "{name}");
+}
+
+#[test]
+fn horse_at_8600_is_a_closed_genus_0_manifold_with_table1_angles() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r, _) = run("horse.obj", "horse.obj", 8600, &[], dir.path());
+    assert_manifold_with_count(&r, 8600, "horse");
+    assert_closed_genus_0(&r, "horse");
+    assert!(float(&r, &["triangles", "theta_min"]) >= 30.0, "{}", r["triangles"]);
+    assert!(float(&r, &["triangles", "theta_min_ave"]) >= 52.0, "{}", r["triangles"]);
+    assert_eq!(float(&r, &["triangles", "pct_theta_below_30"]), 0.0);
+    assert!(float(&r, &["distance", "rms"]) <= 0.04, "{}", r["distance"]);
+}
+
+/// The rest of issue 2's horse acceptance (Qmin >= 0.55, Qave >= 0.90, Hausdorff <= 0.5): not
+/// reached yet (measured 0.524, 0.8995, 0.82).
+#[test]
+#[ignore = "issue 2 open: Qmin, Qave and Hausdorff targets for horse not reached yet"]
+fn horse_at_8600_meets_all_of_issue_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r, _) = run("horse.obj", "horse.obj", 8600, &[], dir.path());
+    assert!(float(&r, &["triangles", "q_min"]) >= 0.55, "{}", r["triangles"]);
+    assert!(float(&r, &["triangles", "q_ave"]) >= 0.90, "{}", r["triangles"]);
+    assert!(float(&r, &["distance", "hausdorff"]) <= 0.5, "{}", r["distance"]);
+}
+
+#[test]
+fn spot_obj_and_glb_give_the_same_closed_manifold() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, out_a) = run("spot.obj", "a.obj", 3000, &["--no-distance"], dir.path());
+    let (b, out_b) = run("spot.glb", "b.obj", 3000, &["--no-distance"], dir.path());
+    assert_manifold_with_count(&a, 3000, "spot.obj");
+    assert_closed_genus_0(&a, "spot.obj");
+    assert_eq!(a["topology"], b["topology"]);
+    for key in ["theta_min", "theta_min_ave", "q_min", "q_ave", "pct_theta_below_30"] {
+        let (x, y) = (float(&a, &["triangles", key]), float(&b, &["triangles", key]));
+        assert!((x - y).abs() <= 1e-5 * (1.0 + x.abs()), "{key}: {x} vs {y}");
+    }
+    // The .glb holds the same surface in f32: the outputs have the same faces and positions that
+    // agree to f32 precision (bbox-100 scale).
+    let (ma, _) = spectral_remesh::io::read_mesh(&out_a).unwrap();
+    let (mb, _) = spectral_remesh::io::read_mesh(&out_b).unwrap();
+    assert_eq!(ma.triangles, mb.triangles);
+    let diag = ma.bbox().unwrap().diagonal();
+    for (p, q) in ma.positions.iter().zip(&mb.positions) {
+        assert!(p.distance(*q) <= 1e-5 * diag, "{p} vs {q}");
+    }
+}
+
+#[test]
+fn the_same_seed_gives_the_same_bytes_and_another_seed_does_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, a) = run("spot.obj", "s1.ply", 1500, &["--seed", "7", "--no-distance"], dir.path());
+    let (_, b) = run("spot.obj", "s2.ply", 1500, &["--seed", "7", "--no-distance"], dir.path());
+    let (_, c) = run("spot.obj", "s3.ply", 1500, &["--seed", "8", "--no-distance"], dir.path());
+    let (a, b, c) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap(), std::fs::read(c).unwrap());
+    assert_eq!(a, b);
+    assert_ne!(a, c);
+}
+
+#[test]
+fn bunny_keeps_its_five_holes_as_five_boundary_loops() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r, _) = run("stanford-bunny.obj", "bunny.obj", 9635, &["--no-distance"], dir.path());
+    assert_manifold_with_count(&r, 9635, "bunny");
+    assert_eq!(int(&r, &["topology", "boundary_loops"]), 5);
+    assert_eq!(int(&r, &["topology", "components"]), 1);
+    // A sphere with five holes.
+    assert_eq!(int(&r, &["topology", "euler_characteristic"]), -3);
+}
+
+#[test]
+#[ignore = "issue 2 open: fandisk's sharp creases leave a hole and a second component"]
+fn fandisk_at_6000_is_a_closed_manifold() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r, _) = run("fandisk.obj", "fandisk.obj", 6000, &["--no-distance"], dir.path());
+    assert_manifold_with_count(&r, 6000, "fandisk");
+    assert_closed_genus_0(&r, "fandisk");
+}
+
+#[test]
+#[ignore = "issue 2 open: cow's thin parts at 3000 points leave holes and split components"]
+fn cow_at_3000_is_a_closed_manifold() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r, _) = run("cow.obj", "cow.obj", 3000, &["--no-distance"], dir.path());
+    assert_manifold_with_count(&r, 3000, "cow");
+    assert_closed_genus_0(&r, "cow");
+}
+
+#[test]
+fn bad_input_is_a_one_line_error_with_a_nonzero_exit_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap();
+    let out = dir.path().join("out.obj");
+    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .arg(&bad)
+        .arg(&out)
+        .args(["--points", "100"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("bad.obj"), "{err}");
+    assert!(!out.exists());
+    // The output path equal to the input path is refused.
+    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .arg(shared("spot.obj"))
+        .arg(shared("spot.obj"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}
