@@ -8,7 +8,9 @@ use std::process::Command;
 use serde_json::Value;
 
 fn shared(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(name)
 }
 
 /// Runs `remesh INPUT OUT --points N --report R` plus `extra`, returns the parsed report and the
@@ -34,7 +36,8 @@ fn int(v: &Value, path: &[&str]) -> i64 {
     for p in path {
         x = &x[*p];
     }
-    x.as_i64().unwrap_or_else(|| panic!("{path:?} is not an integer: {x}"))
+    x.as_i64()
+        .unwrap_or_else(|| panic!("{path:?} is not an integer: {x}"))
 }
 
 fn float(v: &Value, path: &[&str]) -> f64 {
@@ -42,7 +45,8 @@ fn float(v: &Value, path: &[&str]) -> f64 {
     for p in path {
         x = &x[*p];
     }
-    x.as_f64().unwrap_or_else(|| panic!("{path:?} is not a number: {x}"))
+    x.as_f64()
+        .unwrap_or_else(|| panic!("{path:?} is not a number: {x}"))
 }
 
 /// Count within 1%, no non-manifold edge or vertex, consistently oriented.
@@ -54,7 +58,11 @@ fn assert_manifold_with_count(r: &Value, target: usize, name: &str) {
     );
     assert_eq!(int(r, &["topology", "non_manifold_edges"]), 0, "{name}");
     assert_eq!(int(r, &["topology", "non_manifold_vertices"]), 0, "{name}");
-    assert_eq!(int(r, &["topology", "inconsistent_orientation_edges"]), 0, "{name}");
+    assert_eq!(
+        int(r, &["topology", "inconsistent_orientation_edges"]),
+        0,
+        "{name}"
+    );
     assert_eq!(int(r, &["topology", "degenerate_faces"]), 0, "{name}");
     assert_eq!(int(r, &["topology", "duplicate_faces"]), 0, "{name}");
 }
@@ -71,8 +79,16 @@ fn horse_at_8600_is_a_closed_genus_0_manifold_with_table1_angles() {
     let (r, _) = run("horse.obj", "horse.obj", 8600, &[], dir.path());
     assert_manifold_with_count(&r, 8600, "horse");
     assert_closed_genus_0(&r, "horse");
-    assert!(float(&r, &["triangles", "theta_min"]) >= 30.0, "{}", r["triangles"]);
-    assert!(float(&r, &["triangles", "theta_min_ave"]) >= 52.0, "{}", r["triangles"]);
+    assert!(
+        float(&r, &["triangles", "theta_min"]) >= 30.0,
+        "{}",
+        r["triangles"]
+    );
+    assert!(
+        float(&r, &["triangles", "theta_min_ave"]) >= 52.0,
+        "{}",
+        r["triangles"]
+    );
     assert_eq!(float(&r, &["triangles", "pct_theta_below_30"]), 0.0);
     assert!(float(&r, &["distance", "rms"]) <= 0.04, "{}", r["distance"]);
 }
@@ -84,9 +100,21 @@ fn horse_at_8600_is_a_closed_genus_0_manifold_with_table1_angles() {
 fn horse_at_8600_meets_all_of_issue_2() {
     let dir = tempfile::tempdir().unwrap();
     let (r, _) = run("horse.obj", "horse.obj", 8600, &[], dir.path());
-    assert!(float(&r, &["triangles", "q_min"]) >= 0.55, "{}", r["triangles"]);
-    assert!(float(&r, &["triangles", "q_ave"]) >= 0.90, "{}", r["triangles"]);
-    assert!(float(&r, &["distance", "hausdorff"]) <= 0.5, "{}", r["distance"]);
+    assert!(
+        float(&r, &["triangles", "q_min"]) >= 0.55,
+        "{}",
+        r["triangles"]
+    );
+    assert!(
+        float(&r, &["triangles", "q_ave"]) >= 0.90,
+        "{}",
+        r["triangles"]
+    );
+    assert!(
+        float(&r, &["distance", "hausdorff"]) <= 0.5,
+        "{}",
+        r["distance"]
+    );
 }
 
 #[test]
@@ -97,8 +125,17 @@ fn spot_obj_and_glb_give_the_same_closed_manifold() {
     assert_manifold_with_count(&a, 3000, "spot.obj");
     assert_closed_genus_0(&a, "spot.obj");
     assert_eq!(a["topology"], b["topology"]);
-    for key in ["theta_min", "theta_min_ave", "q_min", "q_ave", "pct_theta_below_30"] {
-        let (x, y) = (float(&a, &["triangles", key]), float(&b, &["triangles", key]));
+    for key in [
+        "theta_min",
+        "theta_min_ave",
+        "q_min",
+        "q_ave",
+        "pct_theta_below_30",
+    ] {
+        let (x, y) = (
+            float(&a, &["triangles", key]),
+            float(&b, &["triangles", key]),
+        );
         assert!((x - y).abs() <= 1e-5 * (1.0 + x.abs()), "{key}: {x} vs {y}");
     }
     // The .glb holds the same surface in f32: the outputs have the same faces and positions that
@@ -115,10 +152,32 @@ fn spot_obj_and_glb_give_the_same_closed_manifold() {
 #[test]
 fn the_same_seed_gives_the_same_bytes_and_another_seed_does_not() {
     let dir = tempfile::tempdir().unwrap();
-    let (_, a) = run("spot.obj", "s1.ply", 1500, &["--seed", "7", "--no-distance"], dir.path());
-    let (_, b) = run("spot.obj", "s2.ply", 1500, &["--seed", "7", "--no-distance"], dir.path());
-    let (_, c) = run("spot.obj", "s3.ply", 1500, &["--seed", "8", "--no-distance"], dir.path());
-    let (a, b, c) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap(), std::fs::read(c).unwrap());
+    let (_, a) = run(
+        "spot.obj",
+        "s1.ply",
+        1500,
+        &["--seed", "7", "--no-distance"],
+        dir.path(),
+    );
+    let (_, b) = run(
+        "spot.obj",
+        "s2.ply",
+        1500,
+        &["--seed", "7", "--no-distance"],
+        dir.path(),
+    );
+    let (_, c) = run(
+        "spot.obj",
+        "s3.ply",
+        1500,
+        &["--seed", "8", "--no-distance"],
+        dir.path(),
+    );
+    let (a, b, c) = (
+        std::fs::read(a).unwrap(),
+        std::fs::read(b).unwrap(),
+        std::fs::read(c).unwrap(),
+    );
     assert_eq!(a, b);
     assert_ne!(a, c);
 }
@@ -126,7 +185,13 @@ fn the_same_seed_gives_the_same_bytes_and_another_seed_does_not() {
 #[test]
 fn bunny_keeps_its_five_holes_as_five_boundary_loops() {
     let dir = tempfile::tempdir().unwrap();
-    let (r, _) = run("stanford-bunny.obj", "bunny.obj", 9635, &["--no-distance"], dir.path());
+    let (r, _) = run(
+        "stanford-bunny.obj",
+        "bunny.obj",
+        9635,
+        &["--no-distance"],
+        dir.path(),
+    );
     assert_manifold_with_count(&r, 9635, "bunny");
     assert_eq!(int(&r, &["topology", "boundary_loops"]), 5);
     assert_eq!(int(&r, &["topology", "components"]), 1);
@@ -138,7 +203,13 @@ fn bunny_keeps_its_five_holes_as_five_boundary_loops() {
 #[ignore = "issue 2 open: fandisk's sharp creases leave a hole and a second component"]
 fn fandisk_at_6000_is_a_closed_manifold() {
     let dir = tempfile::tempdir().unwrap();
-    let (r, _) = run("fandisk.obj", "fandisk.obj", 6000, &["--no-distance"], dir.path());
+    let (r, _) = run(
+        "fandisk.obj",
+        "fandisk.obj",
+        6000,
+        &["--no-distance"],
+        dir.path(),
+    );
     assert_manifold_with_count(&r, 6000, "fandisk");
     assert_closed_genus_0(&r, "fandisk");
 }
