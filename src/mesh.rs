@@ -148,6 +148,30 @@ impl TriMesh {
         self.positions.iter().position(|p| !p.is_finite())
     }
 
+    /// Checks that every index is in range and every coordinate finite.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidMesh`] (with an empty path, for the caller to fill in) naming the
+    /// first face with an index out of range or the first vertex with a non-finite coordinate.
+    pub fn check_geometry(&self) -> crate::Result<()> {
+        if let Some((f, i)) = self.check_indices() {
+            return Err(crate::Error::invalid_mesh(
+                "",
+                format!(
+                    "face {f} refers to vertex {i}, but there are {} vertices",
+                    self.vertex_count()
+                ),
+            ));
+        }
+        if let Some(v) = self.first_non_finite_vertex() {
+            return Err(crate::Error::invalid_mesh(
+                "",
+                format!("vertex {v} has a non-finite coordinate"),
+            ));
+        }
+        Ok(())
+    }
+
     /// Removes the vertices no triangle uses, renumbering the triangles. Returns how many were
     /// removed.
     pub fn remove_unreferenced_vertices(&mut self) -> usize {

@@ -136,21 +136,7 @@ pub fn validate_input(mesh: &TriMesh) -> Result<Normalization> {
     if mesh.triangles.is_empty() {
         return Err(Error::invalid_mesh("", "the mesh has no faces"));
     }
-    if let Some((f, i)) = mesh.check_indices() {
-        return Err(Error::invalid_mesh(
-            "",
-            format!(
-                "face {f} refers to vertex {i}, but there are {} vertices",
-                mesh.vertex_count()
-            ),
-        ));
-    }
-    if let Some(v) = mesh.first_non_finite_vertex() {
-        return Err(Error::invalid_mesh(
-            "",
-            format!("vertex {v} has a non-finite coordinate"),
-        ));
-    }
+    mesh.check_geometry()?;
     let bbox = mesh
         .bbox()
         .ok_or_else(|| Error::invalid_mesh("", "the mesh has no vertices"))?;

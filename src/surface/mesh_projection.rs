@@ -42,21 +42,7 @@ impl MeshSurface {
     /// [`Error::InvalidMesh`] when the mesh has no triangle of non-zero area, an index out of
     /// range, or a non-finite coordinate.
     pub fn new(mesh: &TriMesh) -> Result<Self> {
-        if let Some((f, i)) = mesh.check_indices() {
-            return Err(Error::invalid_mesh(
-                "",
-                format!(
-                    "face {f} refers to vertex {i}, but there are {} vertices",
-                    mesh.vertex_count()
-                ),
-            ));
-        }
-        if let Some(v) = mesh.first_non_finite_vertex() {
-            return Err(Error::invalid_mesh(
-                "",
-                format!("vertex {v} has a non-finite coordinate"),
-            ));
-        }
+        mesh.check_geometry()?;
         let face_normals: Vec<DVec3> = (0..mesh.face_count())
             .map(|f| mesh.face_normal(f))
             .collect();

@@ -101,7 +101,7 @@ impl<'a> Builder<'a> {
         if n.dot(avg) <= 0.0 {
             return -1.0;
         }
-        triangle_q(a, b, c)
+        crate::quality::triangle_q([a, b, c])
     }
 
     /// Half-edges bordering holes: `b → a` for every face edge `a → b` with no face on `b → a`
@@ -128,19 +128,6 @@ pub enum FaceSource {
     TwoVotes,
     /// Added to close a hole.
     HoleFill,
-}
-
-/// Q = 6S/(√3 p h) (S area, p half-perimeter, h longest edge): 1 for an equilateral triangle.
-pub fn triangle_q(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let s = 0.5 * (b - a).cross(c - a).length();
-    let (l0, l1, l2) = (a.distance(b), b.distance(c), c.distance(a));
-    let p = 0.5 * (l0 + l1 + l2);
-    let h = l0.max(l1).max(l2);
-    if p * h > 0.0 {
-        6.0 * s / (3f64.sqrt() * p * h)
-    } else {
-        0.0
-    }
 }
 
 /// Assembles a mesh from voted triangles. `boundary_edges` (directed, surface on the left) may
