@@ -6,14 +6,50 @@ use std::num::NonZeroUsize;
 use glam::DVec3;
 use kiddo::{ImmutableKdTree, MutableKdTree, SquaredEuclidean};
 
+/// Points are stored in a fixed, generic rotation of the model frame. CAD models put thousands of
+/// points on one axis-aligned plane; a kd-tree bucket whose points all share the coordinate it
+/// must split on cannot split, and kiddo's mutable tree then refuses the point. A rotation keeps
+/// every distance (to rounding, about 1e-15 relative) and removes those ties.
 #[inline]
 fn arr(p: DVec3) -> [f64; 3] {
-    [p.x, p.y, p.z]
+    // Rows of the rotation by the unit quaternion (0.8, 0.3, 0.4, 0.34)/|.|, precomputed.
+    const R: [[f64; 3]; 3] = rotation();
+    [
+        R[0][0] * p.x + R[0][1] * p.y + R[0][2] * p.z,
+        R[1][0] * p.x + R[1][1] * p.y + R[1][2] * p.z,
+        R[2][0] * p.x + R[2][1] * p.y + R[2][2] * p.z,
+    ]
+}
+
+const fn rotation() -> [[f64; 3]; 3] {
+    // q = (w, x, y, z) with w² + x² + y² + z² = 1: 0.8² + 0.3² + 0.4² + z² = 1 → z² = 0.11.
+    let (w, x, y) = (0.8, 0.3, 0.4);
+    let z = 0.331_662_479_035_539_95; // sqrt(0.11)
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
 }
 
 /// A kd-tree that grows one point at a time (the output set of the linear scan, Sec. 6.3).
 pub struct DynamicTree {
     tree: MutableKdTree<f64, 3>,
+    /// Points the kd-tree refused (exact ties it cannot split, for example duplicates); searched
+    /// by brute force so that no point is ever missing from a query.
+    overflow: Vec<([f64; 3], u32)>,
     len: usize,
 }
 
@@ -28,6 +64,7 @@ impl DynamicTree {
     pub fn new() -> Self {
         DynamicTree {
             tree: MutableKdTree::default(),
+            overflow: Vec::new(),
             len: 0,
         }
     }
@@ -42,14 +79,19 @@ impl DynamicTree {
         self.len == 0
     }
 
-    /// Adds point `p` with index `index`. Returns false if the tree refused it (a degenerate
-    /// split: many points with the same coordinate); such a point is then absent from queries.
-    pub fn add(&mut self, p: DVec3, index: u32) -> bool {
-        let ok = self.tree.add(&arr(p), index).is_ok();
-        if ok {
-            self.len += 1;
+    /// Adds point `p` with index `index`. A point the kd-tree cannot take (a bucket of exact
+    /// coordinate ties) goes to a small list searched by brute force.
+    pub fn add(&mut self, p: DVec3, index: u32) {
+        let q = arr(p);
+        if self.tree.add(&q, index).is_err() {
+            self.overflow.push((q, index));
         }
-        ok
+        self.len += 1;
+    }
+
+    /// Points held outside the kd-tree (see [`DynamicTree::add`]).
+    pub fn overflow_len(&self) -> usize {
+        self.overflow.len()
     }
 
     /// The nearest point to `p` as `(index, squared distance)`; `None` when empty.
@@ -57,12 +99,23 @@ impl DynamicTree {
         if self.len == 0 {
             return None;
         }
-        let r = self
-            .tree
-            .query(&arr(p))
-            .nearest_one::<SquaredEuclidean<f64>>()
-            .execute();
-        Some((r.item, r.distance))
+        let q = arr(p);
+        let mut best = (u32::MAX, f64::INFINITY);
+        if self.len > self.overflow.len() {
+            let r = self
+                .tree
+                .query(&q)
+                .nearest_one::<SquaredEuclidean<f64>>()
+                .execute();
+            best = (r.item, r.distance);
+        }
+        for &(o, i) in &self.overflow {
+            let d = dist2(&o, &q);
+            if d < best.1 || (d == best.1 && i < best.0) {
+                best = (i, d);
+            }
+        }
+        Some(best)
     }
 
     /// All points within squared distance `radius_2` of `p`, nearest first, into `out` as
@@ -72,13 +125,28 @@ impl DynamicTree {
         if self.len == 0 {
             return;
         }
+        let q = arr(p);
         let r = self
             .tree
-            .query(&arr(p))
+            .query(&q)
             .within::<SquaredEuclidean<f64>>(radius_2)
             .execute();
-        out.extend(r.into_iter().map(|q| (q.item, q.distance)));
+        out.extend(r.into_iter().map(|n| (n.item, n.distance)));
+        if !self.overflow.is_empty() {
+            out.extend(
+                self.overflow
+                    .iter()
+                    .map(|&(o, i)| (i, dist2(&o, &q)))
+                    .filter(|x| x.1 <= radius_2),
+            );
+            out.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        }
     }
+}
+
+#[inline]
+fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
 }
 
 /// A kd-tree built once over a fixed point list.
@@ -149,7 +217,7 @@ mod tests {
             .collect();
         let mut dynamic = DynamicTree::new();
         for (i, p) in pts.iter().enumerate() {
-            assert!(dynamic.add(*p, i as u32));
+            dynamic.add(*p, i as u32);
         }
         let fixed = StaticTree::new(&pts);
         let mut out = Vec::new();
@@ -169,6 +237,62 @@ mod tests {
                 out.iter().map(|x| x.0).collect::<Vec<_>>(),
                 all[..7].to_vec()
             );
+        }
+    }
+
+    /// Thousands of points on one axis-aligned plane and on one axis-aligned line (a CAD face and
+    /// edge), plus exact duplicates: no point may be missing from a query.
+    #[test]
+    fn axis_aligned_ties_are_all_found() {
+        let mut pts = Vec::new();
+        for j in 0..60 {
+            for i in 0..60 {
+                pts.push(DVec3::new(i as f64 * 0.5, j as f64 * 0.5, 25.55));
+            }
+        }
+        for i in 0..500 {
+            pts.push(DVec3::new(3.0, 4.0, i as f64 * 0.01));
+        }
+        for _ in 0..40 {
+            pts.push(DVec3::new(1.0, 1.0, 25.55));
+        }
+        let mut dynamic = DynamicTree::new();
+        for (i, p) in pts.iter().enumerate() {
+            dynamic.add(*p, i as u32);
+        }
+        assert_eq!(dynamic.len(), pts.len());
+        let fixed = StaticTree::new(&pts);
+        let mut out = Vec::new();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for _ in 0..300 {
+            let q =
+                DVec3::new(rng.random(), rng.random(), rng.random()) * DVec3::new(30.0, 30.0, 26.0);
+            let mut expect = brute(&pts, q, 2.0);
+            expect.sort_unstable();
+            for found in [
+                {
+                    dynamic.within(q, 2.0, &mut out);
+                    out.clone()
+                },
+                {
+                    fixed.within(q, 2.0, &mut out);
+                    out.clone()
+                },
+            ] {
+                let mut got: Vec<u32> = found.iter().map(|x| x.0).collect();
+                assert!(
+                    found.windows(2).all(|w| w[0].1 <= w[1].1),
+                    "not nearest first"
+                );
+                got.sort_unstable();
+                assert_eq!(got, expect);
+            }
+            let (_, d) = dynamic.nearest(q).unwrap();
+            let best = pts
+                .iter()
+                .map(|p| p.distance_squared(q))
+                .fold(f64::INFINITY, f64::min);
+            assert!((d - best).abs() < 1e-9);
         }
     }
 }
