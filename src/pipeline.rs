@@ -156,12 +156,14 @@ impl Timer {
             last: Instant::now(),
         }
     }
+    /// Ends the current stage; a stage run again (a count correction) adds to its time.
     fn lap(&mut self, name: &'static str) {
         let now = Instant::now();
-        self.stages.push(Stage {
-            name,
-            seconds: (now - self.last).as_secs_f64(),
-        });
+        let seconds = (now - self.last).as_secs_f64();
+        match self.stages.iter_mut().find(|s| s.name == name) {
+            Some(s) => s.seconds += seconds,
+            None => self.stages.push(Stage { name, seconds }),
+        }
         self.last = now;
     }
 }
@@ -215,89 +217,155 @@ pub fn remesh(
     let pool = surface_candidates(&normalized, pool_size, params.seed);
     timer.lap("candidates");
 
-    on_stage("linear scan");
-    let scan = |sigma_p: f64| -> Result<(usize, (LinearScanResult, Vec<[u32; 2]>))> {
-        let kernel = Kernel::new(sigma_p, params.sigma_n)?;
-        let b = sample_boundary(&normalized, &curves, BOUNDARY_SPACING_PER_SIGMA * sigma_p);
-        let r = linear_scan(&kernel, &pool, &b.samples, &params.linear_scan);
-        Ok((r.samples.len(), (r, b.edges)))
+    // The sampler's count is searched for; the triangulation may set a few samples aside (at
+    // parts thinner than the sampling), so when the output's vertex count misses the target by
+    // more than the search tolerance, the search runs again for a target raised by the
+    // shortfall (at most twice).
+    let mut goal = match params.density {
+        Density::Points(n) => n,
+        Density::SigmaP(_) => 0,
     };
-    let (sigma_p, target_reached, search_history, (scan_result, boundary_edges)) =
-        match params.density {
-            Density::SigmaP(s) => {
-                let (count, value) = scan(s)?;
-                (s, true, vec![(s, count)], value)
-            }
-            Density::Points(n) => {
-                let search = TargetCountParams {
-                    tolerance: params.count_tolerance,
-                    ..TargetCountParams::new(n)
-                };
-                let start = (SAMPLES_PER_SIGMA2 * area / n as f64).sqrt();
-                let mut failure = None;
-                let r = find_sigma_p(&search, start, |s| match scan(s) {
-                    Ok(v) => v,
-                    Err(e) => {
-                        failure = Some(e);
-                        (
-                            0,
-                            (
-                                LinearScanResult {
-                                    samples: vec![],
-                                    initial: 0,
-                                    rejected_by_nearest: 0,
-                                    measured: 0,
-                                },
-                                vec![],
-                            ),
-                        )
-                    }
-                });
-                if let Some(e) = failure {
-                    return Err(e);
-                }
-                (r.sigma_p, r.reached, r.history, r.value)
-            }
-        };
-    timer.lap("linear scan");
-
-    on_stage("gradient ascent");
-    let kernel = Kernel::new(sigma_p, params.sigma_n)?;
-    let LinearScanResult {
-        mut samples,
-        initial: boundary_count,
+    let mut start = match params.density {
+        Density::Points(n) => (SAMPLES_PER_SIGMA2 * area / n as f64).sqrt(),
+        Density::SigmaP(s) => s,
+    };
+    let mut full_history = Vec::new();
+    let mut attempt = 0;
+    let (
+        sigma_p,
+        target_reached,
+        samples,
+        boundary_count,
         rejected_by_nearest,
         measured,
-    } = scan_result;
-    let ga = gradient_ascent(
-        &kernel,
-        &surface,
-        &mut samples,
-        boundary_count,
-        &params.gradient_ascent,
-    );
-    timer.lap("gradient ascent");
+        ga,
+        face_sources,
+        assembly,
+        mesh_normalized,
+        dropped_samples,
+    ) = loop {
+        on_stage("linear scan");
+        let scan = |sigma_p: f64| -> Result<(usize, (LinearScanResult, Vec<[u32; 2]>))> {
+            let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+            let b = sample_boundary(&normalized, &curves, BOUNDARY_SPACING_PER_SIGMA * sigma_p);
+            let r = linear_scan(&kernel, &pool, &b.samples, &params.linear_scan);
+            Ok((r.samples.len(), (r, b.edges)))
+        };
+        let (sigma_p, target_reached, search_history, (scan_result, boundary_edges)) =
+            match params.density {
+                Density::SigmaP(s) => {
+                    let (count, value) = scan(s)?;
+                    (s, true, vec![(s, count)], value)
+                }
+                Density::Points(_) => {
+                    let search = TargetCountParams {
+                        tolerance: params.count_tolerance,
+                        ..TargetCountParams::new(goal)
+                    };
+                    let mut failure = None;
+                    let r = find_sigma_p(&search, start, |s| match scan(s) {
+                        Ok(v) => v,
+                        Err(e) => {
+                            failure = Some(e);
+                            (
+                                0,
+                                (
+                                    LinearScanResult {
+                                        samples: vec![],
+                                        initial: 0,
+                                        rejected_by_nearest: 0,
+                                        measured: 0,
+                                    },
+                                    vec![],
+                                ),
+                            )
+                        }
+                    });
+                    if let Some(e) = failure {
+                        return Err(e);
+                    }
+                    (r.sigma_p, r.reached, r.history, r.value)
+                }
+            };
+        timer.lap("linear scan");
 
-    on_stage("triangulate");
-    let positions: Vec<DVec3> = samples.iter().map(|s| s.position).collect();
-    let normals: Vec<DVec3> = samples
-        .par_iter()
-        .map(
-            |s: &SurfaceSample| match surface.closest_point(s.position) {
-                Some(sp) => surface.smooth_normal(&sp),
-                None => s.normal,
-            },
-        )
-        .collect();
-    let set = SampleSet {
-        positions: &positions,
-        normals: &normals,
-        boundary_edges: &boundary_edges,
+        on_stage("gradient ascent");
+        let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+        let LinearScanResult {
+            mut samples,
+            initial: boundary_count,
+            rejected_by_nearest,
+            measured,
+        } = scan_result;
+        let ga = gradient_ascent(
+            &kernel,
+            &surface,
+            &mut samples,
+            boundary_count,
+            &params.gradient_ascent,
+        );
+        timer.lap("gradient ascent");
+
+        on_stage("triangulate");
+        let positions: Vec<DVec3> = samples.iter().map(|s| s.position).collect();
+        let normals: Vec<DVec3> = samples
+            .par_iter()
+            .map(
+                |s: &SurfaceSample| match surface.closest_point(s.position) {
+                    Some(sp) => surface.smooth_normal(&sp),
+                    None => s.normal,
+                },
+            )
+            .collect();
+        let set = SampleSet {
+            positions: &positions,
+            normals: &normals,
+            boundary_edges: &boundary_edges,
+        };
+        let (faces, face_sources, assembly) = triangulate(&set, &params.triangulate);
+        let mut mesh_normalized = TriMesh::new(positions, faces);
+        let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
+        timer.lap("triangulate");
+        full_history.extend(search_history.iter().copied());
+        attempt += 1;
+        let Density::Points(n) = params.density else {
+            break (
+                sigma_p,
+                target_reached,
+                samples,
+                boundary_count,
+                rejected_by_nearest,
+                measured,
+                ga,
+                face_sources,
+                assembly,
+                mesh_normalized,
+                dropped_samples,
+            );
+        };
+        let v = mesh_normalized.vertex_count();
+        let miss = n as f64 - v as f64;
+        if attempt >= 3 || miss.abs() <= params.count_tolerance * n as f64 || dropped_samples == 0 {
+            let reached = (v as f64 - n as f64).abs() <= 0.01 * n as f64;
+            break (
+                sigma_p,
+                reached,
+                samples,
+                boundary_count,
+                rejected_by_nearest,
+                measured,
+                ga,
+                face_sources,
+                assembly,
+                mesh_normalized,
+                dropped_samples,
+            );
+        }
+        let new_goal = ((goal as f64 + miss).round() as usize).max(4);
+        start = sigma_p * (goal as f64 / new_goal as f64).sqrt();
+        goal = new_goal;
     };
-    let (faces, face_sources, assembly) = triangulate(&set, &params.triangulate);
-    let mut mesh_normalized = TriMesh::new(positions, faces);
-    let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
-    timer.lap("triangulate");
+    let search_history = full_history;
 
     let mesh = normalization.invert_mesh(&mesh_normalized);
     Ok(RemeshOutput {

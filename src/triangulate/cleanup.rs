@@ -9,6 +9,7 @@
 use glam::{DVec2, DVec3};
 use rustc_hash::{FxHashMap, FxHashSet};
 
+use super::refine::{flip_edges, insert_loose_samples, RefineParams};
 use super::tangent_delaunay::VotedTriangle;
 
 /// Parameters of the assembly.
@@ -19,6 +20,8 @@ pub struct AssemblyParams {
     /// Accept two-vote triangles greedily before filling holes (default false: the hole filler
     /// chooses better triangles where the umbrellas disagree).
     pub two_vote_phase: bool,
+    /// Insertion of left-over samples and edge flips after the holes are closed.
+    pub refine: RefineParams,
 }
 
 impl Default for AssemblyParams {
@@ -26,6 +29,7 @@ impl Default for AssemblyParams {
         AssemblyParams {
             max_hole_edges: 100,
             two_vote_phase: false,
+            refine: RefineParams::default(),
         }
     }
 }
@@ -47,26 +51,40 @@ pub struct AssemblyStats {
     pub holes_left: usize,
     /// Faces removed to repair vertices whose faces formed several fans.
     pub faces_removed_at_pinched_vertices: usize,
+    /// Faces removed around holes that could not be closed, to retry them larger.
+    pub faces_removed_growing_holes: usize,
+    /// Samples in no face after hole filling that were inserted into a face.
+    pub samples_inserted: usize,
+    /// Edge flips of the refinement.
+    pub edge_flips: usize,
 }
 
-struct Builder<'a> {
-    positions: &'a [DVec3],
-    normals: &'a [DVec3],
-    faces: Vec<Option<[u32; 3]>>,
+pub(super) struct Builder<'a> {
+    pub(super) positions: &'a [DVec3],
+    pub(super) normals: &'a [DVec3],
+    pub(super) faces: Vec<Option<[u32; 3]>>,
     /// How each face came in (see [`FaceSource`]).
-    sources: Vec<FaceSource>,
+    pub(super) sources: Vec<FaceSource>,
     /// Directed edge → face using it (`u32::MAX` for a blocked direction).
-    directed: FxHashMap<(u32, u32), u32>,
+    pub(super) directed: FxHashMap<(u32, u32), u32>,
 }
 
-const BLOCKED: u32 = u32::MAX;
+pub(super) const BLOCKED: u32 = u32::MAX;
 
 impl<'a> Builder<'a> {
-    fn fits(&self, t: [u32; 3]) -> bool {
-        (0..3).all(|k| !self.directed.contains_key(&(t[k], t[(k + 1) % 3])))
+    /// Whether `t` can be added: none of its directed edges is used or blocked, and it is not
+    /// the reverse of an existing face (the two would close on themselves as a flat pillow).
+    pub(super) fn fits(&self, t: [u32; 3]) -> bool {
+        if (0..3).any(|k| self.directed.contains_key(&(t[k], t[(k + 1) % 3]))) {
+            return false;
+        }
+        let reverse = self.directed.get(&(t[1], t[0]));
+        !(reverse.is_some_and(|&f| f != BLOCKED)
+            && reverse == self.directed.get(&(t[2], t[1]))
+            && reverse == self.directed.get(&(t[0], t[2])))
     }
 
-    fn add(&mut self, t: [u32; 3], source: FaceSource) -> bool {
+    pub(super) fn add(&mut self, t: [u32; 3], source: FaceSource) -> bool {
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !self.fits(t) {
             return false;
         }
@@ -79,7 +97,7 @@ impl<'a> Builder<'a> {
         true
     }
 
-    fn remove(&mut self, f: u32) {
+    pub(super) fn remove(&mut self, f: u32) {
         if let Some(t) = self.faces[f as usize].take() {
             for k in 0..3 {
                 self.directed.remove(&(t[k], t[(k + 1) % 3]));
@@ -94,7 +112,7 @@ impl<'a> Builder<'a> {
 
     /// Quality Q = 6S/(√3 p h) of a triangle, or -1 when its normal opposes the corners'
     /// normals (a fold).
-    fn quality(&self, t: [u32; 3]) -> f64 {
+    pub(super) fn quality(&self, t: [u32; 3]) -> f64 {
         let [a, b, c] = t.map(|i| self.positions[i as usize]);
         let n = (b - a).cross(c - a);
         let avg = t.iter().map(|&i| self.normals[i as usize]).sum::<DVec3>();
@@ -128,6 +146,8 @@ pub enum FaceSource {
     TwoVotes,
     /// Added to close a hole.
     HoleFill,
+    /// Made by an edge flip or a sample insertion of the refinement (see `refine`).
+    Refined,
 }
 
 /// Assembles a mesh from voted triangles. `boundary_edges` (directed, surface on the left) may
@@ -173,8 +193,15 @@ pub fn assemble(
             stats.accepted_two_votes += 1;
         }
     }
-    for _round in 0..4 {
-        let (filled, tris, left) = fill_holes(&mut b, params);
+    for round in 0..6 {
+        let mut failed = Vec::new();
+        let (filled, tris, left) = fill_holes(&mut b, params, &mut failed);
+        if round < 4 {
+            // Grow each hole that could not be closed by the faces around its corners: the
+            // larger polygon (with the samples inside it) often has a valid triangulation where
+            // the small one did not, as at thin parts where the local views disagreed.
+            stats.faces_removed_growing_holes += grow_holes(&mut b, &failed);
+        }
         stats.holes_filled += filled;
         stats.hole_triangles += tris;
         stats.holes_left = left;
@@ -184,6 +211,10 @@ pub fn assemble(
             break;
         }
     }
+    if params.refine.insert_loose_samples {
+        stats.samples_inserted = insert_loose_samples(&mut b);
+    }
+    stats.edge_flips = flip_edges(&mut b, &params.refine);
     let (faces, sources) = b
         .faces
         .into_iter()
@@ -191,6 +222,21 @@ pub fn assemble(
         .filter_map(|(f, s)| f.map(|f| (f, s)))
         .unzip();
     (faces, sources, stats)
+}
+
+/// Removes the faces that touch a corner of any of `holes`. Returns how many were removed.
+fn grow_holes(b: &mut Builder, holes: &[Vec<u32>]) -> usize {
+    let corners: FxHashSet<u32> = holes.iter().flatten().copied().collect();
+    let mut removed = 0;
+    for f in 0..b.faces.len() {
+        if let Some(t) = b.faces[f] {
+            if t.iter().any(|v| corners.contains(v)) {
+                b.remove(f as u32);
+                removed += 1;
+            }
+        }
+    }
+    removed
 }
 
 /// Splits a closed walk at repeated vertices into simple loops.
@@ -215,7 +261,11 @@ fn simple_loops(walk: &[u32]) -> Vec<Vec<u32>> {
     out
 }
 
-fn fill_holes(b: &mut Builder, params: &AssemblyParams) -> (usize, usize, usize) {
+fn fill_holes(
+    b: &mut Builder,
+    params: &AssemblyParams,
+    failed: &mut Vec<Vec<u32>>,
+) -> (usize, usize, usize) {
     let edges = b.hole_half_edges();
     let mut referenced = vec![false; b.positions.len()];
     for t in b.faces.iter().flatten() {
@@ -268,7 +318,8 @@ fn fill_holes(b: &mut Builder, params: &AssemblyParams) -> (usize, usize, usize)
                 continue;
             }
             let tris = triangulate_hole_with_interior(b, &lp, &loose)
-                .or_else(|| triangulate_polygon(b, &lp));
+                .or_else(|| triangulate_polygon(b, &lp, false))
+                .or_else(|| triangulate_polygon(b, &lp, true));
             match tris {
                 Some(tris) => {
                     let mut ok = true;
@@ -297,7 +348,15 @@ fn fill_holes(b: &mut Builder, params: &AssemblyParams) -> (usize, usize, usize)
                         left += 1;
                     }
                 }
-                None => left += 1,
+                None => {
+                    if std::env::var("HOLEDBG").is_ok() {
+                        let c = lp.iter().map(|&v| b.positions[v as usize]).sum::<DVec3>()
+                            / lp.len() as f64;
+                        eprintln!("hole fail len {} at {c:.1?}", lp.len());
+                    }
+                    failed.push(lp);
+                    left += 1
+                }
             }
         }
     }
@@ -432,7 +491,11 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
 
 /// The triangulation of the polygon `lp` (a hole's vertices in the order of its half-edges) that
 /// maximizes the smallest triangle quality, with no diagonal that is already a mesh edge.
-fn triangulate_polygon(b: &Builder, lp: &[u32]) -> Option<Vec<[u32; 3]>> {
+///
+/// With `allow_folds`, a triangle facing away from its corners' normals is allowed but scores
+/// below every triangle that does not: at a part thinner than the sampling, where the corners'
+/// normals point to both sides, closing the hole matters more than the shape of its triangles.
+fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec<[u32; 3]>> {
     let m = lp.len();
     if m == 3 {
         let t = [lp[0], lp[1], lp[2]];
@@ -458,8 +521,12 @@ fn triangulate_polygon(b: &Builder, lp: &[u32]) -> Option<Vec<[u32; 3]>> {
                 continue;
             }
             for j in i + 1..k {
-                let q = b.quality([lp[i], lp[j], lp[k]]);
-                if q <= 0.0 {
+                let t = [lp[i], lp[j], lp[k]];
+                let mut q = b.quality(t);
+                if q <= 0.0 && allow_folds {
+                    q = 1e-3 * crate::quality::triangle_q(t.map(|v| b.positions[v as usize]));
+                }
+                if !(q > 1e-9) {
                     continue;
                 }
                 let v = best[idx(i, j)].min(best[idx(j, k)]).min(q);

@@ -2,9 +2,11 @@
 //! manifold clean-up.
 
 pub mod cleanup;
+pub mod refine;
 pub mod tangent_delaunay;
 
 pub use cleanup::{assemble, AssemblyParams, AssemblyStats, FaceSource};
+pub use refine::RefineParams;
 pub use tangent_delaunay::{vote_triangles, SampleSet, TangentDelaunayParams, VotedTriangle};
 
 /// Parameters of [`triangulate`].
