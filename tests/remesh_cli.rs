@@ -93,10 +93,11 @@ fn horse_at_8600_is_a_closed_genus_0_manifold_with_table1_angles() {
     assert!(float(&r, &["distance", "rms"]) <= 0.04, "{}", r["distance"]);
 }
 
-/// The rest of issue 2's horse acceptance (Qmin >= 0.55, Qave >= 0.90, Hausdorff <= 0.5): not
-/// reached yet (measured 0.524, 0.8995, 0.82).
+/// The rest of issue 2's horse acceptance (Qmin >= 0.55, Qave >= 0.90, Hausdorff <= 0.5): Qave
+/// is reached (0.9026); Qmin (0.532) and Hausdorff (0.82) are not, both at the ear tips, thin
+/// shells that the isotropic kernel samples as one sheet.
 #[test]
-#[ignore = "issue 2 open: Qmin, Qave and Hausdorff targets for horse not reached yet"]
+#[ignore = "issue 2 open: horse Qmin and Hausdorff targets not reached yet (ear tips)"]
 fn horse_at_8600_meets_all_of_issue_2() {
     let dir = tempfile::tempdir().unwrap();
     let (r, _) = run("horse.obj", "horse.obj", 8600, &[], dir.path());
@@ -200,7 +201,6 @@ fn bunny_keeps_its_five_holes_as_five_boundary_loops() {
 }
 
 #[test]
-#[ignore = "issue 2 open: fandisk's sharp creases leave a hole and a second component"]
 fn fandisk_at_6000_is_a_closed_manifold() {
     let dir = tempfile::tempdir().unwrap();
     let (r, _) = run(
@@ -214,8 +214,21 @@ fn fandisk_at_6000_is_a_closed_manifold() {
     assert_closed_genus_0(&r, "fandisk");
 }
 
+/// What already holds on cow: a manifold within 1% of the count with no boundary edge, and the
+/// input's non-manifold vertex said in the notes.
 #[test]
-#[ignore = "issue 2 open: cow's thin parts at 3000 points leave holes and split components"]
+fn cow_at_3000_is_manifold_without_holes_and_reports_its_non_manifold_vertex() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r, _) = run("cow.obj", "cow.obj", 3000, &["--no-distance"], dir.path());
+    assert_manifold_with_count(&r, 3000, "cow");
+    assert_eq!(int(&r, &["topology", "boundary_edges"]), 0);
+    assert_eq!(int(&r, &["input_topology", "non_manifold_vertices"]), 1);
+    let notes = r["notes"].to_string();
+    assert!(notes.contains("non-manifold"), "{notes}");
+}
+
+#[test]
+#[ignore = "issue 2 open: cow's horns and tail, thinner than the sampling at 3000 points, come out as separate closed components (chi 10)"]
 fn cow_at_3000_is_a_closed_manifold() {
     let dir = tempfile::tempdir().unwrap();
     let (r, _) = run("cow.obj", "cow.obj", 3000, &["--no-distance"], dir.path());

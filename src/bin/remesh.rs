@@ -101,6 +101,14 @@ fn write_report(path: &PathBuf, json: &str) -> Result<(), Error> {
     })
 }
 
+/// Writes to standard output. A reader that went away (`remesh ... | head`) is not an error:
+/// the output file is already written, so the rest of the report is dropped quietly.
+fn emit(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = out.write_all(text.as_bytes()).and_then(|_| out.flush());
+}
+
 fn run(cli: Cli) -> Result<(), Error> {
     if let Some(Command::Quality {
         mesh,
@@ -112,9 +120,9 @@ fn run(cli: Cli) -> Result<(), Error> {
     {
         let r = run_quality(&mesh, reference.as_deref(), seed)?;
         if json {
-            println!("{}", r.to_json());
+            emit(&format!("{}\n", r.to_json()));
         } else {
-            print!("{r}");
+            emit(&r.to_string());
         }
         if let Some(p) = report {
             write_report(&p, &r.to_json())?;
@@ -169,8 +177,11 @@ fn run(cli: Cli) -> Result<(), Error> {
     bar.finish_and_clear();
     let report = result?;
     if !cli.quiet {
-        println!("{} -> {}", job.input.display(), job.output.display());
-        print!("{report}");
+        emit(&format!(
+            "{} -> {}\n{report}",
+            job.input.display(),
+            job.output.display()
+        ));
     }
     if let Some(p) = cli.report {
         write_report(&p, &report.to_json())?;

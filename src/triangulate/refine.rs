@@ -288,3 +288,133 @@ pub(super) fn insert_loose_samples(b: &mut Builder) -> usize {
     }
     inserted
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn builder<'a>(positions: &'a [DVec3], normals: &'a [DVec3]) -> Builder<'a> {
+        Builder {
+            positions,
+            normals,
+            faces: Vec::new(),
+            sources: Vec::new(),
+            directed: FxHashMap::default(),
+        }
+    }
+
+    fn live(b: &Builder) -> Vec<[u32; 3]> {
+        b.faces.iter().flatten().copied().collect()
+    }
+
+    /// A hexagon fan around a centre, with one long thin diagonal forced in: the flips must
+    /// restore the Delaunay triangulation (raise the smallest angle) and keep every directed
+    /// edge once.
+    #[test]
+    fn flips_raise_the_smallest_angle_and_keep_the_mesh_manifold() {
+        // Convex quad 0-3-1-2 split along its long diagonal 0-1, inside a ring 6-5-7-4 so that
+        // 0 and 1 have six faces each.
+        let positions: Vec<DVec3> = [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (1.0, 0.3),
+            (1.0, -0.3),
+            (1.0, 2.0),
+            (1.0, -2.0),
+            (-1.5, 0.0),
+            (3.5, 0.0),
+        ]
+        .iter()
+        .map(|&(x, y)| DVec3::new(x, y, 0.0))
+        .collect();
+        let normals = vec![DVec3::Z; positions.len()];
+        let mut b = builder(&positions, &normals);
+        for t in [
+            [0, 1, 2],
+            [1, 0, 3],
+            [0, 2, 4],
+            [2, 1, 4],
+            [3, 0, 5],
+            [1, 3, 5],
+            [6, 0, 4],
+            [6, 5, 0],
+            [1, 7, 4],
+            [1, 5, 7],
+        ] {
+            assert!(b.add(t, FaceSource::ThreeVotes));
+        }
+        let worst_before = live(&b)
+            .iter()
+            .filter(|t| t.contains(&0) && t.contains(&1))
+            .map(|&t| min_angle(&b, t))
+            .fold(f64::INFINITY, f64::min);
+        let flips = flip_edges(&mut b, &RefineParams::default());
+        assert!(flips >= 1);
+        // The long edge 0-1 is gone, 2-3 is there.
+        assert!(!b.directed.contains_key(&(0, 1)) && !b.directed.contains_key(&(1, 0)));
+        assert!(b.directed.contains_key(&(2, 3)) || b.directed.contains_key(&(3, 2)));
+        let around: Vec<[u32; 3]> = live(&b)
+            .into_iter()
+            .filter(|t| t.contains(&2) && t.contains(&3))
+            .collect();
+        assert_eq!(around.len(), 2);
+        for t in around {
+            assert!(min_angle(&b, t) > worst_before);
+        }
+        // Every directed edge at most once, and the face list matches the edge map.
+        let mut seen = std::collections::HashSet::new();
+        for t in live(&b) {
+            for k in 0..3 {
+                assert!(seen.insert((t[k], t[(k + 1) % 3])));
+            }
+        }
+        assert_eq!(seen.len(), b.directed.len());
+    }
+
+    /// No flip across a crease: two faces at 90° keep their edge.
+    #[test]
+    fn no_flip_across_a_crease() {
+        let positions = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.2, 0.0),
+            DVec3::new(1.0, 0.0, -0.2),
+        ];
+        let normals = vec![DVec3::new(0.0, 1.0, 1.0).normalize(); 4];
+        let mut b = builder(&positions, &normals);
+        assert!(b.add([0, 1, 2], FaceSource::ThreeVotes));
+        assert!(b.add([1, 0, 3], FaceSource::ThreeVotes));
+        assert_eq!(flip_edges(&mut b, &RefineParams::default()), 0);
+    }
+
+    /// A sample inside a face is inserted by a 1-to-3 split that keeps the orientation.
+    #[test]
+    fn a_loose_sample_is_inserted_into_the_face_it_projects_into() {
+        let positions = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(3.0, 0.0, 0.0),
+            DVec3::new(0.0, 3.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.05),
+        ];
+        let normals = vec![DVec3::Z; 4];
+        let mut b = builder(&positions, &normals);
+        assert!(b.add([0, 1, 2], FaceSource::ThreeVotes));
+        assert_eq!(insert_loose_samples(&mut b), 1);
+        let faces = live(&b);
+        assert_eq!(faces.len(), 3);
+        for t in faces {
+            assert!(t.contains(&3));
+            assert!(b.quality(t) > 0.0);
+        }
+    }
+
+    /// The reverse of an existing face does not fit (it would close a two-face pillow).
+    #[test]
+    fn the_reverse_of_a_face_does_not_fit() {
+        let positions = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        let normals = vec![DVec3::Z; 3];
+        let mut b = builder(&positions, &normals);
+        assert!(b.add([0, 1, 2], FaceSource::ThreeVotes));
+        assert!(!b.fits([0, 2, 1]));
+    }
+}
