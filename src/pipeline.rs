@@ -328,25 +328,18 @@ pub fn remesh(
         timer.lap("triangulate");
         full_history.extend(search_history.iter().copied());
         attempt += 1;
-        let Density::Points(n) = params.density else {
-            break (
-                sigma_p,
-                target_reached,
-                samples,
-                boundary_count,
-                rejected_by_nearest,
-                measured,
-                ga,
-                face_sources,
-                assembly,
-                mesh_normalized,
-                dropped_samples,
-            );
+        let v = mesh_normalized.vertex_count() as f64;
+        let (done, reached, miss) = match params.density {
+            Density::SigmaP(_) => (true, target_reached, 0.0),
+            Density::Points(n) => {
+                let miss = n as f64 - v;
+                let done = attempt >= 3
+                    || miss.abs() <= params.count_tolerance * n as f64
+                    || dropped_samples == 0;
+                (done, miss.abs() <= 0.01 * n as f64, miss)
+            }
         };
-        let v = mesh_normalized.vertex_count();
-        let miss = n as f64 - v as f64;
-        if attempt >= 3 || miss.abs() <= params.count_tolerance * n as f64 || dropped_samples == 0 {
-            let reached = (v as f64 - n as f64).abs() <= 0.01 * n as f64;
+        if done {
             break (
                 sigma_p,
                 reached,
