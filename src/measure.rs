@@ -490,28 +490,34 @@ mod tests {
         assert!(early.used < full.used);
     }
 
+    /// `n` points in the slab |x|, |y| <= 3, |z| <= 0.5 with normals within about 35° of +z,
+    /// embedded with `k`.
+    fn slab_points(k: &Kernel, n: usize, rng: &mut ChaCha8Rng) -> Vec<KernelPoint> {
+        (0..n)
+            .map(|_| {
+                let p = DVec3::new(
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-0.5..0.5),
+                );
+                let n = DVec3::new(
+                    rng.random_range(-0.5..0.5),
+                    rng.random_range(-0.5..0.5),
+                    1.0,
+                )
+                .normalize();
+                k.embed(p, n)
+            })
+            .collect()
+    }
+
     #[test]
     fn cholesky_measure_matches_block_inversion() {
         let k = Kernel::new(1.2, 0.6).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(8);
         let mut ws = MeasureWorkspace::new();
         for _ in 0..20 {
-            let pts: Vec<_> = (0..25)
-                .map(|_| {
-                    let p = DVec3::new(
-                        rng.random_range(-3.0..3.0),
-                        rng.random_range(-3.0..3.0),
-                        rng.random_range(-0.5..0.5),
-                    );
-                    let n = DVec3::new(
-                        rng.random_range(-0.5..0.5),
-                        rng.random_range(-0.5..0.5),
-                        1.0,
-                    )
-                    .normalize();
-                    k.embed(p, n)
-                })
-                .collect();
+            let pts = slab_points(&k, 25, &mut rng);
             let x = k.embed(DVec3::new(0.1, -0.2, 0.05), DVec3::Z);
             let s_eq10 = spectral_measure(&k, &x, pts.clone(), -1.0, &mut ws).s;
             let (s_chol, _) = measure_and_gradient(&k, &x, &pts, &mut ws);
@@ -525,22 +531,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(9);
         let mut ws = MeasureWorkspace::new();
         for trial in 0..25 {
-            let pts: Vec<_> = (0..18)
-                .map(|_| {
-                    let p = DVec3::new(
-                        rng.random_range(-3.0..3.0),
-                        rng.random_range(-3.0..3.0),
-                        rng.random_range(-0.5..0.5),
-                    );
-                    let n = DVec3::new(
-                        rng.random_range(-0.5..0.5),
-                        rng.random_range(-0.5..0.5),
-                        1.0,
-                    )
-                    .normalize();
-                    k.embed(p, n)
-                })
-                .collect();
+            let pts = slab_points(&k, 18, &mut rng);
             let p0 = DVec3::new(
                 rng.random_range(-1.0..1.0),
                 rng.random_range(-1.0..1.0),

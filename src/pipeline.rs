@@ -231,19 +231,7 @@ pub fn remesh(
     };
     let mut full_history = Vec::new();
     let mut attempt = 0;
-    let (
-        sigma_p,
-        target_reached,
-        samples,
-        boundary_count,
-        rejected_by_nearest,
-        measured,
-        ga,
-        face_sources,
-        assembly,
-        mesh_normalized,
-        dropped_samples,
-    ) = loop {
+    let output = loop {
         on_stage("linear scan");
         let scan = |sigma_p: f64| -> Result<(usize, (LinearScanResult, Vec<[u32; 2]>))> {
             let kernel = Kernel::new(sigma_p, params.sigma_n)?;
@@ -326,7 +314,6 @@ pub fn remesh(
         let mut mesh_normalized = TriMesh::new(positions, faces);
         let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
         timer.lap("triangulate");
-        full_history.extend(search_history.iter().copied());
         attempt += 1;
         let v = mesh_normalized.vertex_count() as f64;
         let (done, reached, miss) = match params.density {
@@ -340,48 +327,35 @@ pub fn remesh(
             }
         };
         if done {
-            break (
+            full_history.extend(search_history.iter().copied());
+            break RemeshOutput {
+                mesh: normalization.invert_mesh(&mesh_normalized),
+                mesh_normalized,
+                input_normalized: normalized,
+                normalization,
                 sigma_p,
-                reached,
-                samples,
-                boundary_count,
+                target: match params.density {
+                    Density::Points(n) => Some(n),
+                    Density::SigmaP(_) => None,
+                },
+                target_reached: reached,
+                search_history: full_history,
+                samples: samples.len(),
+                boundary_samples: boundary_count,
+                candidates: pool.len(),
                 rejected_by_nearest,
                 measured,
-                ga,
-                face_sources,
+                gradient_ascent: ga,
                 assembly,
-                mesh_normalized,
+                face_sources,
                 dropped_samples,
-            );
+                stages: std::mem::take(&mut timer.stages),
+            };
         }
+        full_history.extend(search_history.iter().copied());
         let new_goal = ((goal as f64 + miss).round() as usize).max(4);
         start = sigma_p * (goal as f64 / new_goal as f64).sqrt();
         goal = new_goal;
     };
-    let search_history = full_history;
-
-    let mesh = normalization.invert_mesh(&mesh_normalized);
-    Ok(RemeshOutput {
-        mesh,
-        mesh_normalized,
-        input_normalized: normalized,
-        normalization,
-        sigma_p,
-        target: match params.density {
-            Density::Points(n) => Some(n),
-            Density::SigmaP(_) => None,
-        },
-        target_reached,
-        search_history,
-        samples: samples.len(),
-        boundary_samples: boundary_count,
-        candidates: pool.len(),
-        rejected_by_nearest,
-        measured,
-        gradient_ascent: ga,
-        assembly,
-        face_sources,
-        dropped_samples,
-        stages: timer.stages,
-    })
+    Ok(output)
 }
