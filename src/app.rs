@@ -111,6 +111,10 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         "assembly".into(),
         serde_json::to_value(&out.assembly).unwrap_or_default(),
     );
+    extra.insert(
+        "optimize".into(),
+        serde_json::to_value(&out.optimize).unwrap_or_default(),
+    );
     extra.insert("input_vertices".into(), input.vertex_count().into());
     extra.insert("input_faces".into(), input.face_count().into());
     if stats.welded_vertices > 0 {

@@ -19,7 +19,8 @@ use crate::sampling::linear_scan::{linear_scan, LinearScanParams, LinearScanResu
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::sampling::SurfaceSample;
 use crate::surface::MeshSurface;
-use crate::triangulate::{triangulate, AssemblyStats, SampleSet, TriangulateParams};
+use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
+use crate::triangulate::{triangulate, AssemblyStats, FaceSource, SampleSet, TriangulateParams};
 
 /// How dense the output is: a vertex count, or sigma_p directly.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,6 +57,8 @@ pub struct RemeshParams {
     pub gradient_ascent: GradientAscentParams,
     /// The triangulation.
     pub triangulate: TriangulateParams,
+    /// The local optimization against the input surface after triangulation (`None`: skipped).
+    pub optimize: Option<OptimizeParams>,
     /// Relative tolerance of the count search (default 0.005).
     pub count_tolerance: f64,
     /// Seed of every random choice.
@@ -71,6 +74,7 @@ impl Default for RemeshParams {
             linear_scan: LinearScanParams::default(),
             gradient_ascent: GradientAscentParams::default(),
             triangulate: TriangulateParams::default(),
+            optimize: Some(OptimizeParams::default()),
             count_tolerance: 0.005,
             seed: 1,
         }
@@ -119,6 +123,8 @@ pub struct RemeshOutput {
     pub gradient_ascent: GradientAscentResult,
     /// The triangulation's statistics.
     pub assembly: AssemblyStats,
+    /// What the local optimization did.
+    pub optimize: OptimizeStats,
     /// How each face of `mesh` came in.
     pub face_sources: Vec<crate::triangulate::FaceSource>,
     /// Samples that ended in no triangle and were dropped.
@@ -215,6 +221,13 @@ pub fn remesh(
         .ceil()
         .clamp(16.0, 2e8) as usize;
     let pool = surface_candidates(&normalized, pool_size, params.seed);
+    // Input-surface points the optimization keeps within its cover distance of the output.
+    let cover_points: Vec<DVec3> = normalized
+        .positions
+        .iter()
+        .copied()
+        .chain(pool.iter().map(|c| c.position))
+        .collect();
     timer.lap("candidates");
 
     // The sampler's count is searched for; the triangulation may set a few samples aside (at
@@ -312,8 +325,30 @@ pub fn remesh(
         };
         let (faces, face_sources, assembly) = triangulate(&set, &params.triangulate);
         let mut mesh_normalized = TriMesh::new(positions, faces);
-        let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
         timer.lap("triangulate");
+        on_stage("optimize");
+        let mut face_sources = face_sources;
+        let optimize_stats = match &params.optimize {
+            Some(op) => {
+                let fixed: Vec<bool> = (0..samples.len()).map(|i| i < boundary_count).collect();
+                let (st, origin) = optimize(
+                    &mut mesh_normalized,
+                    &surface,
+                    &cover_points,
+                    &fixed,
+                    sigma_p,
+                    op,
+                );
+                face_sources = origin
+                    .iter()
+                    .map(|o| o.map_or(FaceSource::Refined, |f| face_sources[f as usize]))
+                    .collect();
+                st
+            }
+            None => OptimizeStats::default(),
+        };
+        let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
+        timer.lap("optimize");
         attempt += 1;
         let v = mesh_normalized.vertex_count() as f64;
         let (done, reached, miss) = match params.density {
@@ -347,6 +382,7 @@ pub fn remesh(
                 measured,
                 gradient_ascent: ga,
                 assembly,
+                optimize: optimize_stats,
                 face_sources,
                 dropped_samples,
                 stages: std::mem::take(&mut timer.stages),

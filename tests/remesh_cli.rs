@@ -73,49 +73,23 @@ fn assert_closed_genus_0(r: &Value, name: &str) {
     assert_eq!(int(r, &["topology", "components"]), 1, "{name}");
 }
 
+/// Issue 2's horse acceptance: the Table 1 Horse row's levels, closed genus 0, and the distance
+/// to the input of the best reference remeshers.
 #[test]
-fn horse_at_8600_is_a_closed_genus_0_manifold_with_table1_angles() {
+fn horse_at_8600_meets_all_of_issue_2() {
     let dir = tempfile::tempdir().unwrap();
     let (r, _) = run("horse.obj", "horse.obj", 8600, &[], dir.path());
     assert_manifold_with_count(&r, 8600, "horse");
     assert_closed_genus_0(&r, "horse");
-    assert!(
-        float(&r, &["triangles", "theta_min"]) >= 30.0,
-        "{}",
-        r["triangles"]
-    );
-    assert!(
-        float(&r, &["triangles", "theta_min_ave"]) >= 52.0,
-        "{}",
-        r["triangles"]
-    );
-    assert_eq!(float(&r, &["triangles", "pct_theta_below_30"]), 0.0);
-    assert!(float(&r, &["distance", "rms"]) <= 0.04, "{}", r["distance"]);
-}
-
-/// The rest of issue 2's horse acceptance (Qmin >= 0.55, Qave >= 0.90, Hausdorff <= 0.5): Qave
-/// is reached (0.9026); Qmin (0.532) and Hausdorff (0.82) are not, both at the ear tips, thin
-/// shells that the isotropic kernel samples as one sheet.
-#[test]
-#[ignore = "issue 2 open: horse Qmin and Hausdorff targets not reached yet (ear tips)"]
-fn horse_at_8600_meets_all_of_issue_2() {
-    let dir = tempfile::tempdir().unwrap();
-    let (r, _) = run("horse.obj", "horse.obj", 8600, &[], dir.path());
-    assert!(
-        float(&r, &["triangles", "q_min"]) >= 0.55,
-        "{}",
-        r["triangles"]
-    );
-    assert!(
-        float(&r, &["triangles", "q_ave"]) >= 0.90,
-        "{}",
-        r["triangles"]
-    );
-    assert!(
-        float(&r, &["distance", "hausdorff"]) <= 0.5,
-        "{}",
-        r["distance"]
-    );
+    let t = &r["triangles"];
+    assert!(float(&r, &["triangles", "theta_min"]) >= 30.0, "{t}");
+    assert!(float(&r, &["triangles", "theta_min_ave"]) >= 52.0, "{t}");
+    assert_eq!(float(&r, &["triangles", "pct_theta_below_30"]), 0.0, "{t}");
+    assert!(float(&r, &["triangles", "q_min"]) >= 0.55, "{t}");
+    assert!(float(&r, &["triangles", "q_ave"]) >= 0.90, "{t}");
+    let d = &r["distance"];
+    assert!(float(&r, &["distance", "hausdorff"]) <= 0.5, "{d}");
+    assert!(float(&r, &["distance", "rms"]) <= 0.04, "{d}");
 }
 
 #[test]

@@ -349,11 +349,6 @@ fn fill_holes(
                     }
                 }
                 None => {
-                    if std::env::var("HOLEDBG").is_ok() {
-                        let c = lp.iter().map(|&v| b.positions[v as usize]).sum::<DVec3>()
-                            / lp.len() as f64;
-                        eprintln!("hole fail len {} at {c:.1?}", lp.len());
-                    }
                     failed.push(lp);
                     left += 1
                 }

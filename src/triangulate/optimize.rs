@@ -1,0 +1,972 @@
+//! Local optimization of the triangulated samples against the input surface: the few places the
+//! spectral sampling cannot resolve (tips and rims thinner than the sample spacing) are mended
+//! with the input surface at hand.
+//!
+//! Three local operations, each kept only when it does not move the mesh away from the input
+//! surface by more than `max_offset`:
+//! - **Cover:** an input-surface point farther than `cover_distance` from the mesh (the tip of an
+//!   ear or a horn that the samples around it cut off) becomes a vertex: it splits the face it is
+//!   closest to. This bounds the one-sided (input → output) Hausdorff distance.
+//! - **Flip:** an edge near a poor triangle is flipped when that raises the smaller minimum angle
+//!   of its two faces (Lawson's max-min rule) and the new faces stay on the surface.
+//! - **Relax:** a vertex of a poor triangle moves towards the centroid of its neighbours, projected
+//!   back onto the surface, when that raises the smallest Q of its faces and turns none of them
+//!   (Laplacian smoothing with projection, as in Botsch & Kobbelt 2004, Sec. 3, restricted to
+//!   the poor triangles).
+//!
+//! Everything else stays as the sampler and the tangent-plane Delaunay left it: on the models
+//! here these operations touch a few vertices per thousand.
+
+use glam::DVec3;
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::Triangle;
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+
+use crate::mesh::TriMesh;
+use crate::quality::{triangle_angles_deg, triangle_q};
+use crate::surface::mesh_projection::MeshSurface;
+
+/// Parameters of [`optimize`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OptimizeParams {
+    /// Triangles with a shape quality Q below this are worked on (default 0.7).
+    pub q_below: f64,
+    /// Triangles with a smallest angle below this are worked on too, degrees (default 35).
+    pub theta_below_deg: f64,
+    /// Sweeps of flips and relaxation at most (default 6).
+    pub sweeps: usize,
+    /// Largest turn of a face's normal a relaxation move may cause, degrees (default 45).
+    pub max_normal_turn_deg: f64,
+    /// Largest distance an operation may put between the mesh and the input surface, in units of
+    /// sigma_p (default 0.1): a moved vertex's old position must stay within it of its faces; a
+    /// flipped edge's midpoint (on the surface) within it of the new faces, and the new edge's
+    /// midpoint within it of the surface.
+    pub max_offset: f64,
+    /// Input-surface points farther than this from the mesh become vertices, in units of sigma_p
+    /// (default 0.42; `f64::INFINITY` turns covering off).
+    pub cover_distance: f64,
+    /// Rounds of covering at most (default 3).
+    pub cover_rounds: usize,
+    /// Edges of poor triangles shorter than this fraction of the median edge length are
+    /// collapsed (default 0.5).
+    pub short_edge_ratio: f64,
+    /// Largest distance a collapse may put between the removed vertex's position and the mesh, in
+    /// units of sigma_p (default 0.25).
+    pub collapse_offset: f64,
+}
+
+impl Default for OptimizeParams {
+    fn default() -> Self {
+        OptimizeParams {
+            q_below: 0.7,
+            theta_below_deg: 35.0,
+            sweeps: 6,
+            max_normal_turn_deg: 45.0,
+            max_offset: 0.1,
+            cover_distance: 0.42,
+            cover_rounds: 3,
+            short_edge_ratio: 0.5,
+            collapse_offset: 0.25,
+        }
+    }
+}
+
+/// What [`optimize`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub struct OptimizeStats {
+    /// Input-surface points inserted as vertices.
+    pub covered: usize,
+    /// Edges collapsed.
+    pub collapses: usize,
+    /// Edges flipped.
+    pub flips: usize,
+    /// Vertex moves.
+    pub moves: usize,
+}
+
+/// A triangle mesh open to local edits: faces with directed-edge and vertex-face look-ups.
+struct EditMesh {
+    positions: Vec<DVec3>,
+    faces: Vec<[u32; 3]>,
+    /// Directed edge → the face that has it.
+    edge: FxHashMap<(u32, u32), u32>,
+    /// Vertex → the faces around it.
+    around: Vec<Vec<u32>>,
+    /// Faces removed by a collapse are kept as dead slots so face indices stay valid.
+    alive: Vec<bool>,
+    /// Whether the face in each slot is still the input's face of the same index.
+    original: Vec<bool>,
+}
+
+impl EditMesh {
+    fn new(mesh: &TriMesh) -> Self {
+        let mut m = EditMesh {
+            positions: mesh.positions.clone(),
+            faces: Vec::with_capacity(mesh.triangles.len()),
+            edge: FxHashMap::default(),
+            around: vec![Vec::new(); mesh.positions.len()],
+            alive: Vec::with_capacity(mesh.triangles.len()),
+            original: Vec::new(),
+        };
+        for &t in &mesh.triangles {
+            m.push(t);
+        }
+        m.original = vec![true; m.faces.len()];
+        m
+    }
+
+    fn corners(&self, t: [u32; 3]) -> [DVec3; 3] {
+        t.map(|i| self.positions[i as usize])
+    }
+
+    fn push(&mut self, t: [u32; 3]) -> u32 {
+        let f = self.faces.len() as u32;
+        self.faces.push(t);
+        self.alive.push(true);
+        self.original.push(false);
+        self.link(f);
+        f
+    }
+
+    fn link(&mut self, f: u32) {
+        let t = self.faces[f as usize];
+        for k in 0..3 {
+            self.edge.insert((t[k], t[(k + 1) % 3]), f);
+            self.around[t[k] as usize].push(f);
+        }
+    }
+
+    fn unlink(&mut self, f: u32) {
+        let t = self.faces[f as usize];
+        for k in 0..3 {
+            if self.edge.get(&(t[k], t[(k + 1) % 3])) == Some(&f) {
+                self.edge.remove(&(t[k], t[(k + 1) % 3]));
+            }
+            self.around[t[k] as usize].retain(|&g| g != f);
+        }
+    }
+
+    fn replace(&mut self, f: u32, t: [u32; 3]) {
+        self.original[f as usize] = false;
+        self.unlink(f);
+        self.faces[f as usize] = t;
+        self.link(f);
+    }
+
+    fn has_edge(&self, a: u32, b: u32) -> bool {
+        self.edge.contains_key(&(a, b)) || self.edge.contains_key(&(b, a))
+    }
+
+    fn normal(&self, t: [u32; 3]) -> DVec3 {
+        let [a, b, c] = self.corners(t);
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+
+    fn min_angle(&self, t: [u32; 3]) -> f64 {
+        let a = triangle_angles_deg(self.corners(t));
+        a[0].min(a[1]).min(a[2])
+    }
+
+    fn q(&self, t: [u32; 3]) -> f64 {
+        triangle_q(self.corners(t))
+    }
+
+    /// The shape score the operations maximize at their worst face: Q and the smallest angle,
+    /// each relative to a good level (Q 0.6, 30°), whichever is lower.
+    fn score(&self, t: [u32; 3]) -> f64 {
+        (self.q(t) / 0.6).min(self.min_angle(t) / 30.0)
+    }
+
+    /// Whether `t` is one of the triangles the operations work on.
+    fn is_poor(&self, t: [u32; 3], params: &OptimizeParams) -> bool {
+        self.q(t) < params.q_below || self.min_angle(t) < params.theta_below_deg
+    }
+
+    fn distance_to_faces(&self, faces: &[u32], p: DVec3) -> f64 {
+        faces
+            .iter()
+            .map(|&f| {
+                let [a, b, c] = self.corners(self.faces[f as usize]);
+                Triangle::new(a, b, c).distance_to_local_point(p, true)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Whether `v` is on a boundary edge.
+    fn on_boundary(&self, v: u32) -> bool {
+        self.around[v as usize].iter().any(|&f| {
+            let t = self.faces[f as usize];
+            (0..3).any(|k| !self.edge.contains_key(&(t[(k + 1) % 3], t[k])))
+        })
+    }
+
+    /// The vertices sharing a face with `v`, sorted.
+    fn ring(&self, v: u32) -> Vec<u32> {
+        let mut r: Vec<u32> = self.around[v as usize]
+            .iter()
+            .flat_map(|&f| self.faces[f as usize])
+            .filter(|&u| u != v)
+            .collect();
+        r.sort_unstable();
+        r.dedup();
+        r
+    }
+
+    fn kill(&mut self, f: u32) {
+        self.unlink(f);
+        self.alive[f as usize] = false;
+    }
+
+    /// The live faces and, for each, its slot.
+    fn live(&self) -> (Vec<[u32; 3]>, Vec<u32>) {
+        (0..self.faces.len() as u32)
+            .filter(|&f| self.alive[f as usize])
+            .map(|f| (self.faces[f as usize], f))
+            .unzip()
+    }
+
+    /// The mesh, and for each of its faces the index of the input face it still is (`None` for
+    /// a new or changed face).
+    fn into_mesh(self) -> (TriMesh, Vec<Option<u32>>) {
+        let (faces, slots) = self.live();
+        let origin = slots
+            .iter()
+            .map(|&f| self.original[f as usize].then_some(f))
+            .collect();
+        (TriMesh::new(self.positions, faces), origin)
+    }
+}
+
+/// Rotates `t` so that it starts with `v` (which must be a corner).
+fn starting_at(t: [u32; 3], v: u32) -> [u32; 3] {
+    if t[0] == v {
+        t
+    } else if t[1] == v {
+        [t[1], t[2], t[0]]
+    } else {
+        [t[2], t[0], t[1]]
+    }
+}
+
+/// Optimizes `mesh` (bbox-100 units, edge-manifold and consistently oriented) against `surface`
+/// (the input, same units): covers the input points of `cover_points` that are farther than
+/// `params.cover_distance` from it, then flips edges and relaxes vertices around the triangles
+/// with Q below `params.q_below` (see the module documentation). Vertices with `fixed[v]`
+/// (boundary samples) do not move; boundary edges are not flipped. New vertices are appended,
+/// so existing indices stay valid; vertices merged away by a collapse are left unreferenced.
+/// Returns what was done and, for each face of the result, the index of the face of `mesh` it
+/// still is (`None` for a new or changed face). Deterministic.
+pub fn optimize(
+    mesh: &mut TriMesh,
+    surface: &MeshSurface,
+    cover_points: &[DVec3],
+    fixed: &[bool],
+    sigma_p: f64,
+    params: &OptimizeParams,
+) -> (OptimizeStats, Vec<Option<u32>>) {
+    // Distances in bbox-100 units from here on.
+    let params = &OptimizeParams {
+        max_offset: params.max_offset * sigma_p,
+        cover_distance: params.cover_distance * sigma_p,
+        collapse_offset: params.collapse_offset * sigma_p,
+        ..*params
+    };
+    let mut stats = OptimizeStats::default();
+    let mut m = EditMesh::new(mesh);
+    let mut fixed = fixed.to_vec();
+    fixed.resize(m.positions.len(), false);
+    let short = params.short_edge_ratio * median_edge_length(&m);
+    let mut watch = None;
+    for round in 0..params.cover_rounds.max(1) {
+        if params.cover_distance.is_finite() {
+            let added = cover(&mut m, cover_points, &mut watch, params);
+            // Covering vertices stay where they are.
+            fixed.resize(m.positions.len(), true);
+            stats.covered += added;
+            if added == 0 && round > 0 {
+                break;
+            }
+        }
+        for _ in 0..params.sweeps {
+            let c = collapse_short(&mut m, surface, &fixed, short, params);
+            let f = flip_poor(&mut m, surface, params);
+            let r = relax_poor(&mut m, surface, &fixed, params);
+            stats.collapses += c;
+            stats.flips += f;
+            stats.moves += r;
+            if c + f + r == 0 {
+                break;
+            }
+        }
+        if !params.cover_distance.is_finite() {
+            break;
+        }
+    }
+    let (result, origin) = m.into_mesh();
+    *mesh = result;
+    (stats, origin)
+}
+
+/// One round of covering: the points of `points` farther than `cover_distance` from the mesh,
+/// farthest first and at most one per face, each split into the face nearest to it. `watch`
+/// carries, from the first round to the next, the points worth looking at again. Returns how
+/// many were inserted.
+fn cover(
+    m: &mut EditMesh,
+    points: &[DVec3],
+    watch: &mut Option<Vec<u32>>,
+    params: &OptimizeParams,
+) -> usize {
+    let (live, slot) = m.live();
+    let current = TriMesh::new(m.positions.clone(), live);
+    let Ok(output) = MeshSurface::new(&current) else {
+        return 0;
+    };
+    // The points to look at: all of them the first time; then those that could come farther
+    // than the cover distance: a collapse moves the mesh by up to `collapse_offset` from a
+    // surface point, relaxation by less.
+    if watch.is_none() {
+        *watch = Some(
+            points
+                .par_iter()
+                .enumerate()
+                .filter(|(_, &p)| {
+                    output
+                        .closest_point_within(
+                            p,
+                            (params.cover_distance - params.collapse_offset).max(0.0),
+                        )
+                        .is_none()
+                })
+                .map(|(i, _)| i as u32)
+                .collect(),
+        );
+    }
+    let watched = watch.as_deref().unwrap_or_default();
+    let mut far: Vec<(f64, usize, u32)> = watched
+        .par_iter()
+        .filter_map(|&i| {
+            let i = i as usize;
+            let sp = output.closest_point(points[i])?;
+            (sp.distance > params.cover_distance).then_some((
+                sp.distance,
+                i,
+                slot[sp.face as usize],
+            ))
+        })
+        .collect();
+    far.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    let mut touched = vec![false; m.faces.len()];
+    let mut added = 0;
+    for (_, i, f) in far {
+        let t = m.faces[f as usize];
+        // One insertion per face and its neighbours per round: the next round sees the result.
+        if touched[f as usize] {
+            continue;
+        }
+        let p = points[i];
+        let [pa, pb, pc] = m.corners(t);
+        let n = (pb - pa).cross(pc - pa);
+        let corner = [pa, pb, pc];
+        // Which side of each edge k (corner k → k+1) p is on, in the face's plane.
+        let outside: Vec<usize> = (0..3)
+            .filter(|&k| {
+                let (x, y) = (corner[k], corner[(k + 1) % 3]);
+                (y - x).cross(p - x).dot(n) <= 0.0
+            })
+            .collect();
+        let v = m.positions.len() as u32;
+        let plan: Vec<(Option<u32>, [u32; 3], [u32; 3])> = if outside.is_empty() {
+            // Inside the face: split it in three.
+            let [a, b, c] = t;
+            vec![
+                (Some(f), [a, b, v], t),
+                (None, [b, c, v], t),
+                (None, [c, a, v], t),
+            ]
+        } else {
+            // Beyond an edge (or a corner: the nearer of its two edges): split that edge and
+            // the face across it.
+            let k = *outside
+                .iter()
+                .min_by(|&&k1, &&k2| {
+                    let d = |k: usize| segment_distance(corner[k], corner[(k + 1) % 3], p);
+                    d(k1).total_cmp(&d(k2))
+                })
+                .unwrap_or(&outside[0]);
+            let (x, y, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            // A boundary edge stays as the boundary samples made it.
+            let Some(&g) = m.edge.get(&(y, x)) else {
+                continue;
+            };
+            if touched[g as usize] {
+                continue;
+            }
+            let u = m.faces[g as usize];
+            let d = starting_at(u, y)[2];
+            vec![
+                (Some(f), [x, v, c], t),
+                (None, [v, y, c], t),
+                (Some(g), [y, v, d], u),
+                (None, [v, x, d], u),
+            ]
+        };
+        // Every new face must face the way the face it comes from did.
+        m.positions.push(p);
+        let fits = plan
+            .iter()
+            .all(|&(_, new, old)| m.normal(new).dot(m.normal(old)) > 0.0);
+        if !fits {
+            m.positions.pop();
+            continue;
+        }
+        m.around.push(Vec::new());
+        let t_all: Vec<u32> = plan.iter().flat_map(|x| x.1).collect();
+        for (slot, new, _) in plan {
+            match slot {
+                Some(g) => m.replace(g, new),
+                None => {
+                    m.push(new);
+                }
+            }
+        }
+        touched.resize(m.faces.len(), true);
+        for &u in &t_all {
+            for &g in &m.around[u as usize] {
+                touched[g as usize] = true;
+            }
+        }
+        added += 1;
+    }
+    added
+}
+
+/// The distance from `p` to the segment `a`–`b`.
+fn segment_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 {
+        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + t * ab)
+}
+
+/// The vertices of the faces with Q below `q_below`, sorted.
+fn poor_vertices(m: &EditMesh, params: &OptimizeParams) -> Vec<u32> {
+    let mut v: Vec<u32> = m
+        .faces
+        .iter()
+        .zip(&m.alive)
+        .filter(|&(&t, &alive)| alive && m.is_poor(t, params))
+        .map(|(t, _)| t)
+        .flatten()
+        .copied()
+        .collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// Max-min angle flips of the edges of the faces around poor triangles' vertices, where the new
+/// faces stay within `max_offset` of the surface. Returns the number of flips.
+fn flip_poor(m: &mut EditMesh, surface: &MeshSurface, params: &OptimizeParams) -> usize {
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    for v in poor_vertices(m, params) {
+        for &f in &m.around[v as usize] {
+            let t = m.faces[f as usize];
+            for k in 0..3 {
+                let (x, y) = (t[k], t[(k + 1) % 3]);
+                edges.push((x.min(y), x.max(y)));
+            }
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    let mut flips = 0;
+    for (x, y) in edges {
+        let (Some(&f1), Some(&f2)) = (m.edge.get(&(x, y)), m.edge.get(&(y, x))) else {
+            continue;
+        };
+        let t1 = starting_at(m.faces[f1 as usize], x); // [x, y, c]
+        let t2 = starting_at(m.faces[f2 as usize], y); // [y, x, d]
+        if t1[1] != y || t2[1] != x {
+            continue;
+        }
+        let (c, d) = (t1[2], t2[2]);
+        if c == d
+            || m.has_edge(c, d)
+            || m.around[x as usize].len() <= 3
+            || m.around[y as usize].len() <= 3
+        {
+            continue;
+        }
+        let new1 = [x, d, c];
+        let new2 = [y, c, d];
+        let old = m.min_angle(t1).min(m.min_angle(t2));
+        let new = m.min_angle(new1).min(m.min_angle(new2));
+        if new <= old + 1e-6 {
+            continue;
+        }
+        // The new faces must face the way the old ones did and stay on the surface.
+        let (n1, n2) = (m.normal(t1), m.normal(t2));
+        let (m1, m2) = (m.normal(new1), m.normal(new2));
+        let mean_old = n1 + n2;
+        if m1.dot(mean_old) <= 0.0 || m2.dot(mean_old) <= 0.0 || m1.dot(m2) < 0.0 {
+            continue;
+        }
+        let (px, py, pc, pd) = (
+            m.positions[x as usize],
+            m.positions[y as usize],
+            m.positions[c as usize],
+            m.positions[d as usize],
+        );
+        let Some(new_mid) = surface.closest_point(0.5 * (pc + pd)) else {
+            continue;
+        };
+        if new_mid.distance > params.max_offset {
+            continue;
+        }
+        let Some(old_mid) = surface.closest_point(0.5 * (px + py)) else {
+            continue;
+        };
+        let tri_dist = |t: [u32; 3], p: DVec3| {
+            let [a, b, c] = m.corners(t);
+            Triangle::new(a, b, c).distance_to_local_point(p, true)
+        };
+        if tri_dist(new1, old_mid.position).min(tri_dist(new2, old_mid.position))
+            > params.max_offset
+        {
+            continue;
+        }
+        m.replace(f1, new1);
+        m.replace(f2, new2);
+        flips += 1;
+    }
+    flips
+}
+
+/// One sweep of relaxation over the vertices of poor triangles (see the module documentation).
+/// Returns the number of moves.
+fn relax_poor(
+    m: &mut EditMesh,
+    surface: &MeshSurface,
+    fixed: &[bool],
+    params: &OptimizeParams,
+) -> usize {
+    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
+    let mut moves = 0;
+    let mut ring: Vec<u32> = Vec::new();
+    for v in poor_vertices(m, params) {
+        if fixed.get(v as usize).copied().unwrap_or(false) {
+            continue;
+        }
+        let faces = m.around[v as usize].clone();
+        if faces.is_empty() {
+            continue;
+        }
+        // A vertex on a boundary edge stays.
+        if m.on_boundary(v) {
+            continue;
+        }
+        let old_normals: Vec<DVec3> = faces
+            .iter()
+            .map(|&f| m.normal(m.faces[f as usize]))
+            .collect();
+        let worst_q = |m: &EditMesh| {
+            faces
+                .iter()
+                .map(|&f| m.score(m.faces[f as usize]))
+                .fold(f64::INFINITY, f64::min)
+        };
+        ring.clear();
+        for &f in &faces {
+            ring.extend(m.faces[f as usize].iter().filter(|&&u| u != v));
+        }
+        ring.sort_unstable();
+        ring.dedup();
+        let centroid = ring
+            .iter()
+            .map(|&u| m.positions[u as usize])
+            .fold(DVec3::ZERO, |a, b| a + b)
+            / ring.len() as f64;
+        let old = m.positions[v as usize];
+        // Targets: the centroid, and for each poor face the apex of the equilateral triangle on
+        // the edge opposite v (in the face's plane, on v's side).
+        let mut targets = vec![centroid];
+        for &f in &faces {
+            let t = starting_at(m.faces[f as usize], v);
+            if !m.is_poor(t, params) {
+                continue;
+            }
+            let (pb, pc) = (m.positions[t[1] as usize], m.positions[t[2] as usize]);
+            let mid = 0.5 * (pb + pc);
+            let e = pc - pb;
+            let height = old - mid;
+            let across =
+                (height - e * (height.dot(e) / e.length_squared().max(1e-300))).normalize_or_zero();
+            if across != DVec3::ZERO {
+                targets.push(mid + across * (0.75f64.sqrt() * e.length()));
+            }
+        }
+        let mut best = (worst_q(m), old);
+        for (target, t) in targets
+            .iter()
+            .flat_map(|&c| [1.0, 0.5, 0.25].map(|t| (c, t)))
+        {
+            let Some(sp) = surface.closest_point(old.lerp(target, t)) else {
+                continue;
+            };
+            m.positions[v as usize] = sp.position;
+            let turned = faces
+                .iter()
+                .zip(&old_normals)
+                .any(|(&f, &n0)| m.normal(m.faces[f as usize]).dot(n0) < cos_turn);
+            let q = worst_q(m);
+            if !turned && q > best.0 + 1e-9 && m.distance_to_faces(&faces, old) <= params.max_offset
+            {
+                best = (q, sp.position);
+            }
+        }
+        m.positions[v as usize] = best.1;
+        if best.1 != old {
+            moves += 1;
+        }
+    }
+    moves
+}
+
+/// The median edge length of the live faces (0 for an empty mesh).
+fn median_edge_length(m: &EditMesh) -> f64 {
+    let (live, _) = m.live();
+    let mut lengths: Vec<f64> = live
+        .iter()
+        .flat_map(|t| {
+            let [a, b, c] = m.corners(*t);
+            [a.distance(b), b.distance(c), c.distance(a)]
+        })
+        .collect();
+    if lengths.is_empty() {
+        return 0.0;
+    }
+    let mid = lengths.len() / 2;
+    *lengths.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// Collapses the interior edges of poor triangles shorter than `short`, shortest first: one end
+/// merges into the other, at the kept end's position (a fixed end is always the kept one) or at
+/// the surface point nearest the edge's midpoint, whichever leaves the best smallest Q. A
+/// collapse is made only when it keeps the mesh manifold (the link condition: the two ends share
+/// exactly the two opposite vertices), raises the smallest Q of the faces involved, turns no face
+/// by more than `max_normal_turn_deg`, and leaves both old positions within `collapse_offset` of
+/// the new faces. Returns the number of collapses.
+fn collapse_short(
+    m: &mut EditMesh,
+    surface: &MeshSurface,
+    fixed: &[bool],
+    short: f64,
+    params: &OptimizeParams,
+) -> usize {
+    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
+    let mut edges: Vec<(f64, u32, u32)> = Vec::new();
+    for (f, t) in m.faces.iter().enumerate() {
+        if !m.alive[f] || !m.is_poor(*t, params) {
+            continue;
+        }
+        for k in 0..3 {
+            let (x, y) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+            let l = m.positions[x as usize].distance(m.positions[y as usize]);
+            if l < short {
+                edges.push((l, x, y));
+            }
+        }
+    }
+    edges.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    edges.dedup();
+    let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
+    let mut collapses = 0;
+    for (_, a, b) in edges {
+        let (Some(&f1), Some(&f2)) = (m.edge.get(&(a, b)), m.edge.get(&(b, a))) else {
+            continue;
+        };
+        let (pa, pb) = (m.positions[a as usize], m.positions[b as usize]);
+        if pa.distance(pb) >= short {
+            continue;
+        }
+        let c = starting_at(m.faces[f1 as usize], a)[2];
+        let d = starting_at(m.faces[f2 as usize], b)[2];
+        let (ra, rb) = (m.ring(a), m.ring(b));
+        let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
+        if c == d
+            || common.len() != 2
+            || !common.contains(&c)
+            || !common.contains(&d)
+            || m.around[c as usize].len() <= 3
+            || m.around[d as usize].len() <= 3
+        {
+            continue;
+        }
+        let keep_a = is_fixed(a) || m.on_boundary(a);
+        let keep_b = is_fixed(b) || m.on_boundary(b);
+        // (removed, kept, position of the kept vertex)
+        let mut options: Vec<(u32, u32, DVec3)> = Vec::new();
+        match (keep_a, keep_b) {
+            (true, true) => continue,
+            (true, false) => options.push((b, a, pa)),
+            (false, true) => options.push((a, b, pb)),
+            (false, false) => {
+                options.push((b, a, pa));
+                options.push((a, b, pb));
+                if let Some(sp) = surface.closest_point(0.5 * (pa + pb)) {
+                    options.push((b, a, sp.position));
+                }
+            }
+        }
+        // The faces that change: all around a and b but f1 and f2.
+        let mut involved: Vec<u32> = m.around[a as usize]
+            .iter()
+            .chain(&m.around[b as usize])
+            .copied()
+            .filter(|&g| g != f1 && g != f2)
+            .collect();
+        involved.sort_unstable();
+        involved.dedup();
+        let before = involved
+            .iter()
+            .chain([&f1, &f2])
+            .map(|&g| m.score(m.faces[g as usize]))
+            .fold(f64::INFINITY, f64::min);
+        let old_normals: Vec<DVec3> = involved
+            .iter()
+            .map(|&g| m.normal(m.faces[g as usize]))
+            .collect();
+        let mut best: Option<(f64, u32, u32, DVec3)> = None;
+        for (removed, kept, q) in options {
+            let saved = m.positions[kept as usize];
+            m.positions[kept as usize] = q;
+            let new_faces: Vec<[u32; 3]> = involved
+                .iter()
+                .map(|&g| m.faces[g as usize].map(|u| if u == removed { kept } else { u }))
+                .collect();
+            let turned = new_faces
+                .iter()
+                .zip(&old_normals)
+                .any(|(&t, &n0)| m.normal(t).dot(n0) < cos_turn);
+            let worst = new_faces
+                .iter()
+                .map(|&t| m.score(t))
+                .fold(f64::INFINITY, f64::min);
+            let dist = |p: DVec3| {
+                new_faces
+                    .iter()
+                    .map(|&t| {
+                        let [x, y, z] = m.corners(t);
+                        Triangle::new(x, y, z).distance_to_local_point(p, true)
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let near = dist(pa) <= params.collapse_offset && dist(pb) <= params.collapse_offset;
+            m.positions[kept as usize] = saved;
+            if !turned && near && worst > before + 1e-9 && best.is_none_or(|b| worst > b.0) {
+                best = Some((worst, removed, kept, q));
+            }
+        }
+        let Some((_, removed, kept, q)) = best else {
+            continue;
+        };
+        m.kill(f1);
+        m.kill(f2);
+        for g in m.around[removed as usize].clone() {
+            let t = m.faces[g as usize].map(|u| if u == removed { kept } else { u });
+            m.replace(g, t);
+        }
+        m.positions[kept as usize] = q;
+        collapses += 1;
+    }
+    collapses
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quality::{check_invariants, topology, triangle_quality};
+
+    /// An `n × n` grid of squares of side `h` in the plane z = 0, each cut by a diagonal.
+    fn grid(n: usize, h: f64) -> TriMesh {
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                positions.push(DVec3::new(i as f64 * h, j as f64 * h, 0.0));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = (j * (n + 1) + i) as u32;
+                let w = v + n as u32 + 1;
+                triangles.push([v, v + 1, w + 1]);
+                triangles.push([v, w + 1, w]);
+            }
+        }
+        TriMesh::new(positions, triangles)
+    }
+
+    fn no_cover() -> OptimizeParams {
+        OptimizeParams {
+            cover_distance: f64::INFINITY,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn a_distorted_flat_patch_is_relaxed_in_its_plane() {
+        let surface = MeshSurface::new(&grid(10, 1.0)).unwrap();
+        let mut mesh = grid(10, 1.0);
+        // Pull one interior vertex most of the way towards a neighbour: slivers around it.
+        let v = 5 * 11 + 5;
+        mesh.positions[v] += DVec3::new(0.8, 0.1, 0.0);
+        let before = triangle_quality(&mesh);
+        let fixed: Vec<bool> = vec![false; mesh.vertex_count()];
+        let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, 1.0, &no_cover());
+        let after = triangle_quality(&mesh);
+        assert!(stats.moves + stats.flips + stats.collapses > 0);
+        assert!(
+            after.q_min > before.q_min + 0.2,
+            "{} -> {}",
+            before.q_min,
+            after.q_min
+        );
+        assert!(mesh.positions.iter().all(|p| p.z.abs() < 1e-12));
+        mesh.remove_unreferenced_vertices();
+        let t = topology(&mesh);
+        assert!(t.is_manifold() && t.euler_characteristic == 1 && t.components == 1);
+        assert!(
+            check_invariants(&mesh).is_empty(),
+            "{:?}",
+            check_invariants(&mesh)
+        );
+    }
+
+    #[test]
+    fn fixed_and_boundary_vertices_do_not_move() {
+        let surface = MeshSurface::new(&grid(6, 1.0)).unwrap();
+        let mut mesh = grid(6, 1.0);
+        // Distort a boundary vertex (y = 0 row) and an interior one that is fixed.
+        mesh.positions[3] += DVec3::new(0.45, 0.0, 0.0);
+        mesh.positions[3 * 7 + 3] += DVec3::new(0.45, 0.4, 0.0);
+        let original = mesh.positions.clone();
+        let mut fixed = vec![false; mesh.vertex_count()];
+        fixed[3 * 7 + 3] = true;
+        let (_, origin) = optimize(&mut mesh, &surface, &[], &fixed, 1.0, &no_cover());
+        assert_eq!(origin.len(), mesh.face_count());
+        assert!(origin.iter().any(|o| o.is_none()) && origin.iter().any(|o| o.is_some()));
+        assert_eq!(mesh.positions[3], original[3]);
+        assert_eq!(mesh.positions[3 * 7 + 3], original[3 * 7 + 3]);
+        assert_eq!(topology(&mesh).boundary_edges, 24);
+    }
+
+    #[test]
+    fn a_very_short_edge_is_collapsed_and_the_mesh_stays_manifold() {
+        let surface = MeshSurface::new(&grid(8, 1.0)).unwrap();
+        let mut mesh = grid(8, 1.0);
+        // Split the diagonal of one interior square very close to its corner: a vertex 0.1 from
+        // another, with slivers around it.
+        let (a, b) = (3 * 9 + 3, 4 * 9 + 4);
+        let p = mesh.positions[a].lerp(mesh.positions[b], 0.07);
+        let v = mesh.positions.len() as u32;
+        mesh.positions.push(p);
+        let (a, b) = (a as u32, b as u32);
+        let mut triangles = Vec::new();
+        for t in &mesh.triangles {
+            let has = |x: u32| t.contains(&x);
+            if has(a) && has(b) {
+                let t = starting_at(*t, a);
+                let (x, y, c) = (t[0], t[1], t[2]);
+                // [a, b, c] or [a, c, b] around the diagonal: split the edge a-b at v.
+                if y == b {
+                    triangles.push([x, v, c]);
+                    triangles.push([v, y, c]);
+                } else {
+                    triangles.push([x, y, v]);
+                    triangles.push([v, y, c]);
+                }
+            } else {
+                triangles.push(*t);
+            }
+        }
+        mesh.triangles = triangles;
+        let t0 = topology(&mesh);
+        assert!(t0.is_manifold() && t0.euler_characteristic == 1);
+        let fixed = vec![false; mesh.vertex_count()];
+        let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, 1.0, &no_cover());
+        assert!(stats.collapses >= 1, "{stats:?}");
+        mesh.remove_unreferenced_vertices();
+        let t = topology(&mesh);
+        assert!(t.is_manifold() && t.euler_characteristic == 1 && t.components == 1);
+        assert!(
+            check_invariants(&mesh).is_empty(),
+            "{:?}",
+            check_invariants(&mesh)
+        );
+        assert!(triangle_quality(&mesh).theta_min > 30.0);
+    }
+
+    #[test]
+    fn a_cut_off_tip_is_covered() {
+        // Input: a square pyramid, apex at height 8. Output to mend: the same pyramid cut flat
+        // at height 4 (the apex 4 units from it).
+        let base = [
+            DVec3::new(-5.0, -5.0, 0.0),
+            DVec3::new(5.0, -5.0, 0.0),
+            DVec3::new(5.0, 5.0, 0.0),
+            DVec3::new(-5.0, 5.0, 0.0),
+        ];
+        let apex = DVec3::new(0.0, 0.0, 8.0);
+        let mut positions = base.to_vec();
+        positions.push(apex);
+        let input = TriMesh::new(
+            positions,
+            vec![
+                [0, 2, 1],
+                [0, 3, 2],
+                [0, 1, 4],
+                [1, 2, 4],
+                [2, 3, 4],
+                [3, 0, 4],
+            ],
+        );
+        let surface = MeshSurface::new(&input).unwrap();
+        let mut positions = base.to_vec();
+        positions.extend(base.iter().map(|&p| p.lerp(apex, 0.5)));
+        let mut triangles = vec![[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7]];
+        for k in 0..4u32 {
+            let (a, b) = (k, (k + 1) % 4);
+            triangles.push([a, b, b + 4]);
+            triangles.push([a, b + 4, a + 4]);
+        }
+        let mut mesh = TriMesh::new(positions, triangles);
+        assert!(topology(&mesh).is_closed_manifold());
+        let fixed = vec![false; mesh.vertex_count()];
+        let (stats, _) = optimize(
+            &mut mesh,
+            &surface,
+            &input.positions,
+            &fixed,
+            1.0,
+            &OptimizeParams::default(),
+        );
+        assert!(stats.covered >= 1, "{stats:?}");
+        assert!(mesh.positions.contains(&apex));
+        let t = topology(&mesh);
+        assert!(
+            t.is_closed_manifold() && t.euler_characteristic == 2,
+            "{t:?}"
+        );
+        assert!(
+            check_invariants(&mesh).is_empty(),
+            "{:?}",
+            check_invariants(&mesh)
+        );
+    }
+}
