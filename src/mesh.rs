@@ -295,6 +295,34 @@ impl Normalization {
     }
 }
 
+/// Meshes for tests.
+#[cfg(test)]
+pub(crate) mod test_meshes {
+    use super::TriMesh;
+    use glam::DVec3;
+
+    /// An `n × n` grid of squares, each cut by a diagonal; vertex `(i, j)` (0 ..= n each) is at
+    /// `position(i, j)`.
+    pub fn grid(n: usize, position: impl Fn(usize, usize) -> DVec3) -> TriMesh {
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                positions.push(position(i, j));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = (j * (n + 1) + i) as u32;
+                let w = v + n as u32 + 1;
+                triangles.push([v, v + 1, w + 1]);
+                triangles.push([v, w + 1, w]);
+            }
+        }
+        TriMesh::new(positions, triangles)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -155,23 +155,10 @@ mod tests {
         use rand::{RngExt, SeedableRng};
         // A bumpy grid surface.
         let n = 12;
-        let mut positions = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-                positions.push(DVec3::new(x, y, 0.1 * (7.0 * x).sin() * (5.0 * y).cos()));
-            }
-        }
-        let mut triangles = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                let v = (j * (n + 1) + i) as u32;
-                let w = v + n as u32 + 1;
-                triangles.push([v, v + 1, w + 1]);
-                triangles.push([v, w + 1, w]);
-            }
-        }
-        let mesh = TriMesh::new(positions, triangles);
+        let mesh = crate::mesh::test_meshes::grid(n, |i, j| {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            DVec3::new(x, y, 0.1 * (7.0 * x).sin() * (5.0 * y).cos())
+        });
         let s = MeshSurface::new(&mesh).unwrap();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         for _ in 0..200 {

@@ -23,6 +23,7 @@ use parry3d_f64::shape::Triangle;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
+use super::refine::starting_at;
 use crate::mesh::TriMesh;
 use crate::quality::{triangle_angles_deg, triangle_q};
 use crate::surface::mesh_projection::MeshSurface;
@@ -235,17 +236,6 @@ impl EditMesh {
             .map(|&f| self.original[f as usize].then_some(f))
             .collect();
         (TriMesh::new(self.positions, faces), origin)
-    }
-}
-
-/// Rotates `t` so that it starts with `v` (which must be a corner).
-fn starting_at(t: [u32; 3], v: u32) -> [u32; 3] {
-    if t[0] == v {
-        t
-    } else if t[1] == v {
-        [t[1], t[2], t[0]]
-    } else {
-        [t[2], t[0], t[1]]
     }
 }
 
@@ -792,24 +782,18 @@ mod tests {
     use super::*;
     use crate::quality::{check_invariants, topology, triangle_quality};
 
-    /// An `n × n` grid of squares of side `h` in the plane z = 0, each cut by a diagonal.
+    /// An `n × n` grid of squares of side `h` in the plane z = 0.
     fn grid(n: usize, h: f64) -> TriMesh {
-        let mut positions = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                positions.push(DVec3::new(i as f64 * h, j as f64 * h, 0.0));
-            }
-        }
-        let mut triangles = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                let v = (j * (n + 1) + i) as u32;
-                let w = v + n as u32 + 1;
-                triangles.push([v, v + 1, w + 1]);
-                triangles.push([v, w + 1, w]);
-            }
-        }
-        TriMesh::new(positions, triangles)
+        crate::mesh::test_meshes::grid(n, |i, j| DVec3::new(i as f64 * h, j as f64 * h, 0.0))
+    }
+
+    /// A manifold single disk (after dropping unreferenced vertices) that passes every invariant.
+    fn assert_manifold_disk(mesh: &mut TriMesh) {
+        mesh.remove_unreferenced_vertices();
+        let t = topology(mesh);
+        assert!(t.is_manifold() && t.euler_characteristic == 1 && t.components == 1);
+        let problems = check_invariants(mesh);
+        assert!(problems.is_empty(), "{problems:?}");
     }
 
     fn no_cover() -> OptimizeParams {
@@ -838,14 +822,7 @@ mod tests {
             after.q_min
         );
         assert!(mesh.positions.iter().all(|p| p.z.abs() < 1e-12));
-        mesh.remove_unreferenced_vertices();
-        let t = topology(&mesh);
-        assert!(t.is_manifold() && t.euler_characteristic == 1 && t.components == 1);
-        assert!(
-            check_invariants(&mesh).is_empty(),
-            "{:?}",
-            check_invariants(&mesh)
-        );
+        assert_manifold_disk(&mut mesh);
     }
 
     #[test]
@@ -901,14 +878,7 @@ mod tests {
         let fixed = vec![false; mesh.vertex_count()];
         let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, 1.0, &no_cover());
         assert!(stats.collapses >= 1, "{stats:?}");
-        mesh.remove_unreferenced_vertices();
-        let t = topology(&mesh);
-        assert!(t.is_manifold() && t.euler_characteristic == 1 && t.components == 1);
-        assert!(
-            check_invariants(&mesh).is_empty(),
-            "{:?}",
-            check_invariants(&mesh)
-        );
+        assert_manifold_disk(&mut mesh);
         assert!(triangle_quality(&mesh).theta_min > 30.0);
     }
 

@@ -49,8 +49,8 @@ fn min_angle(b: &Builder, t: [u32; 3]) -> f64 {
     a[0].min(a[1]).min(a[2])
 }
 
-/// Rotates `t` so that it starts with `v`.
-fn starting_at(t: [u32; 3], v: u32) -> [u32; 3] {
+/// Rotates `t` so that it starts with `v` (which must be a corner).
+pub(super) fn starting_at(t: [u32; 3], v: u32) -> [u32; 3] {
     if t[0] == v {
         t
     } else if t[1] == v {
