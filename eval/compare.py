@@ -25,6 +25,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from ruler_check import read_obj, triangle_angles, weld
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -84,26 +85,11 @@ def read_mesh(path):
     import trimesh
 
     if Path(path).suffix.lower() == ".obj":
-        v, f = [], []
-        for line in Path(path).read_text().splitlines():
-            p = line.split()
-            if not p:
-                continue
-            if p[0] == "v":
-                v.append([float(x) for x in p[1:4]])
-            elif p[0] == "f":
-                idx = [int(c.split("/")[0]) for c in p[1:]]
-                idx = [i - 1 if i > 0 else len(v) + i for i in idx]
-                f.extend([idx[0], idx[k], idx[k + 1]] for k in range(1, len(idx) - 1))
-        V, F = np.array(v, dtype=np.float64), np.array(f, dtype=np.int64)
+        V, F = read_obj(path)
     else:
         m = trimesh.load(path, force="mesh", process=False)
         V, F = np.asarray(m.vertices, dtype=np.float64), np.asarray(m.faces, dtype=np.int64)
-    _, first, inverse = np.unique(V, axis=0, return_index=True, return_inverse=True)
-    F = first[inverse.ravel()[F]]
-    F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
-    used, F = np.unique(F, return_inverse=True)
-    return V[used], F.reshape(-1, 3)
+    return weld(V, F)
 
 
 def write_obj(path, V, F):
@@ -347,14 +333,7 @@ def histogram_png(model, rows, path):
     for r in rows:
         if not r.get("mesh_file"):
             continue
-        V, F = read_mesh(r["mesh_file"])
-        T = V[F]
-        ang = []
-        for k in range(3):
-            e1 = T[:, (k + 1) % 3] - T[:, k]
-            e2 = T[:, (k + 2) % 3] - T[:, k]
-            ang.append(np.degrees(np.arctan2(np.linalg.norm(np.cross(e1, e2), axis=1), np.einsum("ij,ij->i", e1, e2))))
-        amin = np.min(ang, axis=0)
+        amin = triangle_angles(*read_mesh(r["mesh_file"])).min(1)
         color = plt.get_cmap("tab10")(list(METHODS).index(r["key"]))
         ax.hist(amin, bins=bins, histtype="step", density=True, linewidth=1.4, label=r["method"], color=color)
     ax.axvline(30, color="grey", linestyle=":", linewidth=1)

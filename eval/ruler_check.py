@@ -51,7 +51,8 @@ def weld(V, F):
     return V[used], F.reshape(-1, 3)
 
 
-def measures(V, F):
+def triangle_angles(V, F):
+    """The three interior angles of every triangle, degrees (F×3), by atan2(|e1×e2|, e1·e2)."""
     T = V[F]
     angles = np.empty((len(F), 3))
     for k in range(3):
@@ -60,6 +61,12 @@ def measures(V, F):
         angles[:, k] = np.degrees(
             np.arctan2(np.linalg.norm(np.cross(e1, e2), axis=1), np.einsum("ij,ij->i", e1, e2))
         )
+    return angles
+
+
+def measures(V, F):
+    T = V[F]
+    angles = triangle_angles(V, F)
     lengths = np.linalg.norm(T[:, [1, 2, 0]] - T, axis=2)
     area = 0.5 * np.linalg.norm(np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]), axis=1)
     q = 6 * area / (np.sqrt(3) * 0.5 * lengths.sum(1) * lengths.max(1))
