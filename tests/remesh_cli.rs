@@ -235,3 +235,36 @@ fn bad_input_is_a_one_line_error_with_a_nonzero_exit_and_no_output() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn points_subcommand_writes_a_point_set_on_the_surface() {
+    use spectral_remesh::points::PlyPointReader;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("spot-points.ply");
+    let status = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .args(["points"])
+        .arg(shared("spot.obj"))
+        .arg(&out)
+        .args(["--count", "2000", "--seed", "5"])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let mut r = PlyPointReader::open(&out).unwrap();
+    assert_eq!(r.count(), 2000);
+    assert!(r.has_normals());
+    let mut pts = Vec::new();
+    assert_eq!(r.read_chunk(&mut pts, 5000).unwrap(), 2000);
+    // On the surface: each point within float precision of the input mesh.
+    let (mesh, _) = spectral_remesh::io::read_mesh(&shared("spot.obj")).unwrap();
+    let surface = spectral_remesh::MeshSurface::new(&mesh).unwrap();
+    for p in &pts {
+        let sp = surface.closest_point(p.position).unwrap();
+        assert!(
+            sp.distance < 1e-5,
+            "{:?} is {} off",
+            p.position,
+            sp.distance
+        );
+        assert!((p.normal.length() - 1.0).abs() < 1e-5);
+    }
+}

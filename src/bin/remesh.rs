@@ -16,7 +16,8 @@ Examples:
   remesh data/spot.obj spot-3k.obj --points 3000
   remesh horse.ply horse.glb --points 8600 --report horse.json
   remesh fandisk.obj fandisk.obj.ply --points 6000 --sigma-n 0.75
-  remesh quality out.obj --ref in.obj";
+  remesh quality out.obj --ref in.obj
+  remesh points horse.obj horse-14M.ply --count 14000000";
 
 /// Spectral remeshing of triangle meshes (Öztireli, Alexa, Gross 2010: Spectral Sampling of
 /// Manifolds): samples the input surface with the spectral measure, triangulates the samples,
@@ -92,6 +93,20 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+    /// Draw random points with normals uniformly by area from a mesh's surface and write them as
+    /// binary PLY (streamed: any count fits in memory). Makes large point-cloud inputs.
+    Points {
+        /// The mesh to draw from (.obj, .ply, .gltf, .glb).
+        mesh: PathBuf,
+        /// The output point set (.ply).
+        output: PathBuf,
+        /// How many points.
+        #[arg(long)]
+        count: u64,
+        /// Seed of the random draw.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
 }
 
 fn write_report(path: &PathBuf, json: &str) -> Result<(), Error> {
@@ -110,6 +125,16 @@ fn emit(text: &str) {
 }
 
 fn run(cli: Cli) -> Result<(), Error> {
+    if let Some(Command::Points {
+        mesh,
+        output,
+        count,
+        seed,
+    }) = &cli.command
+    {
+        let (m, _) = spectral_remesh::io::read_mesh(mesh)?;
+        return spectral_remesh::points::generate::write_surface_points(&m, *count, *seed, output);
+    }
     if let Some(Command::Quality {
         mesh,
         reference,

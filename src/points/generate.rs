@@ -1,0 +1,135 @@
+//! Dense random point sets drawn from a mesh's surface, streamed to a PLY file: the large inputs
+//! of the point-cloud tests and benchmarks (millions of points) are made, not committed.
+
+use std::path::Path;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::ply_stream::{PlyPointWriter, Point};
+use crate::error::{Error, Result};
+use crate::mesh::TriMesh;
+
+/// Points drawn per chunk (bounds the memory of [`write_surface_points`]).
+const CHUNK: usize = 1 << 20;
+
+/// Draws `count` points uniformly by area on `mesh` (model units) and writes them with normals
+/// (the angle-weighted vertex normals interpolated at the point) to `path` as binary PLY, in
+/// chunks: memory stays O(mesh + 1M points) whatever `count` is. Deterministic for a `seed`.
+///
+/// # Errors
+/// [`Error::InvalidMesh`] when the mesh has no area; [`Error::Write`] when the file cannot be
+/// written (nothing is left at `path` then).
+pub fn write_surface_points(mesh: &TriMesh, count: u64, seed: u64, path: &Path) -> Result<()> {
+    // Cumulative face areas for inverse-transform sampling of the face.
+    let mut cumulative = Vec::with_capacity(mesh.face_count());
+    let mut total = 0.0;
+    for f in 0..mesh.face_count() {
+        let a = mesh.face_area(f);
+        total += if a.is_finite() { a } else { 0.0 };
+        cumulative.push(total);
+    }
+    if !(total > 0.0) {
+        return Err(Error::invalid_mesh(
+            "",
+            "the mesh has no area to draw points from",
+        ));
+    }
+    let normals = mesh.vertex_normals();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut writer = PlyPointWriter::create(path, count)?;
+    let mut chunk: Vec<Point> = Vec::with_capacity(CHUNK.min(count as usize));
+    let mut left = count;
+    while left > 0 {
+        let n = (left as usize).min(CHUNK);
+        chunk.clear();
+        for _ in 0..n {
+            let r = rng.random::<f64>() * total;
+            let f = cumulative
+                .partition_point(|&c| c <= r)
+                .min(mesh.face_count() - 1);
+            let (mut u, mut v) = (rng.random::<f64>(), rng.random::<f64>());
+            if u + v > 1.0 {
+                u = 1.0 - u;
+                v = 1.0 - v;
+            }
+            let t = mesh.triangles[f];
+            let [a, b, c] = mesh.corners(f);
+            let position = a + u * (b - a) + v * (c - a);
+            let w = 1.0 - u - v;
+            let n = w * normals[t[0] as usize]
+                + u * normals[t[1] as usize]
+                + v * normals[t[2] as usize];
+            let normal = n.try_normalize().unwrap_or_else(|| mesh.face_normal(f));
+            chunk.push(Point { position, normal });
+        }
+        writer.write(&chunk)?;
+        left -= n as u64;
+    }
+    writer.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::points::ply_stream::PlyPointReader;
+    use glam::DVec3;
+
+    #[test]
+    fn points_lie_on_the_surface_with_its_normals_and_the_seed_repeats() {
+        // The unit cube's six faces.
+        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let positions = vec![
+            p(0., 0., 0.),
+            p(1., 0., 0.),
+            p(1., 1., 0.),
+            p(0., 1., 0.),
+            p(0., 0., 1.),
+            p(1., 0., 1.),
+            p(1., 1., 1.),
+            p(0., 1., 1.),
+        ];
+        let triangles = vec![
+            [0, 2, 1],
+            [0, 3, 2],
+            [4, 5, 6],
+            [4, 6, 7],
+            [0, 1, 5],
+            [0, 5, 4],
+            [1, 2, 6],
+            [1, 6, 5],
+            [2, 3, 7],
+            [2, 7, 6],
+            [3, 0, 4],
+            [3, 4, 7],
+        ];
+        let cube = TriMesh::new(positions, triangles);
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.ply"), dir.path().join("b.ply"));
+        write_surface_points(&cube, 5000, 3, &a).unwrap();
+        write_surface_points(&cube, 5000, 3, &b).unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+        let mut r = PlyPointReader::open(&a).unwrap();
+        let mut pts = Vec::new();
+        assert_eq!(r.read_chunk(&mut pts, 10_000).unwrap(), 5000);
+        let mut per_face = [0usize; 6];
+        for q in &pts {
+            let x = q.position;
+            let d = [x.z, 1.0 - x.z, x.y, 1.0 - x.x, 1.0 - x.y, x.x];
+            let (face, dist) = d
+                .iter()
+                .enumerate()
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .map(|(k, &v)| (k, v))
+                .unwrap();
+            assert!(dist.abs() < 1e-6, "{x:?} is off the cube");
+            assert!(q.normal.length() > 0.99);
+            per_face[face] += 1;
+        }
+        // Uniform by area: about 5000/6 per face.
+        assert!(
+            per_face.iter().all(|&c| (700..=970).contains(&c)),
+            "{per_face:?}"
+        );
+    }
+}

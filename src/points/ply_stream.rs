@@ -1,0 +1,524 @@
+//! Streaming PLY for point sets: a reader that hands out the `vertex` element in chunks (so a
+//! file of tens of millions of points never has to be in memory at once) and a writer of binary
+//! little-endian PLY with normals.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use crate::error::{Error, Result};
+
+/// One point of a point set: position and unit normal (`DVec3::ZERO` when the file has none).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Point {
+    /// Position (the file's units).
+    pub position: DVec3,
+    /// Unit normal, or zero.
+    pub normal: DVec3,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Encoding {
+    Ascii,
+    BinaryLittle,
+    BinaryBig,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(name: &str) -> Option<Scalar> {
+        Some(match name {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+
+    fn decode(self, b: &[u8], little: bool) -> f64 {
+        macro_rules! num {
+            ($t:ty, $n:expr) => {{
+                let a: [u8; $n] = b[..$n].try_into().unwrap_or([0; $n]);
+                if little {
+                    <$t>::from_le_bytes(a) as f64
+                } else {
+                    <$t>::from_be_bytes(a) as f64
+                }
+            }};
+        }
+        match self {
+            Scalar::I8 => num!(i8, 1),
+            Scalar::U8 => num!(u8, 1),
+            Scalar::I16 => num!(i16, 2),
+            Scalar::U16 => num!(u16, 2),
+            Scalar::I32 => num!(i32, 4),
+            Scalar::U32 => num!(u32, 4),
+            Scalar::F32 => num!(f32, 4),
+            Scalar::F64 => num!(f64, 8),
+        }
+    }
+}
+
+/// Reads the `vertex` element of a PLY file (ascii or binary of either byte order) in chunks.
+/// The `vertex` element must be the first element of the file; its properties must be scalars;
+/// `x y z` are required, `nx ny nz` are used when all three are present, everything else is
+/// skipped.
+pub struct PlyPointReader {
+    path: PathBuf,
+    input: BufReader<File>,
+    encoding: Encoding,
+    count: u64,
+    read: u64,
+    /// Per property: its type and where it goes (0-2 position, 3-5 normal, none).
+    properties: Vec<(Scalar, Option<usize>)>,
+    record_size: usize,
+    has_normals: bool,
+    buffer: Vec<u8>,
+    line: String,
+    line_number: usize,
+}
+
+impl PlyPointReader {
+    /// Opens `path` and reads its header.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be opened; [`Error::Parse`] naming the file for a
+    /// header that is not PLY, lacks `x y z`, or has no leading `vertex` element.
+    pub fn open(path: &Path) -> Result<Self> {
+        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        let mut input = BufReader::with_capacity(1 << 20, file);
+        let parse = |line: usize, message: String| Error::Parse {
+            path: path.to_path_buf(),
+            line: Some(line),
+            message,
+        };
+        let mut line = String::new();
+        let mut line_number = 0;
+        let next_line = |input: &mut BufReader<File>, line: &mut String, number: &mut usize| {
+            line.clear();
+            *number += 1;
+            let n = input.read_line(line).map_err(|e| Error::io(path, e))?;
+            Ok::<bool, Error>(n > 0)
+        };
+        if !next_line(&mut input, &mut line, &mut line_number)? || line.trim_end() != "ply" {
+            return Err(parse(
+                1,
+                "not a PLY file (the first line is not `ply`)".into(),
+            ));
+        }
+        let mut encoding = None;
+        let mut count = None;
+        let mut in_vertex = false;
+        let mut seen_element = false;
+        let mut properties: Vec<(Scalar, Option<usize>)> = Vec::new();
+        let mut names: Vec<String> = Vec::new();
+        loop {
+            if !next_line(&mut input, &mut line, &mut line_number)? {
+                return Err(parse(line_number, "the header has no `end_header`".into()));
+            }
+            let words: Vec<&str> = line.split_whitespace().collect();
+            match words.as_slice() {
+                ["end_header"] => break,
+                ["format", f, _] => {
+                    encoding = Some(match *f {
+                        "ascii" => Encoding::Ascii,
+                        "binary_little_endian" => Encoding::BinaryLittle,
+                        "binary_big_endian" => Encoding::BinaryBig,
+                        other => {
+                            return Err(parse(line_number, format!("unknown format `{other}`")))
+                        }
+                    })
+                }
+                ["comment", ..] | ["obj_info", ..] | [] => {}
+                ["element", name, n] => {
+                    if !seen_element {
+                        if *name != "vertex" {
+                            return Err(parse(
+                                line_number,
+                                format!(
+                                    "the first element is `{name}`; point sets need `vertex` first"
+                                ),
+                            ));
+                        }
+                        count =
+                            Some(n.parse::<u64>().map_err(|_| {
+                                parse(line_number, format!("bad vertex count `{n}`"))
+                            })?);
+                        in_vertex = true;
+                    } else {
+                        in_vertex = false;
+                    }
+                    seen_element = true;
+                }
+                ["property", "list", ..] if in_vertex => {
+                    return Err(parse(
+                        line_number,
+                        "list properties in `vertex` are not supported".into(),
+                    ))
+                }
+                ["property", ty, name] if in_vertex => {
+                    let scalar = Scalar::parse(ty).ok_or_else(|| {
+                        parse(line_number, format!("unknown property type `{ty}`"))
+                    })?;
+                    properties.push((scalar, None));
+                    names.push((*name).to_string());
+                }
+                ["property", ..] => {}
+                _ => {
+                    return Err(parse(
+                        line_number,
+                        format!("unexpected header line `{}`", line.trim_end()),
+                    ))
+                }
+            }
+        }
+        let encoding =
+            encoding.ok_or_else(|| parse(line_number, "the header has no `format` line".into()))?;
+        let count = count.ok_or_else(|| parse(line_number, "no `vertex` element".into()))?;
+        let slot = |n: &str| names.iter().position(|m| m == n);
+        for (k, name) in ["x", "y", "z"].iter().enumerate() {
+            let i = slot(name)
+                .ok_or_else(|| parse(line_number, format!("the vertex element has no `{name}`")))?;
+            properties[i].1 = Some(k);
+        }
+        let normal_slots: Vec<Option<usize>> = ["nx", "ny", "nz"].iter().map(|n| slot(n)).collect();
+        let has_normals = normal_slots.iter().all(Option::is_some);
+        if has_normals {
+            for (k, i) in normal_slots.into_iter().flatten().enumerate() {
+                properties[i].1 = Some(3 + k);
+            }
+        }
+        let record_size = properties.iter().map(|p| p.0.size()).sum();
+        Ok(PlyPointReader {
+            path: path.to_path_buf(),
+            input,
+            encoding,
+            count,
+            read: 0,
+            properties,
+            record_size,
+            has_normals,
+            buffer: Vec::new(),
+            line,
+            line_number,
+        })
+    }
+
+    /// The number of points the header announces.
+    pub fn count(&self) -> u64 {
+        self.count
+    }
+
+    /// Whether the points have normals (`nx ny nz`).
+    pub fn has_normals(&self) -> bool {
+        self.has_normals
+    }
+
+    /// Replaces `out` with up to `max` next points; returns how many (0 at the end).
+    ///
+    /// # Errors
+    /// [`Error::Parse`] naming the file for a truncated payload, a malformed ascii line or a
+    /// non-finite coordinate; [`Error::Io`] for a read failure.
+    pub fn read_chunk(&mut self, out: &mut Vec<Point>, max: usize) -> Result<usize> {
+        out.clear();
+        let n = (self.count - self.read).min(max as u64) as usize;
+        if n == 0 {
+            return Ok(0);
+        }
+        let mut values = [0.0f64; 6];
+        match self.encoding {
+            Encoding::Ascii => {
+                for _ in 0..n {
+                    self.line.clear();
+                    self.line_number += 1;
+                    let got = self
+                        .input
+                        .read_line(&mut self.line)
+                        .map_err(|e| Error::io(&self.path, e))?;
+                    if got == 0 {
+                        return Err(self.truncated());
+                    }
+                    let mut words = self.line.split_whitespace();
+                    for &(_, slot) in &self.properties {
+                        let w = words.next().ok_or_else(|| Error::Parse {
+                            path: self.path.clone(),
+                            line: Some(self.line_number),
+                            message: "too few values for the vertex properties".into(),
+                        })?;
+                        if let Some(k) = slot {
+                            values[k] = w.parse().map_err(|_| Error::Parse {
+                                path: self.path.clone(),
+                                line: Some(self.line_number),
+                                message: format!("`{w}` is not a number"),
+                            })?;
+                        }
+                    }
+                    self.push(out, &values)?;
+                }
+            }
+            Encoding::BinaryLittle | Encoding::BinaryBig => {
+                let little = self.encoding == Encoding::BinaryLittle;
+                self.buffer.resize(n * self.record_size, 0);
+                self.input.read_exact(&mut self.buffer).map_err(|e| {
+                    if e.kind() == std::io::ErrorKind::UnexpectedEof {
+                        self.truncated()
+                    } else {
+                        Error::io(&self.path, e)
+                    }
+                })?;
+                let buffer = std::mem::take(&mut self.buffer);
+                for record in buffer.chunks_exact(self.record_size) {
+                    let mut offset = 0;
+                    for &(ty, slot) in &self.properties {
+                        if let Some(k) = slot {
+                            values[k] = ty.decode(&record[offset..], little);
+                        }
+                        offset += ty.size();
+                    }
+                    self.push(out, &values)?;
+                }
+                self.buffer = buffer;
+            }
+        }
+        Ok(n)
+    }
+
+    fn push(&mut self, out: &mut Vec<Point>, v: &[f64; 6]) -> Result<()> {
+        let position = DVec3::new(v[0], v[1], v[2]);
+        if !position.is_finite() {
+            return Err(Error::Parse {
+                path: self.path.clone(),
+                line: None,
+                message: format!("point {} has a non-finite coordinate", self.read),
+            });
+        }
+        let normal = if self.has_normals {
+            DVec3::new(v[3], v[4], v[5]).normalize_or_zero()
+        } else {
+            DVec3::ZERO
+        };
+        out.push(Point { position, normal });
+        self.read += 1;
+        Ok(())
+    }
+
+    fn truncated(&self) -> Error {
+        Error::Parse {
+            path: self.path.clone(),
+            line: None,
+            message: format!(
+                "truncated: the header announces {} points, the file ends after {}",
+                self.count, self.read
+            ),
+        }
+    }
+}
+
+/// Writes points with normals as binary little-endian PLY (`x y z nx ny nz`, float32), to a
+/// temporary file beside the target that [`PlyPointWriter::finish`] renames into place: a failure
+/// never leaves a partial file at the target. The count must be known when the file is created.
+pub struct PlyPointWriter {
+    path: PathBuf,
+    temporary: PathBuf,
+    output: BufWriter<File>,
+    count: u64,
+    written: u64,
+}
+
+impl PlyPointWriter {
+    /// Starts a file of exactly `count` points at `path`.
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming `path` when the temporary file cannot be created.
+    pub fn create(path: &Path, count: u64) -> Result<Self> {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let temporary = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+        let write_error = |e: std::io::Error| Error::Write {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        let file = File::create(&temporary).map_err(write_error)?;
+        let mut output = BufWriter::with_capacity(1 << 20, file);
+        write!(
+            output,
+            "ply\nformat binary_little_endian 1.0\ncomment spectral-remesh point set\n\
+             element vertex {count}\nproperty float x\nproperty float y\nproperty float z\n\
+             property float nx\nproperty float ny\nproperty float nz\nend_header\n"
+        )
+        .map_err(write_error)?;
+        Ok(PlyPointWriter {
+            path: path.to_path_buf(),
+            temporary,
+            output,
+            count,
+            written: 0,
+        })
+    }
+
+    /// Appends points.
+    ///
+    /// # Errors
+    /// [`Error::Write`] on a write failure or when more points than announced are written.
+    pub fn write(&mut self, points: &[Point]) -> Result<()> {
+        if self.written + points.len() as u64 > self.count {
+            return Err(self.error(format!("more than the {} points announced", self.count)));
+        }
+        let mut bytes = Vec::with_capacity(points.len() * 24);
+        for p in points {
+            for v in [
+                p.position.x,
+                p.position.y,
+                p.position.z,
+                p.normal.x,
+                p.normal.y,
+                p.normal.z,
+            ] {
+                bytes.extend_from_slice(&(v as f32).to_le_bytes());
+            }
+        }
+        self.output
+            .write_all(&bytes)
+            .map_err(|e| self.error(e.to_string()))?;
+        self.written += points.len() as u64;
+        Ok(())
+    }
+
+    /// Completes the file and moves it to its path.
+    ///
+    /// # Errors
+    /// [`Error::Write`] when fewer points than announced were written or the file cannot be
+    /// completed; the temporary file is removed.
+    pub fn finish(mut self) -> Result<()> {
+        let result = (|| {
+            if self.written != self.count {
+                return Err(self.error(format!(
+                    "{} points written of the {} announced",
+                    self.written, self.count
+                )));
+            }
+            self.output.flush().map_err(|e| self.error(e.to_string()))?;
+            std::fs::rename(&self.temporary, &self.path).map_err(|e| self.error(e.to_string()))
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&self.temporary);
+        }
+        result
+    }
+
+    fn error(&self, message: String) -> Error {
+        Error::Write {
+            path: self.path.clone(),
+            message,
+        }
+    }
+}
+
+impl Drop for PlyPointWriter {
+    fn drop(&mut self) {
+        // Not finished (an error on the way): leave nothing behind. After a rename this fails
+        // harmlessly.
+        let _ = std::fs::remove_file(&self.temporary);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn points(n: usize) -> Vec<Point> {
+        (0..n)
+            .map(|i| Point {
+                position: DVec3::new(i as f64, 0.5 * i as f64, -(i as f64)),
+                normal: DVec3::new(0.0, 0.0, 1.0),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn written_points_read_back_in_chunks() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.ply");
+        let mut w = PlyPointWriter::create(&path, 10).unwrap();
+        w.write(&points(4)).unwrap();
+        w.write(&points(10)[4..]).unwrap();
+        w.finish().unwrap();
+        let mut r = PlyPointReader::open(&path).unwrap();
+        assert_eq!(r.count(), 10);
+        assert!(r.has_normals());
+        let (mut all, mut chunk) = (Vec::new(), Vec::new());
+        while r.read_chunk(&mut chunk, 3).unwrap() > 0 {
+            all.extend_from_slice(&chunk);
+        }
+        assert_eq!(all, points(10));
+        // Only the file itself is left in the folder.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn ascii_without_normals_and_extra_properties() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.ply");
+        std::fs::write(
+            &path,
+            "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty uchar red\n\
+             property float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\n\
+             end_header\n1 255 2 3\n4 0 5 6\n",
+        )
+        .unwrap();
+        let mut r = PlyPointReader::open(&path).unwrap();
+        assert!(!r.has_normals());
+        let mut chunk = Vec::new();
+        assert_eq!(r.read_chunk(&mut chunk, 10).unwrap(), 2);
+        assert_eq!(chunk[1].position, DVec3::new(4.0, 5.0, 6.0));
+        assert_eq!(chunk[1].normal, DVec3::ZERO);
+    }
+
+    #[test]
+    fn a_truncated_file_and_a_short_write_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.ply");
+        let mut w = PlyPointWriter::create(&path, 5).unwrap();
+        w.write(&points(5)).unwrap();
+        w.finish().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() - 10]).unwrap();
+        let mut r = PlyPointReader::open(&path).unwrap();
+        let err = r.read_chunk(&mut Vec::new(), 100).unwrap_err().to_string();
+        assert!(err.contains("truncated") && err.contains("t.ply"), "{err}");
+        let short = dir.path().join("short.ply");
+        let mut w = PlyPointWriter::create(&short, 5).unwrap();
+        w.write(&points(2)).unwrap();
+        assert!(w.finish().is_err());
+        assert!(!short.exists());
+    }
+}
