@@ -4,6 +4,7 @@ use super::SurfaceSample;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{spectral_measure, MeasureWorkspace, DEFAULT_EPSILON};
 use crate::spatial::DynamicTree;
+use glam::DVec3;
 
 /// Parameters of the linear scan.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,6 +40,108 @@ pub struct LinearScanResult {
     pub measured: usize,
 }
 
+/// The state of Algorithm 1 as points stream past: the output set O (embedded in kernel space,
+/// in a dynamic kd-tree over positions) and the statistics. [`linear_scan`] drives it over a
+/// slice; the out-of-core scan drives it over a file. Positions are in bbox-100 units.
+pub struct LinearScanner<'k> {
+    kernel: &'k Kernel,
+    params: LinearScanParams,
+    tree: DynamicTree,
+    embedded: Vec<KernelPoint>,
+    ws: MeasureWorkspace,
+    found: Vec<(u32, f64)>,
+    neighbors: Vec<(f64, KernelPoint)>,
+    /// Candidates rejected by their nearest output sample alone.
+    pub rejected_by_nearest: usize,
+    /// Candidates whose measure was evaluated with eq. 10.
+    pub measured: usize,
+}
+
+impl<'k> LinearScanner<'k> {
+    /// An empty output set.
+    pub fn new(kernel: &'k Kernel, params: &LinearScanParams) -> Self {
+        LinearScanner {
+            kernel,
+            params: *params,
+            tree: DynamicTree::new(),
+            embedded: Vec::new(),
+            ws: MeasureWorkspace::new(),
+            found: Vec::new(),
+            neighbors: Vec::new(),
+            rejected_by_nearest: 0,
+            measured: 0,
+        }
+    }
+
+    /// The number of points in O.
+    pub fn len(&self) -> usize {
+        self.embedded.len()
+    }
+
+    /// Whether O is empty.
+    pub fn is_empty(&self) -> bool {
+        self.embedded.is_empty()
+    }
+
+    /// Puts a point into O without testing it (an initial sample).
+    pub fn insert(&mut self, position: DVec3, normal: DVec3) {
+        self.tree.add(position, self.embedded.len() as u32);
+        self.embedded.push(self.kernel.embed(position, normal));
+    }
+
+    /// One step of Algorithm 1: adds the point to O and returns true when s(x) > epsilon against
+    /// its neighbours in O (or it has none). A candidate whose nearest output sample alone gives
+    /// s <= 1 - k(x, x_1)^2 <= epsilon is rejected without a kernel matrix.
+    pub fn offer(&mut self, position: DVec3, normal: DVec3) -> bool {
+        let kernel = self.kernel;
+        let x = kernel.embed(position, normal);
+        let r_pos = self.params.support_radius * kernel.sigma_p();
+        let r_kernel_2 = self.params.support_radius * self.params.support_radius;
+        let accept = match self.tree.nearest(position) {
+            None => true,
+            Some((j, _)) => {
+                let k1 = kernel.eval(&x, &self.embedded[j as usize]);
+                if k1 * k1 >= 1.0 - self.params.epsilon {
+                    self.rejected_by_nearest += 1;
+                    false
+                } else {
+                    self.tree.within(position, r_pos * r_pos, &mut self.found);
+                    self.neighbors.clear();
+                    for &(j, _) in &self.found {
+                        let y = self.embedded[j as usize];
+                        let d2 = x.dist2(&y);
+                        if d2 <= r_kernel_2 {
+                            self.neighbors.push((d2, y));
+                        }
+                    }
+                    if self.neighbors.is_empty() {
+                        true
+                    } else {
+                        if !kernel.is_isotropic() {
+                            // Nearest first in kernel space (positions alone order them otherwise).
+                            self.neighbors.sort_by(|a, b| a.0.total_cmp(&b.0));
+                        }
+                        self.measured += 1;
+                        let m = spectral_measure(
+                            kernel,
+                            &x,
+                            self.neighbors.iter().map(|n| n.1),
+                            self.params.epsilon,
+                            &mut self.ws,
+                        );
+                        m.s > self.params.epsilon
+                    }
+                }
+            }
+        };
+        if accept {
+            self.tree.add(position, self.embedded.len() as u32);
+            self.embedded.push(x);
+        }
+        accept
+    }
+}
+
 /// Algorithm 1: visits `candidates` in the order given (pass them shuffled) and adds each to the
 /// output set O when its spectral measure s(x) (eq. 9) against its neighbours in O exceeds
 /// epsilon, or when it has no neighbour in O. `initial` samples (for example samples placed on the
@@ -57,74 +160,20 @@ pub fn linear_scan(
     params: &LinearScanParams,
 ) -> LinearScanResult {
     let mut samples: Vec<SurfaceSample> = Vec::with_capacity(initial.len() + candidates.len() / 8);
-    let mut embedded: Vec<KernelPoint> = Vec::with_capacity(samples.capacity());
-    let mut tree = DynamicTree::new();
+    let mut scanner = LinearScanner::new(kernel, params);
     for s in initial {
-        tree.add(s.position, samples.len() as u32);
-        embedded.push(kernel.embed(s.position, s.normal));
+        scanner.insert(s.position, s.normal);
         samples.push(*s);
     }
-
-    let r_pos = params.support_radius * kernel.sigma_p();
-    let r_pos_2 = r_pos * r_pos;
-    let r_kernel_2 = params.support_radius * params.support_radius;
-    // s <= 1 - k_1^2 for any single neighbour; reject when that bound is <= epsilon.
-    let reject_k2 = 1.0 - params.epsilon;
-    let mut ws = MeasureWorkspace::new();
-    let mut found: Vec<(u32, f64)> = Vec::new();
-    let mut neighbors: Vec<(f64, KernelPoint)> = Vec::new();
-    let mut rejected_by_nearest = 0;
-    let mut measured = 0;
-
     for c in candidates {
-        let x = kernel.embed(c.position, c.normal);
-        let accept = match tree.nearest(c.position) {
-            None => true,
-            Some((j, _)) => {
-                let k1 = kernel.eval(&x, &embedded[j as usize]);
-                if k1 * k1 >= reject_k2 {
-                    rejected_by_nearest += 1;
-                    false
-                } else {
-                    tree.within(c.position, r_pos_2, &mut found);
-                    neighbors.clear();
-                    for &(j, _) in &found {
-                        let y = embedded[j as usize];
-                        let d2 = x.dist2(&y);
-                        if d2 <= r_kernel_2 {
-                            neighbors.push((d2, y));
-                        }
-                    }
-                    if neighbors.is_empty() {
-                        true
-                    } else {
-                        if !kernel.is_isotropic() {
-                            // Nearest first in kernel space (positions alone order them otherwise).
-                            neighbors.sort_by(|a, b| a.0.total_cmp(&b.0));
-                        }
-                        measured += 1;
-                        let m = spectral_measure(
-                            kernel,
-                            &x,
-                            neighbors.iter().map(|n| n.1),
-                            params.epsilon,
-                            &mut ws,
-                        );
-                        m.s > params.epsilon
-                    }
-                }
-            }
-        };
-        if accept {
-            tree.add(c.position, samples.len() as u32);
-            embedded.push(x);
+        if scanner.offer(c.position, c.normal) {
             samples.push(*c);
         }
     }
     LinearScanResult {
         samples,
         initial: initial.len(),
-        rejected_by_nearest,
-        measured,
+        rejected_by_nearest: scanner.rejected_by_nearest,
+        measured: scanner.measured,
     }
 }

@@ -1,0 +1,259 @@
+//! Out-of-core simplification of a point set by the randomized linear scan (Sec. 6.1,
+//! Algorithm 1): memory bounded by the output set plus a fixed buffer, not by the input.
+//!
+//! Two passes over the data:
+//! 1. The input is streamed once: its bounding box is taken (for the bbox-100 frame of Sec. 7) and
+//!    every point goes to one of `B` temporary bucket files chosen at random (a bucket shuffle:
+//!    the visit order is random without the input ever being in memory).
+//! 2. Each bucket in turn is loaded (about `bucket_points` points), shuffled, and streamed
+//!    through the linear scan, whose output set O lives in one dynamic kd-tree.
+//!
+//! With `--points N` the sigma_p is found first on the first bucket alone: a uniformly random
+//! subset as dense as the output needs gives the same count (the count depends on sigma_p and the
+//! surface, not on the input's density).
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::DVec3;
+use rand::seq::SliceRandom;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::ply_stream::{PlyPointReader, Point};
+use crate::error::{Error, Result};
+use crate::kernel::Kernel;
+use crate::mesh::{Aabb, Normalization};
+use crate::sampling::linear_scan::{LinearScanParams, LinearScanner};
+use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
+
+/// Parameters of [`simplify_out_of_core`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutOfCoreParams {
+    /// The output density: `Some(n)` searches sigma_p for about n samples.
+    pub target: Option<usize>,
+    /// sigma_p in bbox-100 units, used when `target` is `None`.
+    pub sigma_p: f64,
+    /// sigma_n (infinity: positions only).
+    pub sigma_n: f64,
+    /// The linear scan's epsilon and support radius.
+    pub scan: LinearScanParams,
+    /// Points per bucket (the fixed buffer; default 2^20).
+    pub bucket_points: usize,
+    /// Seed of the bucket assignment and the shuffles.
+    pub seed: u64,
+    /// Where the bucket files go (default: the system's temporary folder).
+    pub temp_dir: Option<PathBuf>,
+}
+
+impl Default for OutOfCoreParams {
+    fn default() -> Self {
+        OutOfCoreParams {
+            target: None,
+            sigma_p: 1.0,
+            sigma_n: f64::INFINITY,
+            scan: LinearScanParams::default(),
+            bucket_points: 1 << 20,
+            seed: 1,
+            temp_dir: None,
+        }
+    }
+}
+
+/// The result of [`simplify_out_of_core`].
+#[derive(Debug, Clone)]
+pub struct OutOfCoreResult {
+    /// The output set O in the input's units, in the order the scan accepted it.
+    pub samples: Vec<Point>,
+    /// Points read.
+    pub input_points: u64,
+    /// Whether the input had normals (without them the kernel uses positions only).
+    pub had_normals: bool,
+    /// The sigma_p used, bbox-100 units.
+    pub sigma_p: f64,
+    /// Model units ↔ bbox-100 units.
+    pub normalization: Normalization,
+    /// Candidates rejected by their nearest output sample alone, and measured with eq. 10.
+    pub rejected_by_nearest: usize,
+    /// Candidates whose measure was evaluated.
+    pub measured: usize,
+    /// Seconds: reading and bucketing, the sigma_p search, the scan.
+    pub seconds: [f64; 3],
+}
+
+const RECORD: usize = 24;
+
+fn encode(p: &Point, out: &mut Vec<u8>) {
+    for v in [
+        p.position.x,
+        p.position.y,
+        p.position.z,
+        p.normal.x,
+        p.normal.y,
+        p.normal.z,
+    ] {
+        out.extend_from_slice(&(v as f32).to_le_bytes());
+    }
+}
+
+fn decode(b: &[u8]) -> Point {
+    let f = |k: usize| {
+        f64::from(f32::from_le_bytes(
+            b[4 * k..4 * k + 4].try_into().unwrap_or([0; 4]),
+        ))
+    };
+    Point {
+        position: DVec3::new(f(0), f(1), f(2)),
+        normal: DVec3::new(f(3), f(4), f(5)),
+    }
+}
+
+/// Simplifies the point set in the PLY file `input` out of core (see the module documentation).
+/// Peak memory: the output set, one bucket, and a 1 MiB write buffer per bucket.
+///
+/// # Errors
+/// Errors of the PLY reader (naming the file); [`Error::InvalidMesh`] for an empty input or one
+/// whose bounding box has no extent; [`Error::Io`] when the temporary files fail.
+pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<OutOfCoreResult> {
+    let t0 = Instant::now();
+    let mut reader = PlyPointReader::open(input)?;
+    let total = reader.count();
+    if total == 0 {
+        return Err(Error::invalid_mesh(input, "the point set is empty"));
+    }
+    let had_normals = reader.has_normals();
+    let buckets = total.div_ceil(params.bucket_points.max(1) as u64).max(1) as usize;
+    let dir = tempfile::Builder::new()
+        .prefix("remesh-buckets")
+        .tempdir_in(params.temp_dir.clone().unwrap_or_else(std::env::temp_dir))
+        .map_err(|e| Error::io(input, e))?;
+    let io_err = |e: std::io::Error| Error::io(dir.path(), e);
+    let mut writers: Vec<BufWriter<File>> = (0..buckets)
+        .map(|b| {
+            File::create(dir.path().join(format!("{b}.bin")))
+                .map(|f| BufWriter::with_capacity(1 << 20, f))
+        })
+        .collect::<std::io::Result<_>>()
+        .map_err(io_err)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    let mut chunk = Vec::new();
+    let mut staged: Vec<Vec<u8>> = vec![Vec::new(); buckets];
+    while reader.read_chunk(&mut chunk, 1 << 16)? > 0 {
+        for p in &chunk {
+            lo = lo.min(p.position);
+            hi = hi.max(p.position);
+            encode(p, &mut staged[rng.random_range(0..buckets)]);
+        }
+        for (w, bytes) in writers.iter_mut().zip(staged.iter_mut()) {
+            w.write_all(bytes).map_err(io_err)?;
+            bytes.clear();
+        }
+    }
+    for w in &mut writers {
+        w.flush().map_err(io_err)?;
+    }
+    drop(writers);
+    let normalization = Normalization::for_bbox(&Aabb { min: lo, max: hi })
+        .ok_or_else(|| Error::invalid_mesh(input, "the points' bounding box has no extent"))?;
+    let t1 = Instant::now();
+
+    let load = |b: usize, rng: &mut ChaCha8Rng| -> Result<Vec<Point>> {
+        let mut bytes = Vec::new();
+        File::open(dir.path().join(format!("{b}.bin")))
+            .and_then(|f| BufReader::new(f).read_to_end(&mut bytes))
+            .map_err(io_err)?;
+        let mut pts: Vec<Point> = bytes
+            .chunks_exact(RECORD)
+            .map(|r| {
+                let p = decode(r);
+                Point {
+                    position: normalization.apply(p.position),
+                    normal: p.normal,
+                }
+            })
+            .collect();
+        pts.shuffle(rng);
+        Ok(pts)
+    };
+
+    // sigma_p: given, or searched on the first bucket.
+    let mut first = Some(load(0, &mut rng)?);
+    let sigma_p = match params.target {
+        None => params.sigma_p,
+        Some(n) => {
+            let pts = first.as_ref().map(Vec::as_slice).unwrap_or_default();
+            let area_guess = surface_area_guess(pts);
+            let start = (area_guess / n.max(1) as f64).sqrt();
+            let search = TargetCountParams::new(n);
+            let mut failure = None;
+            let r = find_sigma_p(&search, start, |s| match Kernel::new(s, params.sigma_n) {
+                Ok(kernel) => {
+                    let mut scanner = LinearScanner::new(&kernel, &params.scan);
+                    for p in pts {
+                        scanner.offer(p.position, p.normal);
+                    }
+                    (scanner.len(), ())
+                }
+                Err(e) => {
+                    failure = Some(e);
+                    (0, ())
+                }
+            });
+            if let Some(e) = failure {
+                return Err(e);
+            }
+            r.sigma_p
+        }
+    };
+    let t2 = Instant::now();
+
+    let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+    let mut scanner = LinearScanner::new(&kernel, &params.scan);
+    let mut samples = Vec::new();
+    for b in 0..buckets {
+        let pts = match first.take() {
+            Some(p) => p,
+            None => load(b, &mut rng)?,
+        };
+        for p in &pts {
+            if scanner.offer(p.position, p.normal) {
+                samples.push(Point {
+                    position: normalization.invert(p.position),
+                    normal: p.normal,
+                });
+            }
+        }
+    }
+    let t3 = Instant::now();
+    Ok(OutOfCoreResult {
+        samples,
+        input_points: total,
+        had_normals,
+        sigma_p,
+        normalization,
+        rejected_by_nearest: scanner.rejected_by_nearest,
+        measured: scanner.measured,
+        seconds: [
+            (t1 - t0).as_secs_f64(),
+            (t2 - t1).as_secs_f64(),
+            (t3 - t2).as_secs_f64(),
+        ],
+    })
+}
+
+/// A first guess of the surface area (bbox-100 units²) of a uniformly random point subset, for
+/// the start of the sigma_p search: the number of occupied cells of a grid of cell size h, times
+/// h² (a surface crosses about area/h² cells).
+fn surface_area_guess(points: &[Point]) -> f64 {
+    let h = 2.0;
+    let mut cells: Vec<[i32; 3]> = points
+        .iter()
+        .map(|p| (p.position / h).floor().as_ivec3().to_array())
+        .collect();
+    cells.sort_unstable();
+    cells.dedup();
+    (cells.len() as f64 * h * h).max(1.0)
+}
