@@ -118,6 +118,31 @@ impl DynamicTree {
         Some(best)
     }
 
+    /// The `k` nearest points to `p`, nearest first, into `out` as `(index, squared distance)`.
+    pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
+        out.clear();
+        let Some(k_nz) = NonZeroUsize::new(k) else {
+            return;
+        };
+        if self.len == 0 {
+            return;
+        }
+        let q = arr(p);
+        if self.len > self.overflow.len() {
+            let r = self
+                .tree
+                .query(&q)
+                .nearest_n::<SquaredEuclidean<f64>>(k_nz)
+                .execute();
+            out.extend(r.into_iter().map(|n| (n.item, n.distance)));
+        }
+        if !self.overflow.is_empty() {
+            out.extend(self.overflow.iter().map(|&(o, i)| (i, dist2(&o, &q))));
+            out.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+            out.truncate(k);
+        }
+    }
+
     /// All points within squared distance `radius_2` of `p`, nearest first, into `out` as
     /// `(index, squared distance)`.
     pub fn within(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {

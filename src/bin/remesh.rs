@@ -286,7 +286,7 @@ fn run_simplify(
     w.finish()?;
     if !quiet {
         emit(&format!(
-            "{} -> {}: {} points -> {} samples, sigma_p {:.4} (bbox-100 units){}\n\
+            "{} -> {}: {} points -> {} samples, sigma_p {:.4} (bbox-100 units){}; {} rejected by the nearest sample, {} measured\n\
              seconds: read+bucket {:.2}, sigma_p search {:.2}, scan {:.2}, total {:.2}\n",
             input.display(),
             output.display(),
@@ -298,6 +298,8 @@ fn run_simplify(
             } else {
                 "; the input has no normals: positions only, zero normals written"
             },
+            r.rejected_by_nearest,
+            r.measured,
             r.seconds[0],
             r.seconds[1],
             r.seconds[2],

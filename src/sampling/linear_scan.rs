@@ -53,7 +53,9 @@ pub struct LinearScanner<'k> {
     neighbors: Vec<(f64, KernelPoint)>,
     /// Candidates rejected by their nearest output sample alone.
     pub rejected_by_nearest: usize,
-    /// Candidates whose measure was evaluated with eq. 10.
+    /// Candidates rejected by the measure over their few nearest output samples.
+    pub rejected_by_few: usize,
+    /// Candidates whose measure was evaluated with eq. 10 over their whole neighbourhood.
     pub measured: usize,
 }
 
@@ -69,6 +71,7 @@ impl<'k> LinearScanner<'k> {
             found: Vec::new(),
             neighbors: Vec::new(),
             rejected_by_nearest: 0,
+            rejected_by_few: 0,
             measured: 0,
         }
     }
@@ -81,6 +84,33 @@ impl<'k> LinearScanner<'k> {
     /// Whether O is empty.
     pub fn is_empty(&self) -> bool {
         self.embedded.is_empty()
+    }
+
+    /// Whether s(x) over the `FEW` nearest points of O (those within the support) is already
+    /// <= epsilon.
+    fn few_nearest_reject(&mut self, position: DVec3, x: &KernelPoint, r_kernel_2: f64) -> bool {
+        const FEW: usize = 4;
+        self.tree.nearest_n(position, FEW, &mut self.found);
+        self.neighbors.clear();
+        for &(j, _) in &self.found {
+            let y = self.embedded[j as usize];
+            let d2 = x.dist2(&y);
+            if d2 <= r_kernel_2 {
+                self.neighbors.push((d2, y));
+            }
+        }
+        if self.neighbors.len() < 2 {
+            return false;
+        }
+        self.neighbors.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let m = spectral_measure(
+            self.kernel,
+            x,
+            self.neighbors.iter().map(|n| n.1),
+            self.params.epsilon,
+            &mut self.ws,
+        );
+        m.s <= self.params.epsilon
     }
 
     /// Puts a point into O without testing it (an initial sample).
@@ -103,6 +133,11 @@ impl<'k> LinearScanner<'k> {
                 let k1 = kernel.eval(&x, &self.embedded[j as usize]);
                 if k1 * k1 >= 1.0 - self.params.epsilon {
                     self.rejected_by_nearest += 1;
+                    false
+                } else if self.few_nearest_reject(position, &x, r_kernel_2) {
+                    // s over a few nearest neighbours is already <= epsilon; s can only fall as
+                    // neighbours are added, so the full neighbourhood would reject too.
+                    self.rejected_by_few += 1;
                     false
                 } else {
                     self.tree.within(position, r_pos * r_pos, &mut self.found);
