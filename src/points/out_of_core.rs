@@ -85,6 +85,9 @@ pub struct OutOfCoreResult {
 
 const RECORD: usize = 24;
 
+/// Input points per wanted sample in the subset the sigma_p search runs on.
+const SEARCH_POINTS_PER_SAMPLE: f64 = 4.0;
+
 fn encode(p: &Point, out: &mut Vec<u8>) {
     for v in [
         p.position.x,
@@ -179,8 +182,19 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         Ok(pts)
     };
 
-    // sigma_p: given, or searched on the first bucket.
-    let mut first = Some(load(0, &mut rng)?);
+    // sigma_p: given, or searched on the first buckets: enough of them for SEARCH_POINTS_PER_SAMPLE
+    // input points per wanted sample (a sparser subset leaves gaps the full scan fills).
+    let search_buckets = match params.target {
+        None => 1,
+        Some(n) => ((SEARCH_POINTS_PER_SAMPLE * n as f64 / params.bucket_points.max(1) as f64)
+            .ceil() as usize)
+            .clamp(1, buckets),
+    };
+    let mut first: Option<Vec<Point>> = None;
+    for b in 0..search_buckets {
+        let pts = load(b, &mut rng)?;
+        first.get_or_insert_with(Vec::new).extend(pts);
+    }
     let sigma_p = match params.target {
         None => params.sigma_p,
         Some(n) => {
@@ -213,11 +227,15 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
     let kernel = Kernel::new(sigma_p, params.sigma_n)?;
     let mut scanner = LinearScanner::new(&kernel, &params.scan);
     let mut samples = Vec::new();
-    for b in 0..buckets {
-        let pts = match first.take() {
-            Some(p) => p,
-            None => load(b, &mut rng)?,
-        };
+    let mut b = search_buckets;
+    while let Some(pts) = match first.take() {
+        Some(p) => Some(p),
+        None if b < buckets => {
+            b += 1;
+            Some(load(b - 1, &mut rng)?)
+        }
+        None => None,
+    } {
         for p in &pts {
             if scanner.offer(p.position, p.normal) {
                 samples.push(Point {

@@ -1,0 +1,80 @@
+//! Point sets: the out-of-core linear scan against the in-memory one on the same input.
+
+use std::path::Path;
+
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use spectral_remesh::kernel::Kernel;
+use spectral_remesh::points::generate::write_surface_points;
+use spectral_remesh::points::out_of_core::{simplify_out_of_core, OutOfCoreParams};
+use spectral_remesh::points::PlyPointReader;
+use spectral_remesh::sampling::linear_scan::{LinearScanParams, LinearScanner};
+use spectral_remesh::spatial::StaticTree;
+
+fn nearest_neighbour_stats(points: &[glam::DVec3]) -> (f64, f64, f64) {
+    let tree = StaticTree::new(points);
+    let mut found = Vec::new();
+    let d: Vec<f64> = points
+        .iter()
+        .map(|&p| {
+            tree.nearest_n(p, 2, &mut found);
+            found[1].1.sqrt()
+        })
+        .collect();
+    let mean = d.iter().sum::<f64>() / d.len() as f64;
+    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / d.len() as f64;
+    let min = d.iter().copied().fold(f64::INFINITY, f64::min);
+    (mean, min, var.sqrt() / mean)
+}
+
+#[test]
+fn out_of_core_scan_matches_the_in_memory_scan() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("spot-200k.ply");
+    let (mesh, _) = spectral_remesh::io::read_mesh(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/spot.obj"),
+    )
+    .unwrap();
+    write_surface_points(&mesh, 200_000, 7, &input).unwrap();
+    let params = OutOfCoreParams {
+        sigma_p: 1.5,
+        bucket_points: 30_000, // several buckets
+        temp_dir: Some(dir.path().to_path_buf()),
+        ..Default::default()
+    };
+    let ooc = simplify_out_of_core(&input, &params).unwrap();
+    // Only the input is left in the folder: the buckets are gone.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+
+    // In memory: all points, one shuffle, the same kernel, in the same bbox-100 frame.
+    let mut r = PlyPointReader::open(&input).unwrap();
+    let mut pts = Vec::new();
+    r.read_chunk(&mut pts, 1_000_000).unwrap();
+    let norm = ooc.normalization;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
+    pts.shuffle(&mut rng);
+    let kernel = Kernel::new(1.5, f64::INFINITY).unwrap();
+    let mut scanner = LinearScanner::new(&kernel, &LinearScanParams::default());
+    let mut in_memory = Vec::new();
+    for p in &pts {
+        let q = norm.apply(p.position);
+        if scanner.offer(q, p.normal) {
+            in_memory.push(q);
+        }
+    }
+    let out_of_core: Vec<_> = ooc.samples.iter().map(|p| norm.apply(p.position)).collect();
+    let (a, b) = (out_of_core.len() as f64, in_memory.len() as f64);
+    assert!((a - b).abs() <= 0.01 * b, "counts {a} vs {b}");
+    let (m1, min1, cv1) = nearest_neighbour_stats(&out_of_core);
+    let (m2, min2, cv2) = nearest_neighbour_stats(&in_memory);
+    assert!((m1 - m2).abs() <= 0.02 * m2, "mean {m1} vs {m2}");
+    // The minimum is one pair each: compare it against the spacing, not to 2%.
+    assert!(
+        min1 > 0.5 * m2 && min2 > 0.5 * m2,
+        "min {min1} {min2} (mean {m2})"
+    );
+    assert!(
+        (cv1 - cv2).abs() <= 0.02 * cv2.max(0.1),
+        "cv {cv1} vs {cv2}"
+    );
+}
