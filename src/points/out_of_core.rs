@@ -199,6 +199,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         None => params.sigma_p,
         Some(n) => {
             let pts = first.as_ref().map(Vec::as_slice).unwrap_or_default();
+            let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
             let area_guess = surface_area_guess(pts);
             let start = (area_guess / n.max(1) as f64).sqrt();
             let search = TargetCountParams::new(n);
@@ -206,9 +207,8 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
             let r = find_sigma_p(&search, start, |s| match Kernel::new(s, params.sigma_n) {
                 Ok(kernel) => {
                     let mut scanner = LinearScanner::new(&kernel, &params.scan);
-                    for p in pts {
-                        scanner.offer(p.position, p.normal);
-                    }
+                    let mut accepted = Vec::new();
+                    scanner.offer_batch(&batch, &mut accepted);
                     (scanner.len(), ())
                 }
                 Err(e) => {
@@ -227,6 +227,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
     let kernel = Kernel::new(sigma_p, params.sigma_n)?;
     let mut scanner = LinearScanner::new(&kernel, &params.scan);
     let mut samples = Vec::new();
+    let mut accepted = Vec::new();
     let mut b = search_buckets;
     while let Some(pts) = match first.take() {
         Some(p) => Some(p),
@@ -236,14 +237,13 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         }
         None => None,
     } {
-        for p in &pts {
-            if scanner.offer(p.position, p.normal) {
-                samples.push(Point {
-                    position: normalization.invert(p.position),
-                    normal: p.normal,
-                });
-            }
-        }
+        let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
+        accepted.clear();
+        scanner.offer_batch(&batch, &mut accepted);
+        samples.extend(accepted.iter().map(|&i| Point {
+            position: normalization.invert(pts[i].position),
+            normal: pts[i].normal,
+        }));
     }
     let t3 = Instant::now();
     Ok(OutOfCoreResult {

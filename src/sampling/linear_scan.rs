@@ -5,6 +5,7 @@ use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{spectral_measure, MeasureWorkspace, DEFAULT_EPSILON};
 use crate::spatial::DynamicTree;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// Parameters of the linear scan.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,6 +41,67 @@ pub struct LinearScanResult {
     pub measured: usize,
 }
 
+/// Per-thread buffers of the rejection tests.
+#[derive(Default)]
+struct Buffers {
+    found: Vec<(u32, f64)>,
+    neighbors: Vec<(f64, KernelPoint)>,
+    ws: MeasureWorkspace,
+}
+
+/// Why a candidate was rejected before its full neighbourhood was looked at.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum QuickReject {
+    /// Its nearest output sample alone gives s <= epsilon.
+    Nearest,
+    /// The measure over its few nearest output samples is <= epsilon.
+    Few,
+}
+
+/// Output samples the second quick test uses.
+const FEW: usize = 4;
+
+/// The quick tests of Algorithm 1 against the output set (`tree`, `embedded`). Both only prove
+/// rejections: s can only fall as points join the output set, so a candidate rejected against
+/// any subset of it is rejected against all of it.
+fn quick_reject(
+    kernel: &Kernel,
+    params: &LinearScanParams,
+    tree: &DynamicTree,
+    embedded: &[KernelPoint],
+    position: DVec3,
+    x: &KernelPoint,
+    b: &mut Buffers,
+) -> Option<QuickReject> {
+    let (j, _) = tree.nearest(position)?;
+    let k1 = kernel.eval(x, &embedded[j as usize]);
+    if k1 * k1 >= 1.0 - params.epsilon {
+        return Some(QuickReject::Nearest);
+    }
+    let r_kernel_2 = params.support_radius * params.support_radius;
+    tree.nearest_n(position, FEW, &mut b.found);
+    b.neighbors.clear();
+    for &(j, _) in &b.found {
+        let y = embedded[j as usize];
+        let d2 = x.dist2(&y);
+        if d2 <= r_kernel_2 {
+            b.neighbors.push((d2, y));
+        }
+    }
+    if b.neighbors.len() < 2 {
+        return None;
+    }
+    b.neighbors.sort_by(|a, c| a.0.total_cmp(&c.0));
+    let m = spectral_measure(
+        kernel,
+        x,
+        b.neighbors.iter().map(|n| n.1),
+        params.epsilon,
+        &mut b.ws,
+    );
+    (m.s <= params.epsilon).then_some(QuickReject::Few)
+}
+
 /// The state of Algorithm 1 as points stream past: the output set O (embedded in kernel space,
 /// in a dynamic kd-tree over positions) and the statistics. [`linear_scan`] drives it over a
 /// slice; the out-of-core scan drives it over a file. Positions are in bbox-100 units.
@@ -48,9 +110,7 @@ pub struct LinearScanner<'k> {
     params: LinearScanParams,
     tree: DynamicTree,
     embedded: Vec<KernelPoint>,
-    ws: MeasureWorkspace,
-    found: Vec<(u32, f64)>,
-    neighbors: Vec<(f64, KernelPoint)>,
+    buffers: Buffers,
     /// Candidates rejected by their nearest output sample alone.
     pub rejected_by_nearest: usize,
     /// Candidates rejected by the measure over their few nearest output samples.
@@ -67,9 +127,7 @@ impl<'k> LinearScanner<'k> {
             params: *params,
             tree: DynamicTree::new(),
             embedded: Vec::new(),
-            ws: MeasureWorkspace::new(),
-            found: Vec::new(),
-            neighbors: Vec::new(),
+            buffers: Buffers::default(),
             rejected_by_nearest: 0,
             rejected_by_few: 0,
             measured: 0,
@@ -86,33 +144,6 @@ impl<'k> LinearScanner<'k> {
         self.embedded.is_empty()
     }
 
-    /// Whether s(x) over the `FEW` nearest points of O (those within the support) is already
-    /// <= epsilon.
-    fn few_nearest_reject(&mut self, position: DVec3, x: &KernelPoint, r_kernel_2: f64) -> bool {
-        const FEW: usize = 4;
-        self.tree.nearest_n(position, FEW, &mut self.found);
-        self.neighbors.clear();
-        for &(j, _) in &self.found {
-            let y = self.embedded[j as usize];
-            let d2 = x.dist2(&y);
-            if d2 <= r_kernel_2 {
-                self.neighbors.push((d2, y));
-            }
-        }
-        if self.neighbors.len() < 2 {
-            return false;
-        }
-        self.neighbors.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let m = spectral_measure(
-            self.kernel,
-            x,
-            self.neighbors.iter().map(|n| n.1),
-            self.params.epsilon,
-            &mut self.ws,
-        );
-        m.s <= self.params.epsilon
-    }
-
     /// Puts a point into O without testing it (an initial sample).
     pub fn insert(&mut self, position: DVec3, normal: DVec3) {
         self.tree.add(position, self.embedded.len() as u32);
@@ -120,60 +151,114 @@ impl<'k> LinearScanner<'k> {
     }
 
     /// One step of Algorithm 1: adds the point to O and returns true when s(x) > epsilon against
-    /// its neighbours in O (or it has none). A candidate whose nearest output sample alone gives
-    /// s <= 1 - k(x, x_1)^2 <= epsilon is rejected without a kernel matrix.
+    /// its neighbours in O (or it has none). Quick tests first (see [`quick_reject`]): the nearest
+    /// output sample alone (s <= 1 - k(x, x_1)^2), then the few nearest.
     pub fn offer(&mut self, position: DVec3, normal: DVec3) -> bool {
         let kernel = self.kernel;
         let x = kernel.embed(position, normal);
-        let r_pos = self.params.support_radius * kernel.sigma_p();
-        let r_kernel_2 = self.params.support_radius * self.params.support_radius;
-        let accept = match self.tree.nearest(position) {
-            None => true,
-            Some((j, _)) => {
-                let k1 = kernel.eval(&x, &self.embedded[j as usize]);
-                if k1 * k1 >= 1.0 - self.params.epsilon {
-                    self.rejected_by_nearest += 1;
-                    false
-                } else if self.few_nearest_reject(position, &x, r_kernel_2) {
-                    // s over a few nearest neighbours is already <= epsilon; s can only fall as
-                    // neighbours are added, so the full neighbourhood would reject too.
-                    self.rejected_by_few += 1;
-                    false
-                } else {
-                    self.tree.within(position, r_pos * r_pos, &mut self.found);
-                    self.neighbors.clear();
-                    for &(j, _) in &self.found {
-                        let y = self.embedded[j as usize];
-                        let d2 = x.dist2(&y);
-                        if d2 <= r_kernel_2 {
-                            self.neighbors.push((d2, y));
-                        }
-                    }
-                    if self.neighbors.is_empty() {
-                        true
-                    } else {
-                        if !kernel.is_isotropic() {
-                            // Nearest first in kernel space (positions alone order them otherwise).
-                            self.neighbors.sort_by(|a, b| a.0.total_cmp(&b.0));
-                        }
-                        self.measured += 1;
-                        let m = spectral_measure(
-                            kernel,
-                            &x,
-                            self.neighbors.iter().map(|n| n.1),
-                            self.params.epsilon,
-                            &mut self.ws,
-                        );
-                        m.s > self.params.epsilon
-                    }
-                }
+        let quick = quick_reject(
+            kernel,
+            &self.params,
+            &self.tree,
+            &self.embedded,
+            position,
+            &x,
+            &mut self.buffers,
+        );
+        let accept = match quick {
+            Some(why) => {
+                self.count(why);
+                false
             }
+            None => self.full_measure_accepts(position, &x),
         };
         if accept {
             self.tree.add(position, self.embedded.len() as u32);
             self.embedded.push(x);
         }
         accept
+    }
+
+    /// Algorithm 1 over `batch` in order, as [`LinearScanner::offer`] one by one would do it (the
+    /// same decisions), but with the quick rejection tests of each chunk run in parallel against
+    /// the output set as it stands at the chunk's start. Pushes the indices (into `batch`) of the
+    /// accepted points to `accepted`.
+    pub fn offer_batch(&mut self, batch: &[(DVec3, DVec3)], accepted: &mut Vec<usize>) {
+        const CHUNK: usize = 8192;
+        let mut verdicts: Vec<Option<QuickReject>> = Vec::with_capacity(CHUNK);
+        for (c, chunk) in batch.chunks(CHUNK).enumerate() {
+            let (kernel, params, tree, embedded) =
+                (self.kernel, &self.params, &self.tree, &self.embedded);
+            chunk
+                .par_iter()
+                .map_init(Buffers::default, |b, &(p, n)| {
+                    quick_reject(kernel, params, tree, embedded, p, &kernel.embed(p, n), b)
+                })
+                .collect_into_vec(&mut verdicts);
+            let size_at_start = self.embedded.len();
+            for (k, (&(p, n), verdict)) in chunk.iter().zip(&verdicts).enumerate() {
+                let take = match verdict {
+                    Some(why) => {
+                        self.count(*why);
+                        false
+                    }
+                    // O as the quick tests saw it: straight to the full measure.
+                    None if self.embedded.len() == size_at_start => {
+                        let x = self.kernel.embed(p, n);
+                        let accept = self.full_measure_accepts(p, &x);
+                        if accept {
+                            self.tree.add(p, self.embedded.len() as u32);
+                            self.embedded.push(x);
+                        }
+                        accept
+                    }
+                    None => self.offer(p, n),
+                };
+                if take {
+                    accepted.push(c * CHUNK + k);
+                }
+            }
+        }
+    }
+
+    fn count(&mut self, why: QuickReject) {
+        match why {
+            QuickReject::Nearest => self.rejected_by_nearest += 1,
+            QuickReject::Few => self.rejected_by_few += 1,
+        }
+    }
+
+    /// The measure over the whole neighbourhood within the support radius, nearest first.
+    fn full_measure_accepts(&mut self, position: DVec3, x: &KernelPoint) -> bool {
+        let kernel = self.kernel;
+        let r_pos = self.params.support_radius * kernel.sigma_p();
+        let r_kernel_2 = self.params.support_radius * self.params.support_radius;
+        let b = &mut self.buffers;
+        self.tree.within(position, r_pos * r_pos, &mut b.found);
+        b.neighbors.clear();
+        for &(j, _) in &b.found {
+            let y = self.embedded[j as usize];
+            let d2 = x.dist2(&y);
+            if d2 <= r_kernel_2 {
+                b.neighbors.push((d2, y));
+            }
+        }
+        if b.neighbors.is_empty() {
+            return true;
+        }
+        if !kernel.is_isotropic() {
+            // Nearest first in kernel space (positions alone order them otherwise).
+            b.neighbors.sort_by(|a, c| a.0.total_cmp(&c.0));
+        }
+        self.measured += 1;
+        let m = spectral_measure(
+            kernel,
+            x,
+            b.neighbors.iter().map(|n| n.1),
+            self.params.epsilon,
+            &mut b.ws,
+        );
+        m.s > self.params.epsilon
     }
 }
 
@@ -200,11 +285,10 @@ pub fn linear_scan(
         scanner.insert(s.position, s.normal);
         samples.push(*s);
     }
-    for c in candidates {
-        if scanner.offer(c.position, c.normal) {
-            samples.push(*c);
-        }
-    }
+    let batch: Vec<(DVec3, DVec3)> = candidates.iter().map(|c| (c.position, c.normal)).collect();
+    let mut accepted = Vec::new();
+    scanner.offer_batch(&batch, &mut accepted);
+    samples.extend(accepted.iter().map(|&i| candidates[i]));
     LinearScanResult {
         samples,
         initial: initial.len(),
