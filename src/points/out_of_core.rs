@@ -79,7 +79,8 @@ pub struct OutOfCoreResult {
     pub rejected_by_nearest: usize,
     /// Candidates whose measure was evaluated.
     pub measured: usize,
-    /// Seconds: reading and bucketing, the sigma_p search, the scan.
+    /// Seconds: reading and bucketing, the sigma_p search (with the scan of the buckets it
+    /// used), the scan of the other buckets.
     pub seconds: [f64; 3],
 }
 
@@ -195,55 +196,61 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         let pts = load(b, &mut rng)?;
         first.get_or_insert_with(Vec::new).extend(pts);
     }
-    let sigma_p = match params.target {
-        None => params.sigma_p,
+
+    // The scanner that has seen the first buckets: the search's best evaluation, or a fresh scan.
+    let first = first.unwrap_or_default();
+    let batch: Vec<(DVec3, DVec3)> = first.iter().map(|p| (p.position, p.normal)).collect();
+    let scan_first = |sigma_p: f64| -> Result<(LinearScanner, Vec<usize>)> {
+        let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+        let mut scanner = LinearScanner::new(&kernel, &params.scan);
+        let mut accepted = Vec::new();
+        scanner.offer_batch(&batch, &mut accepted);
+        Ok((scanner, accepted))
+    };
+    let (sigma_p, (mut scanner, first_accepted)) = match params.target {
+        None => (params.sigma_p, scan_first(params.sigma_p)?),
         Some(n) => {
-            let pts = first.as_ref().map(Vec::as_slice).unwrap_or_default();
-            let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
-            let area_guess = surface_area_guess(pts);
+            let area_guess = surface_area_guess(&first);
             let start = (area_guess / n.max(1) as f64).sqrt();
-            let search = TargetCountParams::new(n);
+            // The subset's count is itself about 5% below the full scan's: 2% is precise enough.
+            let search = TargetCountParams {
+                tolerance: 0.02,
+                ..TargetCountParams::new(n)
+            };
             let mut failure = None;
-            let r = find_sigma_p(&search, start, |s| match Kernel::new(s, params.sigma_n) {
-                Ok(kernel) => {
-                    let mut scanner = LinearScanner::new(&kernel, &params.scan);
-                    let mut accepted = Vec::new();
-                    scanner.offer_batch(&batch, &mut accepted);
-                    (scanner.len(), ())
-                }
+            let r = find_sigma_p(&search, start, |s| match scan_first(s) {
+                Ok(v) => (v.0.len(), Some(v)),
                 Err(e) => {
                     failure = Some(e);
-                    (0, ())
+                    (0, None)
                 }
             });
-            if let Some(e) = failure {
-                return Err(e);
+            match (failure, r.value) {
+                (Some(e), _) => return Err(e),
+                (None, Some(v)) => (r.sigma_p, v),
+                (None, None) => (r.sigma_p, scan_first(r.sigma_p)?),
             }
-            r.sigma_p
         }
     };
     let t2 = Instant::now();
 
-    let kernel = Kernel::new(sigma_p, params.sigma_n)?;
-    let mut scanner = LinearScanner::new(&kernel, &params.scan);
-    let mut samples = Vec::new();
+    let to_model = |p: &Point| Point {
+        position: normalization.invert(p.position),
+        normal: p.normal,
+    };
+    let mut samples: Vec<Point> = first_accepted
+        .iter()
+        .map(|&i| to_model(&first[i]))
+        .collect();
+    drop(batch);
+    drop(first);
     let mut accepted = Vec::new();
-    let mut b = search_buckets;
-    while let Some(pts) = match first.take() {
-        Some(p) => Some(p),
-        None if b < buckets => {
-            b += 1;
-            Some(load(b - 1, &mut rng)?)
-        }
-        None => None,
-    } {
+    for b in search_buckets..buckets {
+        let pts = load(b, &mut rng)?;
         let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
         accepted.clear();
         scanner.offer_batch(&batch, &mut accepted);
-        samples.extend(accepted.iter().map(|&i| Point {
-            position: normalization.invert(pts[i].position),
-            normal: pts[i].normal,
-        }));
+        samples.extend(accepted.iter().map(|&i| to_model(&pts[i])));
     }
     let t3 = Instant::now();
     Ok(OutOfCoreResult {

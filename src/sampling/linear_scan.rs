@@ -105,8 +105,8 @@ fn quick_reject(
 /// The state of Algorithm 1 as points stream past: the output set O (embedded in kernel space,
 /// in a dynamic kd-tree over positions) and the statistics. [`linear_scan`] drives it over a
 /// slice; the out-of-core scan drives it over a file. Positions are in bbox-100 units.
-pub struct LinearScanner<'k> {
-    kernel: &'k Kernel,
+pub struct LinearScanner {
+    kernel: Kernel,
     params: LinearScanParams,
     tree: DynamicTree,
     embedded: Vec<KernelPoint>,
@@ -119,11 +119,11 @@ pub struct LinearScanner<'k> {
     pub measured: usize,
 }
 
-impl<'k> LinearScanner<'k> {
+impl LinearScanner {
     /// An empty output set.
-    pub fn new(kernel: &'k Kernel, params: &LinearScanParams) -> Self {
+    pub fn new(kernel: &Kernel, params: &LinearScanParams) -> Self {
         LinearScanner {
-            kernel,
+            kernel: *kernel,
             params: *params,
             tree: DynamicTree::new(),
             embedded: Vec::new(),
@@ -154,7 +154,7 @@ impl<'k> LinearScanner<'k> {
     /// its neighbours in O (or it has none). Quick tests first (see [`quick_reject`]): the nearest
     /// output sample alone (s <= 1 - k(x, x_1)^2), then the few nearest.
     pub fn offer(&mut self, position: DVec3, normal: DVec3) -> bool {
-        let kernel = self.kernel;
+        let kernel = &self.kernel;
         let x = kernel.embed(position, normal);
         let quick = quick_reject(
             kernel,
@@ -188,7 +188,7 @@ impl<'k> LinearScanner<'k> {
         let mut verdicts: Vec<Option<QuickReject>> = Vec::with_capacity(CHUNK);
         for (c, chunk) in batch.chunks(CHUNK).enumerate() {
             let (kernel, params, tree, embedded) =
-                (self.kernel, &self.params, &self.tree, &self.embedded);
+                (&self.kernel, &self.params, &self.tree, &self.embedded);
             chunk
                 .par_iter()
                 .map_init(Buffers::default, |b, &(p, n)| {
@@ -230,7 +230,7 @@ impl<'k> LinearScanner<'k> {
 
     /// The measure over the whole neighbourhood within the support radius, nearest first.
     fn full_measure_accepts(&mut self, position: DVec3, x: &KernelPoint) -> bool {
-        let kernel = self.kernel;
+        let kernel = &self.kernel;
         let r_pos = self.params.support_radius * kernel.sigma_p();
         let r_kernel_2 = self.params.support_radius * self.params.support_radius;
         let b = &mut self.buffers;
