@@ -3,6 +3,7 @@
 //! out-of-core randomized linear scan.
 
 pub mod generate;
+pub mod normals;
 pub mod out_of_core;
 pub mod ply_stream;
 

@@ -1,0 +1,198 @@
+//! Normals for point sets that have none: a plane fitted to each point's nearest neighbours
+//! (principal component analysis), then a consistent orientation propagated along a minimum
+//! spanning tree of the Riemannian graph (Hoppe, DeRose, Duchamp, McDonald, Stuetzle 1992,
+//! "Surface reconstruction from unorganized points", Sec. 3.3).
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use glam::DVec3;
+use nalgebra::{Matrix3, SymmetricEigen};
+use rayon::prelude::*;
+
+use crate::spatial::StaticTree;
+
+/// How normals are oriented after the plane fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Orientation {
+    /// Propagated along the minimum spanning tree of the k-nearest-neighbour graph, weights
+    /// 1 − |n_i · n_j| (Hoppe 1992), leaving out edges more than 30° off both ends' tangent
+    /// planes (across a part thinner than the neighbourhood), each connected part seeded at its highest point (largest
+    /// z) with its normal pointing up (+z): outward on a closed surface.
+    SpanningTree,
+    /// Each normal towards this viewpoint (a single scan).
+    Viewpoint(DVec3),
+}
+
+/// Unit normals of `points` (any units): the least-variance direction of each point's `k`
+/// nearest neighbours (itself included), oriented as `orientation` says. `k` below 3 is taken
+/// as 3. Deterministic.
+pub fn estimate_normals(points: &[DVec3], k: usize, orientation: Orientation) -> Vec<DVec3> {
+    let k = k.max(3);
+    let tree = StaticTree::new(points);
+    let (mut normals, neighbors): (Vec<DVec3>, Vec<Vec<u32>>) = points
+        .par_iter()
+        .map_init(Vec::new, |found, &p| {
+            tree.nearest_n(p, k, found);
+            let near: Vec<DVec3> = found.iter().map(|&(j, _)| points[j as usize]).collect();
+            let normal = plane_normal(&near);
+            let ids = found.iter().map(|x| x.0).collect();
+            (normal, ids)
+        })
+        .unzip();
+    match orientation {
+        Orientation::Viewpoint(v) => {
+            for (n, &p) in normals.iter_mut().zip(points) {
+                if n.dot(v - p) < 0.0 {
+                    *n = -*n;
+                }
+            }
+        }
+        Orientation::SpanningTree => orient_by_spanning_tree(points, &mut normals, &neighbors),
+    }
+    normals
+}
+
+/// The least-variance direction of `points` (unit; zero when undefined).
+fn plane_normal(points: &[DVec3]) -> DVec3 {
+    let mean = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
+    let mut c = Matrix3::<f64>::zeros();
+    for p in points {
+        let d = *p - mean;
+        let v = nalgebra::Vector3::new(d.x, d.y, d.z);
+        c += v * v.transpose();
+    }
+    let eig = SymmetricEigen::new(c);
+    let e = eig.eigenvectors.column(eig.eigenvalues.imin());
+    DVec3::new(e[0], e[1], e[2]).normalize_or_zero()
+}
+
+/// An edge whose |cos| with both ends' normals exceeds this (more than 30° off both tangent
+/// planes) is across a thin part.
+const TANGENT_SLOPE: f64 = 0.5;
+
+#[derive(PartialEq)]
+struct Edge {
+    weight: f64,
+    from: u32,
+    to: u32,
+}
+
+impl Eq for Edge {}
+
+impl Ord for Edge {
+    fn cmp(&self, other: &Self) -> Ordering {
+        // Smallest weight first (BinaryHeap is a max-heap), ties by indices for determinism.
+        other
+            .weight
+            .total_cmp(&self.weight)
+            .then_with(|| other.to.cmp(&self.to))
+            .then_with(|| other.from.cmp(&self.from))
+    }
+}
+
+impl PartialOrd for Edge {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// Prim's algorithm over the symmetric k-nearest-neighbour graph (without edges more than 30°
+/// off both ends' tangent planes), flipping each newly reached
+/// normal to agree with the one it is reached from.
+fn orient_by_spanning_tree(points: &[DVec3], normals: &mut [DVec3], neighbors: &[Vec<u32>]) {
+    let n = points.len();
+    // Symmetric adjacency.
+    // No edge straight across a thin part (the other side of an ear): one that leaves both
+    // ends' tangent planes steeply, where 1 - |n_i . n_j| would be small for the wrong reason.
+    // Edges across a crease leave only one end's plane and stay.
+    let along = |i: usize, j: usize| {
+        let d = points[j] - points[i];
+        let l = d.length();
+        l > 0.0
+            && (d.dot(normals[i]).abs() <= TANGENT_SLOPE * l
+                || d.dot(normals[j]).abs() <= TANGENT_SLOPE * l)
+    };
+    let mut adjacency: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (i, list) in neighbors.iter().enumerate() {
+        for &j in list {
+            if j as usize != i && along(i, j as usize) {
+                adjacency[i].push(j);
+                adjacency[j as usize].push(i as u32);
+            }
+        }
+    }
+    for list in &mut adjacency {
+        list.sort_unstable();
+        list.dedup();
+    }
+    let mut reached = vec![false; n];
+    // Seeds in order of decreasing height, so each connected part starts at its top.
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    order.sort_by(|&a, &b| {
+        points[b as usize]
+            .z
+            .total_cmp(&points[a as usize].z)
+            .then(a.cmp(&b))
+    });
+    let mut heap = BinaryHeap::new();
+    for seed in order {
+        if reached[seed as usize] {
+            continue;
+        }
+        reached[seed as usize] = true;
+        if normals[seed as usize].z < 0.0 {
+            normals[seed as usize] = -normals[seed as usize];
+        }
+        let push = |heap: &mut BinaryHeap<Edge>, i: u32, normals: &[DVec3], reached: &[bool]| {
+            for &j in &adjacency[i as usize] {
+                if !reached[j as usize] {
+                    let w = 1.0 - normals[i as usize].dot(normals[j as usize]).abs();
+                    heap.push(Edge {
+                        weight: w,
+                        from: i,
+                        to: j,
+                    });
+                }
+            }
+        };
+        push(&mut heap, seed, normals, &reached);
+        while let Some(Edge { from, to, .. }) = heap.pop() {
+            if reached[to as usize] {
+                continue;
+            }
+            reached[to as usize] = true;
+            if normals[to as usize].dot(normals[from as usize]) < 0.0 {
+                normals[to as usize] = -normals[to as usize];
+            }
+            push(&mut heap, to, normals, &reached);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sphere_normals_point_outward() {
+        // A Fibonacci sphere.
+        let n = 2000;
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        let points: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let y = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+                let r = (1.0 - y * y).sqrt();
+                let t = golden * i as f64;
+                DVec3::new(r * t.cos(), y, r * t.sin()) * 3.0
+            })
+            .collect();
+        let normals = estimate_normals(&points, 12, Orientation::SpanningTree);
+        for (p, n) in points.iter().zip(&normals) {
+            assert!(n.dot(p.normalize()) > 0.99, "{p:?} {n:?}");
+        }
+        // A viewpoint inside turns them all inward.
+        let inward = estimate_normals(&points, 12, Orientation::Viewpoint(DVec3::ZERO));
+        assert!(inward.iter().zip(&points).all(|(n, p)| n.dot(*p) < 0.0));
+    }
+}
