@@ -268,3 +268,54 @@ fn points_subcommand_writes_a_point_set_on_the_surface() {
         assert!((p.normal.length() - 1.0).abs() < 1e-5);
     }
 }
+
+#[test]
+fn simplify_a_point_set_without_normals_estimates_outward_normals() {
+    use spectral_remesh::points::PlyPointReader;
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, _) = spectral_remesh::io::read_mesh(&shared("spot.obj")).unwrap();
+    // Dense points without normals: 40k surface points, written as ascii PLY with x y z only.
+    let dense = dir.path().join("dense.ply");
+    spectral_remesh::points::generate::write_surface_points(&mesh, 40_000, 2, &dense).unwrap();
+    let mut r = PlyPointReader::open(&dense).unwrap();
+    let mut pts = Vec::new();
+    r.read_chunk(&mut pts, 100_000).unwrap();
+    let input = dir.path().join("xyz.ply");
+    let mut text = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\nend_header\n",
+        pts.len()
+    );
+    for p in &pts {
+        text.push_str(&format!(
+            "{} {} {}\n",
+            p.position.x, p.position.y, p.position.z
+        ));
+    }
+    std::fs::write(&input, text).unwrap();
+    let out = dir.path().join("out.ply");
+    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .arg("simplify")
+        .arg(&input)
+        .arg(&out)
+        .args(["--points", "2000", "-q"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut r = PlyPointReader::open(&out).unwrap();
+    let n = r.count() as usize;
+    assert!((1700..=2300).contains(&n), "{n} samples");
+    let mut samples = Vec::new();
+    r.read_chunk(&mut samples, n).unwrap();
+    let surface = spectral_remesh::MeshSurface::new(&mesh).unwrap();
+    let outward = samples
+        .iter()
+        .filter(|p| {
+            let sp = surface.closest_point(p.position).unwrap();
+            (p.normal.length() - 1.0).abs() < 1e-4 && p.normal.dot(surface.smooth_normal(&sp)) > 0.5
+        })
+        .count();
+    assert!(
+        outward as f64 >= 0.99 * n as f64,
+        "{outward} of {n} outward"
+    );
+}

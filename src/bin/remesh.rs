@@ -112,6 +112,10 @@ enum Command {
         /// Seed of the visit order.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// For an input without normals: orient the estimated normals towards this point
+        /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
+        #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
+        viewpoint: Option<[f64; 3]>,
         /// Print nothing but errors.
         #[arg(short, long)]
         quiet: bool,
@@ -155,10 +159,13 @@ fn run(cli: Cli) -> Result<(), Error> {
         sigma_p,
         sigma_n,
         seed,
+        viewpoint,
         quiet,
     }) = &cli.command
     {
-        return run_simplify(input, output, *points, *sigma_p, *sigma_n, *seed, *quiet);
+        return run_simplify(
+            input, output, *points, *sigma_p, *sigma_n, *seed, *viewpoint, *quiet,
+        );
     }
     if let Some(Command::Points {
         mesh,
@@ -249,6 +256,19 @@ fn run(cli: Cli) -> Result<(), Error> {
     Ok(())
 }
 
+fn parse_point(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("expected x,y,z: {e}"))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err("expected three finite numbers x,y,z".into()),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn run_simplify(
     input: &std::path::Path,
     output: &std::path::Path,
@@ -256,8 +276,10 @@ fn run_simplify(
     sigma_p: Option<f64>,
     sigma_n: Option<f64>,
     seed: u64,
+    viewpoint: Option<[f64; 3]>,
     quiet: bool,
 ) -> Result<(), Error> {
+    use spectral_remesh::points::normals::{estimate_normals, Orientation};
     use spectral_remesh::points::out_of_core::{simplify_out_of_core, OutOfCoreParams};
     use spectral_remesh::points::PlyPointWriter;
     if points.is_none() && sigma_p.is_none() {
@@ -280,7 +302,31 @@ fn run_simplify(
         ..Default::default()
     };
     let t = std::time::Instant::now();
-    let r = simplify_out_of_core(input, &params)?;
+    if sigma_n.is_some_and(f64::is_finite) {
+        let reader = spectral_remesh::points::PlyPointReader::open(input)?;
+        if !reader.has_normals() {
+            return Err(Error::InvalidParameter {
+                name: "--sigma-n",
+                message: format!("{} has no normals; sigma_n needs them", input.display()),
+            });
+        }
+    }
+    let mut r = simplify_out_of_core(input, &params)?;
+    if !r.had_normals {
+        // Normals of the output set (memory bounded by the output, like the scan).
+        let positions: Vec<_> = r.samples.iter().map(|p| p.position).collect();
+        let orientation = match viewpoint {
+            Some([x, y, z]) => Orientation::Viewpoint(glam::DVec3::new(x, y, z)),
+            None => Orientation::SpanningTree,
+        };
+        for (p, n) in r
+            .samples
+            .iter_mut()
+            .zip(estimate_normals(&positions, 10, orientation))
+        {
+            p.normal = n;
+        }
+    }
     let mut w = PlyPointWriter::create(output, r.samples.len() as u64)?;
     w.write(&r.samples)?;
     w.finish()?;
@@ -296,7 +342,7 @@ fn run_simplify(
             if r.had_normals {
                 ""
             } else {
-                "; the input has no normals: positions only, zero normals written"
+                "; the input has no normals: positions only, normals estimated on the output"
             },
             r.rejected_by_nearest,
             r.measured,
