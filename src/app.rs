@@ -113,7 +113,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     );
     extra.insert(
         "optimize".into(),
-        serde_json::to_value(&out.optimize).unwrap_or_default(),
+        serde_json::to_value(out.optimize).unwrap_or_default(),
     );
     extra.insert("input_vertices".into(), input.vertex_count().into());
     extra.insert("input_faces".into(), input.face_count().into());

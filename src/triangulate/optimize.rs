@@ -450,9 +450,7 @@ fn poor_vertices(m: &EditMesh, params: &OptimizeParams) -> Vec<u32> {
         .iter()
         .zip(&m.alive)
         .filter(|&(&t, &alive)| alive && m.is_poor(t, params))
-        .map(|(t, _)| t)
-        .flatten()
-        .copied()
+        .flat_map(|(t, _)| t.iter().copied())
         .collect();
     v.sort_unstable();
     v.dedup();
