@@ -22,7 +22,7 @@ use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::ply_stream::{PlyPointReader, Point};
+use super::ply_stream::{encode_record, PlyPointReader, Point, RECORD_BYTES};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
 use crate::mesh::{Aabb, Normalization};
@@ -84,23 +84,8 @@ pub struct OutOfCoreResult {
     pub seconds: [f64; 3],
 }
 
-const RECORD: usize = 24;
-
 /// Input points per wanted sample in the subset the sigma_p search runs on.
 const SEARCH_POINTS_PER_SAMPLE: f64 = 4.0;
-
-fn encode(p: &Point, out: &mut Vec<u8>) {
-    for v in [
-        p.position.x,
-        p.position.y,
-        p.position.z,
-        p.normal.x,
-        p.normal.y,
-        p.normal.z,
-    ] {
-        out.extend_from_slice(&(v as f32).to_le_bytes());
-    }
-}
 
 fn decode(b: &[u8]) -> Point {
     let f = |k: usize| {
@@ -149,7 +134,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         for p in &chunk {
             lo = lo.min(p.position);
             hi = hi.max(p.position);
-            encode(p, &mut staged[rng.random_range(0..buckets)]);
+            encode_record(p, &mut staged[rng.random_range(0..buckets)]);
         }
         for (w, bytes) in writers.iter_mut().zip(staged.iter_mut()) {
             w.write_all(bytes).map_err(io_err)?;
@@ -170,7 +155,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
             .and_then(|f| BufReader::new(f).read_to_end(&mut bytes))
             .map_err(io_err)?;
         let mut pts: Vec<Point> = bytes
-            .chunks_exact(RECORD)
+            .chunks_exact(RECORD_BYTES)
             .map(|r| {
                 let p = decode(r);
                 Point {

@@ -341,6 +341,23 @@ impl PlyPointReader {
     }
 }
 
+/// Bytes of one point in the binary layout this module writes (`x y z nx ny nz` as float32 LE).
+pub(crate) const RECORD_BYTES: usize = 24;
+
+/// Appends `p` in that layout.
+pub(crate) fn encode_record(p: &Point, out: &mut Vec<u8>) {
+    for v in [
+        p.position.x,
+        p.position.y,
+        p.position.z,
+        p.normal.x,
+        p.normal.y,
+        p.normal.z,
+    ] {
+        out.extend_from_slice(&(v as f32).to_le_bytes());
+    }
+}
+
 /// Writes points with normals as binary little-endian PLY (`x y z nx ny nz`, float32), to a
 /// temporary file beside the target that [`PlyPointWriter::finish`] renames into place: a failure
 /// never leaves a partial file at the target. The count must be known when the file is created.
@@ -393,18 +410,9 @@ impl PlyPointWriter {
         if self.written + points.len() as u64 > self.count {
             return Err(self.error(format!("more than the {} points announced", self.count)));
         }
-        let mut bytes = Vec::with_capacity(points.len() * 24);
+        let mut bytes = Vec::with_capacity(points.len() * RECORD_BYTES);
         for p in points {
-            for v in [
-                p.position.x,
-                p.position.y,
-                p.position.z,
-                p.normal.x,
-                p.normal.y,
-                p.normal.z,
-            ] {
-                bytes.extend_from_slice(&(v as f32).to_le_bytes());
-            }
+            encode_record(p, &mut bytes);
         }
         self.output
             .write_all(&bytes)
