@@ -256,7 +256,8 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
 
 /// A first guess of the surface area (bbox-100 units²) of a uniformly random point subset, for
 /// the start of the sigma_p search: the number of occupied cells of a grid of cell size h, times
-/// h² (a surface crosses about area/h² cells).
+/// h² / 1.5 (a plane of area A with unit normal n crosses about A (|n_x| + |n_y| + |n_z|) / h²
+/// cells, 1.5 A / h² on average over orientations).
 fn surface_area_guess(points: &[Point]) -> f64 {
     let h = 2.0;
     let mut cells: Vec<[i32; 3]> = points
@@ -265,5 +266,5 @@ fn surface_area_guess(points: &[Point]) -> f64 {
         .collect();
     cells.sort_unstable();
     cells.dedup();
-    (cells.len() as f64 * h * h).max(1.0)
+    (cells.len() as f64 * h * h / 1.5).max(1.0)
 }
