@@ -2,20 +2,24 @@
 //! spectral sampling cannot resolve (tips and rims thinner than the sample spacing) are mended
 //! with the input surface at hand.
 //!
-//! Three local operations, each kept only when it does not move the mesh away from the input
-//! surface by more than `max_offset`:
+//! Four local operations, each kept only when it keeps the mesh near the input surface (see the
+//! offsets in [`OptimizeParams`]):
 //! - **Cover:** an input-surface point farther than `cover_distance` from the mesh (the tip of an
 //!   ear or a horn that the samples around it cut off) becomes a vertex: it splits the face it is
-//!   closest to. This bounds the one-sided (input → output) Hausdorff distance.
+//!   closest to, or the edge it lies beyond. This bounds the one-sided (input → output)
+//!   Hausdorff distance.
+//! - **Collapse:** a short edge of a poor triangle merges its ends (link condition kept).
 //! - **Flip:** an edge near a poor triangle is flipped when that raises the smaller minimum angle
 //!   of its two faces (Lawson's max-min rule) and the new faces stay on the surface.
-//! - **Relax:** a vertex of a poor triangle moves towards the centroid of its neighbours, projected
-//!   back onto the surface, when that raises the smallest Q of its faces and turns none of them
-//!   (Laplacian smoothing with projection, as in Botsch & Kobbelt 2004, Sec. 3, restricted to
-//!   the poor triangles).
+//! - **Relax:** a vertex of a poor triangle moves towards the centroid of its neighbours or the
+//!   apex of an equilateral triangle on a poor face's far edge, projected back onto the surface,
+//!   when that raises the worst shape score min(Q / 0.6, θmin / 30°) of its faces and turns none
+//!   of them much (Laplacian smoothing with projection, as in Botsch & Kobbelt 2004, Sec. 3,
+//!   restricted to the poor triangles).
 //!
-//! Everything else stays as the sampler and the tangent-plane Delaunay left it: on the models
-//! here these operations touch a few vertices per thousand.
+//! Everything else stays as the sampler and the tangent-plane Delaunay left it. On horse at 8600
+//! about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
+//! spacing).
 
 use glam::DVec3;
 use parry3d_f64::query::PointQuery;
