@@ -152,8 +152,8 @@ pub fn triangle_q(p: [DVec3; 3]) -> f64 {
 /// Q is 0, so it sets θmin = 0 and Qmin = 0; its three angles enter P30 as computed (0° at a
 /// corner with a zero-length edge, so it contributes 2 or 3 angles below 30°).
 ///
-/// An empty mesh gives all zeros (no NaN) and `faces_measured = 0`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// An empty mesh gives all zeros (no NaN) and `faces_measured = 0`: the `Default`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct TriangleQuality {
     /// θmin: the smallest angle of the mesh, in degrees.
     pub theta_min: f64,
@@ -212,15 +212,7 @@ pub fn triangle_quality(mesh: &TriMesh) -> TriangleQuality {
         }
     }
     if measured == 0 {
-        return TriangleQuality {
-            theta_min: 0.0,
-            theta_min_ave: 0.0,
-            q_min: 0.0,
-            q_ave: 0.0,
-            pct_theta_below_30: 0.0,
-            p30: 0.0,
-            faces_measured: 0,
-        };
+        return TriangleQuality::default();
     }
     let m = measured as f64;
     TriangleQuality {

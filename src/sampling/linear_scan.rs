@@ -146,8 +146,8 @@ impl LinearScanner {
 
     /// Puts a point into O without testing it (an initial sample).
     pub fn insert(&mut self, position: DVec3, normal: DVec3) {
-        self.tree.add(position, self.embedded.len() as u32);
-        self.embedded.push(self.kernel.embed(position, normal));
+        let x = self.kernel.embed(position, normal);
+        self.add(position, x);
     }
 
     /// One step of Algorithm 1: adds the point to O and returns true when s(x) > epsilon against
@@ -173,10 +173,15 @@ impl LinearScanner {
             None => self.full_measure_accepts(position, &x),
         };
         if accept {
-            self.tree.add(position, self.embedded.len() as u32);
-            self.embedded.push(x);
+            self.add(position, x);
         }
         accept
+    }
+
+    /// Puts an embedded point into O.
+    fn add(&mut self, position: DVec3, x: KernelPoint) {
+        self.tree.add(position, self.embedded.len() as u32);
+        self.embedded.push(x);
     }
 
     /// Algorithm 1 over `batch` in order, as [`LinearScanner::offer`] one by one would do it (the
@@ -207,8 +212,7 @@ impl LinearScanner {
                         let x = self.kernel.embed(p, n);
                         let accept = self.full_measure_accepts(p, &x);
                         if accept {
-                            self.tree.add(p, self.embedded.len() as u32);
-                            self.embedded.push(x);
+                            self.add(p, x);
                         }
                         accept
                     }
