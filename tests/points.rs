@@ -7,7 +7,7 @@ use rand::SeedableRng;
 use spectral_remesh::kernel::Kernel;
 use spectral_remesh::points::generate::write_surface_points;
 use spectral_remesh::points::out_of_core::{simplify_out_of_core, OutOfCoreParams};
-use spectral_remesh::points::PlyPointReader;
+use spectral_remesh::points::PointReader;
 use spectral_remesh::sampling::linear_scan::{LinearScanParams, LinearScanner};
 use spectral_remesh::spatial::StaticTree;
 
@@ -47,7 +47,7 @@ fn out_of_core_scan_matches_the_in_memory_scan() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 
     // In memory: all points, one shuffle, the same kernel, in the same bbox-100 frame.
-    let mut r = PlyPointReader::open(&input).unwrap();
+    let mut r = PointReader::open(&input).unwrap();
     let mut pts = Vec::new();
     r.read_chunk(&mut pts, 1_000_000).unwrap();
     let norm = ooc.normalization;

@@ -238,7 +238,7 @@ fn bad_input_is_a_one_line_error_with_a_nonzero_exit_and_no_output() {
 
 #[test]
 fn points_subcommand_writes_a_point_set_on_the_surface() {
-    use spectral_remesh::points::PlyPointReader;
+    use spectral_remesh::points::PointReader;
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("spot-points.ply");
     let status = Command::new(env!("CARGO_BIN_EXE_remesh"))
@@ -249,7 +249,7 @@ fn points_subcommand_writes_a_point_set_on_the_surface() {
         .status()
         .unwrap();
     assert!(status.success());
-    let mut r = PlyPointReader::open(&out).unwrap();
+    let mut r = PointReader::open(&out).unwrap();
     assert_eq!(r.count(), 2000);
     assert!(r.has_normals());
     let mut pts = Vec::new();
@@ -271,13 +271,13 @@ fn points_subcommand_writes_a_point_set_on_the_surface() {
 
 #[test]
 fn simplify_a_point_set_without_normals_estimates_outward_normals() {
-    use spectral_remesh::points::PlyPointReader;
+    use spectral_remesh::points::PointReader;
     let dir = tempfile::tempdir().unwrap();
     let (mesh, _) = spectral_remesh::io::read_mesh(&shared("spot.obj")).unwrap();
     // Dense points without normals: 40k surface points, written as ascii PLY with x y z only.
     let dense = dir.path().join("dense.ply");
     spectral_remesh::points::generate::write_surface_points(&mesh, 40_000, 2, &dense).unwrap();
-    let mut r = PlyPointReader::open(&dense).unwrap();
+    let mut r = PointReader::open(&dense).unwrap();
     let mut pts = Vec::new();
     r.read_chunk(&mut pts, 100_000).unwrap();
     let input = dir.path().join("xyz.ply");
@@ -301,7 +301,7 @@ fn simplify_a_point_set_without_normals_estimates_outward_normals() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let mut r = PlyPointReader::open(&out).unwrap();
+    let mut r = PointReader::open(&out).unwrap();
     let n = r.count() as usize;
     assert!((1700..=2300).contains(&n), "{n} samples");
     let mut samples = Vec::new();

@@ -96,7 +96,8 @@ enum Command {
     /// Simplify a point set (PLY) out of core with the randomized linear scan (Sec. 6.1):
     /// memory bounded by the output plus a fixed buffer. Writes the samples as PLY with normals.
     Simplify {
-        /// The input point set (.ply, ascii or binary, with or without normals).
+        /// The input point set: .ply (ascii or binary) or XYZ/CSV text (.xyz .csv .txt .pts:
+        /// `x y z` or `x y z nx ny nz` per line, or named columns), with or without normals.
         input: PathBuf,
         /// The output point set (.ply).
         output: PathBuf,
@@ -303,7 +304,7 @@ fn run_simplify(
     };
     let t = std::time::Instant::now();
     if sigma_n.is_some_and(f64::is_finite) {
-        let reader = spectral_remesh::points::PlyPointReader::open(input)?;
+        let reader = spectral_remesh::points::PointReader::open(input)?;
         if !reader.has_normals() {
             return Err(Error::InvalidParameter {
                 name: "--sigma-n",

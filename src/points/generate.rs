@@ -6,7 +6,7 @@ use std::path::Path;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::ply_stream::{PlyPointWriter, Point};
+use super::stream::{PlyPointWriter, Point};
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 
@@ -72,7 +72,7 @@ pub fn write_surface_points(mesh: &TriMesh, count: u64, seed: u64, path: &Path) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::points::ply_stream::PlyPointReader;
+    use crate::points::stream::PointReader;
     use glam::DVec3;
 
     #[test]
@@ -109,7 +109,7 @@ mod tests {
         write_surface_points(&cube, 5000, 3, &a).unwrap();
         write_surface_points(&cube, 5000, 3, &b).unwrap();
         assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
-        let mut r = PlyPointReader::open(&a).unwrap();
+        let mut r = PointReader::open(&a).unwrap();
         let mut pts = Vec::new();
         assert_eq!(r.read_chunk(&mut pts, 10_000).unwrap(), 5000);
         let mut per_face = [0usize; 6];

@@ -22,7 +22,7 @@ use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::ply_stream::{encode_record, PlyPointReader, Point, RECORD_BYTES};
+use super::stream::{encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
 use crate::mesh::{Aabb, Normalization};
@@ -107,7 +107,7 @@ fn decode(b: &[u8]) -> Point {
 /// whose bounding box has no extent; [`Error::Io`] when the temporary files fail.
 pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<OutOfCoreResult> {
     let t0 = Instant::now();
-    let mut reader = PlyPointReader::open(input)?;
+    let mut reader = PointReader::open(input)?;
     let total = reader.count();
     if total == 0 {
         return Err(Error::invalid_mesh(input, "the point set is empty"));

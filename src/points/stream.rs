@@ -1,6 +1,6 @@
-//! Streaming PLY for point sets: a reader that hands out the `vertex` element in chunks (so a
-//! file of tens of millions of points never has to be in memory at once) and a writer of binary
-//! little-endian PLY with normals.
+//! Streaming point sets: a reader that hands out points in chunks (so a file of tens of millions
+//! of points never has to be in memory at once) from PLY (the `vertex` element) or from XYZ/CSV
+//! text, and a writer of binary little-endian PLY with normals.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, BufWriter, Read, Write};
@@ -24,6 +24,8 @@ enum Encoding {
     Ascii,
     BinaryLittle,
     BinaryBig,
+    /// XYZ/CSV text: one point per line, values separated by commas, semicolons or blanks.
+    Text,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,11 +88,16 @@ impl Scalar {
     }
 }
 
-/// Reads the `vertex` element of a PLY file (ascii or binary of either byte order) in chunks.
-/// The `vertex` element must be the first element of the file; its properties must be scalars;
-/// `x y z` are required, `nx ny nz` are used when all three are present, everything else is
-/// skipped.
-pub struct PlyPointReader {
+/// Reads a point set in chunks, from
+/// - PLY (ascii or binary of either byte order): the `vertex` element, which must be the first
+///   element of the file; its properties must be scalars; `x y z` are required, `nx ny nz` are
+///   used when all three are present, everything else is skipped;
+/// - XYZ/CSV text (`.xyz .csv .txt .pts .asc .xyzn`): one point per line, `x y z` or
+///   `x y z nx ny nz` (further columns skipped), separated by commas, semicolons or blanks. A
+///   first line of names (`x,y,z,nx,ny,nz` in any order, any case) picks the columns; blank lines
+///   and lines starting with `#` or `//` are skipped; a leading line with a single number (the
+///   point count of `.pts`) is skipped.
+pub struct PointReader {
     path: PathBuf,
     input: BufReader<File>,
     encoding: Encoding,
@@ -105,13 +112,18 @@ pub struct PlyPointReader {
     line_number: usize,
 }
 
-impl PlyPointReader {
-    /// Opens `path` and reads its header.
+impl PointReader {
+    /// Opens `path` and reads its header. Text files (by extension) are read once here to count
+    /// their points.
     ///
     /// # Errors
     /// [`Error::Io`] when the file cannot be opened; [`Error::Parse`] naming the file for a
-    /// header that is not PLY, lacks `x y z`, or has no leading `vertex` element.
+    /// header that is not PLY, lacks `x y z`, or has no leading `vertex` element, or for a text
+    /// file whose first point has fewer than three numbers.
     pub fn open(path: &Path) -> Result<Self> {
+        if is_text_extension(path) {
+            return Self::open_text(path);
+        }
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let mut input = BufReader::with_capacity(1 << 20, file);
         let parse = |line: usize, message: String| Error::Parse {
@@ -216,7 +228,7 @@ impl PlyPointReader {
             }
         }
         let record_size = properties.iter().map(|p| p.0.size()).sum();
-        Ok(PlyPointReader {
+        Ok(PointReader {
             path: path.to_path_buf(),
             input,
             encoding,
@@ -228,6 +240,105 @@ impl PlyPointReader {
             buffer: Vec::new(),
             line,
             line_number,
+        })
+    }
+
+    /// Opens an XYZ/CSV text file: a first pass counts the points and finds the columns.
+    fn open_text(path: &Path) -> Result<Self> {
+        let open = || -> Result<BufReader<File>> {
+            let file = File::open(path).map_err(|e| Error::io(path, e))?;
+            Ok(BufReader::with_capacity(1 << 20, file))
+        };
+        let parse = |line: usize, message: String| Error::Parse {
+            path: path.to_path_buf(),
+            line: Some(line),
+            message,
+        };
+        let mut input = open()?;
+        let mut line = String::new();
+        let (mut line_number, mut count) = (0usize, 0u64);
+        let mut columns: Option<Vec<Option<usize>>> = None;
+        let mut names: Option<Vec<String>> = None;
+        let mut skipped_head = 0usize;
+        loop {
+            line.clear();
+            if input.read_line(&mut line).map_err(|e| Error::io(path, e))? == 0 {
+                break;
+            }
+            line_number += 1;
+            if is_comment(&line) {
+                continue;
+            }
+            if columns.is_some() {
+                count += 1;
+                continue;
+            }
+            let fields: Vec<&str> = text_fields(&line).collect();
+            let numeric = fields.iter().all(|f| f.parse::<f64>().is_ok());
+            if !numeric && names.is_none() && count == 0 {
+                names = Some(fields.iter().map(|f| f.to_ascii_lowercase()).collect());
+                skipped_head = line_number;
+                continue;
+            }
+            if numeric && fields.len() == 1 && names.is_none() && count == 0 {
+                skipped_head = line_number; // the point count of a .pts file
+                continue;
+            }
+            let slots: Vec<Option<usize>> = match &names {
+                Some(names) => {
+                    let slot = |n: &str| names.iter().position(|m| m == n);
+                    let mut slots = vec![None; names.len().max(fields.len())];
+                    for (k, name) in ["x", "y", "z"].iter().enumerate() {
+                        let i = slot(name).ok_or_else(|| {
+                            parse(skipped_head, format!("the column names have no `{name}`"))
+                        })?;
+                        slots[i] = Some(k);
+                    }
+                    let normal: Vec<Option<usize>> =
+                        ["nx", "ny", "nz"].iter().map(|n| slot(n)).collect();
+                    if normal.iter().all(Option::is_some) {
+                        for (k, i) in normal.into_iter().flatten().enumerate() {
+                            slots[i] = Some(3 + k);
+                        }
+                    }
+                    slots
+                }
+                None if fields.len() >= 3 => (0..fields.len())
+                    .map(|i| (i < 3 || fields.len() >= 6 && i < 6).then_some(i))
+                    .collect(),
+                None => {
+                    return Err(parse(
+                        line_number,
+                        format!(
+                            "a point needs three numbers x y z, the line has {}",
+                            fields.len()
+                        ),
+                    ))
+                }
+            };
+            columns = Some(slots);
+            count = 1;
+        }
+        let columns = columns.unwrap_or_default();
+        let has_normals = columns.iter().filter(|c| c.is_some_and(|k| k >= 3)).count() == 3;
+        // Second pass from the start, past the lines of names or count.
+        let mut input = open()?;
+        for _ in 0..skipped_head {
+            line.clear();
+            input.read_line(&mut line).map_err(|e| Error::io(path, e))?;
+        }
+        Ok(PointReader {
+            path: path.to_path_buf(),
+            input,
+            encoding: Encoding::Text,
+            count,
+            read: 0,
+            properties: columns.into_iter().map(|c| (Scalar::F64, c)).collect(),
+            record_size: 0,
+            has_normals,
+            buffer: Vec::new(),
+            line,
+            line_number: skipped_head,
         })
     }
 
@@ -254,6 +365,45 @@ impl PlyPointReader {
         }
         let mut values = [0.0f64; 6];
         match self.encoding {
+            Encoding::Text => {
+                let mut got = 0;
+                while got < n {
+                    self.line.clear();
+                    self.line_number += 1;
+                    if self
+                        .input
+                        .read_line(&mut self.line)
+                        .map_err(|e| Error::io(&self.path, e))?
+                        == 0
+                    {
+                        return Err(self.truncated());
+                    }
+                    if is_comment(&self.line) {
+                        continue;
+                    }
+                    {
+                        let mut fields = text_fields(&self.line);
+                        for &(_, slot) in &self.properties {
+                            let Some(k) = slot else {
+                                fields.next();
+                                continue;
+                            };
+                            let w = fields.next().ok_or_else(|| Error::Parse {
+                                path: self.path.clone(),
+                                line: Some(self.line_number),
+                                message: "too few values on the line".into(),
+                            })?;
+                            values[k] = w.parse().map_err(|_| Error::Parse {
+                                path: self.path.clone(),
+                                line: Some(self.line_number),
+                                message: format!("`{w}` is not a number"),
+                            })?;
+                        }
+                    }
+                    self.push(out, &values)?;
+                    got += 1;
+                }
+            }
             Encoding::Ascii => {
                 for _ in 0..n {
                     self.line.clear();
@@ -339,6 +489,27 @@ impl PlyPointReader {
             ),
         }
     }
+}
+
+/// Whether `path`'s extension names an XYZ/CSV text point set.
+fn is_text_extension(path: &Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        ["xyz", "csv", "txt", "pts", "asc", "xyzn"]
+            .iter()
+            .any(|t| e.eq_ignore_ascii_case(t))
+    })
+}
+
+/// Blank lines and `#` or `//` comments of a text point set.
+fn is_comment(line: &str) -> bool {
+    let t = line.trim_start();
+    t.is_empty() || t.starts_with('#') || t.starts_with("//")
+}
+
+/// The values of a text line: separated by commas, semicolons or blanks.
+fn text_fields(line: &str) -> impl Iterator<Item = &str> {
+    line.split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+        .filter(|f| !f.is_empty())
 }
 
 /// Bytes of one point in the binary layout this module writes (`x y z nx ny nz` as float32 LE).
@@ -480,7 +651,7 @@ mod tests {
         w.write(&points(4)).unwrap();
         w.write(&points(10)[4..]).unwrap();
         w.finish().unwrap();
-        let mut r = PlyPointReader::open(&path).unwrap();
+        let mut r = PointReader::open(&path).unwrap();
         assert_eq!(r.count(), 10);
         assert!(r.has_normals());
         let (mut all, mut chunk) = (Vec::new(), Vec::new());
@@ -503,7 +674,7 @@ mod tests {
              end_header\n1 255 2 3\n4 0 5 6\n",
         )
         .unwrap();
-        let mut r = PlyPointReader::open(&path).unwrap();
+        let mut r = PointReader::open(&path).unwrap();
         assert!(!r.has_normals());
         let mut chunk = Vec::new();
         assert_eq!(r.read_chunk(&mut chunk, 10).unwrap(), 2);
@@ -520,7 +691,7 @@ mod tests {
         w.finish().unwrap();
         let bytes = std::fs::read(&path).unwrap();
         std::fs::write(&path, &bytes[..bytes.len() - 10]).unwrap();
-        let mut r = PlyPointReader::open(&path).unwrap();
+        let mut r = PointReader::open(&path).unwrap();
         let err = r.read_chunk(&mut Vec::new(), 100).unwrap_err().to_string();
         assert!(err.contains("truncated") && err.contains("t.ply"), "{err}");
         let short = dir.path().join("short.ply");
@@ -528,5 +699,70 @@ mod tests {
         w.write(&points(2)).unwrap();
         assert!(w.finish().is_err());
         assert!(!short.exists());
+    }
+
+    #[test]
+    fn text_point_sets_xyz_and_csv() {
+        let dir = tempfile::tempdir().unwrap();
+        // .pts: a count line, blanks, comments, four columns (the fourth, intensity, skipped).
+        let xyz = dir.path().join("a.pts");
+        std::fs::write(&xyz, "2\n# scan 1\n\n1 2 3 7\n  4\t5 6 8\n").unwrap();
+        let mut r = PointReader::open(&xyz).unwrap();
+        assert_eq!(r.count(), 2);
+        assert!(!r.has_normals());
+        let mut chunk = Vec::new();
+        assert_eq!(r.read_chunk(&mut chunk, 10).unwrap(), 2);
+        assert_eq!(chunk[1].position, DVec3::new(4.0, 5.0, 6.0));
+        assert_eq!(r.read_chunk(&mut chunk, 10).unwrap(), 0);
+        // CSV with named columns in another order.
+        let csv = dir.path().join("b.csv");
+        std::fs::write(
+            &csv,
+            "id,NZ,x,y,z,nx,ny\n0,2,1.5,2.5,3.5,0,0\n1,0,-1,-2,-3,3,0\n",
+        )
+        .unwrap();
+        let mut r = PointReader::open(&csv).unwrap();
+        assert_eq!(r.count(), 2);
+        assert!(r.has_normals());
+        assert_eq!(r.read_chunk(&mut chunk, 1).unwrap(), 1);
+        assert_eq!(chunk[0].position, DVec3::new(1.5, 2.5, 3.5));
+        assert_eq!(chunk[0].normal, DVec3::Z);
+        assert_eq!(r.read_chunk(&mut chunk, 1).unwrap(), 1);
+        assert_eq!(chunk[0].normal, DVec3::X);
+        // Six unnamed columns are x y z nx ny nz.
+        let six = dir.path().join("c.xyz");
+        std::fs::write(&six, "0;0;0;0;1;0\n").unwrap();
+        let mut r = PointReader::open(&six).unwrap();
+        assert!(r.has_normals());
+        r.read_chunk(&mut chunk, 5).unwrap();
+        assert_eq!(chunk[0].normal, DVec3::Y);
+    }
+
+    #[test]
+    fn bad_text_point_sets_are_errors_naming_the_file_and_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let two = dir.path().join("two.xyz");
+        std::fs::write(&two, "1 2\n").unwrap();
+        let err = PointReader::open(&two).err().unwrap().to_string();
+        assert!(
+            err.contains("two.xyz") && err.contains("three numbers"),
+            "{err}"
+        );
+        let bad = dir.path().join("bad.xyz");
+        std::fs::write(&bad, "1 2 3\n4 five 6\n").unwrap();
+        let mut r = PointReader::open(&bad).unwrap();
+        let err = r.read_chunk(&mut Vec::new(), 10).unwrap_err().to_string();
+        assert!(
+            err.contains("bad.xyz") && err.contains("five") && err.contains('2'),
+            "{err}"
+        );
+        let names = dir.path().join("names.csv");
+        std::fs::write(&names, "a,b,c\n1,2,3\n").unwrap();
+        let err = PointReader::open(&names).err().unwrap().to_string();
+        assert!(err.contains("`x`"), "{err}");
+        let nan = dir.path().join("nan.csv");
+        std::fs::write(&nan, "1,2,NaN\n").unwrap();
+        let mut r = PointReader::open(&nan).unwrap();
+        assert!(r.read_chunk(&mut Vec::new(), 10).is_err());
     }
 }
