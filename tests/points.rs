@@ -6,7 +6,9 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use spectral_remesh::kernel::Kernel;
 use spectral_remesh::points::generate::write_surface_points;
-use spectral_remesh::points::out_of_core::{simplify_out_of_core, OutOfCoreParams};
+use spectral_remesh::points::out_of_core::{
+    simplify_out_of_core, simplify_progressive, OutOfCoreParams,
+};
 use spectral_remesh::points::PointReader;
 use spectral_remesh::sampling::linear_scan::{LinearScanParams, LinearScanner};
 use spectral_remesh::spatial::StaticTree;
@@ -140,4 +142,77 @@ fn estimated_normals_agree_with_the_mesh_normals() {
 fn no_estimated_normal_is_flipped_on_horse() {
     let (_, flipped) = normal_agreement("horse.obj");
     assert_eq!(flipped, 0);
+}
+
+#[test]
+fn progressive_levels_are_nested_complete_scans() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("spot-200k.ply");
+    let (mesh, _) = spectral_remesh::io::read_mesh(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/spot.obj"),
+    )
+    .unwrap();
+    write_surface_points(&mesh, 200_000, 3, &input).unwrap();
+    let params = OutOfCoreParams {
+        bucket_points: 50_000,
+        temp_dir: Some(dir.path().to_path_buf()),
+        ..Default::default()
+    };
+    // Given finest first: the levels come out coarsest first.
+    let r = simplify_progressive(&input, &[1.5, 4.0, 2.5], &params).unwrap();
+    assert_eq!(r.sigma_p, vec![4.0, 2.5, 1.5]);
+    assert_eq!(r.level_ends.len(), 3);
+    assert_eq!(*r.level_ends.last().unwrap(), r.samples.len());
+    assert_eq!(r.levels.len(), r.samples.len());
+    let mut all = Vec::new();
+    PointReader::open(&input)
+        .unwrap()
+        .read_chunk(&mut all, 1_000_000)
+        .unwrap();
+    let norm = r.normalization;
+    for (l, &end) in r.level_ends.iter().enumerate() {
+        let start = if l == 0 { 0 } else { r.level_ends[l - 1] };
+        assert!(end > start, "level {} adds no samples", l + 1);
+        // The level attribute marks exactly the samples the level adds.
+        assert!(r.levels[start..end].iter().all(|&v| v as usize == l + 1));
+        // P_l is a complete linear scan at its sigma_p: no input point has s > epsilon.
+        let kernel = Kernel::new(r.sigma_p[l], f64::INFINITY).unwrap();
+        let mut scanner = LinearScanner::new(&kernel, &LinearScanParams::default());
+        for p in &r.samples[..end] {
+            scanner.insert(norm.apply(p.position), p.normal);
+        }
+        let batch: Vec<_> = all
+            .iter()
+            .map(|p| (norm.apply(p.position), p.normal))
+            .collect();
+        let mut accepted = Vec::new();
+        scanner.offer_batch(&batch, &mut accepted);
+        assert!(
+            accepted.is_empty(),
+            "level {}: {} input points would still join",
+            l + 1,
+            accepted.len()
+        );
+        // And about as large as a single scan at that sigma_p.
+        let single = simplify_out_of_core(
+            &input,
+            &OutOfCoreParams {
+                sigma_p: r.sigma_p[l],
+                ..params.clone()
+            },
+        )
+        .unwrap();
+        let (a, b) = (end as f64, single.samples.len() as f64);
+        assert!(
+            (a - b).abs() <= 0.03 * b,
+            "level {}: {a} samples, a single scan {b}",
+            l + 1
+        );
+    }
+    // Seeded: the same again.
+    let again = simplify_progressive(&input, &[4.0, 2.5, 1.5], &params).unwrap();
+    assert_eq!(again.samples, r.samples);
+    // Bad level lists are errors.
+    assert!(simplify_progressive(&input, &[], &params).is_err());
+    assert!(simplify_progressive(&input, &[1.0, -2.0], &params).is_err());
 }

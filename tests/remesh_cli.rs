@@ -319,3 +319,69 @@ fn simplify_a_point_set_without_normals_estimates_outward_normals() {
         "{outward} of {n} outward"
     );
 }
+
+#[test]
+fn simplify_levels_from_xyz_text_writes_a_level_attribute() {
+    use spectral_remesh::points::PointReader;
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh, _) = spectral_remesh::io::read_mesh(&shared("spot.obj")).unwrap();
+    let dense = dir.path().join("dense.ply");
+    spectral_remesh::points::generate::write_surface_points(&mesh, 30_000, 4, &dense).unwrap();
+    let mut pts = Vec::new();
+    PointReader::open(&dense)
+        .unwrap()
+        .read_chunk(&mut pts, 100_000)
+        .unwrap();
+    // XYZ text with normals: x y z nx ny nz per line.
+    let input = dir.path().join("spot.xyz");
+    let mut text = String::from("# spot, 30k points\n");
+    for p in &pts {
+        let (a, n) = (p.position, p.normal);
+        text += &format!("{} {} {} {} {} {}\n", a.x, a.y, a.z, n.x, n.y, n.z);
+    }
+    std::fs::write(&input, text).unwrap();
+    let out = dir.path().join("levels.ply");
+    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .arg("simplify")
+        .arg(&input)
+        .arg(&out)
+        .args(["--levels", "2,6,3.5"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    // The file: a uchar level after the six floats, non-decreasing from 1 to 3.
+    let bytes = std::fs::read(&out).unwrap();
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    assert!(header.contains("property uchar level\n"), "{header}");
+    let records = &bytes[end..];
+    assert_eq!(records.len() % 25, 0);
+    let levels: Vec<u8> = records.chunks_exact(25).map(|r| r[24]).collect();
+    assert_eq!(levels[0], 1);
+    assert_eq!(*levels.last().unwrap(), 3);
+    assert!(levels.windows(2).all(|w| w[0] <= w[1]));
+    // Each level's size as reported: |P_l| = the samples of level <= l.
+    for l in 1..=3u8 {
+        let size = levels.iter().filter(|&&v| v <= l).count();
+        let line = format!("|P{l}| = {size} ");
+        assert!(stdout.contains(&line), "{line} not in:\n{stdout}");
+    }
+    // The standard reader skips the level and reads the points.
+    let r = PointReader::open(&out).unwrap();
+    assert_eq!(r.count() as usize, levels.len());
+    assert!(r.has_normals());
+    // --levels with --points is a usage error.
+    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .arg("simplify")
+        .arg(&input)
+        .arg(&out)
+        .args(["--levels", "2,1", "--points", "100"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}

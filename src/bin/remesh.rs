@@ -17,7 +17,9 @@ Examples:
   remesh horse.ply horse.glb --points 8600 --report horse.json
   remesh fandisk.obj fandisk.obj.ply --points 6000 --sigma-n 0.75
   remesh quality out.obj --ref in.obj
-  remesh points horse.obj horse-14M.ply --count 14000000";
+  remesh points horse.obj horse-14M.ply --count 14000000
+  remesh simplify horse-14M.ply horse-300k.ply --points 300000
+  remesh simplify scan.xyz levels.ply --levels 4,2,1";
 
 /// Spectral remeshing of triangle meshes (Öztireli, Alexa, Gross 2010: Spectral Sampling of
 /// Manifolds): samples the input surface with the spectral measure, triangulates the samples,
@@ -102,11 +104,16 @@ enum Command {
         /// The output point set (.ply).
         output: PathBuf,
         /// About this many output points (sigma_p is searched on a random subset).
-        #[arg(long, conflicts_with = "sigma_p")]
+        #[arg(long, conflicts_with_all = ["sigma_p", "levels"])]
         points: Option<usize>,
         /// Kernel width sigma_p in bbox-100 units, instead of --points.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "levels")]
         sigma_p: Option<f64>,
+        /// Progressive sampling (Sec. 6.4): sigma_p values in bbox-100 units (`4,2,1`), one nested
+        /// level each, coarsest first: P1 ⊂ P2 ⊂ …. The output is ordered by level and has a
+        /// `uchar level` property (1 = coarsest), so the first |P_l| points are P_l.
+        #[arg(long, value_delimiter = ',', value_name = "S1,S2,...")]
+        levels: Option<Vec<f64>>,
         /// Normal width sigma_n (default: infinity, positions only).
         #[arg(long)]
         sigma_n: Option<f64>,
@@ -158,15 +165,25 @@ fn run(cli: Cli) -> Result<(), Error> {
         output,
         points,
         sigma_p,
+        levels,
         sigma_n,
         seed,
         viewpoint,
         quiet,
     }) = &cli.command
     {
-        return run_simplify(
-            input, output, *points, *sigma_p, *sigma_n, *seed, *viewpoint, *quiet,
-        );
+        let density = match (points, sigma_p, levels) {
+            (Some(n), _, _) => PointDensity::Points(*n),
+            (_, Some(s), _) => PointDensity::SigmaP(*s),
+            (_, _, Some(l)) => PointDensity::Levels(l.clone()),
+            _ => {
+                return Err(Error::InvalidParameter {
+                    name: "--points",
+                    message: "give --points N, --sigma-p S or --levels S1,S2,...".into(),
+                })
+            }
+        };
+        return run_simplify(input, output, density, *sigma_n, *seed, *viewpoint, *quiet);
     }
     if let Some(Command::Points {
         mesh,
@@ -269,35 +286,60 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The output density of `remesh simplify`.
+enum PointDensity {
+    Points(usize),
+    SigmaP(f64),
+    Levels(Vec<f64>),
+}
+
+/// Estimated normals for the samples of an input without them.
+fn estimate_output_normals(
+    samples: &mut [spectral_remesh::points::Point],
+    viewpoint: Option<[f64; 3]>,
+) {
+    use spectral_remesh::points::normals::{estimate_normals, Orientation};
+    let positions: Vec<_> = samples.iter().map(|p| p.position).collect();
+    let orientation = match viewpoint {
+        Some([x, y, z]) => Orientation::Viewpoint(glam::DVec3::new(x, y, z)),
+        None => Orientation::SpanningTree,
+    };
+    for (p, n) in samples
+        .iter_mut()
+        .zip(estimate_normals(&positions, 10, orientation))
+    {
+        p.normal = n;
+    }
+}
+
 fn run_simplify(
     input: &std::path::Path,
     output: &std::path::Path,
-    points: Option<usize>,
-    sigma_p: Option<f64>,
+    density: PointDensity,
     sigma_n: Option<f64>,
     seed: u64,
     viewpoint: Option<[f64; 3]>,
     quiet: bool,
 ) -> Result<(), Error> {
-    use spectral_remesh::points::normals::{estimate_normals, Orientation};
-    use spectral_remesh::points::out_of_core::{simplify_out_of_core, OutOfCoreParams};
+    use spectral_remesh::points::out_of_core::{
+        simplify_out_of_core, simplify_progressive, OutOfCoreParams,
+    };
     use spectral_remesh::points::PlyPointWriter;
-    if points.is_none() && sigma_p.is_none() {
-        return Err(Error::InvalidParameter {
-            name: "--points",
-            message: "give --points N or --sigma-p S".into(),
-        });
-    }
-    if points == Some(0) {
+    if matches!(density, PointDensity::Points(0)) {
         return Err(Error::InvalidParameter {
             name: "--points",
             message: "must be at least 1".into(),
         });
     }
     let params = OutOfCoreParams {
-        target: points,
-        sigma_p: sigma_p.unwrap_or(1.0),
+        target: match density {
+            PointDensity::Points(n) => Some(n),
+            _ => None,
+        },
+        sigma_p: match density {
+            PointDensity::SigmaP(s) => s,
+            _ => 1.0,
+        },
         sigma_n: sigma_n.unwrap_or(f64::INFINITY),
         seed,
         ..Default::default()
@@ -312,21 +354,49 @@ fn run_simplify(
             });
         }
     }
+    let no_normals_note =
+        "; the input has no normals: positions only, normals estimated on the output";
+    if let PointDensity::Levels(levels) = &density {
+        let mut r = simplify_progressive(input, levels, &params)?;
+        if !r.had_normals {
+            estimate_output_normals(&mut r.samples, viewpoint);
+        }
+        let mut w = PlyPointWriter::create_with_levels(output, r.samples.len() as u64)?;
+        w.write_levels(&r.samples, &r.levels)?;
+        w.finish()?;
+        if !quiet {
+            let mut text = format!(
+                "{} -> {}: {} points -> {} samples in {} nested levels{}\n",
+                input.display(),
+                output.display(),
+                r.input_points,
+                r.samples.len(),
+                r.level_ends.len(),
+                if r.had_normals { "" } else { no_normals_note }
+            );
+            for (l, (&end, s)) in r.level_ends.iter().zip(&r.sigma_p).enumerate() {
+                let start = if l == 0 { 0 } else { r.level_ends[l - 1] };
+                text += &format!(
+                    "  level {}: sigma_p {s:.4}, |P{}| = {end} (+{}), {:.2} s\n",
+                    l + 1,
+                    l + 1,
+                    end - start,
+                    r.seconds[l + 1]
+                );
+            }
+            text += &format!(
+                "seconds: read+bucket {:.2}, total {:.2}\n",
+                r.seconds[0],
+                t.elapsed().as_secs_f64()
+            );
+            emit(&text);
+        }
+        return Ok(());
+    }
     let mut r = simplify_out_of_core(input, &params)?;
     if !r.had_normals {
         // Normals of the output set (memory bounded by the output, like the scan).
-        let positions: Vec<_> = r.samples.iter().map(|p| p.position).collect();
-        let orientation = match viewpoint {
-            Some([x, y, z]) => Orientation::Viewpoint(glam::DVec3::new(x, y, z)),
-            None => Orientation::SpanningTree,
-        };
-        for (p, n) in r
-            .samples
-            .iter_mut()
-            .zip(estimate_normals(&positions, 10, orientation))
-        {
-            p.normal = n;
-        }
+        estimate_output_normals(&mut r.samples, viewpoint);
     }
     let mut w = PlyPointWriter::create(output, r.samples.len() as u64)?;
     w.write(&r.samples)?;
@@ -340,11 +410,7 @@ fn run_simplify(
             r.input_points,
             r.samples.len(),
             r.sigma_p,
-            if r.had_normals {
-                ""
-            } else {
-                "; the input has no normals: positions only, normals estimated on the output"
-            },
+            if r.had_normals { "" } else { no_normals_note },
             r.rejected_by_nearest,
             r.measured,
             r.seconds[0],

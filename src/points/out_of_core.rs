@@ -107,66 +107,13 @@ fn decode(b: &[u8]) -> Point {
 /// whose bounding box has no extent; [`Error::Io`] when the temporary files fail.
 pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<OutOfCoreResult> {
     let t0 = Instant::now();
-    let mut reader = PointReader::open(input)?;
-    let total = reader.count();
-    if total == 0 {
-        return Err(Error::invalid_mesh(input, "the point set is empty"));
-    }
-    let had_normals = reader.has_normals();
-    let buckets = total.div_ceil(params.bucket_points.max(1) as u64).max(1) as usize;
-    let dir = tempfile::Builder::new()
-        .prefix("remesh-buckets")
-        .tempdir_in(params.temp_dir.clone().unwrap_or_else(std::env::temp_dir))
-        .map_err(|e| Error::io(input, e))?;
-    let io_err = |e: std::io::Error| Error::io(dir.path(), e);
-    let mut writers: Vec<BufWriter<File>> = (0..buckets)
-        .map(|b| {
-            File::create(dir.path().join(format!("{b}.bin")))
-                .map(|f| BufWriter::with_capacity(1 << 20, f))
-        })
-        .collect::<std::io::Result<_>>()
-        .map_err(io_err)?;
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    let mut chunk = Vec::new();
-    let mut staged: Vec<Vec<u8>> = vec![Vec::new(); buckets];
-    while reader.read_chunk(&mut chunk, 1 << 16)? > 0 {
-        for p in &chunk {
-            lo = lo.min(p.position);
-            hi = hi.max(p.position);
-            encode_record(p, &mut staged[rng.random_range(0..buckets)]);
-        }
-        for (w, bytes) in writers.iter_mut().zip(staged.iter_mut()) {
-            w.write_all(bytes).map_err(io_err)?;
-            bytes.clear();
-        }
-    }
-    for w in &mut writers {
-        w.flush().map_err(io_err)?;
-    }
-    drop(writers);
-    let normalization = Normalization::for_bbox(&Aabb { min: lo, max: hi })
-        .ok_or_else(|| Error::invalid_mesh(input, "the points' bounding box has no extent"))?;
+    let buckets = Buckets::write(input, params, &mut rng)?;
+    let (total, had_normals, normalization) =
+        (buckets.total, buckets.had_normals, buckets.normalization);
+    let load = |b: usize, rng: &mut ChaCha8Rng| buckets.load(b, rng);
+    let buckets = buckets.count;
     let t1 = Instant::now();
-
-    let load = |b: usize, rng: &mut ChaCha8Rng| -> Result<Vec<Point>> {
-        let mut bytes = Vec::new();
-        File::open(dir.path().join(format!("{b}.bin")))
-            .and_then(|f| BufReader::new(f).read_to_end(&mut bytes))
-            .map_err(io_err)?;
-        let mut pts: Vec<Point> = bytes
-            .chunks_exact(RECORD_BYTES)
-            .map(|r| {
-                let p = decode(r);
-                Point {
-                    position: normalization.apply(p.position),
-                    normal: p.normal,
-                }
-            })
-            .collect();
-        pts.shuffle(rng);
-        Ok(pts)
-    };
 
     // sigma_p: given, or searched on the first buckets: enough of them for SEARCH_POINTS_PER_SAMPLE
     // input points per wanted sample (a sparser subset leaves gaps the full scan fills).
@@ -252,6 +199,188 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
             (t3 - t2).as_secs_f64(),
         ],
     })
+}
+
+/// The result of [`simplify_progressive`].
+#[derive(Debug, Clone)]
+pub struct ProgressiveResult {
+    /// The nested sets P_1 ⊂ P_2 ⊂ …, coarsest first, in the input's units: P_l is
+    /// `samples[..level_ends[l - 1]]`.
+    pub samples: Vec<Point>,
+    /// The level of each sample: 1 for P_1, l for the samples P_l adds to P_(l-1).
+    pub levels: Vec<u8>,
+    /// Per level, the size of P_l.
+    pub level_ends: Vec<usize>,
+    /// Per level, its sigma_p (bbox-100 units), largest first.
+    pub sigma_p: Vec<f64>,
+    /// Points read.
+    pub input_points: u64,
+    /// Whether the input had normals.
+    pub had_normals: bool,
+    /// Model units ↔ bbox-100 units.
+    pub normalization: Normalization,
+    /// Seconds: reading and bucketing, then one entry per level.
+    pub seconds: Vec<f64>,
+}
+
+/// Progressive sampling (Sec. 6.4, coarse to fine): a linear scan of the whole input with the
+/// largest sigma_p gives P_1; each smaller sigma_p scans the whole input again with O starting
+/// as the previous set, so P_1 ⊂ P_2 ⊂ … ⊂ P_L and each P_l is a complete linear scan at its
+/// sigma_p (no input point has s > epsilon against it). Out of core like
+/// [`simplify_out_of_core`]: one pass over the buckets per level; memory bounded by P_L plus a
+/// bucket. `sigma_ps` (bbox-100 units) may come in any order; `params.target` and
+/// `params.sigma_p` are not used.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for no levels, more than 255, or a sigma_p that is not finite
+/// and positive; the errors of [`simplify_out_of_core`].
+pub fn simplify_progressive(
+    input: &Path,
+    sigma_ps: &[f64],
+    params: &OutOfCoreParams,
+) -> Result<ProgressiveResult> {
+    let invalid = |message: String| Error::InvalidParameter {
+        name: "--levels",
+        message,
+    };
+    if sigma_ps.is_empty() || sigma_ps.len() > 255 {
+        return Err(invalid(format!(
+            "give 1 to 255 sigma_p values, not {}",
+            sigma_ps.len()
+        )));
+    }
+    if let Some(bad) = sigma_ps.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+        return Err(invalid(format!("sigma_p {bad} is not a positive number")));
+    }
+    let mut sigma_p = sigma_ps.to_vec();
+    sigma_p.sort_by(|a, b| b.total_cmp(a));
+    sigma_p.dedup();
+    let t0 = Instant::now();
+    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+    let buckets = Buckets::write(input, params, &mut rng)?;
+    let mut seconds = vec![t0.elapsed().as_secs_f64()];
+    let norm = buckets.normalization;
+    // P_l in bbox-100 units (for the next level's O) and in the input's units (the output).
+    let mut scaled: Vec<(DVec3, DVec3)> = Vec::new();
+    let (mut samples, mut levels, mut level_ends) = (Vec::new(), Vec::new(), Vec::new());
+    let mut accepted = Vec::new();
+    for (l, &s) in sigma_p.iter().enumerate() {
+        let t = Instant::now();
+        let kernel = Kernel::new(s, params.sigma_n)?;
+        let mut scanner = LinearScanner::new(&kernel, &params.scan);
+        for &(p, n) in &scaled {
+            scanner.insert(p, n);
+        }
+        for b in 0..buckets.count {
+            let pts = buckets.load(b, &mut rng)?;
+            let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
+            accepted.clear();
+            scanner.offer_batch(&batch, &mut accepted);
+            for &i in &accepted {
+                scaled.push(batch[i]);
+                samples.push(Point {
+                    position: norm.invert(pts[i].position),
+                    normal: pts[i].normal,
+                });
+                levels.push((l + 1) as u8);
+            }
+        }
+        level_ends.push(samples.len());
+        seconds.push(t.elapsed().as_secs_f64());
+    }
+    Ok(ProgressiveResult {
+        samples,
+        levels,
+        level_ends,
+        sigma_p,
+        input_points: buckets.total,
+        had_normals: buckets.had_normals,
+        normalization: norm,
+        seconds,
+    })
+}
+
+/// The input, bucket-shuffled into temporary files (pass 1 of the module documentation).
+struct Buckets {
+    dir: tempfile::TempDir,
+    /// Number of bucket files.
+    count: usize,
+    /// Points read.
+    total: u64,
+    had_normals: bool,
+    normalization: Normalization,
+}
+
+impl Buckets {
+    /// Streams `input` once: its bounding box, and every point to a random bucket file.
+    fn write(input: &Path, params: &OutOfCoreParams, rng: &mut ChaCha8Rng) -> Result<Buckets> {
+        let mut reader = PointReader::open(input)?;
+        let total = reader.count();
+        if total == 0 {
+            return Err(Error::invalid_mesh(input, "the point set is empty"));
+        }
+        let had_normals = reader.has_normals();
+        let count = total.div_ceil(params.bucket_points.max(1) as u64).max(1) as usize;
+        let dir = tempfile::Builder::new()
+            .prefix("remesh-buckets")
+            .tempdir_in(params.temp_dir.clone().unwrap_or_else(std::env::temp_dir))
+            .map_err(|e| Error::io(input, e))?;
+        let io_err = |e: std::io::Error| Error::io(dir.path(), e);
+        let mut writers: Vec<BufWriter<File>> = (0..count)
+            .map(|b| {
+                File::create(dir.path().join(format!("{b}.bin")))
+                    .map(|f| BufWriter::with_capacity(1 << 20, f))
+            })
+            .collect::<std::io::Result<_>>()
+            .map_err(io_err)?;
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        let mut chunk = Vec::new();
+        let mut staged: Vec<Vec<u8>> = vec![Vec::new(); count];
+        while reader.read_chunk(&mut chunk, 1 << 16)? > 0 {
+            for p in &chunk {
+                lo = lo.min(p.position);
+                hi = hi.max(p.position);
+                encode_record(p, &mut staged[rng.random_range(0..count)]);
+            }
+            for (w, bytes) in writers.iter_mut().zip(staged.iter_mut()) {
+                w.write_all(bytes).map_err(io_err)?;
+                bytes.clear();
+            }
+        }
+        for w in &mut writers {
+            w.flush().map_err(io_err)?;
+        }
+        drop(writers);
+        let normalization = Normalization::for_bbox(&Aabb { min: lo, max: hi })
+            .ok_or_else(|| Error::invalid_mesh(input, "the points' bounding box has no extent"))?;
+        Ok(Buckets {
+            dir,
+            count,
+            total,
+            had_normals,
+            normalization,
+        })
+    }
+
+    /// Bucket `b`'s points in bbox-100 units, shuffled.
+    fn load(&self, b: usize, rng: &mut ChaCha8Rng) -> Result<Vec<Point>> {
+        let mut bytes = Vec::new();
+        File::open(self.dir.path().join(format!("{b}.bin")))
+            .and_then(|f| BufReader::new(f).read_to_end(&mut bytes))
+            .map_err(|e| Error::io(self.dir.path(), e))?;
+        let mut pts: Vec<Point> = bytes
+            .chunks_exact(RECORD_BYTES)
+            .map(|r| {
+                let p = decode(r);
+                Point {
+                    position: self.normalization.apply(p.position),
+                    normal: p.normal,
+                }
+            })
+            .collect();
+        pts.shuffle(rng);
+        Ok(pts)
+    }
 }
 
 /// A first guess of the surface area (bbox-100 units²) of a uniformly random point subset, for

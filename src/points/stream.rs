@@ -529,15 +529,17 @@ pub(crate) fn encode_record(p: &Point, out: &mut Vec<u8>) {
     }
 }
 
-/// Writes points with normals as binary little-endian PLY (`x y z nx ny nz`, float32), to a
-/// temporary file beside the target that [`PlyPointWriter::finish`] renames into place: a failure
-/// never leaves a partial file at the target. The count must be known when the file is created.
+/// Writes points with normals as binary little-endian PLY (`x y z nx ny nz`, float32, and with
+/// [`PlyPointWriter::create_with_levels`] a `uchar level`), to a temporary file beside the target
+/// that [`PlyPointWriter::finish`] renames into place: a failure never leaves a partial file at
+/// the target. The count must be known when the file is created.
 pub struct PlyPointWriter {
     path: PathBuf,
     temporary: PathBuf,
     output: BufWriter<File>,
     count: u64,
     written: u64,
+    with_levels: bool,
 }
 
 impl PlyPointWriter {
@@ -546,6 +548,19 @@ impl PlyPointWriter {
     /// # Errors
     /// [`Error::Write`] naming `path` when the temporary file cannot be created.
     pub fn create(path: &Path, count: u64) -> Result<Self> {
+        Self::start(path, count, false)
+    }
+
+    /// Starts a file of exactly `count` points with a per-point `uchar level` property (the
+    /// level of a progressive sampling, Sec. 6.4), written by [`PlyPointWriter::write_levels`].
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming `path` when the temporary file cannot be created.
+    pub fn create_with_levels(path: &Path, count: u64) -> Result<Self> {
+        Self::start(path, count, true)
+    }
+
+    fn start(path: &Path, count: u64, with_levels: bool) -> Result<Self> {
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
@@ -561,7 +576,12 @@ impl PlyPointWriter {
             output,
             "ply\nformat binary_little_endian 1.0\ncomment spectral-remesh point set\n\
              element vertex {count}\nproperty float x\nproperty float y\nproperty float z\n\
-             property float nx\nproperty float ny\nproperty float nz\nend_header\n"
+             property float nx\nproperty float ny\nproperty float nz\n{}end_header\n",
+            if with_levels {
+                "property uchar level\n"
+            } else {
+                ""
+            }
         )
         .map_err(write_error)?;
         Ok(PlyPointWriter {
@@ -570,20 +590,45 @@ impl PlyPointWriter {
             output,
             count,
             written: 0,
+            with_levels,
         })
     }
 
-    /// Appends points.
+    /// Appends points (to a file made by [`PlyPointWriter::create`]).
     ///
     /// # Errors
-    /// [`Error::Write`] on a write failure or when more points than announced are written.
+    /// [`Error::Write`] on a write failure, when more points than announced are written, or when
+    /// the file has levels.
     pub fn write(&mut self, points: &[Point]) -> Result<()> {
+        if self.with_levels {
+            return Err(self.error("the file has levels: write them with the points".into()));
+        }
+        self.append(points, None)
+    }
+
+    /// Appends points with their levels (to a file made by
+    /// [`PlyPointWriter::create_with_levels`]).
+    ///
+    /// # Errors
+    /// [`Error::Write`] on a write failure, when more points than announced are written, when
+    /// the file has no levels, or when `levels` and `points` differ in length.
+    pub fn write_levels(&mut self, points: &[Point], levels: &[u8]) -> Result<()> {
+        if !self.with_levels || levels.len() != points.len() {
+            return Err(self.error("levels must come one per point, to a file with levels".into()));
+        }
+        self.append(points, Some(levels))
+    }
+
+    fn append(&mut self, points: &[Point], levels: Option<&[u8]>) -> Result<()> {
         if self.written + points.len() as u64 > self.count {
             return Err(self.error(format!("more than the {} points announced", self.count)));
         }
-        let mut bytes = Vec::with_capacity(points.len() * RECORD_BYTES);
-        for p in points {
+        let mut bytes = Vec::with_capacity(points.len() * (RECORD_BYTES + 1));
+        for (k, p) in points.iter().enumerate() {
             encode_record(p, &mut bytes);
+            if let Some(l) = levels {
+                bytes.push(l[k]);
+            }
         }
         self.output
             .write_all(&bytes)
