@@ -216,3 +216,66 @@ fn progressive_levels_are_nested_complete_scans() {
     assert!(simplify_progressive(&input, &[], &params).is_err());
     assert!(simplify_progressive(&input, &[1.0, -2.0], &params).is_err());
 }
+
+/// Issue 4's comparison: horse at 8600 samples, out of core (1M surface points, --points 8600)
+/// against the in-memory scan of the same points at the same sigma_p. One scan's NN coefficient
+/// of variation varies by about 1% from shuffle to shuffle, so each side is the mean of 3 scans
+/// (3 seeds out of core, 3 shuffles in memory).
+#[test]
+fn horse_at_8600_out_of_core_matches_in_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("horse-1M.ply");
+    let (mesh, _) = spectral_remesh::io::read_mesh(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/horse.obj"),
+    )
+    .unwrap();
+    write_surface_points(&mesh, 1_000_000, 11, &input).unwrap();
+    let mut pts = Vec::new();
+    PointReader::open(&input)
+        .unwrap()
+        .read_chunk(&mut pts, 2_000_000)
+        .unwrap();
+    let runs = 3;
+    let (mut ooc_stats, mut mem_stats) = ([0.0; 4], [0.0; 4]);
+    let mut add = |acc: &mut [f64; 4], samples: &[glam::DVec3]| {
+        let (mean, min, cv) = nearest_neighbour_stats(samples);
+        for (a, v) in acc.iter_mut().zip([samples.len() as f64, mean, min, cv]) {
+            *a += v / runs as f64;
+        }
+    };
+    for seed in 1..=runs {
+        let params = OutOfCoreParams {
+            target: Some(8600),
+            seed,
+            temp_dir: Some(dir.path().to_path_buf()),
+            ..Default::default()
+        };
+        let ooc = simplify_out_of_core(&input, &params).unwrap();
+        let norm = ooc.normalization;
+        let out_of_core: Vec<_> = ooc.samples.iter().map(|p| norm.apply(p.position)).collect();
+        assert!(
+            (out_of_core.len() as f64 - 8600.0).abs() <= 0.02 * 8600.0,
+            "{} samples for 8600",
+            out_of_core.len()
+        );
+        add(&mut ooc_stats, &out_of_core);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(100 + seed);
+        pts.shuffle(&mut rng);
+        let kernel = Kernel::new(ooc.sigma_p, f64::INFINITY).unwrap();
+        let mut scanner = LinearScanner::new(&kernel, &LinearScanParams::default());
+        let batch: Vec<_> = pts
+            .iter()
+            .map(|p| (norm.apply(p.position), p.normal))
+            .collect();
+        let mut accepted = Vec::new();
+        scanner.offer_batch(&batch, &mut accepted);
+        let in_memory: Vec<_> = accepted.iter().map(|&i| batch[i].0).collect();
+        add(&mut mem_stats, &in_memory);
+    }
+    println!("out of core: count, NN mean, min, cv {ooc_stats:.4?}; in memory {mem_stats:.4?}");
+    for (k, name) in ["count", "mean", "min", "cv"].iter().enumerate() {
+        let bound = if k == 0 { 0.01 } else { 0.02 };
+        let (a, b) = (ooc_stats[k], mem_stats[k]);
+        assert!((a - b).abs() <= bound * b, "{name}: {a} vs {b}");
+    }
+}
