@@ -42,11 +42,24 @@ pub struct LinearScanResult {
 }
 
 /// Per-thread buffers of the rejection tests.
-#[derive(Default)]
 struct Buffers {
+    /// The sample that last rejected a candidate alone (`u32::MAX`: none). Candidates are visited
+    /// in spatial order, so it often rejects the next one too, without a kd-tree query.
+    last_rejecter: u32,
     found: Vec<(u32, f64)>,
     neighbors: Vec<(f64, KernelPoint)>,
     ws: MeasureWorkspace,
+}
+
+impl Default for Buffers {
+    fn default() -> Self {
+        Buffers {
+            last_rejecter: u32::MAX,
+            found: Vec::new(),
+            neighbors: Vec::new(),
+            ws: MeasureWorkspace::default(),
+        }
+    }
 }
 
 /// Why a candidate was rejected before its full neighbourhood was looked at.
@@ -56,6 +69,20 @@ enum QuickReject {
     Nearest,
     /// The measure over its few nearest output samples is <= epsilon.
     Few,
+}
+
+/// The Morton (Z-order) key of a point with coordinates in [0, 2^21]: the bits of x, y and z
+/// interleaved.
+fn morton_key(q: DVec3) -> u64 {
+    fn spread(v: f64) -> u64 {
+        let mut x = (v.max(0.0) as u64).min((1 << 21) - 1);
+        x = (x | x << 32) & 0x1f00000000ffff;
+        x = (x | x << 16) & 0x1f0000ff0000ff;
+        x = (x | x << 8) & 0x100f00f00f00f00f;
+        x = (x | x << 4) & 0x10c30c30c30c30c3;
+        (x | x << 2) & 0x1249249249249249
+    }
+    spread(q.x) | spread(q.y) << 1 | spread(q.z) << 2
 }
 
 /// Output samples the second quick test uses.
@@ -73,9 +100,18 @@ fn quick_reject(
     x: &KernelPoint,
     b: &mut Buffers,
 ) -> Option<QuickReject> {
+    // Any one sample y of O bounds s(x) <= 1 - k(x, y)^2: first the last one that rejected a
+    // candidate on its own, then the nearest.
+    if let Some(y) = embedded.get(b.last_rejecter as usize) {
+        let k = kernel.eval(x, y);
+        if k * k >= 1.0 - params.epsilon {
+            return Some(QuickReject::Nearest);
+        }
+    }
     let (j, _) = tree.nearest(position)?;
     let k1 = kernel.eval(x, &embedded[j as usize]);
     if k1 * k1 >= 1.0 - params.epsilon {
+        b.last_rejecter = j;
         return Some(QuickReject::Nearest);
     }
     let r_kernel_2 = params.support_radius * params.support_radius;
@@ -185,43 +221,114 @@ impl LinearScanner {
     }
 
     /// Algorithm 1 over `batch` in order, as [`LinearScanner::offer`] one by one would do it (the
-    /// same decisions), but with the quick rejection tests of each chunk run in parallel against
-    /// the output set as it stands at the chunk's start. Pushes the indices (into `batch`) of the
-    /// accepted points to `accepted`.
+    /// same decisions), with the tests of each chunk of candidates run in parallel against O as
+    /// it stands at the chunk's start. Pushes the indices (into `batch`) of the accepted points
+    /// to `accepted`.
+    ///
+    /// Why the decisions are the same: s(x) can only fall as O grows, so a rejection against
+    /// O at the chunk's start stands. An acceptance stands when no sample the chunk has added so
+    /// far lies within the support radius of the candidate (its neighbourhood, and so s(x), is
+    /// unchanged); otherwise the candidate is tested again against O as it is then.
+    ///
+    /// A chunk's tests run in Morton order of the positions (nearby candidates query the same
+    /// parts of the kd-tree, which then stay in cache, and a sample that rejected one candidate
+    /// alone is tried first on the next). Chunks grow as acceptances become rare: the next chunk
+    /// is sized so that it is expected to add about 2% to O (between 8k and 1M candidates).
     pub fn offer_batch(&mut self, batch: &[(DVec3, DVec3)], accepted: &mut Vec<usize>) {
-        const CHUNK: usize = 8192;
-        let mut verdicts: Vec<Option<QuickReject>> = Vec::with_capacity(CHUNK);
-        for (c, chunk) in batch.chunks(CHUNK).enumerate() {
-            let (kernel, params, tree, embedded) =
-                (&self.kernel, &self.params, &self.tree, &self.embedded);
-            chunk
-                .par_iter()
-                .map_init(Buffers::default, |b, &(p, n)| {
-                    quick_reject(kernel, params, tree, embedded, p, &kernel.embed(p, n), b)
-                })
-                .collect_into_vec(&mut verdicts);
+        const MIN_CHUNK: usize = 8192;
+        const MAX_CHUNK: usize = 1 << 20;
+        let mut verdicts: Vec<Verdict> = Vec::new();
+        let mut order: Vec<(u64, u32)> = Vec::new();
+        let (mut start, mut chunk_len) = (0, MIN_CHUNK);
+        let r_pos = self.params.support_radius * self.kernel.sigma_p();
+        while start < batch.len() {
+            let chunk = &batch[start..(start + chunk_len).min(batch.len())];
+            self.parallel_tests(chunk, &mut order, &mut verdicts);
             let size_at_start = self.embedded.len();
             for (k, (&(p, n), verdict)) in chunk.iter().zip(&verdicts).enumerate() {
-                let take = match verdict {
-                    Some(why) => {
-                        self.count(*why);
+                let take = match *verdict {
+                    Verdict::Quick(why) => {
+                        self.count(why);
                         false
                     }
-                    // O as the quick tests saw it: straight to the full measure.
-                    None if self.embedded.len() == size_at_start => {
-                        let x = self.kernel.embed(p, n);
-                        let accept = self.full_measure_accepts(p, &x);
-                        if accept {
-                            self.add(p, x);
+                    Verdict::Measured(accept) => {
+                        self.measured += 1;
+                        accept && {
+                            // Still accepted when the chunk added nothing near it.
+                            let unchanged = self.embedded.len() == size_at_start || {
+                                let found = &mut self.buffers.found;
+                                self.tree.within(p, r_pos * r_pos, found);
+                                found.iter().all(|&(j, _)| (j as usize) < size_at_start)
+                            };
+                            if unchanged {
+                                self.insert(p, n);
+                                true
+                            } else {
+                                self.offer(p, n)
+                            }
                         }
-                        accept
                     }
-                    None => self.offer(p, n),
+                    Verdict::Alone => {
+                        if self.embedded.len() == size_at_start {
+                            self.insert(p, n);
+                            true
+                        } else {
+                            self.offer(p, n)
+                        }
+                    }
                 };
                 if take {
-                    accepted.push(c * CHUNK + k);
+                    accepted.push(start + k);
                 }
             }
+            let added = (self.embedded.len() - size_at_start) as f64;
+            let rate = (added + 1.0) / chunk.len() as f64;
+            start += chunk.len();
+            chunk_len =
+                ((0.02 * self.embedded.len() as f64 / rate) as usize).clamp(MIN_CHUNK, MAX_CHUNK);
+        }
+    }
+
+    /// The tests of `chunk` against O as it stands, in parallel, visited in Morton order of the
+    /// positions; `verdicts[k]` is candidate k's.
+    fn parallel_tests(
+        &self,
+        chunk: &[(DVec3, DVec3)],
+        order: &mut Vec<(u64, u32)>,
+        verdicts: &mut Vec<Verdict>,
+    ) {
+        let (kernel, params, tree, embedded) =
+            (&self.kernel, &self.params, &self.tree, &self.embedded);
+        let (lo, hi) = chunk.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), c| (lo.min(c.0), hi.max(c.0)),
+        );
+        let scale = (1u64 << 21) as f64 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
+        order.clear();
+        chunk
+            .par_iter()
+            .enumerate()
+            .map(|(k, c)| (morton_key((c.0 - lo) * scale), k as u32))
+            .collect_into_vec(order);
+        order.par_sort_unstable();
+        let found: Vec<Verdict> = order
+            .par_iter()
+            .map_init(Buffers::default, |b, &(_, k)| {
+                let (p, n) = chunk[k as usize];
+                let x = kernel.embed(p, n);
+                match quick_reject(kernel, params, tree, embedded, p, &x, b) {
+                    Some(why) => Verdict::Quick(why),
+                    None => match full_measure(kernel, params, tree, embedded, p, &x, b) {
+                        Some(accept) => Verdict::Measured(accept),
+                        None => Verdict::Alone,
+                    },
+                }
+            })
+            .collect();
+        verdicts.clear();
+        verdicts.resize(chunk.len(), Verdict::Alone);
+        for (&(_, k), v) in order.iter().zip(found) {
+            verdicts[k as usize] = v;
         }
     }
 
@@ -232,38 +339,71 @@ impl LinearScanner {
         }
     }
 
-    /// The measure over the whole neighbourhood within the support radius, nearest first.
+    /// The measure over the whole neighbourhood within the support radius: accepts when
+    /// s > epsilon or there is no neighbour.
     fn full_measure_accepts(&mut self, position: DVec3, x: &KernelPoint) -> bool {
-        let kernel = &self.kernel;
-        let r_pos = self.params.support_radius * kernel.sigma_p();
-        let r_kernel_2 = self.params.support_radius * self.params.support_radius;
-        let b = &mut self.buffers;
-        self.tree.within(position, r_pos * r_pos, &mut b.found);
-        b.neighbors.clear();
-        for &(j, _) in &b.found {
-            let y = self.embedded[j as usize];
-            let d2 = x.dist2(&y);
-            if d2 <= r_kernel_2 {
-                b.neighbors.push((d2, y));
-            }
-        }
-        if b.neighbors.is_empty() {
-            return true;
-        }
-        if !kernel.is_isotropic() {
-            // Nearest first in kernel space (positions alone order them otherwise).
-            b.neighbors.sort_by(|a, c| a.0.total_cmp(&c.0));
-        }
-        self.measured += 1;
-        let m = spectral_measure(
-            kernel,
+        let r = full_measure(
+            &self.kernel,
+            &self.params,
+            &self.tree,
+            &self.embedded,
+            position,
             x,
-            b.neighbors.iter().map(|n| n.1),
-            self.params.epsilon,
-            &mut b.ws,
+            &mut self.buffers,
         );
-        m.s > self.params.epsilon
+        self.measured += usize::from(r.is_some());
+        r.unwrap_or(true)
     }
+}
+
+/// A candidate's test against O at the start of its chunk.
+#[derive(Clone, Copy)]
+enum Verdict {
+    /// Rejected by a quick test.
+    Quick(QuickReject),
+    /// Measured over its neighbourhood: whether s > epsilon.
+    Measured(bool),
+    /// No neighbour in O.
+    Alone,
+}
+
+/// The measure of `x` over its whole neighbourhood in O (`tree`, `embedded`) within the support
+/// radius, nearest first: `Some(s > epsilon)`, or `None` when it has no neighbour.
+fn full_measure(
+    kernel: &Kernel,
+    params: &LinearScanParams,
+    tree: &DynamicTree,
+    embedded: &[KernelPoint],
+    position: DVec3,
+    x: &KernelPoint,
+    b: &mut Buffers,
+) -> Option<bool> {
+    let r_pos = params.support_radius * kernel.sigma_p();
+    let r_kernel_2 = params.support_radius * params.support_radius;
+    tree.within(position, r_pos * r_pos, &mut b.found);
+    b.neighbors.clear();
+    for &(j, _) in &b.found {
+        let y = embedded[j as usize];
+        let d2 = x.dist2(&y);
+        if d2 <= r_kernel_2 {
+            b.neighbors.push((d2, y));
+        }
+    }
+    if b.neighbors.is_empty() {
+        return None;
+    }
+    if !kernel.is_isotropic() {
+        // Nearest first in kernel space (positions alone order them otherwise).
+        b.neighbors.sort_by(|a, c| a.0.total_cmp(&c.0));
+    }
+    let m = spectral_measure(
+        kernel,
+        x,
+        b.neighbors.iter().map(|n| n.1),
+        params.epsilon,
+        &mut b.ws,
+    );
+    Some(m.s > params.epsilon)
 }
 
 /// Algorithm 1: visits `candidates` in the order given (pass them shuffled) and adds each to the
@@ -298,5 +438,64 @@ pub fn linear_scan(
         initial: initial.len(),
         rejected_by_nearest: scanner.rejected_by_nearest,
         measured: scanner.measured,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// Points on a unit-ish sphere of radius 20 with outward normals, some bumps in the normals.
+    fn sphere_points(n: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                let v = DVec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                )
+                .normalize_or(DVec3::Z);
+                let bump = DVec3::new(0.0, (7.0 * v.x).sin() * 0.3, 0.0);
+                (20.0 * v, (v + bump).normalize())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_batch_makes_the_decisions_of_one_by_one_offers() {
+        for (sigma_n, seed) in [(f64::INFINITY, 1), (0.75, 2)] {
+            let kernel = Kernel::new(1.0, sigma_n).unwrap();
+            let params = LinearScanParams::default();
+            let points = sphere_points(60_000, seed);
+            let initial = sphere_points(50, seed + 10);
+            let mut one = LinearScanner::new(&kernel, &params);
+            let mut batch = LinearScanner::new(&kernel, &params);
+            for &(p, n) in &initial {
+                one.insert(p, n);
+                batch.insert(p, n);
+            }
+            let by_one: Vec<usize> = (0..points.len())
+                .filter(|&i| one.offer(points[i].0, points[i].1))
+                .collect();
+            let mut by_batch = Vec::new();
+            batch.offer_batch(&points, &mut by_batch);
+            assert!(by_one.len() > 1000, "{} accepted", by_one.len());
+            assert_eq!(by_one, by_batch, "sigma_n {sigma_n}");
+            assert_eq!(one.len(), batch.len());
+        }
+    }
+
+    #[test]
+    fn morton_keys_interleave_the_coordinates() {
+        assert_eq!(morton_key(DVec3::new(1.0, 0.0, 0.0)), 0b001);
+        assert_eq!(morton_key(DVec3::new(0.0, 1.0, 0.0)), 0b010);
+        assert_eq!(morton_key(DVec3::new(0.0, 0.0, 1.0)), 0b100);
+        assert_eq!(morton_key(DVec3::new(3.0, 0.0, 2.0)), 0b101_001);
+        // The top bit of each coordinate and clamping at 2^21 - 1.
+        let top = morton_key(DVec3::splat(4e6));
+        assert_eq!(top, (1u64 << 63) - 1);
+        assert_eq!(morton_key(DVec3::splat(-5.0)), 0);
     }
 }
