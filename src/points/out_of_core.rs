@@ -84,8 +84,6 @@ pub struct OutOfCoreResult {
     pub seconds: [f64; 3],
 }
 
-/// Input points per wanted sample in the subset the sigma_p search runs on.
-const SEARCH_POINTS_PER_SAMPLE: f64 = 4.0;
 
 fn decode(b: &[u8]) -> Point {
     let f = |k: usize| {
@@ -115,74 +113,29 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
     let buckets = buckets.count;
     let t1 = Instant::now();
 
-    // sigma_p: given, or searched on the first buckets: enough of them for SEARCH_POINTS_PER_SAMPLE
-    // input points per wanted sample (a sparser subset leaves gaps the full scan fills).
-    let search_buckets = match params.target {
-        None => 1,
-        Some(n) => ((SEARCH_POINTS_PER_SAMPLE * n as f64 / params.bucket_points.max(1) as f64)
-            .ceil() as usize)
-            .clamp(1, buckets),
-    };
-    let mut first: Option<Vec<Point>> = None;
-    for b in 0..search_buckets {
-        let pts = load(b, &mut rng)?;
-        first.get_or_insert_with(Vec::new).extend(pts);
-    }
-
-    // The scanner that has seen the first buckets: the search's best evaluation, or a fresh scan.
-    let first = first.unwrap_or_default();
-    let batch: Vec<(DVec3, DVec3)> = first.iter().map(|p| (p.position, p.normal)).collect();
-    let scan_first = |sigma_p: f64| -> Result<(LinearScanner, Vec<usize>)> {
-        let kernel = Kernel::new(sigma_p, params.sigma_n)?;
-        let mut scanner = LinearScanner::new(&kernel, &params.scan);
-        let mut accepted = Vec::new();
-        scanner.offer_batch(&batch, &mut accepted);
-        Ok((scanner, accepted))
-    };
-    let (sigma_p, (mut scanner, first_accepted)) = match params.target {
-        None => (params.sigma_p, scan_first(params.sigma_p)?),
+    // sigma_p: given, or searched on a scaled-down problem (see `search_sigma_p`).
+    let sigma_p = match params.target {
+        None => params.sigma_p,
         Some(n) => {
-            let area_guess = surface_area_guess(&first);
-            let start = (area_guess / n.max(1) as f64).sqrt();
-            // The subset's count is itself about 5% below the full scan's: 2% is precise enough.
-            let search = TargetCountParams {
-                tolerance: 0.02,
-                ..TargetCountParams::new(n)
-            };
-            let mut failure = None;
-            let r = find_sigma_p(&search, start, |s| match scan_first(s) {
-                Ok(v) => (v.0.len(), Some(v)),
-                Err(e) => {
-                    failure = Some(e);
-                    (0, None)
-                }
-            });
-            match (failure, r.value) {
-                (Some(e), _) => return Err(e),
-                (None, Some(v)) => (r.sigma_p, v),
-                (None, None) => (r.sigma_p, scan_first(r.sigma_p)?),
-            }
+            let first = load(0, &mut rng)?;
+            search_sigma_p(&first, total, n, params)?
         }
     };
     let t2 = Instant::now();
 
-    let to_model = |p: &Point| Point {
-        position: normalization.invert(p.position),
-        normal: p.normal,
-    };
-    let mut samples: Vec<Point> = first_accepted
-        .iter()
-        .map(|&i| to_model(&first[i]))
-        .collect();
-    drop(batch);
-    drop(first);
+    let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+    let mut scanner = LinearScanner::new(&kernel, &params.scan);
+    let mut samples: Vec<Point> = Vec::new();
     let mut accepted = Vec::new();
-    for b in search_buckets..buckets {
+    for b in 0..buckets {
         let pts = load(b, &mut rng)?;
         let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
         accepted.clear();
         scanner.offer_batch(&batch, &mut accepted);
-        samples.extend(accepted.iter().map(|&i| to_model(&pts[i])));
+        samples.extend(accepted.iter().map(|&i| Point {
+            position: normalization.invert(pts[i].position),
+            normal: pts[i].normal,
+        }));
     }
     let t3 = Instant::now();
     Ok(OutOfCoreResult {
@@ -381,6 +334,60 @@ impl Buckets {
         pts.shuffle(rng);
         Ok(pts)
     }
+}
+
+/// Most samples the scaled-down search problem aims at.
+const SEARCH_SAMPLES: usize = 10_000;
+
+/// Input points per sample above which the scan's count hardly depends on the input's density.
+const SEARCH_MAX_DENSITY: f64 = 50.0;
+
+/// The sigma_p (bbox-100 units) for about `target` samples from `total` input points, searched
+/// on a scaled-down problem: a random subset of `sample` (uniformly random input points) with
+/// the input's points per sample (up to [`SEARCH_MAX_DENSITY`]) and a target of at most
+/// [`SEARCH_SAMPLES`]. On a surface the count goes as sigma_p^-2 at a fixed points-per-sample
+/// ratio, so the subset's sigma_p' for target' gives sigma_p = sigma_p' sqrt(target' / target).
+fn search_sigma_p(
+    sample: &[Point],
+    total: u64,
+    target: usize,
+    params: &OutOfCoreParams,
+) -> Result<f64> {
+    let target = target.max(1);
+    let density = (total as f64 / target as f64).min(SEARCH_MAX_DENSITY);
+    let small_target = target.min(SEARCH_SAMPLES);
+    let subset = ((density * small_target as f64).ceil() as usize).min(sample.len());
+    let small_target = small_target.min(subset);
+    let batch: Vec<(DVec3, DVec3)> = sample[..subset]
+        .iter()
+        .map(|p| (p.position, p.normal))
+        .collect();
+    let start = (surface_area_guess(&sample[..subset]) / small_target as f64).sqrt();
+    let search = TargetCountParams {
+        tolerance: 0.01,
+        ..TargetCountParams::new(small_target)
+    };
+    let mut failure = None;
+    let mut accepted = Vec::new();
+    let r = find_sigma_p(&search, start, |s| {
+        let count = match Kernel::new(s, params.sigma_n) {
+            Ok(kernel) => {
+                let mut scanner = LinearScanner::new(&kernel, &params.scan);
+                accepted.clear();
+                scanner.offer_batch(&batch, &mut accepted);
+                scanner.len()
+            }
+            Err(e) => {
+                failure = Some(e);
+                0
+            }
+        };
+        (count, ())
+    });
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    Ok(r.sigma_p * (small_target as f64 / target as f64).sqrt())
 }
 
 /// A first guess of the surface area (bbox-100 units²) of a uniformly random point subset, for
