@@ -106,18 +106,19 @@ fn decode(b: &[u8]) -> Point {
 pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<OutOfCoreResult> {
     let t0 = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-    let buckets = Buckets::write(input, params, &mut rng)?;
-    let (total, had_normals, normalization) =
-        (buckets.total, buckets.had_normals, buckets.normalization);
-    let load = |b: usize, rng: &mut ChaCha8Rng| buckets.load(b, rng);
-    let buckets = buckets.count;
+    let bucket_set = Buckets::write(input, params, &mut rng)?;
+    let (total, had_normals, normalization) = (
+        bucket_set.total,
+        bucket_set.had_normals,
+        bucket_set.normalization,
+    );
     let t1 = Instant::now();
 
     // sigma_p: given, or searched on a scaled-down problem (see `search_sigma_p`).
     let sigma_p = match params.target {
         None => params.sigma_p,
         Some(n) => {
-            let first = load(0, &mut rng)?;
+            let first = bucket_set.load(0, &mut rng)?;
             search_sigma_p(&first, total, n, params)?
         }
     };
@@ -127,8 +128,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
     let mut scanner = LinearScanner::new(&kernel, &params.scan);
     let mut samples: Vec<Point> = Vec::new();
     let mut accepted = Vec::new();
-    for b in 0..buckets {
-        let pts = load(b, &mut rng)?;
+    bucket_set.for_each(&mut rng, |pts| {
         let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
         accepted.clear();
         scanner.offer_batch(&batch, &mut accepted);
@@ -136,7 +136,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
             position: normalization.invert(pts[i].position),
             normal: pts[i].normal,
         }));
-    }
+    })?;
     let t3 = Instant::now();
     Ok(OutOfCoreResult {
         samples,
@@ -224,8 +224,7 @@ pub fn simplify_progressive(
         for &(p, n) in &scaled {
             scanner.insert(p, n);
         }
-        for b in 0..buckets.count {
-            let pts = buckets.load(b, &mut rng)?;
+        buckets.for_each(&mut rng, |pts| {
             let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
             accepted.clear();
             scanner.offer_batch(&batch, &mut accepted);
@@ -237,7 +236,7 @@ pub fn simplify_progressive(
                 });
                 levels.push((l + 1) as u8);
             }
-        }
+        })?;
         level_ends.push(samples.len());
         seconds.push(t.elapsed().as_secs_f64());
     }
@@ -312,6 +311,35 @@ impl Buckets {
             total,
             had_normals,
             normalization,
+        })
+    }
+
+    /// Calls `f` with each bucket's points in turn (bbox-100 units, shuffled), loading the next
+    /// bucket on another thread meanwhile. The shuffles draw from `rng` in bucket order.
+    fn for_each(&self, rng: &mut ChaCha8Rng, mut f: impl FnMut(Vec<Point>)) -> Result<()> {
+        std::thread::scope(|scope| {
+            let spawn = |b: usize, mut r: ChaCha8Rng| {
+                scope.spawn(move || {
+                    let pts = self.load(b, &mut r);
+                    (pts, r)
+                })
+            };
+            let mut pending = Some(spawn(0, rng.clone()));
+            for b in 0..self.count {
+                let (pts, r) = pending
+                    .take()
+                    .map(|h| h.join())
+                    .transpose()
+                    .map_err(|_| Error::io(self.dir.path(), std::io::Error::other("a bucket loader panicked")))?
+                    .unwrap_or((Ok(Vec::new()), rng.clone()));
+                *rng = r;
+                let pts = pts?;
+                if b + 1 < self.count {
+                    pending = Some(spawn(b + 1, rng.clone()));
+                }
+                f(pts);
+            }
+            Ok(())
         })
     }
 
