@@ -7,7 +7,7 @@ use super::SurfaceSample;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
 use crate::spatial::StaticTree;
-use crate::surface::MeshSurface;
+use crate::surface::Projection;
 
 /// Parameters of the gradient ascent.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,7 +65,7 @@ pub struct GradientAscentResult {
 }
 
 /// Moves each of `samples[fixed..]` along the gradient of its spectral measure (eq. 11) and
-/// projects it onto `surface` (closest point), for `params.iterations` sweeps. `samples[..fixed]`
+/// projects it onto `surface` (see [`Projection`]), for `params.iterations` sweeps. `samples[..fixed]`
 /// (for example samples on the input's boundary curves) act as neighbours but do not move.
 ///
 /// Neighbourhoods are found once with a kd-tree and kept for all sweeps (Sec. 6.3). By default
@@ -76,9 +76,9 @@ pub struct GradientAscentResult {
 /// The gradient is taken with respect to the position part of x with the sample's normal held
 /// fixed; the projection then gives the new position and the normal of the input triangle it
 /// lands on. Units: positions in bbox-100 units.
-pub fn gradient_ascent(
+pub fn gradient_ascent<S: Projection + ?Sized>(
     kernel: &Kernel,
-    surface: &MeshSurface,
+    surface: &S,
     samples: &mut [SurfaceSample],
     fixed: usize,
     params: &GradientAscentParams,
@@ -200,9 +200,9 @@ pub fn gradient_ascent(
 /// bounded step along it, and the projection onto the surface. Returns the moved sample, the
 /// distance moved and s before the move.
 #[allow(clippy::too_many_arguments)]
-fn move_one(
+fn move_one<S: Projection + ?Sized>(
     kernel: &Kernel,
-    surface: &MeshSurface,
+    surface: &S,
     embedded: &[KernelPoint],
     list: &[u32],
     i: usize,
@@ -234,14 +234,7 @@ fn move_one(
     if len > max_move {
         delta *= max_move / len;
     }
-    let project = |delta: glam::DVec3| match surface.closest_point(old.position + delta) {
-        Some(sp) => SurfaceSample {
-            position: sp.position,
-            normal: surface.face_normal(sp.face),
-            face: sp.face,
-        },
-        None => old,
-    };
+    let project = |delta: glam::DVec3| surface.project(old.position + delta).unwrap_or(old);
     let mut moved = project(delta);
     for _ in 0..params.backtracking {
         // Keep the move only if it does not lower s (with the neighbours held where they are).
