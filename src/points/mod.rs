@@ -6,5 +6,6 @@ pub mod generate;
 pub mod normals;
 pub mod out_of_core;
 pub mod ply_stream;
+pub mod rimls;
 
 pub use ply_stream::{PlyPointReader, PlyPointWriter, Point};
