@@ -31,9 +31,11 @@
 //! # References
 //! - A. C. Öztireli, G. Guennebaud, M. Gross. *Feature Preserving Point Set Surfaces based on
 //!   Non-Linear Kernel Regression.* Computer Graphics Forum 28(2) (Eurographics 2009),
-//!   doi:10.1111/j.1467-8659.2009.01388.x. Sec. 4 (robust fitting by iteratively reweighted
-//!   least squares, the residual and normal terms) and Algorithm 1 (the evaluation of f and ∇f
-//!   used here).
+//!   doi:10.1111/j.1467-8659.2009.01388.x: robust fitting by iteratively reweighted least
+//!   squares with the residual and normal terms, and the pseudo-code (Algorithm 1) of the
+//!   evaluation of f and ∇f followed here. That paper's text is not in this repository; the
+//!   defaults of σ_r and of the refitting count come from its public reference implementations
+//!   (see [`RimlsParams`]) rather than from the paper itself.
 //! - A. C. Öztireli, M. Alexa, M. Gross. *Spectral Sampling of Manifolds.* ACM TOG 29(6)
 //!   (SIGGRAPH Asia 2010), Sec. 3 and 5: the kernel and its σ_p, σ_n.
 //!
@@ -60,19 +62,24 @@ pub struct RimlsParams {
     /// spatial part of the spectral sampling kernel (Sec. 3). Default 1.
     pub sigma_p: f64,
     /// Normal kernel width σ_n (> 0; `f64::INFINITY` for positions only): the refitting weight
-    /// exp(-|∇f - n_i|²/σ_n²), the normal part of the sampling kernel (Sec. 3). Smaller values
-    /// give sharper features. Default 0.75, the value the spectral sampling paper reconstructs
-    /// with (Fig. 15) and the middle of the range the RIMLS paper recommends.
+    /// exp(-|∇f - n_i|²/σ_n²), the normal part of the sampling kernel (Sec. 3), with ∇f (not
+    /// normalized, about unit length near the surface) in place of the query's normal, as in the
+    /// RIMLS paper. Smaller values give sharper features. Default 0.75, the value the spectral
+    /// sampling paper reconstructs with (Fig. 15).
     pub sigma_n: f64,
     /// Residual scale σ_r, in units of σ_p (> 0; `f64::INFINITY` turns the residual term off):
     /// the refitting weight exp(-(r_i/(σ_r σ_p))²) on the residual r_i = f - n_iᵀ(x - p_i). The
-    /// RIMLS paper states σ_r relative to the spatial scale of the fit; default 0.5.
+    /// residuals are relative to the spatial scale of the fit (MeshLab's RIMLS, by the paper's
+    /// second author, divides them by the local point radius); here by σ_p. Default 0.5, the
+    /// default of the Ponca library's RIMLS.
     pub sigma_r: f64,
     /// Radius of the neighbourhood, in units of σ_p (> 0): points farther than
     /// `support_radius · σ_p` are ignored. Default 3 (φ = exp(-9) ≈ 1.2e-4 there).
     pub support_radius: f64,
     /// Robust refitting iterations after the first (unweighted) fit (RIMLS paper, Algorithm 1).
-    /// 0 gives plain implicit MLS. Default 3.
+    /// 0 gives plain implicit MLS. Default 3, as in MeshLab's RIMLS. On fandisk near sharp
+    /// edges (σ_p = 1, σ_n = 0.75) 1, 3 and 10 give a mean distance to the true surface of
+    /// 0.026, 0.0097 and 0.0067 bbox-100 units for 0.08, 0.10 and 0.13 s per 3000 projections.
     pub max_refit: usize,
     /// Newton steps of [`Rimls::project`] at most (≥ 1). Default 20.
     pub max_projection_steps: usize,
@@ -350,6 +357,13 @@ impl Rimls {
     /// |f| < `tolerance · σ_p` or `max_projection_steps` steps are taken; returns the position
     /// and the unit normal ∇f/|∇f| there (the last iterate when the steps run out).
     ///
+    /// ∇f is the RIMLS gradient, which holds the robust weights constant; near sharp features it
+    /// can underestimate the slope of f and the Newton step overshoots. After a step across the
+    /// surface (f changes sign) the step length is f divided by the secant slope measured along
+    /// that step instead of by |∇f| (the direction stays ∇f). On fandisk near sharp edges this
+    /// turns 9 (σ_n = 0.75) and 58 (σ_n = ∞) of 3000 projections that had not converged in 20
+    /// steps into none.
+    ///
     /// `None` when an iterate leaves the support (no point within `support_radius · σ_p`), or
     /// ∇f vanishes.
     pub fn project(&self, x: DVec3) -> Option<(DVec3, DVec3)> {
@@ -377,14 +391,33 @@ impl Rimls {
         let threshold = self.params.tolerance * self.params.sigma_p;
         let mut position = x;
         let (mut f, mut grad) = self.evaluate(position, neighbours)?;
+        // The previous f and the signed length of the step taken from it.
+        let mut previous: Option<(f64, f64)> = None;
         let mut steps = 0;
         while f.abs() >= threshold && steps < self.params.max_projection_steps {
-            let g2 = grad.length_squared();
-            // evaluate() returns finite values only, so g2 is a number.
-            if g2 <= f64::MIN_POSITIVE {
+            // evaluate() returns finite values only.
+            let slope = grad.length();
+            if slope <= f64::MIN_POSITIVE.sqrt() {
                 return None;
             }
-            position -= grad * (f / g2);
+            // ∇f holds the robust weights constant, so near features it can underestimate how
+            // fast f changes and the Newton step overshoots (f changes sign, and may oscillate
+            // with growing amplitude). After an overshoot the slope along the last step,
+            // (f_previous - f) / step, measured by the secant, sets the step length instead.
+            let slope = match previous {
+                Some((f_previous, step)) if f_previous.signum() != f.signum() => {
+                    let secant = (f_previous - f) / step;
+                    if secant.is_finite() && secant > 0.0 {
+                        secant
+                    } else {
+                        slope
+                    }
+                }
+                _ => slope,
+            };
+            let step = f / slope;
+            position -= grad * (step / grad.length());
+            previous = Some((f, step));
             (f, grad) = self.evaluate(position, neighbours)?;
             steps += 1;
         }
@@ -422,6 +455,30 @@ mod tests {
         let mean = v.iter().sum::<f64>() / v.len() as f64;
         let p95 = v[((v.len() as f64 * 0.95) as usize).min(v.len() - 1)];
         (mean, p95, v[v.len() - 1])
+    }
+
+    /// [`Rimls::project`] of every query (in parallel), the number of projections that ran out
+    /// of steps, and the most Newton steps taken.
+    fn project_counted(
+        rimls: &Rimls,
+        queries: &[DVec3],
+    ) -> (Vec<Option<(DVec3, DVec3)>>, usize, usize) {
+        let detailed: Vec<Option<Projection>> = queries
+            .par_iter()
+            .map(|&q| rimls.project_detailed(q))
+            .collect();
+        let not_converged = detailed.iter().flatten().filter(|p| !p.converged).count();
+        let most_steps = detailed
+            .iter()
+            .flatten()
+            .map(|p| p.steps)
+            .max()
+            .unwrap_or(0);
+        let projected = detailed
+            .iter()
+            .map(|p| p.map(|p| (p.position, p.normal)))
+            .collect();
+        (projected, not_converged, most_steps)
     }
 
     #[test]
@@ -607,7 +664,8 @@ mod tests {
             .unwrap();
             let mut radial = Vec::new();
             let mut angle = Vec::new();
-            for (q, r) in queries.iter().zip(rimls.project_all(&queries)) {
+            let (projected, not_converged, most_steps) = project_counted(&rimls, &queries);
+            for (q, r) in queries.iter().zip(projected) {
                 let (p, n) = r.unwrap_or_else(|| panic!("{q} did not project"));
                 radial.push((p.length() - R).abs());
                 angle.push(n.angle_between(p.normalize()).to_degrees());
@@ -617,13 +675,15 @@ mod tests {
             println!(
                 "sphere R = {R}, {count} points, sigma_p = {sigma_p}, sigma_n = {sigma_n}: \
                  | |p| - R | mean {mean:.2e}, max {max:.2e} = {:.2e} R \
-                 (planar-fit bias sigma_p^2/(2R) = {:.2e}); normal mean {mean_angle:.3}, max {max_angle:.3} deg",
+                 (planar-fit bias sigma_p^2/(2R) = {:.2e}); normal mean {mean_angle:.3}, max {max_angle:.3} deg; \
+                 {not_converged} not converged, at most {most_steps} Newton steps",
                 max / R,
                 sigma_p * sigma_p / (2.0 * R)
             );
-            worst.push((sigma_n, max, max_angle));
+            worst.push((sigma_n, max, max_angle, not_converged));
         }
-        for (sigma_n, max, max_angle) in worst {
+        for (sigma_n, max, max_angle, not_converged) in worst {
+            assert_eq!(not_converged, 0, "sigma_n {sigma_n}");
             assert!(max <= 1e-3 * R, "sigma_n {sigma_n}: max radial error {max}");
             assert!(
                 max_angle < 1.5,
@@ -672,7 +732,8 @@ mod tests {
             .unwrap();
             let mut dist = Vec::new();
             let mut angle = Vec::new();
-            for (q, r) in queries.iter().zip(rimls.project_all(&queries)) {
+            let (projected, not_converged, most_steps) = project_counted(&rimls, &queries);
+            for (q, r) in queries.iter().zip(projected) {
                 let (p, n) = r.unwrap_or_else(|| panic!("{q} did not project"));
                 let (d, true_n) = truth(p);
                 dist.push(d.abs());
@@ -683,14 +744,16 @@ mod tests {
             println!(
                 "torus {MAJOR}/{MINOR}, {count} points, sigma_p = {sigma_p}, sigma_n = {sigma_n}: \
                  distance mean {mean:.2e}, max {max:.2e} = {:.2e} minor = {:.2e} major radius \
-                 (planar-fit bias sigma_p^2 (k1+k2)/4 <= {:.2e}); normal mean {mean_angle:.3}, max {max_angle:.3} deg",
+                 (planar-fit bias sigma_p^2 (k1+k2)/4 <= {:.2e}); normal mean {mean_angle:.3}, max {max_angle:.3} deg; \
+                 {not_converged} not converged, at most {most_steps} Newton steps",
                 max / MINOR,
                 max / MAJOR,
                 sigma_p * sigma_p * (1.0 / MINOR + 1.0 / (MAJOR + MINOR)) / 4.0
             );
-            worst.push((sigma_n, max, max_angle));
+            worst.push((sigma_n, max, max_angle, not_converged));
         }
-        for (sigma_n, max, max_angle) in worst {
+        for (sigma_n, max, max_angle, not_converged) in worst {
+            assert_eq!(not_converged, 0, "sigma_n {sigma_n}");
             assert!(max <= 1e-3 * MINOR, "sigma_n {sigma_n}: max distance {max}");
             assert!(
                 max_angle < 1.5,
@@ -802,7 +865,7 @@ mod tests {
                 RimlsParams::new(sigma_p, sigma_n),
             )
             .unwrap();
-            let projected = rimls.project_all(&queries);
+            let (projected, not_converged, most_steps) = project_counted(&rimls, &queries);
             let failed = projected.iter().filter(|p| p.is_none()).count();
             let mut dist: Vec<f64> = projected
                 .iter()
@@ -813,11 +876,16 @@ mod tests {
             println!(
                 "fandisk (bbox 100), {count} points, {} sharp edges ({edge_length:.0} long), \
                  {} queries within sigma_p of them, sigma_p = {sigma_p}, sigma_n = {sigma_n}: \
-                 distance to the mesh mean {mean:.4}, 95% {p95:.4}, max {max:.4}; {failed} failed",
+                 distance to the mesh mean {mean:.4}, 95% {p95:.4}, max {max:.4}; {failed} failed, \
+                 {not_converged} not converged, at most {most_steps} Newton steps",
                 sharp.len(),
                 queries.len()
             );
             assert!(failed <= queries.len() / 100, "{failed} projections failed");
+            assert!(
+                not_converged <= queries.len() / 100,
+                "{not_converged} projections did not converge"
+            );
             figures.push((mean, p95, max));
         }
         let (sharp_fit, smooth_fit) = (figures[0], figures[1]);
