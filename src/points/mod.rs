@@ -1,10 +1,11 @@
-//! Point sets without connectivity, the paper's native input (Sec. 3): streaming PLY reading and
-//! writing, dense random point sets drawn from meshes for tests and benchmarks, and the
-//! out-of-core randomized linear scan.
+//! Point sets without connectivity, the paper's native input (Sec. 3): streaming reading (PLY,
+//! XYZ/CSV) and writing, dense random point sets drawn from meshes for tests and benchmarks, the
+//! out-of-core randomized linear scan, normal estimation, and the RIMLS surface of a point set.
 
 pub mod generate;
 pub mod normals;
 pub mod out_of_core;
+pub mod rimls;
 pub mod stream;
 
 pub use stream::{PlyPointWriter, Point, PointReader};
