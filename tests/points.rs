@@ -279,3 +279,73 @@ fn horse_at_8600_out_of_core_matches_in_memory() {
         assert!((a - b).abs() <= bound * b, "{name}: {a} vs {b}");
     }
 }
+
+/// Gradient-ascent resampling onto the RIMLS surface (Sec. 6.2): more even spacing (larger
+/// min/mean nearest-neighbour ratio, smaller coefficient of variation), the samples stay on the
+/// surface, and their normals are the surface's.
+#[test]
+fn resampling_on_rimls_evens_the_spacing_and_stays_on_the_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("spot-200k.ply");
+    let (mesh, _) = spectral_remesh::io::read_mesh(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/spot.obj"),
+    )
+    .unwrap();
+    write_surface_points(&mesh, 200_000, 9, &input).unwrap();
+    let run = |resample| {
+        let params = OutOfCoreParams {
+            target: Some(3000),
+            resample,
+            temp_dir: Some(dir.path().to_path_buf()),
+            ..Default::default()
+        };
+        simplify_out_of_core(&input, &params).unwrap()
+    };
+    let (scan, resampled) = (run(0), run(10));
+    assert_eq!(scan.samples.len(), resampled.samples.len());
+    let norm = scan.normalization;
+    let scaled = |r: &spectral_remesh::points::out_of_core::OutOfCoreResult| -> Vec<_> {
+        r.samples.iter().map(|p| norm.apply(p.position)).collect()
+    };
+    let (_, min0, cv0) = nearest_neighbour_stats(&scaled(&scan));
+    let (mean1, min1, cv1) = nearest_neighbour_stats(&scaled(&resampled));
+    let (mean0, ..) = nearest_neighbour_stats(&scaled(&scan));
+    println!(
+        "scan: rho {:.3} cv {cv0:.3}; resampled: rho {:.3} cv {cv1:.3}",
+        min0 / mean0,
+        min1 / mean1
+    );
+    assert!(min1 / mean1 > min0 / mean0 + 0.02, "rho did not grow");
+    assert!(cv1 < 0.5 * cv0, "cv {cv1} against {cv0}");
+    // On the surface, with the surface's normals (bbox-100 units).
+    let surface = spectral_remesh::MeshSurface::new(&norm.apply_mesh(&mesh)).unwrap();
+    let mut off = Vec::new();
+    let mut angles = Vec::new();
+    for p in &resampled.samples {
+        let sp = surface.closest_point(norm.apply(p.position)).unwrap();
+        off.push(sp.distance);
+        let n = surface.smooth_normal(&sp);
+        angles.push(p.normal.dot(n).clamp(-1.0, 1.0).acos().to_degrees());
+    }
+    off.sort_by(f64::total_cmp);
+    angles.sort_by(f64::total_cmp);
+    let mean_off = off.iter().sum::<f64>() / off.len() as f64;
+    println!(
+        "sigma_p {:.3}; off the surface: mean {mean_off:.4}, max {:.4}; normal angle median {:.2}, max {:.1}",
+        resampled.sigma_p,
+        off[off.len() - 1],
+        angles[angles.len() / 2],
+        angles[angles.len() - 1]
+    );
+    // The RIMLS surface at the sampling's sigma_p is smoother than the mesh: a planar MLS fit
+    // lies about sigma_p^2 (k1 + k2) / 4 off a surface of principal curvatures k1, k2, which is
+    // sigma_p / 10 where the curvature radius is 5 sigma_p. No sample is flung off it.
+    assert!(mean_off < 0.1 * resampled.sigma_p, "mean {mean_off}");
+    assert!(
+        off[off.len() - 1] < resampled.sigma_p,
+        "max {}",
+        off[off.len() - 1]
+    );
+    assert!(angles[angles.len() / 2] < 5.0);
+    assert!(angles[angles.len() - 1] < 90.0, "a flipped normal");
+}

@@ -117,6 +117,10 @@ enum Command {
         /// Normal width sigma_n (default: infinity, positions only).
         #[arg(long)]
         sigma_n: Option<f64>,
+        /// After the scan, K sweeps of gradient-ascent resampling (Sec. 6.2; 10 is typical), each
+        /// move projected onto the RIMLS surface of the input (same sigma_p, sigma_n).
+        #[arg(long, value_name = "K", default_value_t = 0, conflicts_with = "levels")]
+        resample: usize,
         /// Seed of the visit order.
         #[arg(long, default_value_t = 1)]
         seed: u64,
@@ -167,6 +171,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         sigma_p,
         levels,
         sigma_n,
+        resample,
         seed,
         viewpoint,
         quiet,
@@ -183,7 +188,9 @@ fn run(cli: Cli) -> Result<(), Error> {
                 })
             }
         };
-        return run_simplify(input, output, density, *sigma_n, *seed, *viewpoint, *quiet);
+        return run_simplify(
+            input, output, density, *sigma_n, *resample, *seed, *viewpoint, *quiet,
+        );
     }
     if let Some(Command::Points {
         mesh,
@@ -293,34 +300,18 @@ enum PointDensity {
     Levels(Vec<f64>),
 }
 
-/// Estimated normals for the samples of an input without them.
-fn estimate_output_normals(
-    samples: &mut [spectral_remesh::points::Point],
-    viewpoint: Option<[f64; 3]>,
-) {
-    use spectral_remesh::points::normals::{estimate_normals, Orientation};
-    let positions: Vec<_> = samples.iter().map(|p| p.position).collect();
-    let orientation = match viewpoint {
-        Some([x, y, z]) => Orientation::Viewpoint(glam::DVec3::new(x, y, z)),
-        None => Orientation::SpanningTree,
-    };
-    for (p, n) in samples
-        .iter_mut()
-        .zip(estimate_normals(&positions, 10, orientation))
-    {
-        p.normal = n;
-    }
-}
-
+#[allow(clippy::too_many_arguments)]
 fn run_simplify(
     input: &std::path::Path,
     output: &std::path::Path,
     density: PointDensity,
     sigma_n: Option<f64>,
+    resample: usize,
     seed: u64,
     viewpoint: Option<[f64; 3]>,
     quiet: bool,
 ) -> Result<(), Error> {
+    use spectral_remesh::points::normals::Orientation;
     use spectral_remesh::points::out_of_core::{
         simplify_out_of_core, simplify_progressive, OutOfCoreParams,
     };
@@ -331,7 +322,13 @@ fn run_simplify(
             message: "must be at least 1".into(),
         });
     }
+    let orientation = match viewpoint {
+        Some([x, y, z]) => Orientation::Viewpoint(glam::DVec3::new(x, y, z)),
+        None => Orientation::SpanningTree,
+    };
     let params = OutOfCoreParams {
+        resample,
+        orientation,
         target: match density {
             PointDensity::Points(n) => Some(n),
             _ => None,
@@ -357,10 +354,7 @@ fn run_simplify(
     let no_normals_note =
         "; the input has no normals: positions only, normals estimated on the output";
     if let PointDensity::Levels(levels) = &density {
-        let mut r = simplify_progressive(input, levels, &params)?;
-        if !r.had_normals {
-            estimate_output_normals(&mut r.samples, viewpoint);
-        }
+        let r = simplify_progressive(input, levels, &params)?;
         let mut w = PlyPointWriter::create_with_levels(output, r.samples.len() as u64)?;
         w.write_levels(&r.samples, &r.levels)?;
         w.finish()?;
@@ -393,18 +387,14 @@ fn run_simplify(
         }
         return Ok(());
     }
-    let mut r = simplify_out_of_core(input, &params)?;
-    if !r.had_normals {
-        // Normals of the output set (memory bounded by the output, like the scan).
-        estimate_output_normals(&mut r.samples, viewpoint);
-    }
+    let r = simplify_out_of_core(input, &params)?;
     let mut w = PlyPointWriter::create(output, r.samples.len() as u64)?;
     w.write(&r.samples)?;
     w.finish()?;
     if !quiet {
         emit(&format!(
             "{} -> {}: {} points -> {} samples, sigma_p {:.4} (bbox-100 units){}; {} rejected by the nearest sample, {} measured\n\
-             seconds: read+bucket {:.2}, sigma_p search {:.2}, scan {:.2}, total {:.2}\n",
+             seconds: read+bucket {:.2}, sigma_p search {:.2}, scan {:.2}, normals+resample {:.2}, total {:.2}\n",
             input.display(),
             output.display(),
             r.input_points,
@@ -416,6 +406,7 @@ fn run_simplify(
             r.seconds[0],
             r.seconds[1],
             r.seconds[2],
+            r.seconds[3],
             t.elapsed().as_secs_f64()
         ));
     }

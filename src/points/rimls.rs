@@ -165,7 +165,7 @@ impl RimlsParams {
 
 /// The result of [`Rimls::project_detailed`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Projection {
+pub struct RimlsProjection {
     /// The projected position (position units).
     pub position: DVec3,
     /// The unit normal there: ∇f / |∇f|.
@@ -373,7 +373,7 @@ impl Rimls {
     }
 
     /// [`Rimls::project`], also saying how many steps it took and whether it converged.
-    pub fn project_detailed(&self, x: DVec3) -> Option<Projection> {
+    pub fn project_detailed(&self, x: DVec3) -> Option<RimlsProjection> {
         self.project_with(x, &mut Vec::new())
     }
 
@@ -389,7 +389,7 @@ impl Rimls {
     }
 
     /// [`Rimls::project_detailed`] with caller-provided scratch space.
-    fn project_with(&self, x: DVec3, neighbours: &mut Vec<(u32, f64)>) -> Option<Projection> {
+    fn project_with(&self, x: DVec3, neighbours: &mut Vec<(u32, f64)>) -> Option<RimlsProjection> {
         let threshold = self.params.tolerance * self.params.sigma_p;
         let mut position = x;
         let (mut f, mut grad) = self.evaluate(position, neighbours)?;
@@ -424,12 +424,23 @@ impl Rimls {
             steps += 1;
         }
         let normal = grad.try_normalize()?;
-        Some(Projection {
+        Some(RimlsProjection {
             position,
             normal,
             value: f,
             steps,
             converged: f.abs() < threshold,
+        })
+    }
+}
+
+impl crate::surface::Projection for Rimls {
+    /// [`Rimls::project`]; `face` is 0.
+    fn project(&self, p: DVec3) -> Option<crate::sampling::SurfaceSample> {
+        Rimls::project(self, p).map(|(position, normal)| crate::sampling::SurfaceSample {
+            position,
+            normal,
+            face: 0,
         })
     }
 }
@@ -465,7 +476,7 @@ mod tests {
         rimls: &Rimls,
         queries: &[DVec3],
     ) -> (Vec<Option<(DVec3, DVec3)>>, usize, usize) {
-        let detailed: Vec<Option<Projection>> = queries
+        let detailed: Vec<Option<RimlsProjection>> = queries
             .par_iter()
             .map(|&q| rimls.project_detailed(q))
             .collect();
