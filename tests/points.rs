@@ -83,7 +83,11 @@ fn out_of_core_scan_matches_the_in_memory_scan() {
 
 /// Normals estimated on `name`'s vertices (its normals thrown away, k = 10) against the mesh's
 /// vertex normals turned outward: (median angle in degrees, how many point the other way).
-fn normal_agreement(name: &str) -> (f64, usize) {
+/// Estimated normals (k = 10, spanning-tree orientation) of a shared mesh's vertices against the
+/// mesh's outward vertex normals: the median angle (unsigned), the flipped count (angle over
+/// 90°), and the flipped count among the vertices where the mesh resolves its surface: the
+/// normals of the vertex's 10 nearest vertices are all within 60° of its own.
+fn normal_agreement(name: &str) -> (f64, usize, usize) {
     use spectral_remesh::points::normals::{estimate_normals, Orientation};
     let (mesh, _) = spectral_remesh::io::read_mesh(
         &Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -109,12 +113,20 @@ fn normal_agreement(name: &str) -> (f64, usize) {
         .map(|(a, b)| a.dot(*b).abs().clamp(0.0, 1.0).acos().to_degrees())
         .collect();
     angles.sort_by(f64::total_cmp);
-    let flipped = truth
-        .iter()
-        .zip(&estimated)
-        .filter(|(a, b)| a.dot(**b) < 0.0)
-        .count();
-    (angles[angles.len() / 2], flipped)
+    let tree = StaticTree::new(&mesh.positions);
+    let mut found = Vec::new();
+    let (mut flipped, mut flipped_resolved) = (0, 0);
+    for (i, (a, b)) in truth.iter().zip(&estimated).enumerate() {
+        if a.dot(*b) >= 0.0 {
+            continue;
+        }
+        flipped += 1;
+        tree.nearest_n(mesh.positions[i], 11, &mut found);
+        if found.iter().all(|&(j, _)| truth[j as usize].dot(*a) > 0.5) {
+            flipped_resolved += 1;
+        }
+    }
+    (angles[angles.len() / 2], flipped, flipped_resolved)
 }
 
 /// Issue 4: estimated normals agree with the mesh normals (median angle below 5°) and, on the
@@ -127,20 +139,28 @@ fn estimated_normals_agree_with_the_mesh_normals() {
         ("stanford-bunny.obj", false),
         ("horse.obj", true),
     ] {
-        let (median, flipped) = normal_agreement(name);
+        let (median, flipped, flipped_resolved) = normal_agreement(name);
         assert!(median < 5.0, "{name}: median angle {median}");
-        if closed && name != "horse.obj" {
-            assert_eq!(flipped, 0, "{name}: {flipped} normals flipped");
+        if closed {
+            // Where the mesh resolves its surface, none flipped.
+            assert_eq!(
+                flipped_resolved, 0,
+                "{name}: {flipped_resolved} normals flipped"
+            );
+            if name != "horse.obj" {
+                assert_eq!(flipped, 0, "{name}: {flipped} normals flipped");
+            }
         }
     }
 }
 
-/// Horse's ear tips and tail strands are thinner than the vertex spacing: 28 of 48,485
-/// estimated normals point inward there.
+/// Horse's ear tips turn their normal by more than 60° within 10 vertices (599 such vertices),
+/// and one vertex's normal opposes all its neighbours': 28 of 48,485 estimated normals point
+/// against the mesh's there, none elsewhere (see the test above).
 #[test]
-#[ignore = "issue 4 open: 28 of horse's 48,485 estimated normals are flipped (ear tips, thinner than the spacing)"]
+#[ignore = "issue 4: 28 of horse's 48,485 estimated normals are flipped, all where the mesh's normal turns by more than 60 degrees within 10 vertices"]
 fn no_estimated_normal_is_flipped_on_horse() {
-    let (_, flipped) = normal_agreement("horse.obj");
+    let (_, flipped, _) = normal_agreement("horse.obj");
     assert_eq!(flipped, 0);
 }
 
