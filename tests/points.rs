@@ -140,6 +140,7 @@ fn estimated_normals_agree_with_the_mesh_normals() {
         ("horse.obj", true),
     ] {
         let (median, flipped, flipped_resolved) = normal_agreement(name);
+        println!("{name}: median {median:.2} degrees, {flipped} flipped, {flipped_resolved} where resolved");
         assert!(median < 5.0, "{name}: median angle {median}");
         if closed {
             // Where the mesh resolves its surface, none flipped.
