@@ -204,6 +204,18 @@ impl StaticTree {
         }
     }
 
+    /// Points within squared distance `radius_2` of `p`, in no particular order (cheaper than
+    /// [`StaticTree::within`]), as `(index, squared distance)`.
+    pub fn within_unsorted(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {
+        out.clear();
+        if let Some(t) = &self.tree {
+            t.query(&arr(p))
+                .within::<SquaredEuclidean<f64>>(radius_2)
+                .unsorted()
+                .visit(|q| out.push((q.item as u32, q.distance)));
+        }
+    }
+
     /// The `k` nearest points to `p`, nearest first, as `(index, squared distance)`.
     pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
         out.clear();

@@ -301,7 +301,7 @@ impl Rimls {
         if !x.is_finite() {
             return None;
         }
-        self.tree.within(x, self.support_2, neighbours);
+        self.tree.within_unsorted(x, self.support_2, neighbours);
         if neighbours.is_empty() {
             return None;
         }
