@@ -265,6 +265,14 @@ mod tests {
             assert_eq!(out.iter().map(|x| x.0).collect::<Vec<_>>(), expect);
             fixed.within(q, 1.5, &mut out);
             assert_eq!(out.iter().map(|x| x.0).collect::<Vec<_>>(), expect);
+            fixed.within_unsorted(q, 1.5, &mut out);
+            let mut unsorted: Vec<u32> = out.iter().map(|x| x.0).collect();
+            unsorted.sort_by(|a, b| {
+                pts[*a as usize]
+                    .distance_squared(q)
+                    .total_cmp(&pts[*b as usize].distance_squared(q))
+            });
+            assert_eq!(unsorted, expect);
             let (i, d) = dynamic.nearest(q).unwrap();
             let all = brute(&pts, q, f64::INFINITY);
             assert_eq!(i, all[0]);
