@@ -723,10 +723,32 @@ fn empty_files_are_errors() {
         let path = dir.path().join(format!("empty.{ext}"));
         fs::write(&path, b"").unwrap();
         let e = expect_err(&path);
-        if ext == "obj" {
-            assert!(e.to_string().contains("no faces"), "{e}");
-        }
+        assert!(e.to_string().contains("the file is empty"), "{e}");
     }
+}
+
+#[test]
+fn content_that_does_not_match_the_extension_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let copy = |from: &str, to: &str| {
+        let path = dir.path().join(to);
+        fs::copy(model(from), &path).unwrap();
+        path
+    };
+    for (from, to, says) in [
+        ("horse.ply", "ply-content.obj", "the content is PLY"),
+        ("spot.glb", "glb-content.obj", "the content is binary glTF"),
+        ("spot.glb", "glb-content.ply", "the content is binary glTF"),
+        ("spot.obj", "obj-content.ply", "not a PLY file"),
+        ("spot.obj", "obj-content.glb", "not a binary glTF file"),
+    ] {
+        let e = expect_err(&copy(from, to));
+        let text = e.to_string();
+        assert!(text.contains(says), "{to}: {text}");
+        assert_eq!(text.lines().count(), 1, "{text}");
+    }
+    // A binary glTF under .gltf is still read.
+    assert!(read_mesh(&copy("spot.glb", "binary.gltf")).is_ok());
 }
 
 #[test]

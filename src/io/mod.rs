@@ -147,6 +147,7 @@ impl ReadStats {
 ///   non-finite coordinate (naming the vertex), or a file with no triangles ("no faces").
 pub fn read_mesh(path: &Path) -> Result<(TriMesh, ReadStats)> {
     let format = MeshFormat::from_path(path)?;
+    check_content(path, format)?;
     let mut stats = ReadStats::new(format);
     let raw = match format {
         MeshFormat::Obj => obj::read(path, &mut stats)?,
@@ -155,6 +156,61 @@ pub fn read_mesh(path: &Path) -> Result<(TriMesh, ReadStats)> {
     };
     let mesh = finish(path, raw, &mut stats)?;
     Ok((mesh, stats))
+}
+
+/// The format a file's first bytes show, when they show one: `ply` for PLY, `glTF` for binary
+/// glTF; `None` when the bytes are not conclusive (OBJ and glTF JSON have no magic).
+fn sniff(head: &[u8]) -> Option<MeshFormat> {
+    if head.starts_with(b"ply\n") || head.starts_with(b"ply\r\n") {
+        Some(MeshFormat::Ply)
+    } else if head.starts_with(b"glTF") {
+        Some(MeshFormat::Glb)
+    } else {
+        None
+    }
+}
+
+/// A file whose content is plainly another format than its extension names is an input error
+/// naming both, instead of the parse error of the wrong reader.
+fn check_content(path: &Path, format: MeshFormat) -> Result<()> {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    let n = std::fs::File::open(path)
+        .and_then(|mut f| f.read(&mut head))
+        .map_err(|e| Error::io(path, e))?;
+    let shown = sniff(&head[..n]);
+    let name = |f: MeshFormat| match f {
+        MeshFormat::Obj => "OBJ",
+        MeshFormat::Ply => "PLY",
+        MeshFormat::Gltf => "glTF (JSON)",
+        MeshFormat::Glb => "binary glTF (.glb)",
+    };
+    let error = |message: String| {
+        Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: None,
+            message,
+        })
+    };
+    if n == 0 {
+        return error("the file is empty".into());
+    }
+    match shown {
+        Some(f) if f != format && !(f == MeshFormat::Glb && format == MeshFormat::Gltf) => {
+            error(format!(
+                "the content is {} (by its first bytes), not {} as the extension says",
+                name(f),
+                name(format)
+            ))
+        }
+        None if format == MeshFormat::Ply => {
+            error("not a PLY file (it does not start with the line `ply`)".into())
+        }
+        None if format == MeshFormat::Glb => {
+            error("not a binary glTF file (it does not start with `glTF`)".into())
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Writes `mesh` to `path` in the format its extension names, in the mesh's own units, with
