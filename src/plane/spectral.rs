@@ -51,6 +51,9 @@ pub struct TorusAscentParams {
     /// Sweeps over all points (default 10, Sec. 6.3 and 7.1).
     pub iterations: usize,
     /// Step of eq. 11, p ← p + step ∇s(p), in kernel units (default 0.55; eq. 11 prints 0.5).
+    /// Path A at n = 4096, 10 sets, seed 1, mean rho after 10 sweeps: 0.60 at 0.55 (clusters of
+    /// the random start not yet apart in 5 of the 10 sets), 0.69 at 0.7, 0.62 at 0.85, 0.28 at
+    /// 0.4; at 0.55 it reaches 0.79 after 15 sweeps and 0.83 after 30.
     pub step: f64,
     /// Largest move of one point in one sweep, in units of sigma (default 0.25).
     pub max_move: f64,
@@ -63,9 +66,13 @@ pub struct TorusAscentParams {
     /// `max_move`. The gradient of s vanishes with s inside tight clusters of a uniform random
     /// start (about 5 points within 0.5 sigma: s and |∇s| below 1e-3), which then take most of
     /// the 10 sweeps to come apart; the longer step is the step along ∇ log s there.
+    /// Path A at n = 4096, 10 sets, step 0.55, max_move 0.5, s_ref 0.3: mean rho 0.790, 0.790,
+    /// 0.775 for seeds 1, 2, 3 (s_ref 0.5 gives 0.59–0.71: boosting points near the optimum
+    /// s ≈ 0.55 makes them oscillate).
     pub small_s_boost: Option<f64>,
     /// Halvings of a step that would lower s (neighbours held where they are) before it is
-    /// taken anyway (default 0: every step is taken, as in eq. 11).
+    /// taken anyway (default 0: every step is taken, as in eq. 11). Path A, seed 1: step 1.0,
+    /// max_move 0.5 and 2 or 3 halvings give mean rho 0.773; no gain at step 0.55.
     pub backtracking: usize,
 }
 
