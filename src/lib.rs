@@ -14,6 +14,7 @@ pub mod kernel;
 pub mod measure;
 pub mod mesh;
 pub mod pipeline;
+pub mod plane;
 pub mod points;
 pub mod quality;
 pub mod sampling;

@@ -19,7 +19,8 @@ Examples:
   remesh quality out.obj --ref in.obj
   remesh points horse.obj horse-14M.ply --count 14000000
   remesh simplify horse-14M.ply horse-300k.ply --points 300000
-  remesh simplify scan.xyz levels.ply --levels 4,2,1";
+  remesh simplify scan.xyz levels.ply --levels 4,2,1
+  remesh blue-noise --method ours --output ours.json";
 
 /// Spectral remeshing of triangle meshes (Öztireli, Alexa, Gross 2010: Spectral Sampling of
 /// Manifolds): samples the input surface with the spectral measure, triangulates the samples,
@@ -132,6 +133,54 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
+    /// Blue noise on the periodic unit square (Sec. 7.1, Fig. 11): several point sets by one
+    /// method, their normalized Poisson-disk radius (Lagae and Dutré 2008), mean periodogram,
+    /// and radially averaged power and anisotropy (Ulichney 1987). Prints a summary; --output
+    /// writes everything needed to plot as JSON.
+    BlueNoise {
+        /// ours (random start, 10 sweeps of gradient ascent, the paper's), ours-scan (a dense
+        /// random set, the linear scan, then gradient ascent), lloyd (100 iterations, periodic
+        /// Voronoi), dart (dart throwing to n points at rho 0.75), random.
+        #[arg(long, default_value = "ours", value_parser = ["ours", "ours-scan", "lloyd", "dart", "random"])]
+        method: String,
+        /// Points per set.
+        #[arg(long, default_value_t = 4096)]
+        n: usize,
+        /// Point sets.
+        #[arg(long, default_value_t = 10)]
+        sets: usize,
+        /// Seed: set k uses ChaCha8 stream k of it.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Gradient-ascent sweeps (ours, ours-scan).
+        #[arg(long, default_value_t = 10)]
+        iterations: usize,
+        /// Gradient-ascent step of eq. 11 in kernel units (ours, ours-scan).
+        #[arg(long, default_value_t = 0.55)]
+        step: f64,
+        /// Largest move per sweep in units of sigma (ours, ours-scan).
+        #[arg(long, default_value_t = 0.25)]
+        max_move: f64,
+        /// Not in the paper: points whose measure s is below S_REF take steps S_REF / s times
+        /// longer (at most 1000x, still bounded by --max-move) (ours, ours-scan).
+        #[arg(long, value_name = "S_REF")]
+        small_s_boost: Option<f64>,
+        /// Lloyd iterations.
+        #[arg(long, default_value_t = 100)]
+        lloyd_iterations: usize,
+        /// Dart throwing's minimum distance over d_max.
+        #[arg(long, default_value_t = 0.75)]
+        dart_rho: f64,
+        /// Periodogram half-width in integer frequencies (default round(2 sqrt(n))).
+        #[arg(long)]
+        half_width: Option<usize>,
+        /// Write the report as JSON to this file.
+        #[arg(long, value_name = "FILE.json")]
+        output: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(short, long)]
+        quiet: bool,
+    },
     /// Draw random points with normals uniformly by area from a mesh's surface and write them as
     /// binary PLY (streamed: any count fits in memory). Makes large point-cloud inputs.
     Points {
@@ -164,6 +213,77 @@ fn emit(text: &str) {
 }
 
 fn run(cli: Cli) -> Result<(), Error> {
+    if let Some(Command::BlueNoise {
+        method,
+        n,
+        sets,
+        seed,
+        iterations,
+        step,
+        max_move,
+        small_s_boost,
+        lloyd_iterations,
+        dart_rho,
+        half_width,
+        output,
+        quiet,
+    }) = &cli.command
+    {
+        use spectral_remesh::plane::{run_blue_noise, BlueNoiseParams, Method};
+        let method = Method::parse(method).ok_or_else(|| Error::InvalidParameter {
+            name: "--method",
+            message: format!("unknown method {method}"),
+        })?;
+        let mut params = BlueNoiseParams::new(method);
+        params.n = *n;
+        params.sets = *sets;
+        params.seed = *seed;
+        params.ascent.iterations = *iterations;
+        params.ascent.step = *step;
+        params.ascent.max_move = *max_move;
+        params.ascent.small_s_boost = *small_s_boost;
+        params.lloyd_iterations = *lloyd_iterations;
+        params.dart_rho = *dart_rho;
+        params.half_width = *half_width;
+        let t = std::time::Instant::now();
+        let r = run_blue_noise(&params)?;
+        if let Some(p) = output {
+            write_report(p, &r.to_json())?;
+        }
+        if !quiet {
+            let s = &r.summary;
+            let gen: f64 = r.generate_seconds.iter().sum();
+            let mut text = format!(
+                "{}: {} sets of {} points (seed {})\n\
+                 rho mean {:.4} min {:.4} max {:.4}\n\
+                 low-frequency power (< 0.5 sqrt(n)) max {:.4}; peak {:.3} at {:.3} sqrt(n)\n\
+                 anisotropy beyond the peak {:.2} to {:.2} dB (noise floor {:.2} dB)\n\
+                 seconds: generate {:.2} ({:.3} per set), analysis {:.2}, total {:.2}\n",
+                r.method,
+                r.sets,
+                r.n,
+                r.seed,
+                r.rho_mean,
+                r.rho_min,
+                r.rho_max,
+                s.low_frequency_max,
+                s.peak_power,
+                s.peak_frequency,
+                s.anisotropy_beyond_peak_db.0,
+                s.anisotropy_beyond_peak_db.1,
+                s.noise_floor_db,
+                gen,
+                gen / r.sets as f64,
+                r.analysis_seconds,
+                t.elapsed().as_secs_f64()
+            );
+            for note in &r.notes {
+                text += &format!("note: {note}\n");
+            }
+            emit(&text);
+        }
+        return Ok(());
+    }
     if let Some(Command::Simplify {
         input,
         output,
