@@ -16,6 +16,7 @@ pub mod mesh;
 pub mod pipeline;
 pub mod points;
 pub mod quality;
+pub mod reconstruction_eval;
 pub mod sampling;
 pub mod spatial;
 pub mod surface;

@@ -204,6 +204,20 @@ impl StaticTree {
         }
     }
 
+    /// [`StaticTree::within`] in the tree's traversal order (deterministic, not sorted): for
+    /// callers that only sum over the neighbours, without the sort.
+    pub fn within_unsorted(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {
+        out.clear();
+        if let Some(t) = &self.tree {
+            let r = t
+                .query(&arr(p))
+                .within::<SquaredEuclidean<f64>>(radius_2)
+                .unsorted()
+                .execute();
+            out.extend(r.into_iter().map(|q| (q.item as u32, q.distance)));
+        }
+    }
+
     /// The `k` nearest points to `p`, nearest first, as `(index, squared distance)`.
     pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
         out.clear();
