@@ -27,6 +27,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::DVec3;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
@@ -34,7 +36,9 @@ use crate::io::{read_mesh, write_mesh};
 use crate::kernel::Kernel;
 use crate::mesh::{Normalization, TriMesh};
 use crate::points::generate::surface_points;
-use crate::points::reconstruct::{reconstruct_rimls, ReconstructParams, Reconstruction};
+use crate::points::reconstruct::{
+    clip_to_domain, reconstruct_rimls, ReconstructParams, Reconstruction,
+};
 use crate::points::subsample::{
     linear_scan_subsample, poisson_disk_subsample_to_count, random_subsample,
     voxel_grid_subsample_to_count, Subsampler,
@@ -73,19 +77,25 @@ pub struct ReconstructionEvalParams {
     pub methods: Vec<Subsampler>,
     /// Marching-cubes cell in units of σ_p (default 0.5).
     pub cell_per_sigma: f64,
-    /// The reconstructions' restricted domain
-    /// ([`crate::points::reconstruct::ReconstructParams::domain_neighbours`]; default 16, 0 for
-    /// none).
-    pub domain_neighbours: usize,
+    /// The restricted domain of the reconstructions in the table, in units of σ_p
+    /// ([`crate::points::reconstruct::ReconstructParams::domain`]; default 1.5; 0 for none).
+    /// The distances without it are reported too ([`MethodResult::distance_no_domain`]).
+    pub domain: f64,
     /// Random samples per side of each distance, on top of the vertices (default 200,000).
     pub distance_samples: usize,
     /// Relative tolerance of the baselines' count searches (default 0.005).
     pub count_tolerance: f64,
-    /// Seed of the point set, the visit orders and the distance sampling (default 1).
+    /// Seed of the point set and the distance sampling; the subsamplers of repeat r use seeds
+    /// derived from `seed + r` (default 1).
     pub seed: u64,
-    /// When set, every reconstruction is written there as binary PLY (bbox-100 units):
-    /// `MODEL-sS-METHOD.ply`, with METHOD `all` for the surface of all points, and every subset
-    /// as a PLY point set with normals, `MODEL-sS-METHOD-points.ply`.
+    /// Runs of every subsampler with different seeds (visit orders, random choices, voxel-grid
+    /// shifts), all against the same all-points surface (default 3): one run's numbers can
+    /// hinge on a single spurious sheet of RIMLS.
+    pub repeats: usize,
+    /// When set, every reconstruction of the first repeat is written there as binary PLY
+    /// (bbox-100 units, restricted to the domain): `MODEL-sS-METHOD.ply`, with METHOD `all`
+    /// for the surface of all points, and every subset as a PLY point set with normals,
+    /// `MODEL-sS-METHOD-points.ply`.
     pub mesh_dir: Option<PathBuf>,
 }
 
@@ -97,10 +107,11 @@ impl Default for ReconstructionEvalParams {
             source: PointSource::Vertices,
             methods: Subsampler::ALL.to_vec(),
             cell_per_sigma: crate::points::reconstruct::DEFAULT_CELL_PER_SIGMA,
-            domain_neighbours: crate::points::reconstruct::DEFAULT_DOMAIN_NEIGHBOURS,
+            domain: crate::points::reconstruct::DEFAULT_DOMAIN,
             distance_samples: 200_000,
             count_tolerance: 0.005,
             seed: 1,
+            repeats: 3,
             mesh_dir: None,
         }
     }
@@ -119,7 +130,7 @@ pub struct MeshStats {
     pub components: usize,
     /// Grid cells the surface crosses that have an undefined corner.
     pub cells_skipped: usize,
-    /// Triangles dropped outside the restricted domain.
+    /// Triangles dropped outside the restricted domain (of the marching cubes' output).
     pub clipped_triangles: usize,
     /// Evaluations of the RIMLS function (grid corners).
     pub evaluations: usize,
@@ -132,6 +143,8 @@ pub struct MeshStats {
 pub struct MethodResult {
     /// The subsampler's short name (`ours`, `random`, `voxel`, `poisson`).
     pub method: &'static str,
+    /// The repeat (0-based).
+    pub repeat: usize,
     /// Points kept.
     pub points: usize,
     /// The count the baselines aimed at (the linear scan's count; for the scan itself, its own).
@@ -141,15 +154,19 @@ pub struct MethodResult {
     /// The method's size parameter: σ_p for ours, the voxel side, the Poisson radius (bbox-100
     /// units); `None` for random.
     pub parameter: Option<f64>,
-    /// Distance from this reconstruction (side A) to the all-points one (side B); `None` when
-    /// the reconstruction is empty.
+    /// Distance from this reconstruction (side A) to the all-points one (side B), both
+    /// restricted to the domain; `None` when either is empty.
     pub distance: Option<SurfaceDistance>,
-    /// The reconstruction.
+    /// The same without the restricted domain (every zero crossing where RIMLS is defined).
+    pub distance_no_domain: Option<SurfaceDistance>,
+    /// The reconstruction (restricted to the domain).
     pub mesh: MeshStats,
     /// Seconds to subsample.
     pub subsample_seconds: f64,
     /// Seconds to reconstruct.
     pub reconstruct_seconds: f64,
+    /// Seconds for the two distances.
+    pub distance_seconds: f64,
 }
 
 /// Everything at one σ_p.
@@ -159,14 +176,16 @@ pub struct SigmaResult {
     pub sigma_p: f64,
     /// Marching-cubes cell, bbox-100 units.
     pub cell: f64,
-    /// The reconstruction from all points.
+    /// The reconstruction from all points (restricted to the domain).
     pub all_points: MeshStats,
     /// Seconds to reconstruct from all points.
     pub all_points_seconds: f64,
     /// Distance from the all-points reconstruction (A) to the input mesh (B): how well RIMLS
     /// reproduces the model at this σ_p (not part of Table 2).
     pub all_points_to_input: Option<SurfaceDistance>,
-    /// One entry per subsampler, the linear scan first.
+    /// The same without the restricted domain.
+    pub all_points_to_input_no_domain: Option<SurfaceDistance>,
+    /// One entry per repeat and subsampler, by repeat, the linear scan first in each.
     pub methods: Vec<MethodResult>,
 }
 
@@ -191,10 +210,19 @@ pub struct ModelResult {
     pub flipped: bool,
     /// σ_n.
     pub sigma_n: f64,
+    /// The restricted domain, in units of σ_p (0: none).
+    pub domain: f64,
     /// Per σ_p.
     pub sigmas: Vec<SigmaResult>,
     /// Wall-clock seconds for the model.
     pub seconds: f64,
+}
+
+/// The seeds of repeat `repeat`'s subsamplers: linear scan, random, Poisson disk, voxel-grid
+/// shift.
+fn repeat_seeds(seed: u64, repeat: usize) -> [u64; 4] {
+    let base = seed.wrapping_add(1000 * repeat as u64);
+    [base, base + 1, base + 2, base + 3]
 }
 
 /// Reads `path`, normalizes it to bbox 100, orients it outward (flipping the faces when its
@@ -258,22 +286,82 @@ pub fn input_points(
     }
 }
 
-/// Statistics of a reconstruction, writing it to `file` when given.
-fn mesh_stats(rec: &Reconstruction, file: Option<PathBuf>) -> Result<MeshStats> {
+/// Statistics of a reconstruction (its mesh restricted to the domain, `clipped` triangles
+/// dropped), writing the mesh to `file` when given.
+fn mesh_stats(
+    rec: &Reconstruction,
+    mesh: &TriMesh,
+    clipped: usize,
+    file: Option<PathBuf>,
+) -> Result<MeshStats> {
     if let Some(f) = &file {
-        write_mesh(f, &rec.mesh)?;
+        write_mesh(f, mesh)?;
     }
-    let t = topology(&rec.mesh);
+    let t = topology(mesh);
     Ok(MeshStats {
-        vertices: rec.mesh.positions.len(),
-        faces: rec.mesh.triangles.len(),
+        vertices: mesh.positions.len(),
+        faces: mesh.triangles.len(),
         boundary_edges: t.boundary_edges,
         components: t.components,
         cells_skipped: rec.cells_skipped,
-        clipped_triangles: rec.clipped_triangles,
+        clipped_triangles: clipped,
         evaluations: rec.evaluations,
         file,
     })
+}
+
+/// A reconstruction and its search structure (`None` for an empty mesh).
+struct Surface {
+    mesh: TriMesh,
+    search: Option<MeshSurface>,
+}
+
+impl Surface {
+    fn new(mesh: TriMesh) -> Self {
+        let search = MeshSurface::new(&mesh).ok();
+        Surface { mesh, search }
+    }
+
+    /// The Metro-style distance from `self` (A) to `other` (B); `None` when either is empty.
+    fn distance(
+        &self,
+        other: &Surface,
+        params: &ReconstructionEvalParams,
+    ) -> Option<SurfaceDistance> {
+        match (&self.search, &other.search) {
+            (Some(a), Some(b)) => Some(surface_distance_with(
+                &self.mesh,
+                a,
+                &other.mesh,
+                b,
+                params.distance_samples,
+                params.seed,
+            )),
+            _ => None,
+        }
+    }
+}
+
+/// The marching cubes' surface of `positions` and that surface restricted to the domain, with
+/// the statistics of the restricted one.
+fn reconstruct_both(
+    positions: &[DVec3],
+    normals: &[DVec3],
+    rec_params: &ReconstructParams,
+    domain_radius: f64,
+    file: Option<PathBuf>,
+) -> Result<(Surface, Surface, MeshStats, f64)> {
+    let rec = reconstruct_rimls(positions, normals, rec_params)?;
+    let mut clipped = rec.mesh.clone();
+    let dropped = if domain_radius > 0.0 {
+        clip_to_domain(&mut clipped, positions, domain_radius)
+    } else {
+        0
+    };
+    let stats = mesh_stats(&rec, &clipped, dropped, file)?;
+    let seconds = rec.seconds;
+    let (unclipped, clipped) = rayon::join(|| Surface::new(rec.mesh), || Surface::new(clipped));
+    Ok((clipped, unclipped, stats, seconds))
 }
 
 /// Runs the experiment (see the module documentation) on the mesh at `path`. `progress` is
@@ -314,45 +402,53 @@ pub fn evaluate_model(
             ""
         }
     ));
-    let input_surface = MeshSurface::new(&mesh).map_err(|e| with_path(e, path))?;
+    if !(params.domain.is_finite() && params.domain >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "--domain",
+            message: format!("must be a finite number >= 0, got {}", params.domain),
+        });
+    }
+    let input_surface = Surface::new(mesh.clone());
+    if input_surface.search.is_none() {
+        return Err(Error::invalid_mesh(
+            path,
+            "the mesh has no triangle of non-zero area",
+        ));
+    }
     let mut sigmas = Vec::new();
     for &sigma_p in &params.sigma_p {
-        let mut rec_params = ReconstructParams {
+        // Reconstructed without the domain, then restricted to it (both are measured).
+        let rec_params = ReconstructParams {
             cell_per_sigma: params.cell_per_sigma,
+            domain: 0.0,
             ..ReconstructParams::new(sigma_p, params.sigma_n)
         };
-        rec_params.domain_neighbours = params.domain_neighbours;
+        let domain_radius = params.domain * sigma_p;
         let file = |method: &str| {
             params
                 .mesh_dir
                 .as_ref()
                 .map(|d| d.join(format!("{model}-s{sigma_p}-{method}.ply")))
         };
-        let all = reconstruct_rimls(&positions, &normals, &rec_params)?;
-        let all_stats = mesh_stats(&all, file("all"))?;
-        let all_surface = MeshSurface::new(&all.mesh).ok();
-        let all_points_to_input = all_surface.as_ref().map(|s| {
-            surface_distance_with(
-                &all.mesh,
-                s,
-                &mesh,
-                &input_surface,
-                params.distance_samples,
-                params.seed,
-            )
-        });
+        let (all, all_no_domain, all_stats, all_seconds) = reconstruct_both(
+            &positions,
+            &normals,
+            &rec_params,
+            domain_radius,
+            file("all"),
+        )?;
+        let all_points_to_input = all.distance(&input_surface, params);
+        let all_points_to_input_no_domain = all_no_domain.distance(&input_surface, params);
         progress(&format!(
-            "{model} sigma_p {sigma_p}: all {} points -> {} faces in {:.1} s; to the input: {}",
+            "{model} sigma_p {sigma_p}: all {} points -> {} faces in {all_seconds:.1} s; to the input: {}",
             positions.len(),
             all_stats.faces,
-            all.seconds,
             all_points_to_input
                 .as_ref()
                 .map(|d| format!("RMS {:.4} Hausdorff {:.4}", d.rms, d.hausdorff))
                 .unwrap_or_else(|| "empty".into())
         ));
         let kernel = Kernel::new(sigma_p, params.sigma_n)?;
-        let mut target = 0;
         let mut methods = Vec::new();
         // The linear scan first: it sets the count.
         let mut order = vec![Subsampler::LinearScan];
@@ -362,97 +458,106 @@ pub fn evaluate_model(
                 .iter()
                 .filter(|&&m| m != Subsampler::LinearScan),
         );
-        for method in order {
-            let t = Instant::now();
-            let tolerance = TargetCountParams {
-                tolerance: params.count_tolerance,
-                ..TargetCountParams::new(target)
-            };
-            let (indices, parameter, reached) = match method {
-                Subsampler::LinearScan => {
-                    let kept = linear_scan_subsample(
-                        &positions,
-                        &normals,
-                        &kernel,
-                        &LinearScanParams::default(),
-                        params.seed,
-                    );
-                    target = kept.len();
-                    (kept, Some(sigma_p), true)
+        for repeat in 0..params.repeats.max(1) {
+            let seeds = repeat_seeds(params.seed, repeat);
+            let mut target = 0;
+            for &method in &order {
+                let t = Instant::now();
+                let tolerance = TargetCountParams {
+                    tolerance: params.count_tolerance,
+                    ..TargetCountParams::new(target)
+                };
+                let (indices, parameter, reached) = match method {
+                    Subsampler::LinearScan => {
+                        let kept = linear_scan_subsample(
+                            &positions,
+                            &normals,
+                            &kernel,
+                            &LinearScanParams::default(),
+                            seeds[0],
+                        );
+                        target = kept.len();
+                        (kept, Some(sigma_p), true)
+                    }
+                    Subsampler::UniformRandom => (
+                        random_subsample(positions.len(), target, seeds[1]),
+                        None,
+                        true,
+                    ),
+                    Subsampler::VoxelGrid => {
+                        let mut rng = ChaCha8Rng::seed_from_u64(seeds[3]);
+                        let offset = DVec3::new(rng.random(), rng.random(), rng.random());
+                        let r =
+                            voxel_grid_subsample_to_count(&positions, &tolerance, sigma_p, offset);
+                        (r.value, Some(r.sigma_p), r.reached)
+                    }
+                    Subsampler::PoissonDisk => {
+                        let r = poisson_disk_subsample_to_count(
+                            &positions, &tolerance, sigma_p, seeds[2],
+                        );
+                        (r.value, Some(r.sigma_p), r.reached)
+                    }
+                };
+                let subsample_seconds = t.elapsed().as_secs_f64();
+                let (p, n): (Vec<DVec3>, Vec<DVec3>) =
+                    indices.iter().map(|&i| (positions[i], normals[i])).unzip();
+                if let (Some(dir), 0) = (&params.mesh_dir, repeat) {
+                    let file = dir.join(format!("{model}-s{sigma_p}-{}-points.ply", method.name()));
+                    let mut w = PlyPointWriter::create(&file, p.len() as u64)?;
+                    let pts: Vec<Point> = p
+                        .iter()
+                        .zip(&n)
+                        .map(|(&position, &normal)| Point { position, normal })
+                        .collect();
+                    w.write(&pts)?;
+                    w.finish()?;
                 }
-                Subsampler::UniformRandom => (
-                    random_subsample(positions.len(), target, params.seed + 1),
-                    None,
-                    true,
-                ),
-                Subsampler::VoxelGrid => {
-                    let r = voxel_grid_subsample_to_count(&positions, &tolerance, sigma_p);
-                    (r.value, Some(r.sigma_p), r.reached)
-                }
-                Subsampler::PoissonDisk => {
-                    let r = poisson_disk_subsample_to_count(
-                        &positions,
-                        &tolerance,
-                        sigma_p,
-                        params.seed + 2,
-                    );
-                    (r.value, Some(r.sigma_p), r.reached)
-                }
-            };
-            let subsample_seconds = t.elapsed().as_secs_f64();
-            let (p, n): (Vec<DVec3>, Vec<DVec3>) =
-                indices.iter().map(|&i| (positions[i], normals[i])).unzip();
-            if let Some(dir) = &params.mesh_dir {
-                let file = dir.join(format!("{model}-s{sigma_p}-{}-points.ply", method.name()));
-                let mut w = PlyPointWriter::create(&file, p.len() as u64)?;
-                let pts: Vec<Point> = p
-                    .iter()
-                    .zip(&n)
-                    .map(|(&position, &normal)| Point { position, normal })
-                    .collect();
-                w.write(&pts)?;
-                w.finish()?;
-            }
-            let rec = reconstruct_rimls(&p, &n, &rec_params)?;
-            let stats = mesh_stats(&rec, file(method.name()))?;
-            let distance = match (&all_surface, MeshSurface::new(&rec.mesh).ok()) {
-                (Some(a), Some(r)) => Some(surface_distance_with(
-                    &rec.mesh,
-                    &r,
-                    &all.mesh,
-                    a,
-                    params.distance_samples,
-                    params.seed,
-                )),
-                _ => None,
-            };
-            progress(&format!(
-                "{model} sigma_p {sigma_p} {:>7}: {:>7} points, {}",
+                let mesh_file = if repeat == 0 {
+                    file(method.name())
+                } else {
+                    None
+                };
+                let (rec, rec_no_domain, stats, reconstruct_seconds) =
+                    reconstruct_both(&p, &n, &rec_params, domain_radius, mesh_file)?;
+                let t = Instant::now();
+                let distance = rec.distance(&all, params);
+                let distance_no_domain = rec_no_domain.distance(&all_no_domain, params);
+                let distance_seconds = t.elapsed().as_secs_f64();
+                let show = |d: &Option<SurfaceDistance>| {
+                    d.as_ref()
+                        .map(|d| format!("RMS {:.4} Hausdorff {:.4}", d.rms, d.hausdorff))
+                        .unwrap_or_else(|| "no surface".into())
+                };
+                progress(&format!(
+                "{model} sigma_p {sigma_p} run {repeat} {:>7}: {:>7} points, {} (no domain: {})",
                 method.name(),
                 indices.len(),
-                distance
-                    .as_ref()
-                    .map(|d| format!("RMS {:.4} Hausdorff {:.4}", d.rms, d.hausdorff))
-                    .unwrap_or_else(|| "no surface".into())
+                show(&distance),
+                show(&distance_no_domain),
             ));
-            methods.push(MethodResult {
-                method: method.name(),
-                points: indices.len(),
-                target,
-                reached,
-                parameter,
-                distance,
-                mesh: stats,
-                subsample_seconds,
-                reconstruct_seconds: rec.seconds,
-            });
+                methods.push(MethodResult {
+                    method: method.name(),
+                    repeat,
+                    points: indices.len(),
+                    target,
+                    reached,
+                    parameter,
+                    distance,
+                    distance_no_domain,
+                    mesh: stats,
+                    subsample_seconds,
+                    reconstruct_seconds,
+                    distance_seconds,
+                });
+            }
         }
         sigmas.push(SigmaResult {
             sigma_p,
             cell: rec_params.cell(),
             all_points: all_stats,
-            all_points_seconds: all.seconds,
+            all_points_seconds: all_seconds,
             all_points_to_input,
+            all_points_to_input_no_domain,
             methods,
         });
     }
@@ -466,18 +571,8 @@ pub fn evaluate_model(
         area: mesh.area(),
         flipped,
         sigma_n: params.sigma_n,
+        domain: params.domain,
         sigmas,
         seconds: t0.elapsed().as_secs_f64(),
     })
-}
-
-/// Fills in the file of an [`Error::InvalidMesh`] raised without one.
-fn with_path(e: Error, path: &Path) -> Error {
-    match e {
-        Error::InvalidMesh { path: p, message } if p.as_os_str().is_empty() => Error::InvalidMesh {
-            path: path.to_path_buf(),
-            message,
-        },
-        e => e,
-    }
 }

@@ -162,16 +162,20 @@ enum Command {
         /// Marching-cubes cell in units of sigma_p.
         #[arg(long, default_value_t = 0.5)]
         cell: f64,
-        /// RIMLS restricted domain: each point's ball reaches its K-th nearest neighbour (0: the
-        /// whole support).
-        #[arg(long, value_name = "K", default_value_t = 16)]
-        domain: usize,
+        /// Restricted domain of the reconstructions, in units of sigma_p: surface farther than
+        /// this from every point is dropped (0: none). The distances without it are reported
+        /// too.
+        #[arg(long, default_value_t = 1.5)]
+        domain: f64,
         /// Random samples per side of each distance (on top of the vertices).
         #[arg(long, default_value_t = 200_000)]
         samples: usize,
         /// Seed of the points, the visit orders and the distance sampling.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Runs of every subsampler with different seeds, against the same all-points surface.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
         /// Write the results as JSON to this file.
         #[arg(long, value_name = "FILE.json")]
         json: Option<PathBuf>,
@@ -252,6 +256,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         domain,
         samples,
         seed,
+        repeats,
         json,
         meshes,
         quiet,
@@ -275,9 +280,10 @@ fn run(cli: Cli) -> Result<(), Error> {
             },
             methods: parsed,
             cell_per_sigma: *cell,
-            domain_neighbours: *domain,
+            domain: *domain,
             distance_samples: *samples,
             seed: *seed,
+            repeats: *repeats,
             mesh_dir: meshes.clone(),
             ..Default::default()
         };

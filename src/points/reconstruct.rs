@@ -19,9 +19,10 @@ use crate::surface::marching_cubes::{marching_cubes, MarchingCubesParams};
 /// the distances between horse reconstructions by a few percent (see `ARCHITECTURE.md`).
 pub const DEFAULT_CELL_PER_SIGMA: f64 = 0.5;
 
-/// The restricted domain of reconstructions ([`ReconstructParams::domain_neighbours`]): 16, as
-/// in MeshLab's MLS surfaces (each point's ball reaches its 16th nearest neighbour).
-pub const DEFAULT_DOMAIN_NEIGHBOURS: usize = 16;
+/// The restricted domain of reconstructions ([`ReconstructParams::domain`]), in units of σ_p:
+/// 1.5, half the RIMLS support radius (3 σ_p), as MeshLab's MLS surfaces restrict theirs to
+/// half their kernel's support.
+pub const DEFAULT_DOMAIN: f64 = 1.5;
 
 /// Parameters of [`reconstruct_rimls`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,16 +32,17 @@ pub struct ReconstructParams {
     pub rimls: RimlsParams,
     /// Grid cell in units of σ_p (> 0). Default [`DEFAULT_CELL_PER_SIGMA`].
     pub cell_per_sigma: f64,
-    /// Restricted domain: with k > 0, the surface is kept only within `r_i` of some point i,
-    /// where r_i is the distance from point i to its k-th nearest neighbour among the points (its
-    /// local spacing: about 2.3 spacings for k = 16); 0 keeps everything the marching cubes
-    /// find where RIMLS is defined (within the support of a point). Far from the points relative
-    /// to their spacing, RIMLS extrapolates, and its zero set there can hold spurious sheets;
-    /// the restriction cuts them off (triangles whose centroid lies outside are dropped). Default
-    /// [`DEFAULT_DOMAIN_NEIGHBOURS`]. After the restricted domain of the MLS surfaces in MeshLab
-    /// (G. Guennebaud's APSS and RIMLS), the union of balls of twice a point's radius, itself
-    /// half the distance to its 16th nearest neighbour: the same balls as k = 16 here.
-    pub domain_neighbours: usize,
+    /// Restricted domain, in units of σ_p: the surface is kept only within `domain · σ_p` of
+    /// a point (triangles whose centroid lies farther from every point are dropped); 0 keeps
+    /// everything the marching cubes find where RIMLS is defined (within the support,
+    /// `support_radius · σ_p`, of a point). Far from the points RIMLS extrapolates, and its zero
+    /// set there can hold spurious sheets; the restriction cuts them off (the surface may end
+    /// there instead). Default [`DEFAULT_DOMAIN`]. After the restricted domain of the MLS
+    /// surfaces in MeshLab (G. Guennebaud's APSS and RIMLS), where the domain's balls are half
+    /// the kernel's support; the radius here is a multiple of the kernel width rather than of
+    /// each point's local spacing, so that point sets of different densities reconstructed
+    /// with the same kernel get the same domain (up to their spacing), at open boundaries too.
+    pub domain: f64,
     /// A lattice point of the grid (the points' units). Reconstructions compared with each other
     /// should share it (and the cell), so that their discretizations are the same. Default the
     /// origin.
@@ -52,7 +54,7 @@ impl ReconstructParams {
     pub fn new(sigma_p: f64, sigma_n: f64) -> Self {
         ReconstructParams {
             rimls: RimlsParams::new(sigma_p, sigma_n),
-            domain_neighbours: DEFAULT_DOMAIN_NEIGHBOURS,
+            domain: DEFAULT_DOMAIN,
             cell_per_sigma: DEFAULT_CELL_PER_SIGMA,
             origin: DVec3::ZERO,
         }
@@ -87,12 +89,13 @@ pub struct Reconstruction {
 /// and triangulates it by marching cubes on the grid `params.origin + cell · (i, j, k)`, with
 /// cell = `params.cell_per_sigma` · σ_p, visiting the cells around the points and following the
 /// surface from there; then drops the triangles outside the restricted domain
-/// (`params.domain_neighbours`) and the vertices no triangle uses.
+/// (`params.domain`, [`clip_to_domain`]).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] from [`Rimls::new`] (bad parameters, empty or mismatched
 /// inputs, non-finite points or normals) or from [`marching_cubes`] (a point too far from the
-/// origin for the grid), or when `cell_per_sigma` is not positive and finite.
+/// origin for the grid), or when `cell_per_sigma` is not positive and finite or `domain` is
+/// negative or not finite.
 pub fn reconstruct_rimls(
     positions: &[DVec3],
     normals: &[DVec3],
@@ -108,6 +111,12 @@ pub fn reconstruct_rimls(
             ),
         });
     }
+    if !(params.domain.is_finite() && params.domain >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "domain",
+            message: format!("must be a finite number >= 0, got {}", params.domain),
+        });
+    }
     let rimls = Rimls::new(positions.to_vec(), normals.to_vec(), params.rimls)?;
     let grid = MarchingCubesParams {
         cell: params.cell(),
@@ -116,8 +125,8 @@ pub fn reconstruct_rimls(
     };
     let out = marching_cubes(&rimls, positions, &grid)?;
     let mut mesh = out.mesh;
-    let clipped_triangles = if params.domain_neighbours > 0 {
-        clip_to_domain(&mut mesh, positions, params.domain_neighbours)
+    let clipped_triangles = if params.domain > 0.0 {
+        clip_to_domain(&mut mesh, positions, params.domain * params.rimls.sigma_p)
     } else {
         0
     };
@@ -131,26 +140,18 @@ pub fn reconstruct_rimls(
     })
 }
 
-/// Drops the triangles of `mesh` whose centroid lies outside every ball about a point of
-/// `positions` reaching its `k`-th nearest neighbour, and the vertices left unused; returns how
-/// many triangles were dropped.
-fn clip_to_domain(mesh: &mut TriMesh, positions: &[DVec3], k: usize) -> usize {
+/// Drops the triangles of `mesh` whose centroid lies farther than `radius` from every point of
+/// `positions` (the same units), and the vertices left unused; returns how many triangles were
+/// dropped. With no points, every triangle goes.
+pub fn clip_to_domain(mesh: &mut TriMesh, positions: &[DVec3], radius: f64) -> usize {
     let tree = StaticTree::new(positions);
-    // A point is its own nearest neighbour: ask for k + 1.
-    let radius_2: Vec<f64> = positions
-        .par_iter()
-        .map_init(Vec::new, |found, &p| {
-            tree.nearest_n(p, k + 1, found);
-            found.last().map_or(0.0, |&(_, d2)| d2)
-        })
-        .collect();
-    let reach_2 = radius_2.iter().copied().fold(0.0, f64::max);
+    let radius_2 = radius * radius;
     let keep: Vec<bool> = (0..mesh.triangles.len())
         .into_par_iter()
         .map_init(Vec::new, |found, f| {
             let [a, b, c] = mesh.corners(f);
-            tree.within_unsorted((a + b + c) / 3.0, reach_2, found);
-            found.iter().any(|&(i, d2)| d2 <= radius_2[i as usize])
+            tree.nearest_n((a + b + c) / 3.0, 1, found);
+            found.first().is_some_and(|&(_, d2)| d2 <= radius_2)
         })
         .collect();
     let before = mesh.triangles.len();
@@ -196,6 +197,11 @@ mod tests {
         assert!(reconstruct_rimls(&positions, &normals[1..], &params).is_err());
         let bad = ReconstructParams {
             cell_per_sigma: 0.0,
+            ..params
+        };
+        assert!(reconstruct_rimls(&positions, &normals, &bad).is_err());
+        let bad = ReconstructParams {
+            domain: -1.0,
             ..params
         };
         assert!(reconstruct_rimls(&positions, &normals, &bad).is_err());
