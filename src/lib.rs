@@ -17,6 +17,7 @@ pub mod pipeline;
 pub mod plane;
 pub mod points;
 pub mod quality;
+pub mod reconstruction_eval;
 pub mod sampling;
 pub mod spatial;
 pub mod surface;

@@ -104,6 +104,26 @@ impl TriMesh {
         (0..self.face_count()).map(|f| self.face_area(f)).sum()
     }
 
+    /// Signed volume enclosed (units³): Σ over faces of a·(b×c)/6. Positive when a closed mesh's
+    /// faces are oriented outward (counter-clockwise seen from outside), negative when inward;
+    /// for an open mesh, the volume of the cone from the origin, whose sign still tells the
+    /// orientation of a mostly closed surface whose holes are small.
+    pub fn signed_volume(&self) -> f64 {
+        (0..self.face_count())
+            .map(|f| {
+                let [a, b, c] = self.corners(f);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// Reverses every face's orientation (and so the vertex normals).
+    pub fn flip_orientation(&mut self) {
+        for t in &mut self.triangles {
+            t.swap(1, 2);
+        }
+    }
+
     /// Bounding box of the vertices; `None` for an empty mesh.
     pub fn bbox(&self) -> Option<Aabb> {
         Aabb::of(&self.positions)

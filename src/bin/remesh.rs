@@ -9,6 +9,8 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::app::{run_quality, run_remesh, RemeshJob};
 use spectral_remesh::pipeline::{Density, RemeshParams};
+use spectral_remesh::points::subsample::Subsampler;
+use spectral_remesh::reconstruction_eval::{evaluate_model, PointSource, ReconstructionEvalParams};
 use spectral_remesh::Error;
 
 const EXAMPLES: &str = "\
@@ -20,7 +22,8 @@ Examples:
   remesh points horse.obj horse-14M.ply --count 14000000
   remesh simplify horse-14M.ply horse-300k.ply --points 300000
   remesh simplify scan.xyz levels.ply --levels 4,2,1
-  remesh blue-noise --method ours --output ours.json";
+  remesh blue-noise --method ours --output ours.json
+  remesh reconstruct-eval horse.obj fandisk.obj --spacing 0.15 --json table2.json";
 
 /// Spectral remeshing of triangle meshes (Öztireli, Alexa, Gross 2010: Spectral Sampling of
 /// Manifolds): samples the input surface with the spectral measure, triangulates the samples,
@@ -181,6 +184,57 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
+    /// The reconstruction experiment of Sec. 7.2 (Table 2): per model and sigma_p, the RIMLS
+    /// surface of all points against that of a subset chosen by the linear scan (same kernel)
+    /// and by the baselines at the same count; RMS and Hausdorff distances in bbox-100 units.
+    ReconstructEval {
+        /// Meshes (.obj, .ply, .gltf, .glb): normalized to bbox 100 and oriented outward.
+        #[arg(required = true)]
+        models: Vec<PathBuf>,
+        /// Kernel widths sigma_p, bbox-100 units, for sampling and reconstruction alike.
+        #[arg(long, value_delimiter = ',', default_value = "0.5,0.75,1")]
+        sigma_p: Vec<f64>,
+        /// Normal width sigma_n.
+        #[arg(long, default_value_t = 0.75)]
+        sigma_n: f64,
+        /// Input points: area-uniform random points this far apart on average (bbox-100 units),
+        /// with interpolated vertex normals. Default: the mesh's vertices.
+        #[arg(long)]
+        spacing: Option<f64>,
+        /// Subsamplers (ours is required: it sets the count).
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "ours,random,voxel,poisson"
+        )]
+        methods: Vec<String>,
+        /// Marching-cubes cell in units of sigma_p.
+        #[arg(long, default_value_t = 0.5)]
+        cell: f64,
+        /// Restricted domain of the reconstructions, in units of sigma_p: surface farther than
+        /// this from every point is dropped (0: none). The distances without it are reported
+        /// too.
+        #[arg(long, default_value_t = 1.5)]
+        domain: f64,
+        /// Random samples per side of each distance (on top of the vertices).
+        #[arg(long, default_value_t = 200_000)]
+        samples: usize,
+        /// Seed of the points, the visit orders and the distance sampling.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Runs of every subsampler with different seeds, against the same all-points surface.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Write the results as JSON to this file.
+        #[arg(long, value_name = "FILE.json")]
+        json: Option<PathBuf>,
+        /// Write every reconstruction into this folder (binary PLY, bbox-100 units).
+        #[arg(long, value_name = "DIR")]
+        meshes: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(short, long)]
+        quiet: bool,
+    },
     /// Draw random points with normals uniformly by area from a mesh's surface and write them as
     /// binary PLY (streamed: any count fits in memory). Makes large point-cloud inputs.
     Points {
@@ -311,6 +365,68 @@ fn run(cli: Cli) -> Result<(), Error> {
         return run_simplify(
             input, output, density, *sigma_n, *resample, *seed, *viewpoint, *quiet,
         );
+    }
+    if let Some(Command::ReconstructEval {
+        models,
+        sigma_p,
+        sigma_n,
+        spacing,
+        methods,
+        cell,
+        domain,
+        samples,
+        seed,
+        repeats,
+        json,
+        meshes,
+        quiet,
+    }) = &cli.command
+    {
+        let mut parsed = Vec::new();
+        for m in methods {
+            parsed.push(
+                Subsampler::from_name(m).ok_or_else(|| Error::InvalidParameter {
+                    name: "--methods",
+                    message: format!("unknown method {m:?} (ours, random, voxel, poisson)"),
+                })?,
+            );
+        }
+        let params = ReconstructionEvalParams {
+            sigma_p: sigma_p.clone(),
+            sigma_n: *sigma_n,
+            source: match spacing {
+                Some(s) => PointSource::Surface { spacing: *s },
+                None => PointSource::Vertices,
+            },
+            methods: parsed,
+            cell_per_sigma: *cell,
+            domain: *domain,
+            distance_samples: *samples,
+            seed: *seed,
+            repeats: *repeats,
+            mesh_dir: meshes.clone(),
+            ..Default::default()
+        };
+        if let Some(dir) = meshes {
+            std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        }
+        let progress = |line: &str| {
+            if !*quiet {
+                eprintln!("{line}");
+            }
+        };
+        let mut results = Vec::new();
+        for m in models {
+            results.push(evaluate_model(m, &params, &progress)?);
+        }
+        if let Some(p) = json {
+            let text = serde_json::to_string_pretty(&results).map_err(|e| Error::Internal {
+                stage: "report",
+                message: e.to_string(),
+            })?;
+            write_report(p, &text)?;
+        }
+        return Ok(());
     }
     if let Some(Command::Points {
         mesh,

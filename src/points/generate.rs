@@ -21,52 +21,88 @@ const CHUNK: usize = 1 << 20;
 /// [`Error::InvalidMesh`] when the mesh has no area; [`Error::Write`] when the file cannot be
 /// written (nothing is left at `path` then).
 pub fn write_surface_points(mesh: &TriMesh, count: u64, seed: u64, path: &Path) -> Result<()> {
-    // Cumulative face areas for inverse-transform sampling of the face.
-    let mut cumulative = Vec::with_capacity(mesh.face_count());
-    let mut total = 0.0;
-    for f in 0..mesh.face_count() {
-        let a = mesh.face_area(f);
-        total += if a.is_finite() { a } else { 0.0 };
-        cumulative.push(total);
-    }
-    if !(total > 0.0) {
-        return Err(Error::invalid_mesh(
-            "",
-            "the mesh has no area to draw points from",
-        ));
-    }
-    let normals = mesh.vertex_normals();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut sampler = SurfaceSampler::new(mesh, seed)?;
     let mut writer = PlyPointWriter::create(path, count)?;
     let mut chunk: Vec<Point> = Vec::with_capacity(CHUNK.min(count as usize));
     let mut left = count;
     while left > 0 {
         let n = (left as usize).min(CHUNK);
         chunk.clear();
-        for _ in 0..n {
-            let r = rng.random::<f64>() * total;
-            let f = cumulative
-                .partition_point(|&c| c <= r)
-                .min(mesh.face_count() - 1);
-            let (mut u, mut v) = (rng.random::<f64>(), rng.random::<f64>());
-            if u + v > 1.0 {
-                u = 1.0 - u;
-                v = 1.0 - v;
-            }
-            let t = mesh.triangles[f];
-            let [a, b, c] = mesh.corners(f);
-            let position = a + u * (b - a) + v * (c - a);
-            let w = 1.0 - u - v;
-            let n = w * normals[t[0] as usize]
-                + u * normals[t[1] as usize]
-                + v * normals[t[2] as usize];
-            let normal = n.try_normalize().unwrap_or_else(|| mesh.face_normal(f));
-            chunk.push(Point { position, normal });
-        }
+        chunk.extend((0..n).map(|_| sampler.draw()));
         writer.write(&chunk)?;
         left -= n as u64;
     }
     writer.finish()
+}
+
+/// `count` points drawn uniformly by area on `mesh` (its units), in memory, each with the
+/// angle-weighted vertex normals interpolated at the point (a smooth normal field, like a
+/// scanner's), in the order drawn. The same points as [`write_surface_points`] with the same
+/// seed. Deterministic for a `seed`.
+///
+/// # Errors
+/// [`Error::InvalidMesh`] when the mesh has no area.
+pub fn surface_points(mesh: &TriMesh, count: usize, seed: u64) -> Result<Vec<Point>> {
+    let mut sampler = SurfaceSampler::new(mesh, seed)?;
+    Ok((0..count).map(|_| sampler.draw()).collect())
+}
+
+/// Area-uniform random points on a mesh with interpolated vertex normals.
+struct SurfaceSampler<'a> {
+    mesh: &'a TriMesh,
+    /// Running sums of the face areas (inverse-transform sampling of the face).
+    cumulative: Vec<f64>,
+    total: f64,
+    normals: Vec<glam::DVec3>,
+    rng: ChaCha8Rng,
+}
+
+impl<'a> SurfaceSampler<'a> {
+    fn new(mesh: &'a TriMesh, seed: u64) -> Result<Self> {
+        let mut cumulative = Vec::with_capacity(mesh.face_count());
+        let mut total = 0.0;
+        for f in 0..mesh.face_count() {
+            let a = mesh.face_area(f);
+            total += if a.is_finite() { a } else { 0.0 };
+            cumulative.push(total);
+        }
+        if !(total > 0.0) {
+            return Err(Error::invalid_mesh(
+                "",
+                "the mesh has no area to draw points from",
+            ));
+        }
+        Ok(SurfaceSampler {
+            mesh,
+            cumulative,
+            total,
+            normals: mesh.vertex_normals(),
+            rng: ChaCha8Rng::seed_from_u64(seed),
+        })
+    }
+
+    fn draw(&mut self) -> Point {
+        let mesh = self.mesh;
+        let r = self.rng.random::<f64>() * self.total;
+        let f = self
+            .cumulative
+            .partition_point(|&c| c <= r)
+            .min(mesh.face_count() - 1);
+        let (mut u, mut v) = (self.rng.random::<f64>(), self.rng.random::<f64>());
+        if u + v > 1.0 {
+            u = 1.0 - u;
+            v = 1.0 - v;
+        }
+        let t = mesh.triangles[f];
+        let [a, b, c] = mesh.corners(f);
+        let position = a + u * (b - a) + v * (c - a);
+        let w = 1.0 - u - v;
+        let n = w * self.normals[t[0] as usize]
+            + u * self.normals[t[1] as usize]
+            + v * self.normals[t[2] as usize];
+        let normal = n.try_normalize().unwrap_or_else(|| mesh.face_normal(f));
+        Point { position, normal }
+    }
 }
 
 #[cfg(test)]

@@ -302,6 +302,12 @@ impl Rimls {
             return None;
         }
         self.tree.within_unsorted(x, self.support_2, neighbours);
+        // The spatial weights do not change between refits: replace each squared distance by
+        // the Gaussian exp(-d²/σ_p²), dropping the points on or beyond the cut-off (φ <= 0).
+        neighbours.retain_mut(|(_, d2)| {
+            *d2 = (-*d2 * self.inv_sigma_p2).exp();
+            *d2 > self.tail
+        });
         if neighbours.is_empty() {
             return None;
         }
@@ -313,13 +319,9 @@ impl Rimls {
             let mut sum_gw = DVec3::ZERO;
             let mut sum_gwf = DVec3::ZERO;
             let mut sum_wn = DVec3::ZERO;
-            for &(i, d2) in neighbours.iter() {
+            for &(i, gauss) in neighbours.iter() {
                 let (p, n) = (self.positions[i as usize], self.normals[i as usize]);
-                let gauss = (-d2 * self.inv_sigma_p2).exp();
                 let phi = gauss - self.tail;
-                if phi <= 0.0 {
-                    continue;
-                }
                 let diff = x - p;
                 let offset = diff.dot(n);
                 let alpha = if iteration == 0 {
@@ -431,6 +433,23 @@ impl Rimls {
             steps,
             converged: f.abs() < threshold,
         })
+    }
+}
+
+impl crate::surface::ImplicitFunction for Rimls {
+    /// f of [`Rimls::value_and_gradient`]; `None` outside the support.
+    fn value(&self, x: DVec3) -> Option<f64> {
+        self.value_and_gradient(x).map(|(f, _)| f)
+    }
+
+    /// [`ImplicitFunction::value`](crate::surface::ImplicitFunction::value) at every point, in
+    /// parallel, reusing each thread's neighbour buffer.
+    fn values(&self, xs: &[DVec3]) -> Vec<Option<f64>> {
+        xs.par_iter()
+            .map_init(Vec::new, |neighbours, &x| {
+                self.evaluate(x, neighbours).map(|(f, _)| f)
+            })
+            .collect()
     }
 }
 
