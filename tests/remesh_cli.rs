@@ -393,7 +393,14 @@ fn reconstruct_eval_writes_json_and_meshes_and_refuses_an_unknown_method() {
     let meshes = dir.path().join("meshes");
     let status = Command::new(env!("CARGO_BIN_EXE_remesh"))
         .args(["reconstruct-eval", "-q", "--sigma-p", "3", "--spacing", "1"])
-        .args(["--repeats", "1", "--samples", "10000", "--methods", "ours,random"])
+        .args([
+            "--repeats",
+            "1",
+            "--samples",
+            "10000",
+            "--methods",
+            "ours,random",
+        ])
         .arg(shared("spot.obj"))
         .arg("--json")
         .arg(&json)
@@ -409,7 +416,10 @@ fn reconstruct_eval_writes_json_and_meshes_and_refuses_an_unknown_method() {
     assert_eq!(methods[0]["points"], methods[1]["points"]);
     assert!(float(&methods[0], &["distance", "rms"]) < float(&methods[1], &["distance", "rms"]));
     for name in ["all", "ours", "random", "ours-points"] {
-        assert!(meshes.join(format!("spot-s3-{name}.ply")).exists(), "{name}");
+        assert!(
+            meshes.join(format!("spot-s3-{name}.ply")).exists(),
+            "{name}"
+        );
     }
 
     let out = Command::new(env!("CARGO_BIN_EXE_remesh"))
@@ -419,5 +429,8 @@ fn reconstruct_eval_writes_json_and_meshes_and_refuses_an_unknown_method() {
         .expect("run remesh");
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("--methods") && err.lines().count() == 1, "{err}");
+    assert!(
+        err.contains("--methods") && err.lines().count() == 1,
+        "{err}"
+    );
 }
