@@ -89,7 +89,7 @@ pub struct ReconstructionEvalParams {
     /// derived from `seed + r` (default 1).
     pub seed: u64,
     /// Runs of every subsampler with different seeds (visit orders, random choices, voxel-grid
-    /// shifts), all against the same all-points surface (default 3): one run's numbers can
+    /// shifts), all against the same all-points surface (default 5): one run's numbers can
     /// hinge on a single spurious sheet of RIMLS.
     pub repeats: usize,
     /// When set, every reconstruction of the first repeat is written there as binary PLY
@@ -111,7 +111,7 @@ impl Default for ReconstructionEvalParams {
             distance_samples: 200_000,
             count_tolerance: 0.005,
             seed: 1,
-            repeats: 3,
+            repeats: 5,
             mesh_dir: None,
         }
     }

@@ -385,3 +385,52 @@ fn simplify_levels_from_xyz_text_writes_a_level_attribute() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn reconstruct_eval_writes_json_and_meshes_and_refuses_an_unknown_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("r.json");
+    let meshes = dir.path().join("meshes");
+    let status = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .args(["reconstruct-eval", "-q", "--sigma-p", "3", "--spacing", "1"])
+        .args([
+            "--repeats",
+            "1",
+            "--samples",
+            "10000",
+            "--methods",
+            "ours,random",
+        ])
+        .arg(shared("spot.obj"))
+        .arg("--json")
+        .arg(&json)
+        .arg("--meshes")
+        .arg(&meshes)
+        .status()
+        .expect("run remesh");
+    assert!(status.success());
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let methods = &r[0]["sigmas"][0]["methods"];
+    assert_eq!(methods.as_array().map(Vec::len), Some(2));
+    assert_eq!(methods[0]["method"], "ours");
+    assert_eq!(methods[0]["points"], methods[1]["points"]);
+    assert!(float(&methods[0], &["distance", "rms"]) < float(&methods[1], &["distance", "rms"]));
+    for name in ["all", "ours", "random", "ours-points"] {
+        assert!(
+            meshes.join(format!("spot-s3-{name}.ply")).exists(),
+            "{name}"
+        );
+    }
+
+    let out = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .args(["reconstruct-eval", "--methods", "ours,lloyd"])
+        .arg(shared("spot.obj"))
+        .output()
+        .expect("run remesh");
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--methods") && err.lines().count() == 1,
+        "{err}"
+    );
+}

@@ -223,7 +223,7 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Runs of every subsampler with different seeds, against the same all-points surface.
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = 5)]
         repeats: usize,
         /// Write the results as JSON to this file.
         #[arg(long, value_name = "FILE.json")]

@@ -15,8 +15,10 @@ use crate::spatial::StaticTree;
 use crate::surface::marching_cubes::{marching_cubes, MarchingCubesParams};
 
 /// The grid cell of a reconstruction, in units of σ_p: 0.5 (cell = σ_p/2). The RIMLS surface
-/// varies on the scale of σ_p, so cells of σ_p/2 resolve it; halving the cell (σ_p/4) changed
-/// the distances between horse reconstructions by a few percent (see `ARCHITECTURE.md`).
+/// varies on the scale of σ_p, so cells of σ_p/2 resolve it. Measured on horse (475k surface
+/// points, σ_p 0.75, one run of each subsampler): halving the cell to σ_p/4 changed the RMS
+/// distances between reconstructions by 0–7% (their order not at all) and the Hausdorff
+/// distances by up to 15%, for 4 times the time.
 pub const DEFAULT_CELL_PER_SIGMA: f64 = 0.5;
 
 /// The restricted domain of reconstructions ([`ReconstructParams::domain`]), in units of σ_p:

@@ -227,24 +227,35 @@ fn edge_of(a: usize, b: usize) -> usize {
         .unwrap_or(0)
 }
 
-/// The six faces' corners in counter-clockwise order seen from outside the cube.
-fn faces() -> [[usize; 4]; 6] {
+/// The six faces' corners in counter-clockwise order seen from outside the cube: face
+/// `2 · axis + side` holds the corners whose bit `axis` is `side`.
+const fn face_rings() -> [[usize; 4]; 6] {
     let mut out = [[0; 4]; 6];
-    for axis in 0..3 {
+    let mut axis = 0;
+    while axis < 3 {
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-        for side in 0..2 {
-            // (u, v) = (0,0), (1,0), (1,1), (0,1) turns counter-clockwise about +axis.
-            let mut ring = [0usize; 4];
-            for (k, (du, dv)) in [(0, 0), (1, 0), (1, 1), (0, 1)].into_iter().enumerate() {
-                ring[k] = side << axis | du << u | dv << v;
+        let mut side = 0;
+        while side < 2 {
+            // (u, v) = (0,0), (1,0), (1,1), (0,1) turns counter-clockwise about +axis; the face
+            // at side 0 looks along -axis, so its ring is reversed.
+            let steps = [(0, 0), (1, 0), (1, 1), (0, 1)];
+            let mut k = 0;
+            while k < 4 {
+                let (du, dv) = steps[if side == 1 { k } else { 3 - k }];
+                out[axis * 2 + side][k] = side << axis | du << u | dv << v;
+                k += 1;
             }
-            if side == 0 {
-                ring.reverse();
-            }
-            out[axis * 2 + side] = ring;
+            side += 1;
         }
+        axis += 1;
     }
     out
+}
+const FACES: [[usize; 4]; 6] = face_rings();
+
+/// The six faces' corner rings ([`FACES`]).
+fn faces() -> [[usize; 4]; 6] {
+    FACES
 }
 
 /// One polygon of a sign case: a cycle of cube edges in the order that makes its normal point
