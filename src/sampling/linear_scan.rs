@@ -114,16 +114,8 @@ fn quick_reject(
         b.last_rejecter = j;
         return Some(QuickReject::Nearest);
     }
-    let r_kernel_2 = params.support_radius * params.support_radius;
     tree.nearest_n(position, FEW, &mut b.found);
-    b.neighbors.clear();
-    for &(j, _) in &b.found {
-        let y = embedded[j as usize];
-        let d2 = x.dist2(&y);
-        if d2 <= r_kernel_2 {
-            b.neighbors.push((d2, y));
-        }
-    }
+    gather_neighbors(params, embedded, x, b);
     if b.neighbors.len() < 2 {
         return None;
     }
@@ -251,25 +243,19 @@ impl LinearScanner {
                         self.count(why);
                         false
                     }
-                    Verdict::Measured(accept) => {
+                    Verdict::Measured(false) => {
                         self.measured += 1;
-                        accept && {
-                            // Still accepted when the chunk added nothing near it.
-                            let unchanged = self.embedded.len() == size_at_start || {
-                                let found = &mut self.buffers.found;
-                                self.tree.within(p, r_pos * r_pos, found);
-                                found.iter().all(|&(j, _)| (j as usize) < size_at_start)
-                            };
-                            if unchanged {
-                                self.insert(p, n);
-                                true
-                            } else {
-                                self.offer(p, n)
-                            }
-                        }
+                        false
                     }
-                    Verdict::Alone => {
-                        if self.embedded.len() == size_at_start {
+                    Verdict::Measured(true) | Verdict::Alone => {
+                        self.measured += usize::from(*verdict != Verdict::Alone);
+                        // Still accepted when the chunk added nothing near it.
+                        let unchanged = self.embedded.len() == size_at_start || {
+                            let found = &mut self.buffers.found;
+                            self.tree.within(p, r_pos * r_pos, found);
+                            found.iter().all(|&(j, _)| (j as usize) < size_at_start)
+                        };
+                        if unchanged {
                             self.insert(p, n);
                             true
                         } else {
@@ -357,7 +343,7 @@ impl LinearScanner {
 }
 
 /// A candidate's test against O at the start of its chunk.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq, Eq)]
 enum Verdict {
     /// Rejected by a quick test.
     Quick(QuickReject),
@@ -365,6 +351,25 @@ enum Verdict {
     Measured(bool),
     /// No neighbour in O.
     Alone,
+}
+
+/// The samples of `b.found` (indices into `embedded`) within the support radius of `x` in kernel
+/// space, with their squared kernel-space distances, into `b.neighbors` (in `b.found`'s order).
+fn gather_neighbors(
+    params: &LinearScanParams,
+    embedded: &[KernelPoint],
+    x: &KernelPoint,
+    b: &mut Buffers,
+) {
+    let r_kernel_2 = params.support_radius * params.support_radius;
+    b.neighbors.clear();
+    for &(j, _) in &b.found {
+        let y = embedded[j as usize];
+        let d2 = x.dist2(&y);
+        if d2 <= r_kernel_2 {
+            b.neighbors.push((d2, y));
+        }
+    }
 }
 
 /// The measure of `x` over its whole neighbourhood in O (`tree`, `embedded`) within the support
@@ -379,16 +384,8 @@ fn full_measure(
     b: &mut Buffers,
 ) -> Option<bool> {
     let r_pos = params.support_radius * kernel.sigma_p();
-    let r_kernel_2 = params.support_radius * params.support_radius;
     tree.within(position, r_pos * r_pos, &mut b.found);
-    b.neighbors.clear();
-    for &(j, _) in &b.found {
-        let y = embedded[j as usize];
-        let d2 = x.dist2(&y);
-        if d2 <= r_kernel_2 {
-            b.neighbors.push((d2, y));
-        }
-    }
+    gather_neighbors(params, embedded, x, b);
     if b.neighbors.is_empty() {
         return None;
     }
