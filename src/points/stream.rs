@@ -273,7 +273,7 @@ impl PointReader {
                 count += 1;
                 continue;
             }
-            let fields: Vec<&str> = text_fields(&line).collect();
+            let fields: Vec<&str> = split_fields(&line, true).collect();
             let numeric = fields.iter().all(|f| f.parse::<f64>().is_ok());
             if !numeric && names.is_none() && count == 0 {
                 names = Some(fields.iter().map(|f| f.to_ascii_lowercase()).collect());
@@ -365,7 +365,8 @@ impl PointReader {
         }
         let mut values = [0.0f64; 6];
         match self.encoding {
-            Encoding::Text => {
+            Encoding::Ascii | Encoding::Text => {
+                let text = self.encoding == Encoding::Text;
                 let mut got = 0;
                 while got < n {
                     self.line.clear();
@@ -378,59 +379,12 @@ impl PointReader {
                     {
                         return Err(self.truncated());
                     }
-                    if is_comment(&self.line) {
+                    if text && is_comment(&self.line) {
                         continue;
                     }
-                    {
-                        let mut fields = text_fields(&self.line);
-                        for &(_, slot) in &self.properties {
-                            let Some(k) = slot else {
-                                fields.next();
-                                continue;
-                            };
-                            let w = fields.next().ok_or_else(|| Error::Parse {
-                                path: self.path.clone(),
-                                line: Some(self.line_number),
-                                message: "too few values on the line".into(),
-                            })?;
-                            values[k] = w.parse().map_err(|_| Error::Parse {
-                                path: self.path.clone(),
-                                line: Some(self.line_number),
-                                message: format!("`{w}` is not a number"),
-                            })?;
-                        }
-                    }
+                    self.parse_line(text, &mut values)?;
                     self.push(out, &values)?;
                     got += 1;
-                }
-            }
-            Encoding::Ascii => {
-                for _ in 0..n {
-                    self.line.clear();
-                    self.line_number += 1;
-                    let got = self
-                        .input
-                        .read_line(&mut self.line)
-                        .map_err(|e| Error::io(&self.path, e))?;
-                    if got == 0 {
-                        return Err(self.truncated());
-                    }
-                    let mut words = self.line.split_whitespace();
-                    for &(_, slot) in &self.properties {
-                        let w = words.next().ok_or_else(|| Error::Parse {
-                            path: self.path.clone(),
-                            line: Some(self.line_number),
-                            message: "too few values for the vertex properties".into(),
-                        })?;
-                        if let Some(k) = slot {
-                            values[k] = w.parse().map_err(|_| Error::Parse {
-                                path: self.path.clone(),
-                                line: Some(self.line_number),
-                                message: format!("`{w}` is not a number"),
-                            })?;
-                        }
-                    }
-                    self.push(out, &values)?;
                 }
             }
             Encoding::BinaryLittle | Encoding::BinaryBig => {
@@ -458,6 +412,38 @@ impl PointReader {
             }
         }
         Ok(n)
+    }
+
+    /// The values of the line just read into their slots of `values`. Ascii PLY: blank-separated,
+    /// every property present. Text: also comma- or semicolon-separated, and columns past the
+    /// last one used may be missing.
+    fn parse_line(&self, text: bool, values: &mut [f64; 6]) -> Result<()> {
+        let error = |message: String| Error::Parse {
+            path: self.path.clone(),
+            line: Some(self.line_number),
+            message,
+        };
+        let mut fields = split_fields(&self.line, text);
+        for &(_, slot) in &self.properties {
+            let field = fields.next();
+            let Some(k) = slot else {
+                if field.is_none() && !text {
+                    return Err(error("too few values for the vertex properties".into()));
+                }
+                continue;
+            };
+            let w = field.ok_or_else(|| {
+                error(if text {
+                    "too few values on the line".into()
+                } else {
+                    "too few values for the vertex properties".into()
+                })
+            })?;
+            values[k] = w
+                .parse()
+                .map_err(|_| error(format!("`{w}` is not a number")))?;
+        }
+        Ok(())
     }
 
     fn push(&mut self, out: &mut Vec<Point>, v: &[f64; 6]) -> Result<()> {
@@ -506,9 +492,10 @@ fn is_comment(line: &str) -> bool {
     t.is_empty() || t.starts_with('#') || t.starts_with("//")
 }
 
-/// The values of a text line: separated by commas, semicolons or blanks.
-fn text_fields(line: &str) -> impl Iterator<Item = &str> {
-    line.split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+/// The values of a line: separated by blanks, and for text point sets (`text`) also by commas
+/// or semicolons.
+fn split_fields(line: &str, text: bool) -> impl Iterator<Item = &str> {
+    line.split(move |c: char| c.is_whitespace() || (text && (c == ',' || c == ';')))
         .filter(|f| !f.is_empty())
 }
 
