@@ -96,15 +96,11 @@ fn normal_agreement(name: &str) -> (f64, usize, usize) {
     )
     .unwrap();
     // Outward truth: horse.obj is oriented inward (negative signed volume).
-    let volume: f64 = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-            a.dot(b.cross(c)) / 6.0
-        })
-        .sum();
-    let sign = if volume < 0.0 { -1.0 } else { 1.0 };
+    let sign = if mesh.signed_volume() < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
     let truth: Vec<_> = mesh.vertex_normals().iter().map(|n| *n * sign).collect();
     let estimated = estimate_normals(&mesh.positions, 10, Orientation::SpanningTree);
     let mut angles: Vec<f64> = truth

@@ -178,14 +178,9 @@ mod tests {
     fn sphere_normals_point_outward() {
         // A Fibonacci sphere.
         let n = 2000;
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        let points: Vec<DVec3> = (0..n)
-            .map(|i| {
-                let y = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-                let r = (1.0 - y * y).sqrt();
-                let t = golden * i as f64;
-                DVec3::new(r * t.cos(), y, r * t.sin()) * 3.0
-            })
+        let points: Vec<DVec3> = crate::mesh::test_meshes::fibonacci_sphere(n)
+            .into_iter()
+            .map(|u| DVec3::new(u.x, u.z, u.y) * 3.0)
             .collect();
         let normals = estimate_normals(&points, 12, Orientation::SpanningTree);
         for (p, n) in points.iter().zip(&normals) {

@@ -173,15 +173,7 @@ mod tests {
     fn a_sampled_sphere_comes_back_closed_and_near_its_radius() {
         // 20,000 points on a sphere of radius 20 (a Fibonacci spiral), exact normals.
         let (r, n) = (20.0, 20_000);
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        let normals: Vec<DVec3> = (0..n)
-            .map(|i| {
-                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-                let s = (1.0 - z * z).sqrt();
-                let a = golden * i as f64;
-                DVec3::new(s * a.cos(), s * a.sin(), z)
-            })
-            .collect();
+        let normals = crate::mesh::test_meshes::fibonacci_sphere(n);
         let positions: Vec<DVec3> = normals.iter().map(|n| *n * r).collect();
         // Spacing about 0.5; sigma_p 1.
         let params = ReconstructParams::new(1.0, 0.75);

@@ -709,15 +709,9 @@ mod tests {
     }
 
     fn seeds_on_sphere(c: DVec3, r: f64, n: usize) -> Vec<DVec3> {
-        // A Fibonacci spiral.
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        (0..n)
-            .map(|i| {
-                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-                let s = (1.0 - z * z).sqrt();
-                let a = golden * i as f64;
-                c + r * DVec3::new(s * a.cos(), s * a.sin(), z)
-            })
+        crate::mesh::test_meshes::fibonacci_sphere(n)
+            .into_iter()
+            .map(|u| c + r * u)
             .collect()
     }
 

@@ -110,14 +110,9 @@ mod tests {
         // 100,000 points on a sphere of radius 10 (a Fibonacci spiral). (On an axis-aligned
         // plane the count is a coarse step function of the size and may miss the tolerance.)
         let n = 100_000;
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        let positions: Vec<DVec3> = (0..n)
-            .map(|i| {
-                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-                let s = (1.0 - z * z).sqrt();
-                let a = golden * i as f64;
-                10.0 * DVec3::new(s * a.cos(), s * a.sin(), z)
-            })
+        let positions: Vec<DVec3> = crate::mesh::test_meshes::fibonacci_sphere(n)
+            .into_iter()
+            .map(|u| 10.0 * u)
             .collect();
         let r = voxel_grid_subsample_to_count(
             &positions,
