@@ -24,7 +24,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::normals::{estimate_normals, Orientation};
 use super::rimls::{Rimls, RimlsParams};
-use super::stream::{encode_record, Point, PointReader, RECORD_BYTES};
+use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
 use crate::mesh::{Aabb, Normalization};
@@ -93,18 +93,6 @@ pub struct OutOfCoreResult {
     /// Seconds: reading and bucketing, the sigma_p search, the scan, and the normals and
     /// resampling after it.
     pub seconds: [f64; 4],
-}
-
-fn decode(b: &[u8]) -> Point {
-    let f = |k: usize| {
-        f64::from(f32::from_le_bytes(
-            b[4 * k..4 * k + 4].try_into().unwrap_or([0; 4]),
-        ))
-    };
-    Point {
-        position: DVec3::new(f(0), f(1), f(2)),
-        normal: DVec3::new(f(3), f(4), f(5)),
-    }
 }
 
 /// Simplifies the point set in the file `input` (PLY or XYZ/CSV, see [`PointReader`]) out of
@@ -424,23 +412,20 @@ impl Buckets {
                     (pts, r)
                 })
             };
-            let mut pending = Some(spawn(0, rng.clone()));
-            for b in 0..self.count {
-                let (pts, r) = pending
-                    .take()
-                    .map(|h| h.join())
-                    .transpose()
-                    .map_err(|_| {
-                        Error::io(
-                            self.dir.path(),
-                            std::io::Error::other("a bucket loader panicked"),
-                        )
-                    })?
-                    .unwrap_or((Ok(Vec::new()), rng.clone()));
+            let mut next = Some(spawn(0, rng.clone()));
+            let mut b = 0;
+            while let Some(loader) = next.take() {
+                let (pts, r) = loader.join().map_err(|_| {
+                    Error::io(
+                        self.dir.path(),
+                        std::io::Error::other("a bucket loader panicked"),
+                    )
+                })?;
                 *rng = r;
                 let pts = pts?;
-                if b + 1 < self.count {
-                    pending = Some(spawn(b + 1, rng.clone()));
+                b += 1;
+                if b < self.count {
+                    next = Some(spawn(b, rng.clone()));
                 }
                 f(pts);
             }
@@ -457,7 +442,7 @@ impl Buckets {
         let mut pts: Vec<Point> = bytes
             .chunks_exact(RECORD_BYTES)
             .map(|r| {
-                let p = decode(r);
+                let p = decode_record(r);
                 Point {
                     position: self.normalization.apply(p.position),
                     normal: p.normal,

@@ -502,6 +502,19 @@ fn split_fields(line: &str, text: bool) -> impl Iterator<Item = &str> {
 /// Bytes of one point in the binary layout this module writes (`x y z nx ny nz` as float32 LE).
 pub(crate) const RECORD_BYTES: usize = 24;
 
+/// The point of one record in that layout (`b` holds at least [`RECORD_BYTES`] bytes).
+pub(crate) fn decode_record(b: &[u8]) -> Point {
+    let f = |k: usize| {
+        f64::from(f32::from_le_bytes(
+            b[4 * k..4 * k + 4].try_into().unwrap_or([0; 4]),
+        ))
+    };
+    Point {
+        position: DVec3::new(f(0), f(1), f(2)),
+        normal: DVec3::new(f(3), f(4), f(5)),
+    }
+}
+
 /// Appends `p` in that layout.
 pub(crate) fn encode_record(p: &Point, out: &mut Vec<u8>) {
     for v in [
