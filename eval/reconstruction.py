@@ -38,23 +38,47 @@ OUT = HERE / "results" / "reconstruction"
 METHODS = ["ours", "random", "voxel", "poisson"]
 LABELS = {"ours": "Ours", "random": "Random", "voxel": "Voxel", "poisson": "Poisson"}
 
-# Variants: name -> (extra remesh arguments, description).
+# Variants (the input point sets): name -> (extra remesh arguments, description).
 VARIANTS = {
+    "crease": (
+        ["--spacing", "0.15", "--crease-angle", "60"],
+        "input: area-uniform random points 0.15 apart on average (bbox-100 units); normals: "
+        "the mesh's corner normals with a 60° crease angle, interpolated (sharp edges stay sharp)",
+    ),
     "dense": (
         ["--spacing", "0.15"],
-        "input: area-uniform random points 0.15 apart on average (bbox-100 units) with "
-        "interpolated vertex normals",
+        "input: area-uniform random points 0.15 apart on average (bbox-100 units); normals: "
+        "the vertex normals interpolated (smooth across sharp edges too)",
     ),
     "vertices": (
         [],
         "input: the mesh vertices with their vertex normals",
     ),
 }
-# Which distance: the surfaces restricted to the domain (1.5 sigma_p from a point), or not.
+# Which reconstruction of a subset and which distance: (key path into a method's JSON, label).
+# Weighted: the subset reconstructed with the weights of the points it dropped as masses (Sec. 5).
 DISTANCES = {
-    "distance": "restricted domain (surface within 1.5 σp of a point)",
-    "distance_no_domain": "no restricted domain (every zero crossing where RIMLS is defined)",
+    "weighted": (("weighted", "distance"),
+                 "weighted subsets (Sec. 5 weights as masses), restricted domain (surface within "
+                 "1.5 σp of a point)"),
+    "weighted_no_domain": (("weighted", "distance_no_domain"),
+                           "weighted subsets, no restricted domain (every zero crossing where "
+                           "RIMLS is defined)"),
+    "plain": (("distance",),
+              "unweighted subsets (every point mass 1), restricted domain"),
+    "plain_no_domain": (("distance_no_domain",),
+                        "unweighted subsets, no restricted domain"),
 }
+# The setting of the headline table and the acceptance check.
+PRIMARY = ("crease", "weighted")
+
+
+def distance_of(run, which):
+    """The distance record `which` (a DISTANCES key) of one method run, or None."""
+    d = run
+    for k in DISTANCES[which][0]:
+        d = d.get(k) if d else None
+    return d
 
 
 def parse_args():
@@ -62,7 +86,7 @@ def parse_args():
     p.add_argument("--models", default="horse,stanford-bunny,fandisk",
                    help="model names in ../shared/data (OBJ)")
     p.add_argument("--sigma-p", default="0.5,0.75,1", help="sigma_p values, bbox-100 units")
-    p.add_argument("--variants", default="dense,vertices",
+    p.add_argument("--variants", default="crease,dense,vertices",
                    help="which settings to run: " + ", ".join(VARIANTS))
     p.add_argument("--quick", action="store_true",
                    help="spot at sigma_p 2 from points 0.5 apart, one run; writes "
@@ -76,7 +100,7 @@ def parse_args():
 def run(variant, models, sigmas, out, meshes, quick=False):
     extra, _ = VARIANTS[variant]
     if quick:
-        extra = ["--spacing", "0.5", "--repeats", "1"]
+        extra = ["--spacing", "0.5", "--crease-angle", "60", "--repeats", "1"]
     json_path = out / f"reconstruction-{variant}.json"
     cmd = [REMESH, "reconstruct-eval", *[str(SHARED / f"{m}.obj") for m in models],
            "--sigma-p", sigmas, "--json", str(json_path), *extra]
@@ -108,7 +132,7 @@ def aggregate(sigma, which):
         runs = [r for r in sigma["methods"] if r["method"] == m]
         if not runs:
             continue
-        d = [r[which] for r in runs]
+        d = [distance_of(r, which) for r in runs]
         inf = float("inf")
         rms = [x["rms"] if x else inf for x in d]
         haus = [x["hausdorff"] if x else inf for x in d]
@@ -210,18 +234,20 @@ def acceptance(data, which):
     summary = (f"Ours has the strictly lowest mean RMS in {wins['rms']} of {cells} cells (tied in "
                f"{ties['rms']}) and the strictly lowest mean Hausdorff in {wins['hausdorff']} of "
                f"{cells} (tied in {ties['hausdorff']}).")
-    return summary, "\n".join(lines)
+    counts = {"cells": cells, "wins": wins, "ties": ties}
+    return summary, "\n".join(lines), counts
 
 
-def render(meshes, model, sigma, out_png):
-    """The all-points reconstruction and each subsampler's, same camera: full view above, a
-    close-up below; the close-up shaded by the distance to the all-points surface."""
+def render(meshes, model, sigma, out_png, suffix=""):
+    """The all-points reconstruction and each subsampler's (`suffix` "-weighted": reconstructed
+    with the Sec. 5 weights), same camera: full view above, a close-up below; the close-up shaded
+    by the distance to the all-points surface."""
     import pyvista as pv
     from scipy.spatial import cKDTree
 
     pv.OFF_SCREEN = True
     names = ["all"] + METHODS
-    files = {n: meshes / f"{model}-s{sigma}-{n}.ply" for n in names}
+    files = {n: meshes / f"{model}-s{sigma}-{n}{'' if n == 'all' else suffix}.ply" for n in names}
     if not all(f.exists() for f in files.values()):
         print(f"reconstruction: no meshes for {model} at sigma_p {sigma}; no rendering", file=sys.stderr)
         return False
@@ -272,10 +298,10 @@ def main():
     args = parse_args()
     if args.quick:
         out = OUT / "quick"
-        models, sigmas, variants = ["spot"], "2", ["dense"]
+        models, sigmas, variants = ["spot"], "2", ["crease"]
         args.render_model, args.render_sigma = "spot", "2"
-        VARIANTS["dense"] = (VARIANTS["dense"][0], "input: area-uniform random points 0.5 apart on "
-                             "average (bbox-100 units) with interpolated vertex normals (--quick)")
+        VARIANTS["crease"] = (VARIANTS["crease"][0], "input: area-uniform random points 0.5 apart "
+                              "on average (bbox-100 units), 60° crease normals (--quick)")
     else:
         out = OUT
         models, sigmas = args.models.split(","), args.sigma_p
@@ -299,23 +325,49 @@ def main():
           "symmetric Hausdorff distance; 200,000 random samples per side plus the vertices; bbox-100 "
           "units). Ours = the randomized linear scan alone (Algorithm 1, no resampling) with the same "
           "σp, σn; the others are chosen at its count (* = count search missed its 0.5% tolerance). "
-          "Lowest per group in bold.", ""]
+          "Lowest per group in bold.", "",
+          "Every subset is reconstructed twice: *unweighted* (every point has mass 1 in RIMLS) and "
+          "*weighted*: each kept point carries the weight of the input points it stands for, as "
+          "Sec. 5 of the paper prescribes for dropping a point from a kernel sum (each dropped "
+          "point's φ(x_j) is projected onto the span of the kept points near it, a = K⁻¹k, and "
+          "its weight moves to them: w_i += a_i). The same rule weights every subsampler's "
+          "points. The all-points surface has unit masses.", ""]
+    summaries = []
+    sections = []
     for v in variants:
         data = results[v]
         seconds_file = out / f"reconstruction-{v}.seconds"
         seconds = seconds_file.read_text().strip() if seconds_file.exists() else "?"
         repeats = max(m["repeat"] for m in data[0]["sigmas"][0]["methods"]) + 1
-        md += [f"## `{v}`: {VARIANTS[v][1]}", "",
-               f"Run time: {seconds} s wall (2 cores, shared machine). Means over {repeats} runs of "
-               "every subsampler (different seeds) against one all-points surface.", ""]
-        for which, label in DISTANCES.items():
-            summary, detail = acceptance(data, which)
-            md += [f"### {label}", "", table(data, which), "", summary, "", detail, ""]
-        md += ["### Context", "", context_table(data), ""]
-    for v in variants:
-        png = out / f"{args.render_model}-s{args.render_sigma}-{v}.png"
-        if render(out / "tmp" / v, args.render_model, args.render_sigma, png):
-            md += [f"## Renderings: {args.render_model} at σp = {args.render_sigma} (`{v}`, run 0)", "",
+        sections += [f"## `{v}`: {VARIANTS[v][1]}", "",
+                     f"Run time: {seconds} s wall (2 cores, shared machine). Means over {repeats} runs "
+                     "of every subsampler (different seeds) against one all-points surface.", ""]
+        for which, (_, label) in DISTANCES.items():
+            if not any(distance_of(r, which) for s_ in data[0]["sigmas"] for r in s_["methods"]):
+                continue
+            summary, detail, counts = acceptance(data, which)
+            summaries.append((v, which, counts))
+            sections += [f"### {label}", "", table(data, which), "", summary, "", detail, ""]
+        sections += ["### Context", "", context_table(data), ""]
+    md += ["## Summary: cells (model × σp) where ours has the lowest mean", "",
+           "| input | reconstruction of the subsets | RMS lowest | HAUS lowest |", "|---|---|---|---|"]
+    for v, which, c in summaries:
+        mark = " (headline)" if (v, which) == PRIMARY else ""
+        tie = lambda k: f" (+{c['ties'][k]} tied)" if c["ties"][k] else ""
+        md.append(f"| `{v}` | {DISTANCES[which][1]}{mark} | {c['wins']['rms']} of {c['cells']}{tie('rms')} "
+                  f"| {c['wins']['hausdorff']} of {c['cells']}{tie('hausdorff')} |")
+    md.append("")
+    if PRIMARY[0] in results:
+        summary, detail, _ = acceptance(results[PRIMARY[0]], PRIMARY[1])
+        md += [f"## Headline: `{PRIMARY[0]}`, {DISTANCES[PRIMARY[1]][1]}", "",
+               table(results[PRIMARY[0]], PRIMARY[1]), "", summary, "", detail, ""]
+    md += sections
+    render_variant = PRIMARY[0] if PRIMARY[0] in variants else variants[0]
+    for suffix, label in (("-weighted", "weighted subsets"), ("", "unweighted subsets")):
+        png = out / f"{args.render_model}-s{args.render_sigma}-{render_variant}{suffix}.png"
+        if render(out / "tmp" / render_variant, args.render_model, args.render_sigma, png, suffix):
+            md += [f"## Renderings: {args.render_model} at σp = {args.render_sigma} (`{render_variant}`, "
+                   f"{label}, run 0)", "",
                    f"![reconstructions]({png.name})", "",
                    "Top: the whole model; bottom: the head, coloured by the distance to the "
                    f"all-points surface (0 to σp/4 = {float(args.render_sigma) / 4:g} bbox-100 units; "

@@ -222,6 +222,55 @@ pub fn measure_and_gradient(
     neighbors: &[KernelPoint],
     ws: &mut MeasureWorkspace,
 ) -> (f64, [f64; 3]) {
+    let q = solve_alpha(kernel, x, neighbors, ws);
+    let mut grad = [0.0; 3];
+    for (r, &j) in ws.kept.iter().enumerate() {
+        let y = &neighbors[j];
+        let w = 4.0 * ws.z[r] * ws.k[r];
+        for c in 0..3 {
+            grad[c] += w * (x.0[c] - y.0[c]);
+        }
+    }
+    ((1.0 - q).clamp(0.0, 1.0), grad)
+}
+
+/// The coefficients α = K^-1 k of the projection of φ(x) onto the span of the φ(y) of
+/// `neighbors` (Sec. 5 and Appendix B: φ(x) ≈ Σ α_i φ(y_i), so that k(z, x) ≈ Σ α_i k(z, y_i)
+/// for every z), written to `alpha` as `(neighbour index, α_i)` pairs; returns s(x) (eq. 9) over
+/// the same neighbours.
+///
+/// Sec. 5 uses them to drop a point x_j from a kernel sum Σ w_i k(·, x_i): the weight w_j moves
+/// to the others as w_i + w_j α_i (the error left is w_j times the orthogonal part, whose squared
+/// norm relative to |φ(x_j)|² is s(x_j)). [`crate::points::subsample::representation_weights`]
+/// does that for every point a subsampler dropped.
+///
+/// The neighbours are taken in the order given (nearest first) with the same Cholesky
+/// factorization as [`measure_and_gradient`]; those numerically in the span of the ones before
+/// them (squared pivot below [`SINGULAR_TOLERANCE`], exactly the neighbours eq. 10 skips) get no
+/// pair. With no neighbours `alpha` is empty and s = 1; a neighbour equal to x gets α = 1 and
+/// the others 0 (up to rounding).
+pub fn projection_coefficients(
+    kernel: &Kernel,
+    x: &KernelPoint,
+    neighbors: &[KernelPoint],
+    ws: &mut MeasureWorkspace,
+    alpha: &mut Vec<(usize, f64)>,
+) -> f64 {
+    let q = solve_alpha(kernel, x, neighbors, ws);
+    alpha.clear();
+    alpha.extend(ws.kept.iter().copied().zip(ws.z.iter().copied()));
+    (1.0 - q).clamp(0.0, 1.0)
+}
+
+/// α = K^-1 k over `neighbors` (in the order given, near-singular ones skipped) by a Cholesky
+/// factorization built row by row: afterwards `ws.kept[r]` is the neighbour of row r, `ws.z[r]`
+/// its α and `ws.k[r]` its k(x, y). Returns q = k^T K^-1 k.
+fn solve_alpha(
+    kernel: &Kernel,
+    x: &KernelPoint,
+    neighbors: &[KernelPoint],
+    ws: &mut MeasureWorkspace,
+) -> f64 {
     let n = neighbors.len();
     // Lower-triangular L with stride n over the kept rows; kept[r] = neighbour index of row r.
     ws.chol.clear();
@@ -248,7 +297,7 @@ pub fn measure_and_gradient(
         }
         let pivot2 = 1.0 - dot;
         if !(pivot2 > SINGULAR_TOLERANCE) {
-            // Clear the partial row; it will be overwritten by the next kept neighbour anyway.
+            // The partial row is overwritten by the next kept neighbour.
             continue;
         }
         let d = pivot2.sqrt();
@@ -274,15 +323,7 @@ pub fn measure_and_gradient(
         }
         ws.z[r] = s / ws.chol[r * n + r];
     }
-    let mut grad = [0.0; 3];
-    for r in 0..m {
-        let y = &neighbors[ws.kept[r]];
-        let w = 4.0 * ws.z[r] * ws.k[r];
-        for c in 0..3 {
-            grad[c] += w * (x.0[c] - y.0[c]);
-        }
-    }
-    ((1.0 - q).clamp(0.0, 1.0), grad)
+    q
 }
 
 #[cfg(test)]
@@ -525,6 +566,47 @@ mod tests {
             let (s_chol, _) = measure_and_gradient(&k, &x, &pts, &mut ws);
             assert!((s_eq10 - s_chol).abs() < 1e-9, "{s_eq10} vs {s_chol}");
         }
+    }
+
+    #[test]
+    fn projection_coefficients_match_a_direct_solve_and_reproduce_a_neighbour() {
+        let k = Kernel::new(1.2, 0.6).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(10);
+        let mut ws = MeasureWorkspace::new();
+        let mut alpha = Vec::new();
+        for _ in 0..20 {
+            let pts = slab_points(&k, 20, &mut rng);
+            let x = k.embed(DVec3::new(0.3, 0.1, -0.05), DVec3::Z);
+            let s = projection_coefficients(&k, &x, &pts, &mut ws, &mut alpha);
+            // Oracle: α = K^-1 k by LU over the neighbours kept (none is near-singular here).
+            assert_eq!(alpha.len(), pts.len());
+            let n = pts.len();
+            let kmat = DMatrix::from_fn(n, n, |i, j| k.eval(&pts[i], &pts[j]));
+            let kvec = DVector::from_fn(n, |i, _| k.eval(&x, &pts[i]));
+            let direct = kmat.lu().solve(&kvec).unwrap();
+            for &(i, a) in &alpha {
+                assert!(
+                    (a - direct[i]).abs() < 1e-6 * (1.0 + direct[i].abs()),
+                    "{a} vs {}",
+                    direct[i]
+                );
+            }
+            assert!((s - (1.0 - kvec.dot(&direct))).abs() < 1e-9);
+            // x equal to neighbour 3: φ(x) is φ(y_3), α = e_3 and s = 0.
+            let s = projection_coefficients(&k, &pts[3], &pts, &mut ws, &mut alpha);
+            assert!(s < 1e-9, "{s}");
+            for &(i, a) in &alpha {
+                let want = if i == 3 { 1.0 } else { 0.0 };
+                assert!((a - want).abs() < 1e-6, "neighbour {i}: {a}");
+            }
+        }
+        // No neighbours: nothing to project on.
+        let x = k.embed(DVec3::ZERO, DVec3::Z);
+        assert_eq!(
+            projection_coefficients(&k, &x, &[], &mut ws, &mut alpha),
+            1.0
+        );
+        assert!(alpha.is_empty());
     }
 
     #[test]

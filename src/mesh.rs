@@ -154,6 +154,54 @@ impl TriMesh {
         normals
     }
 
+    /// Unit normals per face corner, `F × 3`, with a crease angle: corner k of face f gets the
+    /// angle-weighted average of the normals of the faces around its vertex whose normal is
+    /// within `crease_angle_deg` of face f's own (smooth shading with a crease angle, as
+    /// renderers' "auto smooth" does, comparing normals rather than walking the fan). Across
+    /// an edge sharper than the angle the two sides keep their own normals; 180° or more gives
+    /// the vertex normals ([`TriMesh::vertex_normals`]) at every corner, 0° the face normal
+    /// wherever no neighbour is exactly parallel. A degenerate face's corners get zero.
+    pub fn corner_normals(&self, crease_angle_deg: f64) -> Vec<[DVec3; 3]> {
+        let face_normals: Vec<DVec3> = (0..self.triangles.len())
+            .map(|f| self.face_normal(f))
+            .collect();
+        // Faces around each vertex, with the corner angle there.
+        let mut around: Vec<Vec<(u32, f64)>> = vec![Vec::new(); self.positions.len()];
+        for (f, tri) in self.triangles.iter().enumerate() {
+            if face_normals[f] == DVec3::ZERO {
+                continue;
+            }
+            let p = self.corners(f);
+            for k in 0..3 {
+                let angle = (p[(k + 1) % 3] - p[k]).angle_between(p[(k + 2) % 3] - p[k]);
+                if angle.is_finite() {
+                    around[tri[k] as usize].push((f as u32, angle));
+                }
+            }
+        }
+        let cos_crease = crease_angle_deg.to_radians().cos();
+        let all = crease_angle_deg >= 180.0;
+        self.triangles
+            .iter()
+            .enumerate()
+            .map(|(f, tri)| {
+                let nf = face_normals[f];
+                if nf == DVec3::ZERO {
+                    return [DVec3::ZERO; 3];
+                }
+                tri.map(|v| {
+                    around[v as usize]
+                        .iter()
+                        .filter(|&&(g, _)| all || face_normals[g as usize].dot(nf) >= cos_crease)
+                        .fold(DVec3::ZERO, |acc, &(g, angle)| {
+                            acc + angle * face_normals[g as usize]
+                        })
+                        .normalize_or_zero()
+                })
+            })
+            .collect()
+    }
+
     /// The first triangle that names a vertex index `>= V`, as `(face, index)`.
     pub fn check_indices(&self) -> Option<(usize, u32)> {
         let n = self.positions.len() as u64;
@@ -392,6 +440,55 @@ mod tests {
         assert_eq!(m.weld_identical_positions(), 1);
         assert_eq!(m.positions.len(), 4);
         assert_eq!(m.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+    }
+
+    #[test]
+    fn corner_normals_split_at_creases_sharper_than_the_angle() {
+        // A roof: two planes meeting at a ridge along x with a 90° dihedral angle, each a 2 x 2
+        // grid of squares; the ridge vertices are shared.
+        let mut positions = Vec::new();
+        for j in 0..=4 {
+            for i in 0..=2 {
+                let y = j as f64 - 2.0;
+                positions.push(DVec3::new(i as f64, y, 2.0 - y.abs()));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..4u32 {
+            for i in 0..2u32 {
+                let v = j * 3 + i;
+                triangles.push([v, v + 1, v + 4]);
+                triangles.push([v, v + 4, v + 3]);
+            }
+        }
+        let m = TriMesh::new(positions, triangles);
+        let vertex = m.vertex_normals();
+        for (crease, sharp) in [(60.0, true), (100.0, false), (180.0, false)] {
+            let corners = m.corner_normals(crease);
+            for (f, tri) in m.triangles.iter().enumerate() {
+                for k in 0..3 {
+                    let n = corners[f][k];
+                    assert!((n.length() - 1.0).abs() < 1e-12);
+                    let want = if sharp {
+                        m.face_normal(f)
+                    } else {
+                        vertex[tri[k] as usize]
+                    };
+                    assert!(
+                        (n - want).length() < 1e-12,
+                        "crease {crease} face {f}: {n} vs {want}"
+                    );
+                }
+            }
+        }
+        // On the ridge the vertex normal points straight up, between the two faces.
+        let ridge = 2 * 3 + 1;
+        assert_eq!(m.positions[ridge], DVec3::new(1.0, 0.0, 2.0));
+        assert!(
+            (vertex[ridge] - DVec3::Z).length() < 1e-12,
+            "{}",
+            vertex[ridge]
+        );
     }
 
     #[test]

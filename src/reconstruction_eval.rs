@@ -35,13 +35,14 @@ use crate::error::{Error, Result};
 use crate::io::{read_mesh, write_mesh};
 use crate::kernel::Kernel;
 use crate::mesh::{Normalization, TriMesh};
-use crate::points::generate::surface_points;
+use crate::points::generate::{surface_points_with, NormalField};
 use crate::points::reconstruct::{
-    clip_to_domain, reconstruct_rimls, ReconstructParams, Reconstruction,
+    clip_to_domain, reconstruct_rimls, reconstruct_rimls_with_masses, ReconstructParams,
+    Reconstruction,
 };
 use crate::points::subsample::{
     linear_scan_subsample, poisson_disk_subsample_to_count, random_subsample,
-    voxel_grid_subsample_to_count, Subsampler,
+    representation_weights, voxel_grid_subsample_to_count, RepresentationParams, Subsampler,
 };
 use crate::points::{PlyPointWriter, Point};
 use crate::quality::{surface_distance_with, topology, SurfaceDistance};
@@ -56,10 +57,13 @@ pub enum PointSource {
     /// The mesh's vertices with its (angle-weighted) vertex normals.
     Vertices,
     /// ⌈area / spacing²⌉ points drawn uniformly by area on the mesh (bbox-100 units), each with
-    /// the vertex normals interpolated at it: a dense, scanner-like point set.
+    /// the normals of `normals` interpolated at it: a dense, scanner-like point set.
     Surface {
         /// Mean spacing (bbox-100 units, > 0).
         spacing: f64,
+        /// The normal field ([`NormalField`]: smooth vertex normals, or corner normals with a
+        /// crease angle that keep sharp edges sharp).
+        normals: NormalField,
     },
 }
 
@@ -85,6 +89,10 @@ pub struct ReconstructionEvalParams {
     pub distance_samples: usize,
     /// Relative tolerance of the baselines' count searches (default 0.005).
     pub count_tolerance: f64,
+    /// Whether every subset is also reconstructed with the weights of the points it dropped as
+    /// masses ([`representation_weights`], Sec. 5; [`MethodResult::weighted`]), beside the
+    /// plain reconstruction with unit masses. Default true.
+    pub weighted: bool,
     /// Seed of the point set and the distance sampling; the subsamplers of repeat r use seeds
     /// derived from `seed + r` (default 1).
     pub seed: u64,
@@ -110,6 +118,7 @@ impl Default for ReconstructionEvalParams {
             domain: crate::points::reconstruct::DEFAULT_DOMAIN,
             distance_samples: 200_000,
             count_tolerance: 0.005,
+            weighted: true,
             seed: 1,
             repeats: 5,
             mesh_dir: None,
@@ -163,6 +172,34 @@ pub struct MethodResult {
     pub mesh: MeshStats,
     /// Seconds to subsample.
     pub subsample_seconds: f64,
+    /// Seconds to reconstruct.
+    pub reconstruct_seconds: f64,
+    /// Seconds for the two distances.
+    pub distance_seconds: f64,
+    /// The same subset reconstructed with its representation weights as masses (when
+    /// [`ReconstructionEvalParams::weighted`]).
+    pub weighted: Option<WeightedResult>,
+}
+
+/// A subset reconstructed with the weights of the points it dropped ([`representation_weights`]:
+/// Sec. 5 of the paper) as RIMLS masses.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WeightedResult {
+    /// Distance to the all-points reconstruction, both restricted to the domain.
+    pub distance: Option<SurfaceDistance>,
+    /// The same without the restricted domain.
+    pub distance_no_domain: Option<SurfaceDistance>,
+    /// The reconstruction (restricted to the domain).
+    pub mesh: MeshStats,
+    /// Kept points whose weight came out negative and was set to 0.
+    pub weights_clamped: usize,
+    /// Input points with no kept point within the kernel's support (their weight went to the
+    /// nearest kept point).
+    pub weights_unsupported: usize,
+    /// The smallest and largest weight, in input points.
+    pub weight_range: (f64, f64),
+    /// Seconds to compute the weights.
+    pub weights_seconds: f64,
     /// Seconds to reconstruct.
     pub reconstruct_seconds: f64,
     /// Seconds for the two distances.
@@ -266,7 +303,7 @@ pub fn input_points(
                 .map(|(p, n)| (*p, n))
                 .unzip())
         }
-        PointSource::Surface { spacing } => {
+        PointSource::Surface { spacing, normals } => {
             if !(spacing.is_finite() && spacing > 0.0) {
                 return Err(Error::InvalidParameter {
                     name: "--spacing",
@@ -280,7 +317,15 @@ pub fn input_points(
                     message: format!("{spacing} asks for {count} points, more than 100 million"),
                 });
             }
-            let points = surface_points(mesh, count as usize, seed)?;
+            if let NormalField::Crease { angle_deg } = normals {
+                if !(angle_deg.is_finite() && angle_deg >= 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name: "--crease-angle",
+                        message: format!("must be a number of degrees >= 0, got {angle_deg}"),
+                    });
+                }
+            }
+            let points = surface_points_with(mesh, count as usize, seed, normals)?;
             Ok(points.into_iter().map(|p| (p.position, p.normal)).unzip())
         }
     }
@@ -347,11 +392,15 @@ impl Surface {
 fn reconstruct_both(
     positions: &[DVec3],
     normals: &[DVec3],
+    masses: Option<&[f64]>,
     rec_params: &ReconstructParams,
     domain_radius: f64,
     file: Option<PathBuf>,
 ) -> Result<(Surface, Surface, MeshStats, f64)> {
-    let rec = reconstruct_rimls(positions, normals, rec_params)?;
+    let rec = match masses {
+        Some(m) => reconstruct_rimls_with_masses(positions, normals, m, rec_params)?,
+        None => reconstruct_rimls(positions, normals, rec_params)?,
+    };
     let mut clipped = rec.mesh.clone();
     let dropped = if domain_radius > 0.0 {
         clip_to_domain(&mut clipped, positions, domain_radius)
@@ -433,6 +482,7 @@ pub fn evaluate_model(
         let (all, all_no_domain, all_stats, all_seconds) = reconstruct_both(
             &positions,
             &normals,
+            None,
             &rec_params,
             domain_radius,
             file("all"),
@@ -518,11 +568,12 @@ pub fn evaluate_model(
                     None
                 };
                 let (rec, rec_no_domain, stats, reconstruct_seconds) =
-                    reconstruct_both(&p, &n, &rec_params, domain_radius, mesh_file)?;
+                    reconstruct_both(&p, &n, None, &rec_params, domain_radius, mesh_file)?;
                 let t = Instant::now();
                 let distance = rec.distance(&all, params);
                 let distance_no_domain = rec_no_domain.distance(&all_no_domain, params);
                 let distance_seconds = t.elapsed().as_secs_f64();
+                drop((rec, rec_no_domain));
                 let show = |d: &Option<SurfaceDistance>| {
                     d.as_ref()
                         .map(|d| format!("RMS {:.4} Hausdorff {:.4}", d.rms, d.hausdorff))
@@ -535,6 +586,59 @@ pub fn evaluate_model(
                 show(&distance),
                 show(&distance_no_domain),
             ));
+                let weighted = if params.weighted {
+                    let t = Instant::now();
+                    let w = representation_weights(
+                        &positions,
+                        &normals,
+                        &indices,
+                        &kernel,
+                        &RepresentationParams::default(),
+                    )?;
+                    let weights_seconds = t.elapsed().as_secs_f64();
+                    let mesh_file = if repeat == 0 {
+                        file(&format!("{}-weighted", method.name()))
+                    } else {
+                        None
+                    };
+                    let (rec, rec_no_domain, mesh, reconstruct_seconds) = reconstruct_both(
+                        &p,
+                        &n,
+                        Some(&w.weights),
+                        &rec_params,
+                        domain_radius,
+                        mesh_file,
+                    )?;
+                    let t = Instant::now();
+                    let distance = rec.distance(&all, params);
+                    let distance_no_domain = rec_no_domain.distance(&all_no_domain, params);
+                    let distance_seconds = t.elapsed().as_secs_f64();
+                    progress(&format!(
+                        "{model} sigma_p {sigma_p} run {repeat} {:>7}: weighted, {} (no domain: {})",
+                        method.name(),
+                        show(&distance),
+                        show(&distance_no_domain),
+                    ));
+                    let range = w
+                        .weights
+                        .iter()
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+                            (lo.min(x), hi.max(x))
+                        });
+                    Some(WeightedResult {
+                        distance,
+                        distance_no_domain,
+                        mesh,
+                        weights_clamped: w.clamped,
+                        weights_unsupported: w.unsupported,
+                        weight_range: range,
+                        weights_seconds,
+                        reconstruct_seconds,
+                        distance_seconds,
+                    })
+                } else {
+                    None
+                };
                 methods.push(MethodResult {
                     method: method.name(),
                     repeat,
@@ -548,6 +652,7 @@ pub fn evaluate_model(
                     subsample_seconds,
                     reconstruct_seconds,
                     distance_seconds,
+                    weighted,
                 });
             }
         }

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use spectral_remesh::points::generate::NormalField;
 use spectral_remesh::points::subsample::Subsampler;
 use spectral_remesh::reconstruction_eval::{
     evaluate_model, input_points, read_normalized_outward, PointSource, ReconstructionEvalParams,
@@ -17,7 +18,10 @@ fn spot_pipeline_reconstructs_the_input_and_every_subsampler_hits_the_count() {
     let sigma_p = 2.0;
     let params = ReconstructionEvalParams {
         sigma_p: vec![sigma_p],
-        source: PointSource::Surface { spacing: 0.5 },
+        source: PointSource::Surface {
+            spacing: 0.5,
+            normals: NormalField::Smooth,
+        },
         distance_samples: 50_000,
         repeats: 1,
         ..Default::default()
@@ -83,6 +87,25 @@ fn spot_pipeline_reconstructs_the_input_and_every_subsampler_hits_the_count() {
         rms("ours"),
         rms("random")
     );
+    // With the weights of the points it dropped as masses (Sec. 5), every subset is
+    // reconstructed a second time; ours then follows the all-points surface more closely still
+    // (RMS 0.018 against 0.023 unweighted when this was written; random 0.070).
+    let weighted_rms = |name: &str| {
+        let m = s.methods.iter().find(|m| m.method == name).unwrap();
+        let w = m.weighted.as_ref().unwrap();
+        assert!(
+            w.weight_range.0 >= 0.0 && w.weight_range.1 > 1.0,
+            "{name}: {w:?}"
+        );
+        w.distance.as_ref().unwrap().rms
+    };
+    assert!(
+        weighted_rms("ours") < rms("ours"),
+        "{} vs {}",
+        weighted_rms("ours"),
+        rms("ours")
+    );
+    assert!(weighted_rms("ours") < 0.5 * weighted_rms("random"));
 }
 
 #[test]
@@ -121,10 +144,23 @@ fn bad_parameters_are_errors() {
     };
     assert!(evaluate_model(&path, &bad_sigma, &|_| {}).is_err());
     let bad_spacing = ReconstructionEvalParams {
-        source: PointSource::Surface { spacing: 0.0 },
+        source: PointSource::Surface {
+            spacing: 0.0,
+            normals: NormalField::Smooth,
+        },
         ..Default::default()
     };
     assert!(evaluate_model(&path, &bad_spacing, &|_| {}).is_err());
+    let bad_crease = ReconstructionEvalParams {
+        source: PointSource::Surface {
+            spacing: 1.0,
+            normals: NormalField::Crease {
+                angle_deg: f64::NAN,
+            },
+        },
+        ..Default::default()
+    };
+    assert!(evaluate_model(&path, &bad_crease, &|_| {}).is_err());
     let bad_domain = ReconstructionEvalParams {
         domain: f64::NAN,
         ..Default::default()

@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::app::{run_quality, run_remesh, RemeshJob};
 use spectral_remesh::pipeline::{Density, RemeshParams};
+use spectral_remesh::points::generate::NormalField;
 use spectral_remesh::points::subsample::Subsampler;
 use spectral_remesh::reconstruction_eval::{evaluate_model, PointSource, ReconstructionEvalParams};
 use spectral_remesh::Error;
@@ -201,6 +202,14 @@ enum Command {
         /// with interpolated vertex normals. Default: the mesh's vertices.
         #[arg(long)]
         spacing: Option<f64>,
+        /// With --spacing: the points' normals keep the mesh's edges sharper than this many
+        /// degrees sharp (corner normals with a crease angle) instead of averaging across them.
+        #[arg(long, value_name = "DEG", requires = "spacing")]
+        crease_angle: Option<f64>,
+        /// Skip the second reconstruction of every subset, with the weights of the points it
+        /// dropped as masses (Sec. 5 of the paper).
+        #[arg(long)]
+        no_weights: bool,
         /// Subsamplers (ours is required: it sets the count).
         #[arg(
             long,
@@ -371,6 +380,8 @@ fn run(cli: Cli) -> Result<(), Error> {
         sigma_p,
         sigma_n,
         spacing,
+        crease_angle,
+        no_weights,
         methods,
         cell,
         domain,
@@ -395,7 +406,13 @@ fn run(cli: Cli) -> Result<(), Error> {
             sigma_p: sigma_p.clone(),
             sigma_n: *sigma_n,
             source: match spacing {
-                Some(s) => PointSource::Surface { spacing: *s },
+                Some(s) => PointSource::Surface {
+                    spacing: *s,
+                    normals: match crease_angle {
+                        Some(a) => NormalField::Crease { angle_deg: *a },
+                        None => NormalField::Smooth,
+                    },
+                },
                 None => PointSource::Vertices,
             },
             methods: parsed,
@@ -404,6 +421,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             distance_samples: *samples,
             seed: *seed,
             repeats: *repeats,
+            weighted: !*no_weights,
             mesh_dir: meshes.clone(),
             ..Default::default()
         };

@@ -43,7 +43,40 @@ pub fn write_surface_points(mesh: &TriMesh, count: u64, seed: u64, path: &Path) 
 /// # Errors
 /// [`Error::InvalidMesh`] when the mesh has no area.
 pub fn surface_points(mesh: &TriMesh, count: usize, seed: u64) -> Result<Vec<Point>> {
+    surface_points_with(mesh, count, seed, NormalField::Smooth)
+}
+
+/// The normals given to points drawn on a mesh.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum NormalField {
+    /// The vertex normals ([`TriMesh::vertex_normals`]) interpolated across each face: smooth
+    /// everywhere, also across the model's sharp edges (where they average the two sides).
+    Smooth,
+    /// The corner normals with a crease angle ([`TriMesh::corner_normals`]) interpolated
+    /// across each face: smooth across edges flatter than the angle, the two sides' own
+    /// normals across sharper ones (the creases of CAD models such as fandisk).
+    Crease {
+        /// The crease angle in degrees (dihedral angle between face normals).
+        angle_deg: f64,
+    },
+}
+
+/// [`surface_points`] with the normals of `normals`: the same positions for the same seed,
+/// whatever the normal field.
+///
+/// # Errors
+/// [`Error::InvalidMesh`] when the mesh has no area.
+pub fn surface_points_with(
+    mesh: &TriMesh,
+    count: usize,
+    seed: u64,
+    normals: NormalField,
+) -> Result<Vec<Point>> {
     let mut sampler = SurfaceSampler::new(mesh, seed)?;
+    if let NormalField::Crease { angle_deg } = normals {
+        sampler.corner_normals = Some(mesh.corner_normals(angle_deg));
+    }
     Ok((0..count).map(|_| sampler.draw()).collect())
 }
 
@@ -54,6 +87,8 @@ struct SurfaceSampler<'a> {
     cumulative: Vec<f64>,
     total: f64,
     normals: Vec<glam::DVec3>,
+    /// Per face corner, replacing `normals` when set.
+    corner_normals: Option<Vec<[glam::DVec3; 3]>>,
     rng: ChaCha8Rng,
 }
 
@@ -77,6 +112,7 @@ impl<'a> SurfaceSampler<'a> {
             cumulative,
             total,
             normals: mesh.vertex_normals(),
+            corner_normals: None,
             rng: ChaCha8Rng::seed_from_u64(seed),
         })
     }
@@ -97,9 +133,11 @@ impl<'a> SurfaceSampler<'a> {
         let [a, b, c] = mesh.corners(f);
         let position = a + u * (b - a) + v * (c - a);
         let w = 1.0 - u - v;
-        let n = w * self.normals[t[0] as usize]
-            + u * self.normals[t[1] as usize]
-            + v * self.normals[t[2] as usize];
+        let [na, nb, nc] = match &self.corner_normals {
+            Some(c) => c[f],
+            None => t.map(|i| self.normals[i as usize]),
+        };
+        let n = w * na + u * nb + v * nc;
         let normal = n.try_normalize().unwrap_or_else(|| mesh.face_normal(f));
         Point { position, normal }
     }
@@ -167,5 +205,28 @@ mod tests {
             per_face.iter().all(|&c| (700..=970).contains(&c)),
             "{per_face:?}"
         );
+        // With a crease angle below the cube's 90° the normals are the faces' own; smooth ones
+        // lean towards the neighbouring faces near the edges.
+        let outward = |x: DVec3| {
+            let c = x - DVec3::splat(0.5);
+            let k = (0..3)
+                .max_by(|&a, &b| c[a].abs().total_cmp(&c[b].abs()))
+                .unwrap();
+            let mut n = DVec3::ZERO;
+            n[k] = c[k].signum();
+            n
+        };
+        let creased =
+            surface_points_with(&cube, 2000, 3, NormalField::Crease { angle_deg: 60.0 }).unwrap();
+        let smooth = surface_points(&cube, 2000, 3).unwrap();
+        let mut leaning = 0;
+        for (c, s) in creased.iter().zip(&smooth) {
+            assert_eq!(c.position, s.position);
+            assert!((c.normal - outward(c.position)).length() < 1e-12, "{c:?}");
+            if s.normal.dot(outward(s.position)) < 0.99 {
+                leaning += 1;
+            }
+        }
+        assert!(leaning > 500, "{leaning}");
     }
 }

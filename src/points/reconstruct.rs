@@ -103,6 +103,32 @@ pub fn reconstruct_rimls(
     normals: &[DVec3],
     params: &ReconstructParams,
 ) -> Result<Reconstruction> {
+    reconstruct(positions, normals, None, params)
+}
+
+/// [`reconstruct_rimls`] of points that carry masses (`masses`, one per point, finite, ≥ 0):
+/// the RIMLS surface of [`Rimls::with_masses`]. A subset reconstructed with the weights of the
+/// points it dropped ([`crate::points::subsample::representation_weights`]) follows the
+/// reconstruction of the whole set (Sec. 5 of the paper).
+///
+/// # Errors
+/// Those of [`reconstruct_rimls`], and those of [`Rimls::with_masses`] for bad masses.
+pub fn reconstruct_rimls_with_masses(
+    positions: &[DVec3],
+    normals: &[DVec3],
+    masses: &[f64],
+    params: &ReconstructParams,
+) -> Result<Reconstruction> {
+    reconstruct(positions, normals, Some(masses), params)
+}
+
+/// [`reconstruct_rimls`] with or without masses.
+fn reconstruct(
+    positions: &[DVec3],
+    normals: &[DVec3],
+    masses: Option<&[f64]>,
+    params: &ReconstructParams,
+) -> Result<Reconstruction> {
     let t = Instant::now();
     if !(params.cell_per_sigma.is_finite() && params.cell_per_sigma > 0.0) {
         return Err(Error::InvalidParameter {
@@ -119,7 +145,15 @@ pub fn reconstruct_rimls(
             message: format!("must be a finite number >= 0, got {}", params.domain),
         });
     }
-    let rimls = Rimls::new(positions.to_vec(), normals.to_vec(), params.rimls)?;
+    let rimls = match masses {
+        Some(m) => Rimls::with_masses(
+            positions.to_vec(),
+            normals.to_vec(),
+            m.to_vec(),
+            params.rimls,
+        )?,
+        None => Rimls::new(positions.to_vec(), normals.to_vec(), params.rimls)?,
+    };
     let grid = MarchingCubesParams {
         cell: params.cell(),
         origin: params.origin,

@@ -28,6 +28,12 @@
 //! (σ_n = ∞ turns it off: positions only). φ is cut off at `support_radius · σ_p` and shifted down
 //! by its value there, so that f stays continuous when a point enters or leaves the support.
 //!
+//! A point may carry a mass m_i ≥ 0 ([`Rimls::with_masses`]; 1 by default) that multiplies its
+//! weight: the point then counts as m_i coincident points. A subsampled point set carries the
+//! weights of the points it dropped this way (Sec. 5 of the spectral sampling paper: a dropped
+//! point's weight moves to the points that span it; see
+//! [`crate::points::subsample::representation_weights`]).
+//!
 //! # References
 //! - A. C. Öztireli, G. Guennebaud, M. Gross. *Feature Preserving Point Set Surfaces based on
 //!   Non-Linear Kernel Regression.* Computer Graphics Forum 28(2) (Eurographics 2009),
@@ -182,6 +188,8 @@ pub struct RimlsProjection {
 pub struct Rimls {
     positions: Vec<DVec3>,
     normals: Vec<DVec3>,
+    /// Per-point masses; empty when every mass is 1.
+    masses: Vec<f64>,
     params: RimlsParams,
     tree: StaticTree,
     /// Squared support radius (position units²).
@@ -260,6 +268,7 @@ impl Rimls {
         Ok(Rimls {
             positions,
             normals: unit,
+            masses: Vec::new(),
             tree,
             support_2: support * support,
             inv_sigma_p2: 1.0 / (params.sigma_p * params.sigma_p),
@@ -268,6 +277,47 @@ impl Rimls {
             tail: (-params.support_radius * params.support_radius).exp(),
             params,
         })
+    }
+
+    /// [`Rimls::new`] with a mass per point (`N`, finite, ≥ 0, dimensionless): point i's weight
+    /// is multiplied by `masses[i]`, as if it stood `masses[i]` times at the same place (a
+    /// point of mass 0 takes no part). Scaling every mass by the same factor changes nothing.
+    ///
+    /// # Errors
+    /// Those of [`Rimls::new`], and [`Error::InvalidParameter`] when `masses` has another
+    /// length than `positions`, a mass is negative or not finite (the message names its
+    /// index), or every mass is 0.
+    pub fn with_masses(
+        positions: Vec<DVec3>,
+        normals: Vec<DVec3>,
+        masses: Vec<f64>,
+        params: RimlsParams,
+    ) -> Result<Self> {
+        let mut rimls = Self::new(positions, normals, params)?;
+        if masses.len() != rimls.positions.len() {
+            return Err(Error::InvalidParameter {
+                name: "masses",
+                message: format!(
+                    "{} masses for {} positions",
+                    masses.len(),
+                    rimls.positions.len()
+                ),
+            });
+        }
+        if let Some(i) = masses.iter().position(|m| !(m.is_finite() && *m >= 0.0)) {
+            return Err(Error::InvalidParameter {
+                name: "masses",
+                message: format!("mass {i} is {}, not a finite number >= 0", masses[i]),
+            });
+        }
+        if !masses.iter().any(|&m| m > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "masses",
+                message: "every mass is 0".into(),
+            });
+        }
+        rimls.masses = masses;
+        Ok(rimls)
     }
 
     /// The parameters.
@@ -330,6 +380,10 @@ impl Rimls {
                     let r = offset - f;
                     (-(r * r) * self.inv_sigma_r2 - (n - grad).length_squared() * self.inv_sigma_n2)
                         .exp()
+                };
+                let alpha = match self.masses.get(i as usize) {
+                    Some(&mass) => alpha * mass,
+                    None => alpha,
                 };
                 let w = alpha * phi;
                 // ∇φ = -2 (x - p) / σ_p² · exp(-|x - p|²/σ_p²); the shift is a constant.
@@ -511,6 +565,74 @@ mod tests {
             .map(|p| p.map(|p| (p.position, p.normal)))
             .collect();
         (projected, not_converged, most_steps)
+    }
+
+    #[test]
+    fn a_mass_counts_as_coincident_copies_and_a_zero_mass_as_absence() {
+        // 400 points on a bumpy patch with noisy normals; queries near it.
+        let mut rng = ChaCha8Rng::seed_from_u64(21);
+        let mut p = Vec::new();
+        let mut n = Vec::new();
+        for _ in 0..400 {
+            let (x, y): (f64, f64) = (rng.random_range(-4.0..4.0), rng.random_range(-4.0..4.0));
+            p.push(DVec3::new(x, y, 0.3 * (x * 0.7).sin() * (y * 0.5).cos()));
+            n.push((DVec3::Z + 0.3 * random_unit(&mut rng)).normalize());
+        }
+        let params = RimlsParams::new(1.0, 0.75);
+        let mut masses: Vec<f64> = (0..400).map(|_| rng.random_range(0.5..2.0)).collect();
+        masses[7] = 2.0;
+        masses[11] = 0.0;
+        let weighted = Rimls::with_masses(p.clone(), n.clone(), masses.clone(), params).unwrap();
+        // The same set with point 7 twice at mass 1 each, point 11 left out.
+        let mut p2 = p.clone();
+        let mut n2 = n.clone();
+        let mut m2 = masses.clone();
+        m2[7] = 1.0;
+        p2.push(p[7]);
+        n2.push(n[7]);
+        m2.push(1.0);
+        p2.remove(11);
+        n2.remove(11);
+        m2.remove(11);
+        let copied = Rimls::with_masses(p2, n2, m2, params).unwrap();
+        let scaled = Rimls::with_masses(
+            p.clone(),
+            n.clone(),
+            masses.iter().map(|m| 3.0 * m).collect(),
+            params,
+        )
+        .unwrap();
+        let unweighted = Rimls::new(p.clone(), n.clone(), params).unwrap();
+        let mut differs = 0;
+        for _ in 0..200 {
+            let q = DVec3::new(
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-0.5..0.5),
+            );
+            let (f, g) = weighted.value_and_gradient(q).unwrap();
+            for other in [&copied, &scaled] {
+                let (f2, g2) = other.value_and_gradient(q).unwrap();
+                assert!(
+                    (f - f2).abs() < 1e-10 && (g - g2).length() < 1e-9,
+                    "{q}: {f} vs {f2}"
+                );
+            }
+            let (f0, _) = unweighted.value_and_gradient(q).unwrap();
+            if (f - f0).abs() > 1e-4 {
+                differs += 1;
+            }
+        }
+        // The masses matter.
+        assert!(differs > 100, "{differs}");
+        // Bad masses.
+        assert!(Rimls::with_masses(p.clone(), n.clone(), vec![1.0; 399], params).is_err());
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            let mut m = vec![1.0; 400];
+            m[5] = bad;
+            assert!(Rimls::with_masses(p.clone(), n.clone(), m, params).is_err());
+        }
+        assert!(Rimls::with_masses(p, n, vec![0.0; 400], params).is_err());
     }
 
     #[test]

@@ -14,11 +14,13 @@ pub mod linear_scan;
 pub mod poisson_disk;
 pub mod random;
 pub mod voxel_grid;
+pub mod weights;
 
 pub use linear_scan::linear_scan_subsample;
 pub use poisson_disk::{poisson_disk_subsample, poisson_disk_subsample_to_count};
 pub use random::random_subsample;
 pub use voxel_grid::{voxel_grid_subsample, voxel_grid_subsample_to_count};
+pub use weights::{representation_weights, RepresentationParams, RepresentationWeights};
 
 /// A subsampler of the reconstruction experiment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
