@@ -46,6 +46,7 @@ fn main() {
             density: Density::Points(points),
             ..Default::default()
         },
+        strict: false,
         measure_distance: false,
     };
     let mut totals = Vec::new();

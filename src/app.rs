@@ -25,13 +25,22 @@ pub struct RemeshJob {
     pub params: RemeshParams,
     /// Whether to measure the distance to the input (Hausdorff, RMS).
     pub measure_distance: bool,
+    /// Whether a violated output invariant ([`crate::quality::check_invariants`]: manifold,
+    /// oriented, no degenerate, duplicate or intersecting faces) is an error, with nothing
+    /// written, rather than a line of the report.
+    pub strict: bool,
 }
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
 ///
+/// The output's invariants ([`crate::quality::check_invariants`]) are checked before it is
+/// written; violations go into the report ([`QualityReport::invariant_violations`] and a note).
+///
 /// # Errors
 /// Whatever reading, the pipeline or writing return, each naming the file concerned; an
-/// [`Error::InvalidParameter`] when the output path is the input path.
+/// [`Error::InvalidParameter`] when the output path is the input path; with `job.strict`, an
+/// [`Error::Internal`] (stage `invariant check`) naming the violations when the output breaks
+/// an invariant, and then nothing is written.
 pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<QualityReport> {
     if same_file(&job.input, &job.output) {
         return Err(Error::InvalidParameter {
@@ -51,16 +60,35 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         params.density = Density::Points(input.vertex_count());
     }
     let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
+    on_stage("check");
+    let t = Instant::now();
+    let mut report = QualityReport::new(&out.mesh_normalized);
+    let check_seconds = t.elapsed().as_secs_f64();
+    if !report.invariant_violations.is_empty() {
+        let list = report.invariant_violations.join("; ");
+        if job.strict {
+            return Err(Error::Internal {
+                stage: "invariant check",
+                message: format!(
+                    "the output mesh breaks its invariants ({list}); {} was not written (--strict)",
+                    job.output.display()
+                ),
+            });
+        }
+        report
+            .notes
+            .push(format!("the output mesh breaks its invariants: {list}"));
+    }
     on_stage("write");
     let t = Instant::now();
     write_mesh(&job.output, &out.mesh)?;
     let write_seconds = t.elapsed().as_secs_f64();
 
-    let mut report = QualityReport::new(&out.mesh_normalized);
     report.push_stage("read", read_seconds);
     for s in &out.stages {
         report.push_stage(s.name, s.seconds);
     }
+    report.push_stage("check (report)", check_seconds);
     report.push_stage("write", write_seconds);
     let input_topology = crate::quality::topology(&out.input_normalized);
     if input_topology.non_manifold_vertices > 0 || input_topology.non_manifold_edges > 0 {
@@ -115,6 +143,10 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         "optimize".into(),
         serde_json::to_value(out.optimize).unwrap_or_default(),
     );
+    extra.insert(
+        "untangle".into(),
+        serde_json::to_value(out.untangle).unwrap_or_default(),
+    );
     extra.insert("input_vertices".into(), input.vertex_count().into());
     extra.insert("input_faces".into(), input.face_count().into());
     if stats.welded_vertices > 0 {
@@ -131,6 +163,15 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             ));
         }
     }
+    if out.buried_candidates + out.buried_samples > 0 {
+        report.notes.push(format!(
+            "the input passes through itself: {} candidate points inside its own solid were left \
+             out and {} samples moved there were put back, so the output follows its outer \
+             surface there",
+            out.buried_candidates, out.buried_samples
+        ));
+    }
+    extra.insert("buried_candidates".into(), out.buried_candidates.into());
     if out.dropped_samples > 0 {
         report.notes.push(format!(
             "{} samples ended in no triangle and were left out",

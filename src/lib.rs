@@ -19,6 +19,7 @@ pub mod points;
 pub mod quality;
 pub mod reconstruction_eval;
 pub mod sampling;
+pub mod self_intersection;
 pub mod spatial;
 pub mod surface;
 pub mod triangulate;

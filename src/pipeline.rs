@@ -18,8 +18,10 @@ use crate::sampling::gradient_ascent::{
 use crate::sampling::linear_scan::{linear_scan, LinearScanParams, LinearScanResult};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::sampling::SurfaceSample;
+use crate::surface::winding::BuriedTest;
 use crate::surface::MeshSurface;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
+use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, FaceSource, SampleSet, TriangulateParams};
 
 /// How dense the output is: a vertex count, or sigma_p directly.
@@ -59,6 +61,8 @@ pub struct RemeshParams {
     pub triangulate: TriangulateParams,
     /// The local optimization against the input surface after triangulation (`None`: skipped).
     pub optimize: Option<OptimizeParams>,
+    /// The separation of crossing faces, last.
+    pub untangle: UntangleParams,
     /// Relative tolerance of the count search (default 0.005).
     pub count_tolerance: f64,
     /// Seed of every random choice.
@@ -75,6 +79,7 @@ impl Default for RemeshParams {
             gradient_ascent: GradientAscentParams::default(),
             triangulate: TriangulateParams::default(),
             optimize: Some(OptimizeParams::default()),
+            untangle: UntangleParams::default(),
             count_tolerance: 0.005,
             seed: 1,
         }
@@ -125,10 +130,18 @@ pub struct RemeshOutput {
     pub assembly: AssemblyStats,
     /// What the local optimization did.
     pub optimize: OptimizeStats,
+    /// What the separation of crossing faces did.
+    pub untangle: UntangleStats,
     /// How each face of `mesh` came in.
     pub face_sources: Vec<crate::triangulate::FaceSource>,
     /// Samples that ended in no triangle and were dropped.
     pub dropped_samples: usize,
+    /// Candidates left out as buried inside the input's own solid (a self-intersecting input;
+    /// [`BuriedTest`]).
+    pub buried_candidates: usize,
+    /// Samples the gradient ascent moved onto the buried part of a face, put back where the
+    /// scan put them.
+    pub buried_samples: usize,
     /// Timed stages in order.
     pub stages: Vec<Stage>,
 }
@@ -220,10 +233,38 @@ pub fn remesh(
     let pool_size = (params.candidates_per_sample * expected)
         .ceil()
         .clamp(16.0, 2e8) as usize;
-    let pool = surface_candidates(&normalized, pool_size, params.seed);
+    let mut pool = surface_candidates(&normalized, pool_size, params.seed);
+    // Where the input passes through itself, the candidates inside its own solid are left out
+    // (and samples the gradient ascent moves there are put back): the output follows the outer
+    // surface and does not cross itself there.
+    let buried_test = BuriedTest::new(&normalized, 2 * pool_size + normalized.positions.len());
+    let mut buried_candidates = 0;
+    let mut input_points: Vec<DVec3> = normalized.positions.clone();
+    if let Some(test) = &buried_test {
+        // Candidates on faces that are buried in part.
+        let buried = test.buried(
+            &pool
+                .iter()
+                .map(|c| (c.position, c.normal))
+                .collect::<Vec<_>>(),
+        );
+        buried_candidates = buried.iter().filter(|&&b| b).count();
+        let mut keep = buried.iter().map(|b| !b);
+        pool.retain(|_| keep.next().unwrap_or(true));
+        let vertex_normals = normalized.vertex_normals();
+        let buried = test.buried(
+            &normalized
+                .positions
+                .iter()
+                .copied()
+                .zip(vertex_normals.iter().copied())
+                .collect::<Vec<_>>(),
+        );
+        let mut keep = buried.iter().map(|b| !b);
+        input_points.retain(|_| keep.next().unwrap_or(true));
+    }
     // Input-surface points the optimization keeps within its cover distance of the output.
-    let cover_points: Vec<DVec3> = normalized
-        .positions
+    let cover_points: Vec<DVec3> = input_points
         .iter()
         .copied()
         .chain(pool.iter().map(|c| c.position))
@@ -298,6 +339,7 @@ pub fn remesh(
             rejected_by_nearest,
             measured,
         } = scan_result;
+        let before_ascent = buried_test.as_ref().map(|_| samples.clone());
         let ga = gradient_ascent(
             &kernel,
             &surface,
@@ -305,6 +347,23 @@ pub fn remesh(
             boundary_count,
             &params.gradient_ascent,
         );
+        // A face buried only in part can still take a sample onto its buried part (the closest
+        // point of the input can lie there): such a sample goes back to where the scan put it.
+        let mut buried_samples = 0;
+        if let (Some(test), Some(before)) = (&buried_test, &before_ascent) {
+            let buried = test.buried(
+                &samples
+                    .iter()
+                    .map(|s| (s.position, s.normal))
+                    .collect::<Vec<_>>(),
+            );
+            for (i, b) in buried.iter().enumerate() {
+                if *b && i >= boundary_count {
+                    samples[i] = before[i];
+                    buried_samples += 1;
+                }
+            }
+        }
         timer.lap("gradient ascent");
 
         on_stage("triangulate");
@@ -349,6 +408,13 @@ pub fn remesh(
         };
         let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
         timer.lap("optimize");
+        // Faces that still cross (where the input's sheets lie closer than the output's chords
+        // bend away from them) are moved apart.
+        let fixed: Vec<bool> = (0..mesh_normalized.positions.len())
+            .map(|i| i < boundary_count)
+            .collect();
+        let untangle_stats = untangle(&mut mesh_normalized, &fixed, sigma_p, &params.untangle);
+        timer.lap("untangle");
         attempt += 1;
         let v = mesh_normalized.vertex_count() as f64;
         let (done, reached, miss) = match params.density {
@@ -383,8 +449,11 @@ pub fn remesh(
                 gradient_ascent: ga,
                 assembly,
                 optimize: optimize_stats,
+                untangle: untangle_stats,
                 face_sources,
                 dropped_samples,
+                buried_candidates,
+                buried_samples,
                 stages: std::mem::take(&mut timer.stages),
             };
         }

@@ -51,6 +51,7 @@ use serde::Serialize;
 
 use crate::error::Result;
 use crate::mesh::TriMesh;
+use crate::self_intersection::{self_intersections, SelfIntersections};
 use crate::surface::MeshSurface;
 
 // ---------------------------------------------------------------------------------------------
@@ -641,13 +642,18 @@ fn analyze(mesh: &TriMesh) -> Analysis {
 /// The invariants: every index in range; every coordinate finite; no degenerate face
 /// ([`is_degenerate_face`]); no duplicate face; every edge in at most 2 faces; every vertex a
 /// single fan (see [`Topology::non_manifold_vertices`](Topology)); every interior edge traversed
-/// once each way (consistent orientation); no unreferenced vertex. Boundaries are allowed (an
+/// once each way (consistent orientation); no unreferenced vertex; no two non-adjacent faces
+/// sharing a point ([`self_intersections`]: exact, through a BVH). Boundaries are allowed (an
 /// open mesh passes), and so is an empty mesh.
 ///
 /// Source: this project's invariant checker (STYLE.md, practice 7), in the spirit of spade's
 /// `sanity_check`; the definitions are those of [`Topology`].
 pub fn check_invariants(mesh: &TriMesh) -> Vec<String> {
-    let a = analyze(mesh);
+    invariant_messages(mesh, &analyze(mesh), &self_intersections(mesh))
+}
+
+/// The messages of [`check_invariants`] from the analysis and the self-intersections of `mesh`.
+fn invariant_messages(mesh: &TriMesh, a: &Analysis, crossings: &SelfIntersections) -> Vec<String> {
     let t = &a.topology;
     let mut out = Vec::new();
     let plural =
@@ -710,6 +716,16 @@ pub fn check_invariants(mesh: &TriMesh) -> Vec<String> {
         out.push(format!(
             "{} used by no face (first: vertex {v})",
             plural(t.unreferenced_vertices, "vertex", "vertices")
+        ));
+    }
+    if let Some([f, g]) = crossings.first {
+        out.push(format!(
+            "{} (first: faces {f} and {g})",
+            plural(
+                crossings.pairs,
+                "pair of non-adjacent faces intersects",
+                "pairs of non-adjacent faces intersect"
+            )
         ));
     }
     out
@@ -1025,6 +1041,11 @@ pub struct QualityReport {
     pub triangles: TriangleQuality,
     /// Topology of the output ([`topology`]).
     pub topology: Topology,
+    /// Pairs of non-adjacent output faces that intersect ([`self_intersections`]).
+    pub self_intersections: SelfIntersections,
+    /// The output's violated invariants ([`check_invariants`]), one line per kind; empty when
+    /// all hold.
+    pub invariant_violations: Vec<String>,
     /// Distance between output (side A, "forward") and input (side B), in bbox-100 units
     /// ([`surface_distance`]); `None` when not measured.
     pub distance: Option<SurfaceDistance>,
@@ -1043,9 +1064,13 @@ impl QualityReport {
     /// The report of `mesh` with its triangle measures and topology; no distance, input
     /// topology, stages, notes or extras yet.
     pub fn new(mesh: &TriMesh) -> Self {
+        let analysis = analyze(mesh);
+        let crossings = self_intersections(mesh);
         QualityReport {
             triangles: triangle_quality(mesh),
-            topology: topology(mesh),
+            invariant_violations: invariant_messages(mesh, &analysis, &crossings),
+            self_intersections: crossings,
+            topology: analysis.topology,
             distance: None,
             input_topology: None,
             stages: Vec::new(),
@@ -1163,6 +1188,24 @@ impl fmt::Display for QualityReport {
                     get(inp)
                 )?,
                 None => row(f, label, get(&self.topology))?,
+            }
+        }
+
+        writeln!(f)?;
+        writeln!(f, "Invariants")?;
+        row(
+            f,
+            "self-intersecting face pairs",
+            self.self_intersections.pairs.to_string(),
+        )?;
+        if self.invariant_violations.is_empty() {
+            writeln!(
+                f,
+                "  all hold (manifold, consistently oriented, no degenerate, duplicate or intersecting faces)"
+            )?;
+        } else {
+            for v in &self.invariant_violations {
+                writeln!(f, "  VIOLATED: {v}")?;
             }
         }
 

@@ -254,7 +254,7 @@ fn horse_at_8600_out_of_core_matches_in_memory() {
         .unwrap();
     let runs = 3;
     let (mut ooc_stats, mut mem_stats) = ([0.0; 4], [0.0; 4]);
-    let mut add = |acc: &mut [f64; 4], samples: &[glam::DVec3]| {
+    let add = |acc: &mut [f64; 4], samples: &[glam::DVec3]| {
         let (mean, min, cv) = nearest_neighbour_stats(samples);
         for (a, v) in acc.iter_mut().zip([samples.len() as f64, mean, min, cv]) {
             *a += v / runs as f64;

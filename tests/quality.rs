@@ -915,7 +915,15 @@ fn shared_models_match_the_data_readme() {
     assert_eq!((t.vertices, t.faces), (48_485, 96_966));
     assert!(t.is_closed_manifold());
     assert_eq!((t.components, t.genus), (1, Some(0)));
-    assert!(check_invariants(&horse).is_empty());
+    // Every invariant holds but one: a small fin on the tail passes through two faces of the
+    // tail (faces 70686 with 71145 and 71399, at about (9.3, -37.0, 15.9) in bbox-100 units).
+    let problems = check_invariants(&horse);
+    assert_eq!(problems.len(), 1, "{problems:?}");
+    assert!(
+        problems[0]
+            .starts_with("2 pairs of non-adjacent faces intersect (first: faces 70686 and 71145)"),
+        "{problems:?}"
+    );
 
     // "open scan: 5 holes (223 boundary edges), 1,113 unreferenced vertices".
     let bunny = read_obj_for_test("stanford-bunny.obj").unwrap();

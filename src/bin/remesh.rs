@@ -75,6 +75,11 @@ struct Cli {
     #[arg(long)]
     no_distance: bool,
 
+    /// Fail (exit 1, nothing written) when the output breaks an invariant (manifold, oriented,
+    /// no degenerate, duplicate or self-intersecting faces) instead of reporting it.
+    #[arg(long)]
+    strict: bool,
+
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
@@ -507,6 +512,7 @@ fn run(cli: Cli) -> Result<(), Error> {
         output,
         params,
         measure_distance: !cli.no_distance,
+        strict: cli.strict,
     };
     let bar = if cli.quiet {
         ProgressBar::hidden()

@@ -2,6 +2,7 @@
 
 pub mod marching_cubes;
 pub mod mesh_projection;
+pub mod winding;
 
 pub use marching_cubes::{
     marching_cubes, ImplicitFunction, MarchingCubesParams, MarchingCubesResult,

@@ -5,6 +5,7 @@ pub mod cleanup;
 pub mod optimize;
 pub mod refine;
 pub mod tangent_delaunay;
+pub mod untangle;
 
 pub use cleanup::{assemble, AssemblyParams, AssemblyStats, FaceSource};
 pub use refine::RefineParams;

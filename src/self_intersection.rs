@@ -1,0 +1,418 @@
+//! Self-intersections of a triangle mesh: pairs of non-adjacent triangles that share a point,
+//! found through a bounding-volume hierarchy and decided by exact predicates.
+
+use glam::DVec3;
+use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use rayon::prelude::*;
+use robust::{orient2d, orient3d, Coord, Coord3D};
+use serde::Serialize;
+
+use crate::mesh::TriMesh;
+use crate::quality::is_degenerate_face;
+
+/// The outcome of [`self_intersections`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct SelfIntersections {
+    /// Pairs of non-adjacent faces (no vertex index in common) whose closed triangles share at
+    /// least one point: they cross, or touch at a point, along an edge or in a common area.
+    pub pairs: usize,
+    /// The first such pair `[f, g]`, f < g, in lexicographic order.
+    pub first: Option<[u32; 2]>,
+    /// Pairs of non-adjacent faces whose bounding boxes overlap: the exact tests made.
+    pub candidates: usize,
+}
+
+/// Faces per sequential run of the search (fixed, so the result does not depend on the number
+/// of threads).
+const CHUNK: usize = 1024;
+
+/// Finds the pairs of non-adjacent faces of `mesh` that intersect (see [`SelfIntersections`]).
+/// Faces with an index out of range, a non-finite corner or zero area are left out (the
+/// invariant check reports them on their own), and so are pairs that share a vertex index, since
+/// adjacent triangles meet by construction.
+///
+/// The bounding boxes of the faces go into a BVH (parry's); each face queries it with its own
+/// box, and every overlapping pair is decided by [`triangles_intersect`], which is exact. O(F log
+/// F) for a mesh whose triangles are small against the model; parallel (rayon) and
+/// deterministic.
+pub fn self_intersections(mesh: &TriMesh) -> SelfIntersections {
+    let (pairs, candidates) = search(mesh);
+    SelfIntersections {
+        pairs: pairs.len(),
+        first: pairs.first().copied(),
+        candidates,
+    }
+}
+
+/// Every pair `[f, g]` (f < g) of [`self_intersections`], in lexicographic order.
+pub fn intersecting_pairs(mesh: &TriMesh) -> Vec<[u32; 2]> {
+    search(mesh).0
+}
+
+/// The intersecting pairs, sorted, and the number of exact tests made.
+fn search(mesh: &TriMesh) -> (Vec<[u32; 2]>, usize) {
+    let n = mesh.positions.len();
+    let valid = |f: usize| {
+        let t = mesh.triangles[f];
+        t.iter().all(|&i| (i as usize) < n)
+            && t.iter().all(|&i| mesh.positions[i as usize].is_finite())
+            && !is_degenerate_face(mesh, f)
+    };
+    let boxes: Vec<(usize, Aabb)> = (0..mesh.triangles.len())
+        .filter(|&f| valid(f))
+        .map(|f| {
+            let [a, b, c] = mesh.corners(f);
+            (f, Aabb::new(a.min(b).min(c), a.max(b).max(c)))
+        })
+        .collect();
+    if boxes.len() < 2 {
+        return (Vec::new(), 0);
+    }
+    let bvh = Bvh::from_iter(BvhBuildStrategy::Binned, boxes.iter().copied());
+    let per_chunk: Vec<(Vec<[u32; 2]>, usize)> = boxes
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let (mut pairs, mut candidates) = (Vec::new(), 0);
+            let mut found = Vec::new();
+            for &(f, aabb) in chunk {
+                let tf = mesh.triangles[f];
+                found.clear();
+                found.extend(
+                    bvh.intersect_aabb(&aabb)
+                        .map(|g| g as usize)
+                        .filter(|&g| g > f && !tf.iter().any(|i| mesh.triangles[g].contains(i))),
+                );
+                found.sort_unstable();
+                for &g in &found {
+                    candidates += 1;
+                    if triangles_intersect(mesh.corners(f), mesh.corners(g)) {
+                        pairs.push([f as u32, g as u32]);
+                    }
+                }
+            }
+            (pairs, candidates)
+        })
+        .collect();
+    let mut pairs = Vec::new();
+    let mut candidates = 0;
+    for (p, c) in per_chunk {
+        pairs.extend(p);
+        candidates += c;
+    }
+    pairs.sort_unstable();
+    (pairs, candidates)
+}
+
+fn c3(p: DVec3) -> Coord3D<f64> {
+    Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
+}
+
+/// The sign of orient3d(a, b, c, d): exact (Shewchuk's adaptive predicate, the `robust` crate).
+fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
+    let v = orient3d(c3(a), c3(b), c3(c), c3(d));
+    if v > 0.0 {
+        1
+    } else if v < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Whether the closed triangles `a` and `b` (non-degenerate) share at least one point, decided
+/// exactly for the given coordinates (no tolerance: touching counts).
+///
+/// Two triangles that are not coplanar meet in a segment whose ends lie on the edges of one or
+/// the other, so they intersect exactly when an edge of one meets the other triangle
+/// ([`segment_meets_triangle`], 6 tests); coplanar triangles are compared in 2D, projected along
+/// their normal's largest component (a projection that keeps incidence for points of one
+/// plane).
+///
+/// Source: the orientation-predicate formulation of triangle–triangle tests (P. Guigue,
+/// O. Devillers, *Fast and Robust Triangle-Triangle Overlap Test Using Orientation Predicates*,
+/// Journal of Graphics Tools 8(1), 2003), with J. R. Shewchuk's exact predicates (*Adaptive
+/// Precision Floating-Point Arithmetic and Fast Robust Geometric Predicates*, Discrete Comput.
+/// Geom. 18, 1997).
+pub fn triangles_intersect(a: [DVec3; 3], b: [DVec3; 3]) -> bool {
+    // Both of b's corners strictly on one side of a's plane (or the reverse): apart.
+    let sb = b.map(|p| orient(a[0], a[1], a[2], p));
+    if sb.iter().all(|&s| s > 0) || sb.iter().all(|&s| s < 0) {
+        return false;
+    }
+    let sa = a.map(|p| orient(b[0], b[1], b[2], p));
+    if sa.iter().all(|&s| s > 0) || sa.iter().all(|&s| s < 0) {
+        return false;
+    }
+    if sb.iter().all(|&s| s == 0) {
+        return coplanar_triangles_intersect(a, b);
+    }
+    (0..3).any(|k| segment_meets_triangle(a[k], a[(k + 1) % 3], b))
+        || (0..3).any(|k| segment_meets_triangle(b[k], b[(k + 1) % 3], a))
+}
+
+/// Whether the closed segment `p q` meets the closed triangle `t` (non-degenerate), exactly.
+pub fn segment_meets_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
+    let sp = orient(t[0], t[1], t[2], p);
+    let sq = orient(t[0], t[1], t[2], q);
+    if sp != 0 && sp == sq {
+        return false;
+    }
+    if sp == 0 && sq == 0 {
+        // The segment lies in the triangle's plane.
+        let axis = drop_axis(t);
+        let (p2, q2, t2) = (
+            project(p, axis),
+            project(q, axis),
+            t.map(|v| project(v, axis)),
+        );
+        return segment_meets_triangle_2d(p2, q2, t2);
+    }
+    // The segment crosses (or touches) the plane once: the line p q passes through the closed
+    // triangle when it sees the three edges turning the same way (or along one of them).
+    let s = [
+        orient(p, q, t[0], t[1]),
+        orient(p, q, t[1], t[2]),
+        orient(p, q, t[2], t[0]),
+    ];
+    !(s.iter().any(|&x| x > 0) && s.iter().any(|&x| x < 0))
+}
+
+/// The coordinate to drop when projecting points of the plane of `t` to 2D: the largest
+/// component of its normal (any nonzero one keeps incidence and orientation up to sign).
+fn drop_axis(t: [DVec3; 3]) -> usize {
+    let n = (t[1] - t[0]).cross(t[2] - t[0]).abs();
+    if n.x >= n.y && n.x >= n.z {
+        0
+    } else if n.y >= n.z {
+        1
+    } else {
+        2
+    }
+}
+
+fn project(p: DVec3, axis: usize) -> [f64; 2] {
+    match axis {
+        0 => [p.y, p.z],
+        1 => [p.z, p.x],
+        _ => [p.x, p.y],
+    }
+}
+
+fn orient_2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
+    let v = orient2d(
+        Coord { x: a[0], y: a[1] },
+        Coord { x: b[0], y: b[1] },
+        Coord { x: c[0], y: c[1] },
+    );
+    if v > 0.0 {
+        1
+    } else if v < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Whether point `p` lies in the closed 2D triangle `t` (non-degenerate).
+fn point_in_triangle_2d(p: [f64; 2], t: [[f64; 2]; 3]) -> bool {
+    let s = [
+        orient_2d(t[0], t[1], p),
+        orient_2d(t[1], t[2], p),
+        orient_2d(t[2], t[0], p),
+    ];
+    !(s.iter().any(|&x| x > 0) && s.iter().any(|&x| x < 0))
+}
+
+/// Whether the closed 2D segments `a b` and `c d` share a point.
+fn segments_meet_2d(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    let (o1, o2) = (orient_2d(a, b, c), orient_2d(a, b, d));
+    let (o3, o4) = (orient_2d(c, d, a), orient_2d(c, d, b));
+    if o1 != o2 && o3 != o4 && o1 * o2 <= 0 && o3 * o4 <= 0 {
+        return true;
+    }
+    // Collinear cases: an end of one on the other.
+    let on = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        orient_2d(p, q, r) == 0
+            && r[0] >= p[0].min(q[0])
+            && r[0] <= p[0].max(q[0])
+            && r[1] >= p[1].min(q[1])
+            && r[1] <= p[1].max(q[1])
+    };
+    on(a, b, c) || on(a, b, d) || on(c, d, a) || on(c, d, b)
+}
+
+fn segment_meets_triangle_2d(p: [f64; 2], q: [f64; 2], t: [[f64; 2]; 3]) -> bool {
+    point_in_triangle_2d(p, t)
+        || point_in_triangle_2d(q, t)
+        || (0..3).any(|k| segments_meet_2d(p, q, t[k], t[(k + 1) % 3]))
+}
+
+fn coplanar_triangles_intersect(a: [DVec3; 3], b: [DVec3; 3]) -> bool {
+    let axis = drop_axis(a);
+    let (a2, b2) = (a.map(|v| project(v, axis)), b.map(|v| project(v, axis)));
+    (0..3).any(|k| segment_meets_triangle_2d(a2[k], a2[(k + 1) % 3], b2))
+        || point_in_triangle_2d(b2[0], a2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn v(x: f64, y: f64, z: f64) -> DVec3 {
+        DVec3::new(x, y, z)
+    }
+
+    #[test]
+    fn crossing_touching_and_apart_triangles() {
+        let a = [v(0., 0., 0.), v(4., 0., 0.), v(0., 4., 0.)];
+        // Pierces a's interior.
+        assert!(triangles_intersect(
+            a,
+            [v(1., 1., -1.), v(1., 1., 1.), v(2., 1., 1.)]
+        ));
+        // Above it.
+        assert!(!triangles_intersect(
+            a,
+            [v(1., 1., 0.5), v(1., 2., 1.), v(2., 1., 1.)]
+        ));
+        // A corner touching a's interior from above.
+        assert!(triangles_intersect(
+            a,
+            [v(1., 1., 0.), v(1., 2., 1.), v(2., 1., 1.)]
+        ));
+        // A corner touching a's edge.
+        assert!(triangles_intersect(
+            a,
+            [v(2., 0., 0.), v(2., -1., 1.), v(3., -1., 1.)]
+        ));
+        // Crosses a's plane outside a.
+        assert!(!triangles_intersect(
+            a,
+            [v(3., 3., -1.), v(3., 3., 1.), v(4., 3., 1.)]
+        ));
+        // Coplanar: overlapping, one inside the other, touching at a corner, apart.
+        assert!(triangles_intersect(
+            a,
+            [v(1., 1., 0.), v(5., 1., 0.), v(1., 5., 0.)]
+        ));
+        assert!(triangles_intersect(
+            a,
+            [v(0.5, 0.5, 0.), v(1., 0.5, 0.), v(0.5, 1., 0.)]
+        ));
+        assert!(triangles_intersect(
+            a,
+            [v(4., 0., 0.), v(5., 0., 0.), v(5., 1., 0.)]
+        ));
+        assert!(!triangles_intersect(
+            a,
+            [v(3., 3., 0.), v(5., 3., 0.), v(3., 5., 0.)]
+        ));
+        // An edge lying in a's plane across it, the third corner above.
+        assert!(triangles_intersect(
+            a,
+            [v(-1., 1., 0.), v(5., 1., 0.), v(2., 2., 3.)]
+        ));
+        // Symmetric.
+        let b = [v(1., 1., -1.), v(1., 1., 1.), v(2., 1., 1.)];
+        assert_eq!(triangles_intersect(a, b), triangles_intersect(b, a));
+    }
+
+    #[test]
+    fn exact_at_a_grazing_contact() {
+        // b's edge passes through a's edge at a point, at 1e-17-scale offsets that a
+        // floating-point plane test would get wrong.
+        let a = [v(0., 0., 0.), v(1., 0., 0.), v(0., 1., 0.)];
+        let t = 0.1 + 0.2; // 0.30000000000000004
+        let b = [v(t, 0., -1.), v(t, 0., 1.), v(t, -1., 0.)];
+        assert!(triangles_intersect(a, b));
+        let b2 = [v(t, -1e-300, -1.), v(t, -1e-300, 1.), v(t, -1., 0.)];
+        assert!(!triangles_intersect(a, b2));
+    }
+
+    #[test]
+    fn random_pairs_agree_with_parrys_distance() {
+        // Oracle: parry's triangle–triangle distance (GJK, floating point), trusted where it is
+        // clearly positive or where the pair clearly crosses.
+        use parry3d_f64::math::Pose;
+        use parry3d_f64::query::distance;
+        use parry3d_f64::shape::Triangle;
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut r = || {
+            v(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+        };
+        let id = Pose::IDENTITY;
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..2000 {
+            let a = [r(), r(), r()];
+            let b = [r(), r(), r()];
+            let d = distance(
+                &id,
+                &Triangle::new(a[0], a[1], a[2]),
+                &id,
+                &Triangle::new(b[0], b[1], b[2]),
+            )
+            .unwrap()
+            .distance;
+            if d > 1e-9 {
+                assert!(!triangles_intersect(a, b), "{a:?} {b:?} apart by {d}");
+                misses += 1;
+            } else {
+                assert!(triangles_intersect(a, b), "{a:?} {b:?} at distance {d}");
+                hits += 1;
+            }
+        }
+        assert!(hits > 100 && misses > 100, "{hits} {misses}");
+    }
+
+    #[test]
+    fn a_sphere_has_none_and_a_pushed_vertex_makes_some() {
+        // A closed UV sphere: no self-intersection.
+        let (nu, nv) = (24, 12);
+        let mut positions = vec![v(0., 0., 1.), v(0., 0., -1.)];
+        for j in 1..nv {
+            let th = std::f64::consts::PI * j as f64 / nv as f64;
+            for i in 0..nu {
+                let ph = std::f64::consts::TAU * i as f64 / nu as f64;
+                positions.push(v(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()));
+            }
+        }
+        let idx = |j: usize, i: usize| (2 + (j - 1) * nu + i % nu) as u32;
+        let mut triangles = Vec::new();
+        for i in 0..nu {
+            triangles.push([0, idx(1, i), idx(1, i + 1)]);
+            triangles.push([1, idx(nv - 1, i + 1), idx(nv - 1, i)]);
+        }
+        for j in 1..nv - 1 {
+            for i in 0..nu {
+                triangles.push([idx(j, i), idx(j + 1, i), idx(j + 1, i + 1)]);
+                triangles.push([idx(j, i), idx(j + 1, i + 1), idx(j, i + 1)]);
+            }
+        }
+        let mut m = TriMesh::new(positions, triangles);
+        let r = self_intersections(&m);
+        assert_eq!((r.pairs, r.first), (0, None), "{r:?}");
+        assert!(r.candidates > 0);
+        // Push one vertex through the opposite side: its fan crosses faces there.
+        let k = idx(6, 0) as usize;
+        m.positions[k] = -1.5 * m.positions[k];
+        let r = self_intersections(&m);
+        assert!(r.pairs > 0, "{r:?}");
+        let [f, g] = r.first.unwrap();
+        assert!(triangles_intersect(
+            m.corners(f as usize),
+            m.corners(g as usize)
+        ));
+        assert_eq!(r, self_intersections(&m));
+    }
+}

@@ -1,0 +1,265 @@
+//! Separating the faces of a triangulation that cross each other.
+//!
+//! The triangulation follows the input surface. Where that surface passes through itself (cow:
+//! the tail's root inside the rump; horse: a fin on the tail; beetle: its legs), or where two of
+//! its sheets lie closer than the chords of the output bend away from them, faces of the output
+//! cross. This stage moves the vertices of each crossing pair just out of the other face's plane
+//! until no pair is left.
+
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::mesh::TriMesh;
+use crate::self_intersection::{intersecting_pairs, triangles_intersect};
+
+/// Parameters of [`untangle`]. Lengths are in units of σ_p.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct UntangleParams {
+    /// Rounds at most (each: find every crossing pair, then move). Default 30.
+    pub max_rounds: usize,
+    /// How far past the other face's plane a moved vertex goes (> 0; σ_p units). Default 0.01.
+    pub margin: f64,
+    /// The longest move of a vertex in one round (σ_p units). Default 0.25.
+    pub max_step: f64,
+}
+
+impl Default for UntangleParams {
+    fn default() -> Self {
+        UntangleParams {
+            max_rounds: 30,
+            margin: 0.01,
+            max_step: 0.25,
+        }
+    }
+}
+
+/// What [`untangle`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct UntangleStats {
+    /// Crossing pairs of non-adjacent faces before.
+    pub pairs_before: usize,
+    /// Crossing pairs left after (0 unless the rounds ran out).
+    pub pairs_after: usize,
+    /// Rounds run.
+    pub rounds: usize,
+    /// Distinct vertices moved.
+    pub vertices_moved: usize,
+    /// The largest total displacement of a vertex (σ_p units).
+    pub max_displacement: f64,
+}
+
+/// Moves vertices of `mesh` (bbox-100 units) until no two non-adjacent faces intersect
+/// ([`intersecting_pairs`]) or `params.max_rounds` rounds have run. In a round the crossing pairs
+/// are taken in order; for a pair that still crosses, the shortest of four moves separates it
+/// (for either face: its corners behind the other's plane move along that plane's normal to
+/// `margin · σ_p` in front of it, or the other face moves back along its normal until they
+/// are; at most `max_step · σ_p` per round). A move of a vertex marked in `fixed` (a boundary
+/// sample) counts as four times as long, so those move only when nothing else separates the
+/// pair. A round that does not
+/// lower the number of crossing pairs is undone and tried again with moves half as long (never
+/// worse than before). Connectivity is unchanged; faces that cross nothing do not move.
+///
+/// The moves are local and small where the output merely grazes itself, and they press the
+/// crossing sheet onto the other where the input itself passes through itself (the output then
+/// lies against itself there instead of through it).
+pub fn untangle(
+    mesh: &mut TriMesh,
+    fixed: &[bool],
+    sigma_p: f64,
+    params: &UntangleParams,
+) -> UntangleStats {
+    let start = mesh.positions.clone();
+    let mut stats = UntangleStats::default();
+    let mut moved = vec![false; mesh.positions.len()];
+    let margin = params.margin * sigma_p;
+    let mut pairs = intersecting_pairs(mesh);
+    stats.pairs_before = pairs.len();
+    let mut scale = 1.0;
+    while !pairs.is_empty() && stats.rounds < params.max_rounds {
+        stats.rounds += 1;
+        let moves = round_moves(
+            mesh,
+            &pairs,
+            fixed,
+            margin,
+            scale * params.max_step * sigma_p,
+        );
+        if moves.is_empty() {
+            break;
+        }
+        let saved: Vec<(usize, DVec3)> =
+            moves.iter().map(|&(v, _)| (v, mesh.positions[v])).collect();
+        for &(v, d) in &moves {
+            mesh.positions[v] += d;
+        }
+        let after = intersecting_pairs(mesh);
+        if after.len() < pairs.len() {
+            for &(v, _) in &moves {
+                moved[v] = true;
+            }
+            pairs = after;
+            scale = 1.0;
+        } else {
+            // Never worse: undo, and try shorter moves next round (three halvings at most).
+            for (v, p) in saved {
+                mesh.positions[v] = p;
+            }
+            scale *= 0.5;
+            if scale < 0.1 {
+                break;
+            }
+        }
+    }
+    stats.pairs_after = pairs.len();
+    stats.vertices_moved = moved.iter().filter(|&&m| m).count();
+    stats.max_displacement = mesh
+        .positions
+        .iter()
+        .zip(&start)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max)
+        / sigma_p;
+    stats
+}
+
+/// One round's moves for the crossing `pairs`: `(vertex, displacement)`. The pairs are taken in
+/// order against the positions as moved so far (a pair an earlier move already separated is
+/// skipped), so one move of a vertex poking through a sheet resolves all its pairs.
+fn round_moves(
+    mesh: &TriMesh,
+    pairs: &[[u32; 2]],
+    fixed: &[bool],
+    margin: f64,
+    max_step: f64,
+) -> Vec<(usize, DVec3)> {
+    let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
+    let mut positions = mesh.positions.clone();
+    let mut total = vec![DVec3::ZERO; mesh.positions.len()];
+    let corners = |p: &[DVec3], f: u32| mesh.triangles[f as usize].map(|v| p[v as usize]);
+    for &[f, g] in pairs {
+        if !triangles_intersect(corners(&positions, f), corners(&positions, g)) {
+            continue;
+        }
+        // Two ways to separate face a from face b: a's corners behind b's plane move forward
+        // along b's normal to `margin` in front of it, or (`back`) b's corners move back along
+        // its normal until a's deepest corner is `margin` in front of it. Each with the length
+        // of its longest move as its cost.
+        let option = |a: u32, b: u32, back: bool| -> Option<(f64, Vec<(u32, DVec3)>)> {
+            let [p, q, r] = corners(&positions, b);
+            let n = (q - p).cross(r - p).try_normalize()?;
+            let needs: Vec<(u32, f64)> = mesh.triangles[a as usize]
+                .iter()
+                .map(|&v| (v, margin - n.dot(positions[v as usize] - p)))
+                .filter(|&(_, need)| need > 0.0)
+                .collect();
+            let deepest = needs.iter().map(|x| x.1).fold(0.0f64, f64::max);
+            if deepest <= 0.0 {
+                return None;
+            }
+            let moves: Vec<(u32, DVec3)> = if back {
+                mesh.triangles[b as usize]
+                    .iter()
+                    .map(|&v| (v, -n * deepest.min(max_step)))
+                    .collect()
+            } else {
+                needs
+                    .iter()
+                    .map(|&(v, need)| (v, n * need.min(max_step)))
+                    .collect()
+            };
+            // A move of a fixed vertex (a boundary sample, on the input's boundary curve) is
+            // the last resort: it counts as four times as long.
+            let cost = if moves.iter().any(|&(v, _)| is_fixed(v)) {
+                4.0 * deepest
+            } else {
+                deepest
+            };
+            Some((cost, moves))
+        };
+        let best = [
+            option(f, g, false),
+            option(g, f, false),
+            option(f, g, true),
+            option(g, f, true),
+        ]
+        .into_iter()
+        .flatten()
+        .min_by(|x, y| x.0.total_cmp(&y.0));
+        if let Some((_, moves)) = best {
+            for (v, d) in moves {
+                positions[v as usize] += d;
+                total[v as usize] += d;
+            }
+        }
+    }
+    total
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| **d != DVec3::ZERO)
+        .map(|(v, &d)| (v, d))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes::grid;
+    use crate::quality::check_invariants;
+
+    #[test]
+    fn a_dent_through_a_nearby_sheet_is_pulled_back_and_a_clean_mesh_is_left_alone() {
+        // Two parallel 6 x 6 grids 0.2 apart; one vertex of the upper one pokes through the
+        // lower one.
+        let a = grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let b = grid(6, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
+        let mut m = a.clone();
+        let off = m.positions.len() as u32;
+        m.positions.extend(b.positions.iter().copied());
+        m.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        let poke = off as usize + 3 * 7 + 3;
+        m.positions[poke].z = -0.3;
+        assert!(!intersecting_pairs(&m).is_empty());
+        let fixed = vec![false; m.positions.len()];
+        let s = untangle(&mut m, &fixed, 1.0, &UntangleParams::default());
+        assert!(s.pairs_before > 0 && s.pairs_after == 0, "{s:?}");
+        assert!(
+            check_invariants(&m).is_empty(),
+            "{:?}",
+            check_invariants(&m)
+        );
+        assert!(s.max_displacement < 0.6, "{s:?}");
+        // A fixed vertex stays when its partner can give way.
+        let mut m2 = m.clone();
+        m2.positions[poke].z = -0.3;
+        let mut fixed = vec![false; m2.positions.len()];
+        fixed[poke] = true;
+        let s = untangle(&mut m2, &fixed, 1.0, &UntangleParams::default());
+        assert_eq!(s.pairs_after, 0, "{s:?}");
+        assert_eq!(m2.positions[poke].z, -0.3);
+        // A mesh without crossings is unchanged.
+        let mut clean = a.clone();
+        let none = vec![false; clean.positions.len()];
+        let s = untangle(&mut clean, &none, 1.0, &UntangleParams::default());
+        assert_eq!((s.pairs_before, s.rounds, s.vertices_moved), (0, 0, 0));
+        assert_eq!(clean.positions, a.positions);
+    }
+
+    #[test]
+    fn crossing_sheets_that_cannot_be_separated_are_not_made_worse() {
+        // A flat grid and a tilted one through it: no small move separates them.
+        let a = grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let b = grid(6, |i, j| {
+            DVec3::new(i as f64 + 0.25, j as f64 + 0.3, 0.1 * i as f64 - 0.26)
+        });
+        let mut m = a.clone();
+        let off = m.positions.len() as u32;
+        m.positions.extend(b.positions.iter().copied());
+        m.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        let fixed = vec![false; m.positions.len()];
+        let s = untangle(&mut m, &fixed, 1.0, &UntangleParams::default());
+        assert!(s.pairs_after <= s.pairs_before, "{s:?}");
+        assert_eq!(s.pairs_after, intersecting_pairs(&m).len());
+    }
+}
