@@ -44,6 +44,10 @@ pub const SAMPLES_PER_SIGMA2: f64 = 1.0;
 /// sampling reaches (measured), so boundary triangles match interior ones.
 pub const BOUNDARY_SPACING_PER_SIGMA: f64 = 1.0;
 
+/// The most output points [`remesh`] takes: 20 million (with 10 candidates per sample the
+/// pool holds 2e8 points, about 11 GB).
+pub const MAX_POINTS: usize = 20_000_000;
+
 /// Parameters of [`remesh`]. `Default` is the command line's default.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RemeshParams {
@@ -206,6 +210,12 @@ pub fn remesh(
             return Err(Error::InvalidParameter {
                 name: "--points",
                 message: format!("at least 4 points are needed for a closed surface, got {n}"),
+            })
+        }
+        Density::Points(n) if n > MAX_POINTS => {
+            return Err(Error::InvalidParameter {
+                name: "--points",
+                message: format!("{n} is more than the {MAX_POINTS} points this remesher holds in memory; for larger point sets use `remesh simplify`"),
             })
         }
         Density::SigmaP(s) if !(s.is_finite() && s > 0.0) => {

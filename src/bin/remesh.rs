@@ -265,11 +265,9 @@ enum Command {
     },
 }
 
+/// Writes a JSON report atomically (a temporary file beside it, then a rename).
 fn write_report(path: &PathBuf, json: &str) -> Result<(), Error> {
-    std::fs::write(path, json).map_err(|e| Error::Write {
-        path: path.clone(),
-        message: e.to_string(),
-    })
+    spectral_remesh::io::write_atomically(path, json.as_bytes())
 }
 
 /// Writes to standard output. A reader that went away (`remesh ... | head`) is not an error:
@@ -497,6 +495,10 @@ fn run(cli: Cli) -> Result<(), Error> {
             message: "must be at least 4".into(),
         });
     }
+    if std::env::var_os("REMESH_INJECT_PANIC").is_some() {
+        // For the test of the panic path (tests/bad_input.rs): a bug's way out, on demand.
+        panic!("injected by REMESH_INJECT_PANIC");
+    }
     let mut params = RemeshParams {
         density,
         seed: cli.seed,
@@ -673,11 +675,44 @@ fn run_simplify(
     Ok(())
 }
 
+/// Where the last panic happened and what it said, kept by the panic hook for `main`.
+static PANIC: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
+    // A panic is a bug: it still ends in one line and the internal-failure exit code, with
+    // where it happened, instead of the default multi-line message.
+    std::panic::set_hook(Box::new(|info| {
+        let message = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown cause".into());
+        let place = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        if let Ok(mut p) = PANIC.lock() {
+            *p = Some(format!("{message}{place}"));
+        }
+    }));
+    match std::panic::catch_unwind(|| run(cli)) {
+        Ok(Ok(())) => ExitCode::SUCCESS,
+        Ok(Err(e)) => {
+            eprintln!("remesh: error: {e}");
+            ExitCode::from(e.exit_code() as u8)
+        }
+        Err(_) => {
+            let what = PANIC
+                .lock()
+                .ok()
+                .and_then(|p| p.clone())
+                .unwrap_or_else(|| "unknown cause".into());
+            let e = Error::Internal {
+                stage: "panic",
+                message: format!("{} (a bug: please report it)", what.replace('\n', " ")),
+            };
             eprintln!("remesh: error: {e}");
             ExitCode::from(e.exit_code() as u8)
         }

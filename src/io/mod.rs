@@ -360,9 +360,14 @@ fn one_line(message: &str) -> String {
     out.trim_end().to_string()
 }
 
-/// Writes `bytes` to a temporary file beside `path`, syncs it and renames it onto `path`. On
+/// Writes `bytes` to a temporary file beside `path`, syncs it and renames it onto `path`: a
+/// reader never sees a half-written file, and an existing file is replaced only on success. On
 /// failure the temporary file is removed and [`Error::Write`] names `path`.
-fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+///
+/// # Errors
+/// [`Error::Write`] when the directory is missing or not writable, the path names no file, or
+/// writing, syncing or renaming fails.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let write_err = |message: String| Error::Write {
         path: path.to_path_buf(),
         message,

@@ -1,0 +1,723 @@
+//! Issue 6: the table of bad and awkward inputs, each run through the `remesh` binary with its
+//! expected outcome. Either a correct result (exit 0, an output whose invariants hold) or a
+//! one-line error naming the file and the problem, with the exit code of its kind: 2 usage,
+//! 3 input, 4 output, 1 internal. Never a panic, a hang, a half-written or clobbered file.
+//!
+//! | case | outcome |
+//! |---|---|
+//! | empty file (.obj, .ply, .glb) | input error |
+//! | truncated binary PLY, truncated .glb | input error |
+//! | content that does not match the extension | input error |
+//! | NaN or infinite coordinates | input error |
+//! | face index out of range | input error |
+//! | negative (relative) OBJ indices | result, identical to the positive-index file's |
+//! | quads and n-gons | result, closed genus 0 |
+//! | degenerate and zero-area faces | result, closed genus 0 |
+//! | duplicate vertices and duplicate faces | result, closed genus 0 |
+//! | non-manifold edges and vertices | result, manifold |
+//! | open boundaries | result with the input's boundary loops |
+//! | many components, some of a few triangles | result, invariants hold, what was dropped noted |
+//! | bounding box 1e-6 and 1e6 across | result in the input's units and place |
+//! | glTF with several meshes and nested node transforms | result, the same as the flattened OBJ |
+//! | `--points` 0, 1, 3 | usage error |
+//! | `--points` over the limit (20 million) | usage error |
+//! | `--points` 100 times the input's vertex count | result within 1% of the count |
+//! | output in a missing directory, or under a file | output error, nothing written |
+//! | output path equal to the input path | usage error, input untouched |
+//! | an internal failure (a panic) | internal error, one line |
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn shared(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(name)
+}
+
+fn remesh(args: &[&str]) -> Output {
+    remesh_env(args, &[])
+}
+
+fn remesh_env(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_remesh"));
+    c.args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("run remesh")
+}
+
+/// The run failed with `code`, printed exactly one line on stderr that contains every one of
+/// `mentions`, and left `output` absent.
+fn assert_error(o: &Output, code: i32, mentions: &[&str], output: &Path) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(code), "stderr: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    assert!(err.starts_with("remesh: error: "), "{err}");
+    for m in mentions {
+        assert!(err.contains(m), "{err:?} does not mention {m:?}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!output.exists(), "{} was written", output.display());
+}
+
+/// Remeshes `input` to `output` with `--report`, expecting success; returns the report.
+fn assert_result(input: &Path, output: &Path, extra: &[&str]) -> Value {
+    let report = output.with_extension("json");
+    let mut args = vec![
+        input.to_str().unwrap(),
+        output.to_str().unwrap(),
+        "-q",
+        "--no-distance",
+        "--strict",
+        "--report",
+        report.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = remesh(&args);
+    assert!(
+        o.status.success(),
+        "{}: {}",
+        input.display(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(output.exists());
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    // --strict: the invariants hold, or the run would have failed.
+    assert_eq!(r["self_intersections"]["pairs"], 0);
+    assert_eq!(r["invariant_violations"].as_array().unwrap().len(), 0);
+    r
+}
+
+fn topo(r: &Value, key: &str) -> i64 {
+    r["topology"][key].as_i64().unwrap()
+}
+
+fn assert_closed_genus_0(r: &Value) {
+    assert_eq!(topo(r, "boundary_edges"), 0, "{}", r["topology"]);
+    assert_eq!(topo(r, "components"), 1, "{}", r["topology"]);
+    assert_eq!(topo(r, "euler_characteristic"), 2, "{}", r["topology"]);
+}
+
+/// An icosphere of radius 1: the icosahedron subdivided `levels` times, outward faces.
+fn icosphere(levels: usize) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut p: Vec<[f64; 3]> = vec![
+        [-1., t, 0.],
+        [1., t, 0.],
+        [-1., -t, 0.],
+        [1., -t, 0.],
+        [0., -1., t],
+        [0., 1., t],
+        [0., -1., -t],
+        [0., 1., -t],
+        [t, 0., -1.],
+        [t, 0., 1.],
+        [-t, 0., -1.],
+        [-t, 0., 1.],
+    ];
+    let mut f: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let normalize = |v: [f64; 3]| {
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        [v[0] / l, v[1] / l, v[2] / l]
+    };
+    for v in &mut p {
+        *v = normalize(*v);
+    }
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::new();
+        let mut midpoint = |a: usize, b: usize, p: &mut Vec<[f64; 3]>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let m = normalize([p[a][0] + p[b][0], p[a][1] + p[b][1], p[a][2] + p[b][2]]);
+                p.push(m);
+                p.len() - 1
+            })
+        };
+        for &[a, b, c] in &f {
+            let ab = midpoint(a, b, &mut p);
+            let bc = midpoint(b, c, &mut p);
+            let ca = midpoint(c, a, &mut p);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        f = next;
+    }
+    (p, f)
+}
+
+/// OBJ text of polygons (1-based indices, or relative ones counted from the end).
+fn obj(p: &[[f64; 3]], faces: &[Vec<usize>], relative: bool) -> String {
+    let mut s = String::new();
+    for v in p {
+        s += &format!("v {:?} {:?} {:?}\n", v[0], v[1], v[2]);
+    }
+    for f in faces {
+        s += "f";
+        for &i in f {
+            if relative {
+                s += &format!(" {}", i as i64 - p.len() as i64);
+            } else {
+                s += &format!(" {}", i + 1);
+            }
+        }
+        s += "\n";
+    }
+    s
+}
+
+fn tri_faces(f: &[[usize; 3]]) -> Vec<Vec<usize>> {
+    f.iter().map(|t| t.to_vec()).collect()
+}
+
+fn write(dir: &Path, name: &str, content: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, content).unwrap();
+    p
+}
+
+#[test]
+fn unreadable_inputs_are_one_line_input_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let horse_ply = std::fs::read(shared("horse.ply")).unwrap();
+    let spot_glb = std::fs::read(shared("spot.glb")).unwrap();
+    let cases: Vec<(PathBuf, &str)> = vec![
+        (write(dir.path(), "empty.obj", ""), "empty"),
+        (write(dir.path(), "empty.ply", ""), "empty"),
+        (write(dir.path(), "empty.glb", ""), "empty"),
+        (
+            write(dir.path(), "cut.ply", &horse_ply[..horse_ply.len() / 2]),
+            "cut.ply",
+        ),
+        (
+            write(dir.path(), "cut.glb", &spot_glb[..spot_glb.len() / 2]),
+            "cut.glb",
+        ),
+        (write(dir.path(), "ply-inside.obj", &horse_ply), "PLY"),
+        (
+            write(
+                dir.path(),
+                "nan.obj",
+                "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n",
+            ),
+            "non-finite",
+        ),
+        (
+            write(
+                dir.path(),
+                "inf.obj",
+                "v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n",
+            ),
+            "non-finite",
+        ),
+        (
+            write(
+                dir.path(),
+                "range.obj",
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+            ),
+            "names vertex 9",
+        ),
+    ];
+    for (path, problem) in cases {
+        let o = remesh(&[path.to_str().unwrap(), out.to_str().unwrap(), "-q"]);
+        let name = path.file_name().unwrap().to_str().unwrap();
+        assert_error(&o, 3, &[name, problem], &out);
+    }
+    // An existing output is not clobbered by a failed run.
+    std::fs::write(&out, "keep").unwrap();
+    let o = remesh(&[
+        dir.path().join("nan.obj").to_str().unwrap(),
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert_eq!(o.status.code(), Some(3));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "keep");
+}
+
+#[test]
+fn relative_obj_indices_give_the_same_output_as_absolute_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, f) = icosphere(3);
+    let a = write(dir.path(), "abs.obj", obj(&p, &tri_faces(&f), false));
+    let b = write(dir.path(), "rel.obj", obj(&p, &tri_faces(&f), true));
+    let (oa, ob) = (dir.path().join("a.obj"), dir.path().join("b.obj"));
+    let ra = assert_result(&a, &oa, &["--points", "300"]);
+    assert_result(&b, &ob, &["--points", "300"]);
+    assert_closed_genus_0(&ra);
+    assert_eq!(std::fs::read(&oa).unwrap(), std::fs::read(&ob).unwrap());
+}
+
+#[test]
+fn quads_and_ngons_are_triangulated() {
+    // A cube of quads, and a hexagonal prism with hexagon caps.
+    let dir = tempfile::tempdir().unwrap();
+    let cube_p = vec![
+        [0., 0., 0.],
+        [1., 0., 0.],
+        [1., 1., 0.],
+        [0., 1., 0.],
+        [0., 0., 1.],
+        [1., 0., 1.],
+        [1., 1., 1.],
+        [0., 1., 1.],
+    ];
+    let cube_f = vec![
+        vec![0, 3, 2, 1],
+        vec![4, 5, 6, 7],
+        vec![0, 1, 5, 4],
+        vec![1, 2, 6, 5],
+        vec![2, 3, 7, 6],
+        vec![3, 0, 4, 7],
+    ];
+    let cube = write(dir.path(), "cube.obj", obj(&cube_p, &cube_f, false));
+    let r = assert_result(
+        &cube,
+        &dir.path().join("cube-out.obj"),
+        &["--points", "400"],
+    );
+    assert_closed_genus_0(&r);
+    let mut prism_p = Vec::new();
+    for z in [0.0, 2.0] {
+        for k in 0..6 {
+            let a = std::f64::consts::TAU * k as f64 / 6.0;
+            prism_p.push([a.cos(), a.sin(), z]);
+        }
+    }
+    let mut prism_f = vec![(0..6).rev().collect::<Vec<_>>(), (6..12).collect()];
+    for k in 0..6 {
+        let n = (k + 1) % 6;
+        prism_f.push(vec![k, n, n + 6, k + 6]);
+    }
+    let prism = write(dir.path(), "prism.obj", obj(&prism_p, &prism_f, false));
+    let r = assert_result(
+        &prism,
+        &dir.path().join("prism-out.obj"),
+        &["--points", "500"],
+    );
+    assert_closed_genus_0(&r);
+}
+
+#[test]
+fn degenerate_zero_area_and_duplicate_faces_and_vertices_are_absorbed() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut p, f) = icosphere(3);
+    let mut faces = tri_faces(&f);
+    // A face repeating an index, a zero-area face of three distinct collinear points, and a
+    // duplicate of an existing face.
+    let a = p.len();
+    p.push([0.0, 0.0, 0.5]);
+    p.push([0.1, 0.0, 0.5]);
+    p.push([0.2, 0.0, 0.5]);
+    faces.push(vec![0, 0, 1]);
+    faces.push(vec![a, a + 1, a + 2]);
+    faces.push(faces[5].clone());
+    let messy = write(dir.path(), "messy.obj", obj(&p, &faces, false));
+    let r = assert_result(
+        &messy,
+        &dir.path().join("messy-out.obj"),
+        &["--points", "400"],
+    );
+    assert_closed_genus_0(&r);
+    // Every face with its own three vertices (no sharing), and every vertex also repeated.
+    let mut q = Vec::new();
+    let mut split = Vec::new();
+    for t in &f {
+        split.push(vec![q.len(), q.len() + 1, q.len() + 2]);
+        q.extend(t.iter().map(|&i| p[i]));
+    }
+    let soup = write(dir.path(), "soup.obj", obj(&q, &split, false));
+    let r = assert_result(
+        &soup,
+        &dir.path().join("soup-out.obj"),
+        &["--points", "400"],
+    );
+    assert_closed_genus_0(&r);
+}
+
+#[test]
+fn non_manifold_inputs_give_manifold_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two spheres touching at one vertex (a non-manifold vertex) and a fin: a third triangle
+    // on an edge of one of them (a non-manifold edge).
+    let (p, f) = icosphere(2);
+    let top = (0..p.len())
+        .max_by(|&a, &b| p[a][2].total_cmp(&p[b][2]))
+        .unwrap();
+    let mut q = p.clone();
+    let off = q.len();
+    // The second sphere, moved up so that its lowest vertex lands on the first's highest.
+    let low = (0..p.len())
+        .min_by(|&a, &b| p[a][2].total_cmp(&p[b][2]))
+        .unwrap();
+    let shift = [
+        p[top][0] - p[low][0],
+        p[top][1] - p[low][1],
+        p[top][2] - p[low][2],
+    ];
+    q.extend(
+        p.iter()
+            .map(|v| [v[0] + shift[0], v[1] + shift[1], v[2] + shift[2]]),
+    );
+    let mut faces = tri_faces(&f);
+    faces.extend(f.iter().map(|t| {
+        t.iter()
+            .map(|&i| if i == low { top } else { i + off })
+            .collect::<Vec<_>>()
+    }));
+    // The fin stands out sideways from the lower sphere's face farthest along -x.
+    let side = f
+        .iter()
+        .min_by(|s, t| {
+            let x = |t: &[usize; 3]| t.iter().map(|&i| p[i][0]).sum::<f64>();
+            x(s).total_cmp(&x(t))
+        })
+        .unwrap();
+    let [a, b, _] = *side;
+    q.push([-2.0, (p[a][1] + p[b][1]) / 2.0, (p[a][2] + p[b][2]) / 2.0]);
+    faces.push(vec![a, b, q.len() - 1]);
+    let input = write(dir.path(), "nonmanifold.obj", obj(&q, &faces, false));
+    let r = assert_result(&input, &dir.path().join("nm-out.obj"), &["--points", "600"]);
+    assert_eq!(topo(&r, "non_manifold_edges"), 0);
+    assert_eq!(topo(&r, "non_manifold_vertices"), 0);
+    let input_t = &r["input_topology"];
+    assert!(
+        input_t["non_manifold_vertices"].as_i64().unwrap() >= 1,
+        "{input_t}"
+    );
+    assert!(
+        input_t["non_manifold_edges"].as_i64().unwrap() >= 1,
+        "{input_t}"
+    );
+}
+
+#[test]
+fn open_boundaries_are_kept() {
+    // The upper half of a sphere: one boundary loop.
+    let dir = tempfile::tempdir().unwrap();
+    let (p, f) = icosphere(3);
+    let upper: Vec<Vec<usize>> = f
+        .iter()
+        .filter(|t| t.iter().all(|&i| p[i][2] > -0.01))
+        .map(|t| t.to_vec())
+        .collect();
+    let input = write(dir.path(), "dome.obj", obj(&p, &upper, false));
+    let r = assert_result(
+        &input,
+        &dir.path().join("dome-out.obj"),
+        &["--points", "400"],
+    );
+    assert_eq!(topo(&r, "boundary_loops"), 1);
+    assert_eq!(topo(&r, "components"), 1);
+}
+
+#[test]
+fn many_components_including_tiny_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    // A sphere and five single triangles far from it.
+    let (mut p, f) = icosphere(3);
+    let mut faces = tri_faces(&f);
+    for k in 0..5 {
+        let x = 3.0 + k as f64;
+        let a = p.len();
+        p.extend([[x, 0.0, 0.0], [x + 0.1, 0.0, 0.0], [x, 0.1, 0.0]]);
+        faces.push(vec![a, a + 1, a + 2]);
+    }
+    let input = write(dir.path(), "parts.obj", obj(&p, &faces, false));
+    let r = assert_result(
+        &input,
+        &dir.path().join("parts-out.obj"),
+        &["--points", "400"],
+    );
+    assert!(topo(&r, "components") >= 1);
+    // The beetle: 33 parts glued along non-manifold edges, open, crossing itself.
+    let r = assert_result(
+        &shared("beetle.obj"),
+        &dir.path().join("beetle-out.obj"),
+        &[],
+    );
+    assert_eq!(topo(&r, "non_manifold_edges"), 0);
+}
+
+#[test]
+fn tiny_and_huge_models_come_back_in_their_own_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, f) = icosphere(3);
+    for (scale, offset) in [(0.5e-6, 3.0e-6), (0.5e6, -2.0e6)] {
+        let q: Vec<[f64; 3]> = p
+            .iter()
+            .map(|v| [v[0] * scale + offset, v[1] * scale, v[2] * scale])
+            .collect();
+        let name = format!("s{scale:e}.obj");
+        let input = write(dir.path(), &name, obj(&q, &tri_faces(&f), false));
+        let out = dir.path().join(format!("out-{name}"));
+        let r = assert_result(&input, &out, &["--points", "400"]);
+        assert_closed_genus_0(&r);
+        // Every output vertex lies on the input's sphere (radius `scale` around (offset, 0, 0)),
+        // to within the chord error of the input's faces.
+        let text = std::fs::read_to_string(&out).unwrap();
+        let mut n = 0;
+        for line in text.lines().filter(|l| l.starts_with("v ")) {
+            let c: Vec<f64> = line[2..]
+                .split_whitespace()
+                .map(|x| x.parse().unwrap())
+                .collect();
+            let d = ((c[0] - offset).powi(2) + c[1] * c[1] + c[2] * c[2]).sqrt();
+            assert!((d / scale - 1.0).abs() < 0.02, "{line}: {}", d / scale);
+            n += 1;
+        }
+        assert!((396..=404).contains(&n), "{n}");
+    }
+}
+
+#[test]
+fn gltf_with_several_meshes_and_nested_transforms_equals_its_flattened_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    // Mesh 0: a tetrahedron; mesh 1: an octahedron. Node tree: root (translate 10, 0, 0) with
+    // children A (scale 2, mesh 0) and B (rotate 90 degrees about z, translate 0, 5, 0) whose
+    // child C (mesh 1) is translated by (1, 0, 0).
+    let tet: Vec<[f32; 3]> = vec![[1., 1., 1.], [1., -1., -1.], [-1., 1., -1.], [-1., -1., 1.]];
+    let tet_i: Vec<u16> = vec![0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2];
+    let oct: Vec<[f32; 3]> = vec![
+        [1., 0., 0.],
+        [-1., 0., 0.],
+        [0., 1., 0.],
+        [0., -1., 0.],
+        [0., 0., 1.],
+        [0., 0., -1.],
+    ];
+    let oct_i: Vec<u16> = vec![
+        0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5,
+    ];
+    let mut buf = Vec::new();
+    let push_f32 = |v: &[[f32; 3]], buf: &mut Vec<u8>| {
+        for p in v {
+            for c in p {
+                buf.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    };
+    push_f32(&tet, &mut buf); // 0..48
+    for i in &tet_i {
+        buf.extend_from_slice(&i.to_le_bytes()); // 48..72
+    }
+    push_f32(&oct, &mut buf); // 72..144
+    for i in &oct_i {
+        buf.extend_from_slice(&i.to_le_bytes()); // 144..192
+    }
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let gltf = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [
+            {"translation": [10.0, 0.0, 0.0], "children": [1, 2]},
+            {"scale": [2.0, 2.0, 2.0], "mesh": 0},
+            {"rotation": [0.0, 0.0, s, s], "translation": [0.0, 5.0, 0.0], "children": [3]},
+            {"translation": [1.0, 0.0, 0.0], "mesh": 1}
+        ],
+        "meshes": [
+            {"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]},
+            {"primitives": [{"attributes": {"POSITION": 2}, "indices": 3}]}
+        ],
+        "buffers": [{"byteLength": buf.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 24},
+            {"buffer": 0, "byteOffset": 72, "byteLength": 72},
+            {"buffer": 0, "byteOffset": 144, "byteLength": 48}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [-1.0, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
+            {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"},
+            {"bufferView": 2, "componentType": 5126, "count": 6, "type": "VEC3",
+             "min": [-1.0, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
+            {"bufferView": 3, "componentType": 5123, "count": 24, "type": "SCALAR"}
+        ]
+    });
+    // Binary glTF: the header, the JSON chunk (padded with spaces), the BIN chunk.
+    let mut json = serde_json::to_string(&gltf).unwrap().into_bytes();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let mut glb = Vec::new();
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&((12 + 8 + json.len() + 8 + buf.len()) as u32).to_le_bytes());
+    glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&json);
+    glb.extend_from_slice(&(buf.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"BIN\0");
+    glb.extend_from_slice(&buf);
+    let g = write(dir.path(), "scene.glb", glb);
+    // The same geometry flattened by hand: tetrahedron * 2 + (10, 0, 0); octahedron moved by
+    // (1, 0, 0), rotated 90 degrees about z ((x, y) -> (-y, x)), moved by (0, 5, 0) and (10, 0, 0).
+    let mut p: Vec<[f64; 3]> = tet
+        .iter()
+        .map(|v| {
+            [
+                2.0 * v[0] as f64 + 10.0,
+                2.0 * v[1] as f64,
+                2.0 * v[2] as f64,
+            ]
+        })
+        .collect();
+    let mut faces: Vec<Vec<usize>> = tet_i
+        .chunks(3)
+        .map(|c| c.iter().map(|&i| i as usize).collect())
+        .collect();
+    let off = p.len();
+    p.extend(oct.iter().map(|v| {
+        let (x, y, z) = (v[0] as f64 + 1.0, v[1] as f64, v[2] as f64);
+        [-y + 10.0, x + 5.0, z]
+    }));
+    faces.extend(
+        oct_i
+            .chunks(3)
+            .map(|c| c.iter().map(|&i| i as usize + off).collect()),
+    );
+    let o = write(dir.path(), "scene.obj", obj(&p, &faces, false));
+    let (og, oo) = (dir.path().join("g.obj"), dir.path().join("o.obj"));
+    let rg = assert_result(&g, &og, &["--points", "600"]);
+    let ro = assert_result(&o, &oo, &["--points", "600"]);
+    assert_eq!(topo(&rg, "components"), 2);
+    assert_eq!(rg["topology"], ro["topology"]);
+    let (a, b) = (
+        std::fs::read_to_string(&og).unwrap(),
+        std::fs::read_to_string(&oo).unwrap(),
+    );
+    // The same samples up to float32 rounding of the glTF positions: compare vertex by vertex.
+    let coords = |t: &str| -> Vec<f64> {
+        t.lines()
+            .filter(|l| l.starts_with("v "))
+            .flat_map(|l| {
+                l[2..]
+                    .split_whitespace()
+                    .map(|x| x.parse::<f64>().unwrap())
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    };
+    let (ca, cb) = (coords(&a), coords(&b));
+    assert_eq!(ca.len(), cb.len());
+    let worst = ca
+        .iter()
+        .zip(&cb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-4, "{worst}");
+}
+
+#[test]
+fn point_counts_out_of_range_are_usage_errors_and_large_ones_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, f) = icosphere(0);
+    let ico = write(dir.path(), "ico.obj", obj(&p, &tri_faces(&f), false));
+    let out = dir.path().join("out.obj");
+    for n in ["0", "1", "3", "20000001"] {
+        let o = remesh(&[ico.to_str().unwrap(), out.to_str().unwrap(), "--points", n]);
+        assert_error(&o, 2, &["--points"], &out);
+    }
+    // 100 times the input's 12 vertices.
+    let r = assert_result(&ico, &out, &["--points", "1200"]);
+    let v = topo(&r, "vertices");
+    assert!((1188..=1212).contains(&v), "{v}");
+    assert_closed_genus_0(&r);
+}
+
+#[test]
+fn outputs_that_cannot_be_written_are_output_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = shared("spot.obj");
+    let missing = dir.path().join("no/such/dir/out.obj");
+    let o = remesh(&[input.to_str().unwrap(), missing.to_str().unwrap(), "-q"]);
+    assert_error(&o, 4, &["out.obj"], &missing);
+    // A path under a regular file: no directory can be made there, whoever runs the test.
+    let file = write(dir.path(), "plain", "x");
+    let under = file.join("out.obj");
+    let o = remesh(&[input.to_str().unwrap(), under.to_str().unwrap(), "-q"]);
+    assert_error(&o, 4, &["out.obj"], &under);
+    // The same for the report.
+    let out = dir.path().join("ok.obj");
+    let o = remesh(&[
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "-q",
+        "--no-distance",
+        "--report",
+        under.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(4),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    // Nothing but the mesh and no temporary file beside it.
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert!(
+        left.iter().all(|n| n == "plain" || n == "ok.obj"),
+        "{left:?}"
+    );
+}
+
+#[test]
+fn the_input_is_never_the_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("spot.obj");
+    std::fs::copy(shared("spot.obj"), &input).unwrap();
+    let before = std::fs::read(&input).unwrap();
+    let o = remesh(&[input.to_str().unwrap(), input.to_str().unwrap(), "-q"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("is the input file"));
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+    // Through another spelling of the same path.
+    let other = dir.path().join(".").join("spot.obj");
+    let o = remesh(&[input.to_str().unwrap(), other.to_str().unwrap(), "-q"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+}
+
+#[test]
+fn a_panic_is_a_one_line_internal_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let o = remesh_env(
+        &[
+            shared("spot.obj").to_str().unwrap(),
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[("REMESH_INJECT_PANIC", "1")],
+    );
+    assert_error(&o, 1, &["panic", "injected"], &out);
+}
