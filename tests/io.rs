@@ -860,6 +860,33 @@ fn bad_ply_content() {
     assert!(e.to_string().contains("vertex 2"), "{e}");
 }
 
+/// Found by the read_gltf fuzz target: a primitive whose POSITION names an accessor the file does
+/// not have made gltf-json's validation panic (an unchecked index); now a one-line error.
+#[test]
+fn fuzz_regression_gltf_position_accessor_out_of_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("no-accessors.gltf");
+    fs::write(
+        &path,
+        r#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#,
+    )
+    .unwrap();
+    let e = expect_err(&path);
+    assert!(e.to_string().contains("uses accessor 0"), "{e}");
+    let path = dir.path().join("indices-out-of-range.gltf");
+    fs::write(
+        &path,
+        r#"{"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,1]}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":7}]}]}"#,
+    )
+    .unwrap();
+    let e = expect_err(&path);
+    assert!(e.to_string().contains("uses accessor 7"), "{e}");
+    // The fuzzer's own input.
+    let found = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fuzz"))
+        .join("read_gltf-position-accessor-out-of-range.gltf");
+    expect_err(&found);
+}
+
 #[test]
 fn bad_gltf_content() {
     let dir = tempfile::tempdir().unwrap();

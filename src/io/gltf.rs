@@ -161,6 +161,24 @@ fn validate(document: &::gltf::Document) -> std::result::Result<(), String> {
             ));
         }
     }
+    // gltf-json's own validation indexes the accessor of each primitive's POSITION without a
+    // range check (it panics on an out-of-range index; found by the read_gltf fuzz target), so
+    // the ranges of every primitive's accessors are checked first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let used = primitive
+                .attributes
+                .values()
+                .chain(primitive.indices.as_ref())
+                .map(|i| i.value());
+            if let Some(i) = used.into_iter().find(|&i| i >= root.accessors.len()) {
+                return Err(format!(
+                    "invalid glTF: meshes[{m}].primitives[{p}] uses accessor {i}, but the file has {} accessors",
+                    root.accessors.len()
+                ));
+            }
+        }
+    }
     let mut errors: Vec<(String, ValidationError)> = Vec::new();
     root.validate(root, ::gltf::json::Path::new, &mut |path, error| {
         errors.push((path().to_string(), error))

@@ -84,8 +84,14 @@ impl<'a> Builder<'a> {
             && reverse == self.directed.get(&(t[0], t[2])))
     }
 
+    /// Adds `t` when it [fits](Builder::fits) and has area (three samples on a line give no
+    /// face: found by the triangulate fuzz target, where a hole of three collinear samples was
+    /// closed by a flat triangle).
     pub(super) fn add(&mut self, t: [u32; 3], source: FaceSource) -> bool {
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !self.fits(t) {
+            return false;
+        }
+        if crate::quality::is_degenerate_triangle(t.map(|v| self.positions[v as usize])) {
             return false;
         }
         let f = self.faces.len() as u32;

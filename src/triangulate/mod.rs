@@ -11,6 +11,11 @@ pub use cleanup::{assemble, AssemblyParams, AssemblyStats, FaceSource};
 pub use refine::RefineParams;
 pub use tangent_delaunay::{vote_triangles, SampleSet, TangentDelaunayParams, VotedTriangle};
 
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+
+use crate::quality::is_degenerate_triangle;
+
 /// Parameters of [`triangulate`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TriangulateParams {
@@ -23,11 +28,62 @@ pub struct TriangulateParams {
 /// Triangulates samples on a surface: every sample's tangent-plane Delaunay umbrella, merged by
 /// votes, then cleaned up into an edge- and vertex-manifold mesh oriented like `normals`.
 /// Returns the faces (indices into `set.positions`), how each came in, and what the assembly did.
+///
+/// Samples at exactly the same position count as one (the first of them); the others are in no
+/// face. Candidate triangles of zero area (three samples on a line) are never used.
 pub fn triangulate(
     set: &SampleSet,
     params: &TriangulateParams,
 ) -> (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats) {
-    let voted = vote_triangles(set, &params.local);
+    // Coincident samples would give faces of zero area (found by the triangulate fuzz target):
+    // triangulate the distinct positions and map the faces back.
+    let mut first_at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+    let mut distinct: Vec<u32> = Vec::new();
+    let mut to_distinct: Vec<u32> = Vec::with_capacity(set.positions.len());
+    for (i, p) in set.positions.iter().enumerate() {
+        let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let k = *first_at.entry(key).or_insert_with(|| {
+            distinct.push(i as u32);
+            (distinct.len() - 1) as u32
+        });
+        to_distinct.push(k);
+    }
+    let (faces, sources, stats) = if distinct.len() == set.positions.len() {
+        triangulate_distinct(set, params)
+    } else {
+        let positions: Vec<DVec3> = distinct
+            .iter()
+            .map(|&i| set.positions[i as usize])
+            .collect();
+        let normals: Vec<DVec3> = distinct.iter().map(|&i| set.normals[i as usize]).collect();
+        let boundary_edges: Vec<[u32; 2]> = set
+            .boundary_edges
+            .iter()
+            .map(|e| e.map(|v| to_distinct[v as usize]))
+            .filter(|e| e[0] != e[1])
+            .collect();
+        let reduced = SampleSet {
+            positions: &positions,
+            normals: &normals,
+            boundary_edges: &boundary_edges,
+        };
+        let (faces, sources, stats) = triangulate_distinct(&reduced, params);
+        let faces = faces
+            .into_iter()
+            .map(|f| f.map(|v| distinct[v as usize]))
+            .collect();
+        (faces, sources, stats)
+    };
+    (faces, sources, stats)
+}
+
+/// [`triangulate`] of samples at distinct positions.
+fn triangulate_distinct(
+    set: &SampleSet,
+    params: &TriangulateParams,
+) -> (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats) {
+    let mut voted = vote_triangles(set, &params.local);
+    voted.retain(|t| !is_degenerate_triangle(t.corners.map(|v| set.positions[v as usize])));
     assemble(
         set.positions,
         set.normals,
