@@ -22,6 +22,7 @@
 //! | `--points` 0, 1, 3 | usage error |
 //! | `--points` over the limit (20 million) | usage error |
 //! | `--points` 100 times the input's vertex count | result within 1% of the count |
+//! | `--points` 5000 on a single triangle | result within 1%, one boundary loop |
 //! | output in a missing directory, or under a file | output error, nothing written |
 //! | output path equal to the input path | usage error, input untouched |
 //! | an internal failure (a panic) | internal error, one line |
@@ -649,6 +650,12 @@ fn point_counts_out_of_range_are_usage_errors_and_large_ones_work() {
     let v = topo(&r, "vertices");
     assert!((1188..=1212).contains(&v), "{v}");
     assert_closed_genus_0(&r);
+    // Far more points than the input has: a single triangle remeshed with 5000 vertices.
+    let tri = write(dir.path(), "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let r = assert_result(&tri, &dir.path().join("tri-out.obj"), &["--points", "5000"]);
+    let v = topo(&r, "vertices");
+    assert!((4950..=5050).contains(&v), "{v}");
+    assert_eq!((topo(&r, "components"), topo(&r, "boundary_loops")), (1, 1));
 }
 
 #[test]
