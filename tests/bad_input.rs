@@ -103,71 +103,16 @@ fn assert_closed_genus_0(r: &Value) {
     assert_eq!(topo(r, "euler_characteristic"), 2, "{}", r["topology"]);
 }
 
-/// An icosphere of radius 1: the icosahedron subdivided `levels` times, outward faces.
-fn icosphere(levels: usize) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut p: Vec<[f64; 3]> = vec![
-        [-1., t, 0.],
-        [1., t, 0.],
-        [-1., -t, 0.],
-        [1., -t, 0.],
-        [0., -1., t],
-        [0., 1., t],
-        [0., -1., -t],
-        [0., 1., -t],
-        [t, 0., -1.],
-        [t, 0., 1.],
-        [-t, 0., -1.],
-        [-t, 0., 1.],
-    ];
-    let mut f: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let normalize = |v: [f64; 3]| {
-        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        [v[0] / l, v[1] / l, v[2] / l]
-    };
-    for v in &mut p {
-        *v = normalize(*v);
-    }
-    for _ in 0..levels {
-        let mut mid = std::collections::HashMap::new();
-        let mut next = Vec::new();
-        let mut midpoint = |a: usize, b: usize, p: &mut Vec<[f64; 3]>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let m = normalize([p[a][0] + p[b][0], p[a][1] + p[b][1], p[a][2] + p[b][2]]);
-                p.push(m);
-                p.len() - 1
-            })
-        };
-        for &[a, b, c] in &f {
-            let ab = midpoint(a, b, &mut p);
-            let bc = midpoint(b, c, &mut p);
-            let ca = midpoint(c, a, &mut p);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = next;
-    }
-    (p, f)
+mod common;
+
+/// An icosphere of radius 1 (the icosahedron subdivided `levels` times, outward faces) as plain
+/// coordinates and faces.
+fn icosphere(levels: u32) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+    let m = common::icosphere(levels);
+    (
+        m.positions.iter().map(|p| p.to_array()).collect(),
+        m.triangles.iter().map(|t| t.map(|v| v as usize)).collect(),
+    )
 }
 
 /// OBJ text of polygons (1-based indices, or relative ones counted from the end).
@@ -651,7 +596,11 @@ fn point_counts_out_of_range_are_usage_errors_and_large_ones_work() {
     assert!((1188..=1212).contains(&v), "{v}");
     assert_closed_genus_0(&r);
     // Far more points than the input has: a single triangle remeshed with 5000 vertices.
-    let tri = write(dir.path(), "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let tri = write(
+        dir.path(),
+        "tri.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
     let r = assert_result(&tri, &dir.path().join("tri-out.obj"), &["--points", "5000"]);
     let v = topo(&r, "vertices");
     assert!((4950..=5050).contains(&v), "{v}");

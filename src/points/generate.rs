@@ -152,32 +152,7 @@ mod tests {
     #[test]
     fn points_lie_on_the_surface_with_its_normals_and_the_seed_repeats() {
         // The unit cube's six faces.
-        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-        let positions = vec![
-            p(0., 0., 0.),
-            p(1., 0., 0.),
-            p(1., 1., 0.),
-            p(0., 1., 0.),
-            p(0., 0., 1.),
-            p(1., 0., 1.),
-            p(1., 1., 1.),
-            p(0., 1., 1.),
-        ];
-        let triangles = vec![
-            [0, 2, 1],
-            [0, 3, 2],
-            [4, 5, 6],
-            [4, 6, 7],
-            [0, 1, 5],
-            [0, 5, 4],
-            [1, 2, 6],
-            [1, 6, 5],
-            [2, 3, 7],
-            [2, 7, 6],
-            [3, 0, 4],
-            [3, 4, 7],
-        ];
-        let cube = TriMesh::new(positions, triangles);
+        let cube = crate::mesh::test_meshes::cuboid(DVec3::ZERO, DVec3::ONE);
         let dir = tempfile::tempdir().unwrap();
         let (a, b) = (dir.path().join("a.ply"), dir.path().join("b.ply"));
         write_surface_points(&cube, 5000, 3, &a).unwrap();

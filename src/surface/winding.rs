@@ -222,42 +222,7 @@ impl<'a> BuriedTest<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A closed axis-aligned box from `lo` to `hi`, faces outward.
-    fn cuboid(lo: DVec3, hi: DVec3) -> TriMesh {
-        let p = |x: usize, y: usize, z: usize| {
-            DVec3::new(
-                if x == 0 { lo.x } else { hi.x },
-                if y == 0 { lo.y } else { hi.y },
-                if z == 0 { lo.z } else { hi.z },
-            )
-        };
-        let positions = vec![
-            p(0, 0, 0),
-            p(1, 0, 0),
-            p(1, 1, 0),
-            p(0, 1, 0),
-            p(0, 0, 1),
-            p(1, 0, 1),
-            p(1, 1, 1),
-            p(0, 1, 1),
-        ];
-        let triangles = vec![
-            [0, 2, 1],
-            [0, 3, 2],
-            [4, 5, 6],
-            [4, 6, 7],
-            [0, 1, 5],
-            [0, 5, 4],
-            [1, 2, 6],
-            [1, 6, 5],
-            [2, 3, 7],
-            [2, 7, 6],
-            [3, 0, 4],
-            [3, 4, 7],
-        ];
-        TriMesh::new(positions, triangles)
-    }
+    use crate::mesh::test_meshes::cuboid;
 
     fn union_of(a: &TriMesh, b: &TriMesh) -> TriMesh {
         let mut m = a.clone();

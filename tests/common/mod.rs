@@ -1,0 +1,85 @@
+//! Meshes built in code, shared by the integration tests.
+#![allow(dead_code)]
+
+use glam::DVec3;
+use spectral_remesh::TriMesh;
+
+/// Flips every face whose normal points towards the origin (for convex meshes around it).
+pub fn orient_outward(mut m: TriMesh) -> TriMesh {
+    for f in 0..m.triangles.len() {
+        let [a, b, c] = m.corners(f);
+        if m.face_cross(f).dot(a + b + c) < 0.0 {
+            m.triangles[f].swap(1, 2);
+        }
+    }
+    m
+}
+
+/// The regular icosahedron with edge length 2 (V 12, E 30, F 20), outward oriented.
+pub fn icosahedron() -> TriMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let positions = vec![
+        DVec3::new(-1.0, t, 0.0),
+        DVec3::new(1.0, t, 0.0),
+        DVec3::new(-1.0, -t, 0.0),
+        DVec3::new(1.0, -t, 0.0),
+        DVec3::new(0.0, -1.0, t),
+        DVec3::new(0.0, 1.0, t),
+        DVec3::new(0.0, -1.0, -t),
+        DVec3::new(0.0, 1.0, -t),
+        DVec3::new(t, 0.0, -1.0),
+        DVec3::new(t, 0.0, 1.0),
+        DVec3::new(-t, 0.0, -1.0),
+        DVec3::new(-t, 0.0, 1.0),
+    ];
+    let triangles = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    orient_outward(TriMesh::new(positions, triangles))
+}
+
+/// The icosahedron subdivided `level` times (each triangle into 4), projected onto the unit
+/// sphere: 20·4^level faces.
+pub fn icosphere(level: u32) -> TriMesh {
+    let mut m = icosahedron();
+    for p in &mut m.positions {
+        *p = p.normalize();
+    }
+    for _ in 0..level {
+        let mut mid: rustc_hash::FxHashMap<(u32, u32), u32> = Default::default();
+        let mut tris = Vec::with_capacity(4 * m.triangles.len());
+        let mut midpoint = |a: u32, b: u32, pos: &mut Vec<DVec3>| -> u32 {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                pos.push((0.5 * (pos[a as usize] + pos[b as usize])).normalize());
+                (pos.len() - 1) as u32
+            })
+        };
+        for t in m.triangles.clone() {
+            let ab = midpoint(t[0], t[1], &mut m.positions);
+            let bc = midpoint(t[1], t[2], &mut m.positions);
+            let ca = midpoint(t[2], t[0], &mut m.positions);
+            tris.extend([[t[0], ab, ca], [t[1], bc, ab], [t[2], ca, bc], [ab, bc, ca]]);
+        }
+        m.triangles = tris;
+    }
+    m
+}
