@@ -251,27 +251,15 @@ pub fn remesh(
     let mut buried_candidates = 0;
     let mut input_points: Vec<DVec3> = normalized.positions.clone();
     if let Some(test) = &buried_test {
-        // Candidates on faces that are buried in part.
-        let buried = test.buried(
-            &pool
-                .iter()
-                .map(|c| (c.position, c.normal))
-                .collect::<Vec<_>>(),
-        );
-        buried_candidates = buried.iter().filter(|&&b| b).count();
-        let mut keep = buried.iter().map(|b| !b);
-        pool.retain(|_| keep.next().unwrap_or(true));
-        let vertex_normals = normalized.vertex_normals();
-        let buried = test.buried(
-            &normalized
-                .positions
-                .iter()
-                .copied()
-                .zip(vertex_normals.iter().copied())
-                .collect::<Vec<_>>(),
-        );
-        let mut keep = buried.iter().map(|b| !b);
-        input_points.retain(|_| keep.next().unwrap_or(true));
+        buried_candidates = test.remove_buried(&mut pool, |c| (c.position, c.normal));
+        let mut vertices: Vec<(DVec3, DVec3)> = normalized
+            .positions
+            .iter()
+            .copied()
+            .zip(normalized.vertex_normals())
+            .collect();
+        test.remove_buried(&mut vertices, |&v| v);
+        input_points = vertices.into_iter().map(|(p, _)| p).collect();
     }
     // Input-surface points the optimization keeps within its cover distance of the output.
     let cover_points: Vec<DVec3> = input_points

@@ -210,6 +210,19 @@ impl<'a> BuriedTest<'a> {
         }
     }
 
+    /// Removes the buried items of `items` (keeping the order of the others), each seen as the
+    /// surface point and normal `point` gives; returns how many were removed. In parallel.
+    pub fn remove_buried<T>(
+        &self,
+        items: &mut Vec<T>,
+        point: impl Fn(&T) -> (DVec3, DVec3),
+    ) -> usize {
+        let buried = self.buried(&items.iter().map(point).collect::<Vec<_>>());
+        let mut keep = buried.iter().map(|b| !b);
+        items.retain(|_| keep.next().unwrap_or(true));
+        buried.iter().filter(|&&b| b).count()
+    }
+
     /// [`BuriedTest::is_buried`] for every point, in parallel.
     pub fn buried(&self, points: &[(DVec3, DVec3)]) -> Vec<bool> {
         points
