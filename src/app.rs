@@ -7,7 +7,7 @@ use std::time::Instant;
 use crate::error::{Error, Result};
 use crate::io::{read_mesh, write_mesh};
 use crate::pipeline::{remesh, Density, RemeshParams};
-use crate::quality::{surface_distance, surface_distance_with, QualityReport};
+use crate::report::{surface_distance, surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
 
 /// Samples per side for the Hausdorff and RMS distances of the report (Metro-style, on top of
@@ -25,7 +25,7 @@ pub struct RemeshJob {
     pub params: RemeshParams,
     /// Whether to measure the distance to the input (Hausdorff, RMS).
     pub measure_distance: bool,
-    /// Whether a violated output invariant ([`crate::quality::check_invariants`]: manifold,
+    /// Whether a violated output invariant ([`crate::check::check_invariants`]: manifold,
     /// oriented, no degenerate, duplicate or intersecting faces) is an error, with nothing
     /// written, rather than a line of the report.
     pub strict: bool,
@@ -33,7 +33,7 @@ pub struct RemeshJob {
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
 ///
-/// The output's invariants ([`crate::quality::check_invariants`]) are checked before it is
+/// The output's invariants ([`crate::check::check_invariants`]) are checked before it is
 /// written; violations go into the report ([`QualityReport::invariant_violations`] and a note).
 ///
 /// # Errors
@@ -65,7 +65,12 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     let mut report = QualityReport::new(&out.mesh_normalized);
     let check_seconds = t.elapsed().as_secs_f64();
     if !report.invariant_violations.is_empty() {
-        let list = report.invariant_violations.join("; ");
+        let list = report
+            .invariant_violations
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join("; ");
         if job.strict {
             return Err(Error::Internal {
                 stage: "invariant check",
@@ -90,7 +95,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     }
     report.push_stage("check (report)", check_seconds);
     report.push_stage("write", write_seconds);
-    let input_topology = crate::quality::topology(&out.input_normalized);
+    let input_topology = crate::check::topology(&out.input_normalized);
     if input_topology.non_manifold_vertices > 0 || input_topology.non_manifold_edges > 0 {
         report.notes.push(format!(
             "the input has {} non-manifold vertices and {} non-manifold edges; the sampler works on \
@@ -208,7 +213,7 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
     if let Some(r) = &reference {
         let t = Instant::now();
         let rn = normalization.apply_mesh(r);
-        report.input_topology = Some(crate::quality::topology(&rn));
+        report.input_topology = Some(crate::check::topology(&rn));
         report.distance = Some(
             surface_distance(&m, &rn, DISTANCE_SAMPLES, seed).map_err(|e| with_path(e, path))?,
         );

@@ -8,7 +8,9 @@
 //! gradient ascent + projection → triangulate → clean up → report → write.
 
 pub mod app;
+pub mod check;
 pub mod error;
+pub mod geometry;
 pub mod io;
 pub mod kernel;
 pub mod measure;
@@ -16,10 +18,9 @@ pub mod mesh;
 pub mod pipeline;
 pub mod plane;
 pub mod points;
-pub mod quality;
 pub mod reconstruction_eval;
+pub mod report;
 pub mod sampling;
-pub mod self_intersection;
 pub mod spatial;
 pub mod surface;
 pub mod triangulate;

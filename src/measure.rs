@@ -12,10 +12,7 @@ use crate::kernel::{Kernel, KernelPoint};
 /// results).
 pub const DEFAULT_EPSILON: f64 = 0.5;
 
-/// A neighbour x_{n+1} whose g_n^-1 = k(x_{n+1}, x_{n+1}) - k_n^T K_n^-1 k_n falls below this is
-/// skipped: φ(x_{n+1}) is then (numerically) in the span of the neighbours already taken and adds
-/// nothing to the projection (Sec. 6.1). Dimensionless (k(x, x) = 1).
-pub const SINGULAR_TOLERANCE: f64 = 1e-9;
+pub use crate::geometry::tolerance::SINGULAR_TOLERANCE;
 
 /// The outcome of one evaluation of the measure.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -12,7 +12,7 @@
 //!    resampling"); its count is the target of the others;
 //! 4. each subset's RIMLS surface with the same σ_p, σ_n on the same grid, compared with the
 //!    all-points surface by the Metro-style two-sided distance
-//!    ([`crate::quality::surface_distance`]: RMS and Hausdorff, bbox-100 units);
+//!    ([`crate::report::surface_distance`]: RMS and Hausdorff, bbox-100 units);
 //! 5. unless [`ReconstructionEvalParams::weighted`] is off, each subset again with the weights of
 //!    the points it dropped as RIMLS masses ([`representation_weights`], Sec. 5: a dropped
 //!    point's weight moves to the kept points that span its φ), the same rule for every
@@ -45,6 +45,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
+use crate::check::topology;
 use crate::error::{Error, Result};
 use crate::io::{read_mesh, write_mesh};
 use crate::kernel::Kernel;
@@ -59,7 +60,7 @@ use crate::points::subsample::{
     representation_weights, voxel_grid_subsample_to_count, RepresentationParams, Subsampler,
 };
 use crate::points::{PlyPointWriter, Point};
-use crate::quality::{surface_distance_with, topology, SurfaceDistance};
+use crate::report::{surface_distance_with, SurfaceDistance};
 use crate::sampling::linear_scan::LinearScanParams;
 use crate::sampling::target_count::TargetCountParams;
 use crate::surface::MeshSurface;

@@ -1,7 +1,10 @@
 //! The quality report on meshes built in code, with exact expected numbers.
 
 use glam::DVec3;
-use spectral_remesh::{quality::*, MeshSurface, TriMesh};
+use spectral_remesh::check::{check_invariants, topology, Topology, Violation};
+use spectral_remesh::geometry::triangle::triangle_angles_deg;
+use spectral_remesh::report::*;
+use spectral_remesh::{MeshSurface, TriMesh};
 
 mod common;
 use common::{icosahedron, icosphere, orient_outward};
@@ -385,7 +388,16 @@ fn tetrahedra_sharing_a_vertex_are_one_component_with_a_non_manifold_vertex() {
     assert!(!t.is_manifold());
     let problems = check_invariants(&m);
     assert_eq!(problems.len(), 1, "{problems:?}");
-    assert!(problems[0].contains("non-manifold vertex") && problems[0].contains("vertex 0"));
+    assert_eq!(
+        problems[0],
+        Violation::NonManifoldVertex {
+            count: 1,
+            vertex: 0
+        }
+    );
+    assert!(problems[0]
+        .to_string()
+        .contains("1 non-manifold vertex whose faces form 2 or more fans"));
 }
 
 #[test]
@@ -410,7 +422,15 @@ fn three_triangles_on_one_edge() {
     assert!(!t.is_manifold());
     let problems = check_invariants(&m);
     assert_eq!(problems.len(), 1, "{problems:?}");
-    assert!(problems[0].contains("edge 0-1, in 3 faces"), "{problems:?}");
+    assert_eq!(
+        problems[0],
+        Violation::NonManifoldEdge {
+            count: 1,
+            edge: [0, 1],
+            faces: 3
+        }
+    );
+    assert!(problems[0].to_string().contains("edge 0-1, in 3 faces"));
 }
 
 #[test]
@@ -426,9 +446,23 @@ fn duplicate_face() {
     assert_eq!(t.genus, None);
     let problems = check_invariants(&m);
     assert_eq!(problems.len(), 2, "{problems:?}");
-    assert!(problems
-        .iter()
-        .any(|p| p.contains("face 20") && p.contains("face 0")));
+    assert!(problems.iter().any(|p| matches!(
+        p,
+        Violation::DuplicateFace {
+            count: 1,
+            face: 20,
+            earlier: 0,
+            ..
+        }
+    )));
+    assert!(problems.iter().any(|p| matches!(
+        p,
+        Violation::NonManifoldEdge {
+            count: 3,
+            faces: 3,
+            ..
+        }
+    )));
 }
 
 #[test]
@@ -453,7 +487,14 @@ fn degenerate_faces() {
     assert_eq!(q.p30, 100.0 * 2.0 / 9.0);
     let problems = check_invariants(&m);
     assert_eq!(problems.len(), 1, "{problems:?}");
-    assert!(problems[0].contains("face 2"));
+    assert_eq!(
+        problems[0],
+        Violation::DegenerateFace {
+            count: 1,
+            face: 2,
+            triangle: [0, 4, 1]
+        }
+    );
 
     // A repeated index is degenerate too, and the faces are then no simplicial complex.
     let mut m = icosahedron();
@@ -476,8 +517,16 @@ fn flipped_face_gives_three_inconsistent_edges() {
     assert!(t.is_closed_manifold());
     let problems = check_invariants(&m);
     assert_eq!(problems.len(), 1, "{problems:?}");
-    assert!(problems[0].starts_with("3 inconsistently oriented edges"));
-    assert!(problems[0].contains("faces"));
+    assert!(
+        matches!(
+            problems[0],
+            Violation::InconsistentOrientation { count: 3, faces: [f, g], .. } if f == 7 || g == 7
+        ),
+        "{problems:?}"
+    );
+    assert!(problems[0]
+        .to_string()
+        .starts_with("3 inconsistently oriented edges"));
 }
 
 #[test]
@@ -523,7 +572,14 @@ fn unreferenced_and_out_of_range_vertices() {
     let problems = check_invariants(&m);
     assert_eq!(
         problems,
-        vec!["1 vertex used by no face (first: vertex 12)".to_string()]
+        vec![Violation::UnreferencedVertex {
+            count: 1,
+            vertex: 12
+        }]
+    );
+    assert_eq!(
+        problems[0].to_string(),
+        "1 vertex used by no face (first: vertex 12)"
     );
 
     // An index out of range is reported, and neither function panics.
@@ -537,7 +593,15 @@ fn unreferenced_and_out_of_range_vertices() {
     assert_eq!(t.faces, 2);
     assert_eq!(t.genus, None);
     let problems = check_invariants(&m);
-    assert!(problems[0].contains("face 1 uses vertex 7"), "{problems:?}");
+    assert_eq!(
+        problems[0],
+        Violation::IndexOutOfRange {
+            count: 1,
+            face: 1,
+            vertex: 7,
+            vertex_count: 3
+        }
+    );
 
     // Huge indices neither panic nor allocate by index; they count as vertices of their own.
     let m = TriMesh::new(
@@ -552,11 +616,16 @@ fn unreferenced_and_out_of_range_vertices() {
     assert_eq!(triangle_quality(&m).faces_measured, 1);
     let problems = check_invariants(&m);
     assert_eq!(problems.len(), 1, "{problems:?}");
-    assert!(problems[0].starts_with("2 faces refer"), "{problems:?}");
-    assert!(
-        problems[0].contains(&format!("uses vertex {}", u32::MAX)),
-        "{problems:?}"
+    assert_eq!(
+        problems[0],
+        Violation::IndexOutOfRange {
+            count: 2,
+            face: 1,
+            vertex: u32::MAX,
+            vertex_count: 3
+        }
     );
+    assert!(problems[0].to_string().starts_with("2 faces refer"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -795,9 +864,11 @@ fn timing_on_a_large_mesh() {
 
 /// A minimal OBJ reader for these tests only (`v` lines and the vertex index of `f` corners,
 /// polygons fanned); the crate's reader lives in `spectral_remesh::io`.
-fn read_obj_for_test(name: &str) -> Option<TriMesh> {
+/// Panics when the file is missing: the shared models are part of the test setup.
+fn read_obj_for_test(name: &str) -> TriMesh {
     let path = format!("{}/../shared/data/{name}", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(path).ok()?;
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{path}: {e} (the tests need ../shared/data beside the crate)"));
     let mut m = TriMesh::default();
     for line in text.lines() {
         let mut it = line.split_whitespace();
@@ -824,15 +895,12 @@ fn read_obj_for_test(name: &str) -> Option<TriMesh> {
             _ => {}
         }
     }
-    Some(m)
+    m
 }
 
 #[test]
 fn shared_models_match_the_data_readme() {
-    let Some(horse) = read_obj_for_test("horse.obj") else {
-        eprintln!("../shared/data not found: skipped");
-        return;
-    };
+    let horse = read_obj_for_test("horse.obj");
     // "closed genus-0 scan", 48,485 / 96,966.
     let t = topology(&horse);
     assert_eq!((t.vertices, t.faces), (48_485, 96_966));
@@ -842,14 +910,17 @@ fn shared_models_match_the_data_readme() {
     // tail (faces 70686 with 71145 and 71399, at about (9.3, -37.0, 15.9) in bbox-100 units).
     let problems = check_invariants(&horse);
     assert_eq!(problems.len(), 1, "{problems:?}");
-    assert!(
-        problems[0]
-            .starts_with("2 pairs of non-adjacent faces intersect (first: faces 70686 and 71145)"),
-        "{problems:?}"
+    assert_eq!(
+        problems[0],
+        Violation::Crossing {
+            count: 2,
+            f: 70686,
+            g: 71145
+        }
     );
 
     // "open scan: 5 holes (223 boundary edges), 1,113 unreferenced vertices".
-    let bunny = read_obj_for_test("stanford-bunny.obj").unwrap();
+    let bunny = read_obj_for_test("stanford-bunny.obj");
     let t = topology(&bunny);
     assert_eq!((t.boundary_edges, t.boundary_loops), (223, 5));
     assert_eq!(t.unreferenced_vertices, 1113);
@@ -858,7 +929,7 @@ fn shared_models_match_the_data_readme() {
     assert_eq!(check_invariants(&bunny).len(), 1);
 
     // "closed, but one non-manifold vertex".
-    let cow = read_obj_for_test("cow.obj").unwrap();
+    let cow = read_obj_for_test("cow.obj");
     let t = topology(&cow);
     assert_eq!(t.non_manifold_vertices, 1);
     assert_eq!((t.boundary_edges, t.non_manifold_edges), (0, 0));
@@ -866,7 +937,7 @@ fn shared_models_match_the_data_readme() {
 
     // "smooth closed genus 0".
     for name in ["spot.obj", "fandisk.obj"] {
-        let m = read_obj_for_test(name).unwrap();
+        let m = read_obj_for_test(name);
         let t = topology(&m);
         assert!(
             t.is_closed_manifold() && t.genus == Some(0),
@@ -878,7 +949,7 @@ fn shared_models_match_the_data_readme() {
     // has 2 components when faces join through shared vertices (our convention) or edges, and
     // 33 only when they join through two-face edges alone (its 47 non-manifold edges glue those
     // parts together).
-    let beetle = read_obj_for_test("beetle.obj").unwrap();
+    let beetle = read_obj_for_test("beetle.obj");
     let t = topology(&beetle);
     assert_eq!((t.vertices, t.faces), (1148, 2053));
     assert_eq!((t.components, t.non_manifold_edges), (2, 47));

@@ -4,7 +4,8 @@
 //! triangulation's guarantees.
 
 use glam::DVec3;
-use spectral_remesh::quality::topology;
+use spectral_remesh::check::{check_invariants, Violation};
+use spectral_remesh::triangulate::untangle::{untangle, UntangleParams};
 use spectral_remesh::triangulate::{triangulate, SampleSet, TriangulateParams};
 use spectral_remesh::TriMesh;
 
@@ -54,9 +55,15 @@ pub fn noisy_points(data: &[u8]) -> (Vec<DVec3>, Vec<DVec3>) {
     (positions, normals)
 }
 
-/// Triangulates the points and asserts the assembly's guarantees: indices in range, every edge
-/// in at most two faces, every vertex one fan, consistent orientation, no degenerate or
-/// duplicate face.
+/// Triangulates the points and asserts the assembly's guarantees with the full invariant check
+/// (`check_invariants`, self-intersections included), on the typed violations: indices in range,
+/// every edge in at most two faces, every vertex one fan, consistent orientation, no degenerate
+/// or duplicate face. Samples the triangulation leaves out (unreferenced vertices) are allowed.
+///
+/// Crossing faces are not excluded by the triangulation of noisy points (sparse samples with
+/// normals turned by up to 45° bridge across the torus's hole; making them impossible is issue
+/// 15's work), so for them the target asserts the untangle stage's guarantee instead: it never
+/// leaves more crossing pairs than it found, and what it reports is what the check finds.
 pub fn assert_triangulation_is_clean(positions: Vec<DVec3>, normals: &[DVec3]) {
     let set = SampleSet {
         positions: &positions,
@@ -64,12 +71,45 @@ pub fn assert_triangulation_is_clean(positions: Vec<DVec3>, normals: &[DVec3]) {
         boundary_edges: &[],
     };
     let (faces, _, _) = triangulate(&set, &TriangulateParams::default());
-    let mesh = TriMesh::new(positions.clone(), faces);
-    assert!(mesh.check_indices().is_none());
-    let t = topology(&mesh);
-    assert_eq!(t.non_manifold_edges, 0, "{t:?}");
-    assert_eq!(t.non_manifold_vertices, 0, "{t:?}");
-    assert_eq!(t.inconsistent_orientation_edges, 0, "{t:?}");
-    assert_eq!(t.degenerate_faces, 0, "{t:?}");
-    assert_eq!(t.duplicate_faces, 0, "{t:?}");
+    let mut mesh = TriMesh::new(positions.clone(), faces);
+    let crossings = |violations: &[Violation]| {
+        violations
+            .iter()
+            .map(|v| match v {
+                Violation::Crossing { count, .. } => *count,
+                _ => 0,
+            })
+            .sum::<usize>()
+    };
+    let violations = check_invariants(&mesh);
+    let structural: Vec<&Violation> = violations
+        .iter()
+        .filter(|v| {
+            !matches!(
+                v,
+                Violation::UnreferencedVertex { .. } | Violation::Crossing { .. }
+            )
+        })
+        .collect();
+    assert!(structural.is_empty(), "{structural:?}");
+
+    let before = crossings(&violations);
+    if before > 0 {
+        // The untangle stage with sigma_p the mean edge length.
+        let (mut total, mut edges) = (0.0, 0usize);
+        for t in &mesh.triangles {
+            for k in 0..3 {
+                total +=
+                    mesh.positions[t[k] as usize].distance(mesh.positions[t[(k + 1) % 3] as usize]);
+                edges += 1;
+            }
+        }
+        let sigma_p = total / edges as f64;
+        let fixed = vec![false; mesh.positions.len()];
+        let stats = untangle(&mut mesh, &fixed, sigma_p, &UntangleParams::default());
+        let after = check_invariants(&mesh);
+        assert_eq!(stats.pairs_before, before);
+        assert_eq!(stats.pairs_after, crossings(&after));
+        assert!(stats.pairs_after <= before, "{stats:?}");
+    }
 }

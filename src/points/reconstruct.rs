@@ -201,7 +201,7 @@ pub fn clip_to_domain(mesh: &mut TriMesh, positions: &[DVec3], radius: f64) -> u
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quality::topology;
+    use crate::check::topology;
 
     #[test]
     fn a_sampled_sphere_comes_back_closed_and_near_its_radius() {

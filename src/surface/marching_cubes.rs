@@ -660,7 +660,7 @@ pub fn marching_cubes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quality::{check_invariants, topology};
+    use crate::check::{check_invariants, topology};
 
     /// Every case's cycles use each crossing edge exactly once and no other edge.
     #[test]

@@ -7,9 +7,10 @@ use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use parry3d_f64::query::{Ray, RayCast};
 use rayon::prelude::*;
 
+use crate::check::{self_intersections, topology};
+use crate::geometry::tolerance::BURIED_OFFSET;
+use crate::geometry::triangle::is_degenerate_face;
 use crate::mesh::TriMesh;
-use crate::quality::{is_degenerate_face, topology};
-use crate::self_intersection::self_intersections;
 
 /// The directions of the crossing-count rays: fixed, unit length, far from every axis and
 /// diagonal and from each other. A ray that passes exactly through an edge or a vertex can
@@ -57,7 +58,7 @@ impl<'a> RayWinding<'a> {
                 let t = mesh.triangles[f];
                 t.iter()
                     .all(|&i| (i as usize) < n && mesh.positions[i as usize].is_finite())
-                    && !is_degenerate_face(mesh, f)
+                    && !is_degenerate_face(&mesh.positions, mesh.triangles[f])
             })
             .map(|f| {
                 let [a, b, c] = mesh.corners(f);
@@ -151,10 +152,6 @@ pub fn generalized_winding_number(mesh: &TriMesh, p: DVec3) -> f64 {
     }
     total / (4.0 * std::f64::consts::PI)
 }
-
-/// How far in front of the surface a point is tested by [`BuriedTest`], bbox-100 units: far
-/// below any sampling spacing, far above rounding.
-pub const BURIED_OFFSET: f64 = 1e-3;
 
 /// The largest (faces × points to test) for which [`BuriedTest`] uses the generalized winding
 /// number on an open mesh (O(F) per point): about a second on 2 cores.

@@ -91,7 +91,8 @@ impl<'a> Builder<'a> {
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !self.fits(t) {
             return false;
         }
-        if crate::quality::is_degenerate_triangle(t.map(|v| self.positions[v as usize])) {
+        if crate::geometry::triangle::is_degenerate_triangle(t.map(|v| self.positions[v as usize]))
+        {
             return false;
         }
         let f = self.faces.len() as u32;
@@ -125,7 +126,7 @@ impl<'a> Builder<'a> {
         if n.dot(avg) <= 0.0 {
             return -1.0;
         }
-        crate::quality::triangle_q([a, b, c])
+        crate::geometry::triangle::triangle_q([a, b, c])
     }
 
     /// Half-edges bordering holes: `b → a` for every face edge `a → b` with no face on `b → a`
@@ -525,7 +526,8 @@ fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec
                 let t = [lp[i], lp[j], lp[k]];
                 let mut q = b.quality(t);
                 if q <= 0.0 && allow_folds {
-                    q = 1e-3 * crate::quality::triangle_q(t.map(|v| b.positions[v as usize]));
+                    q = 1e-3
+                        * crate::geometry::triangle::triangle_q(t.map(|v| b.positions[v as usize]));
                 }
                 if !(q > 1e-9) {
                     continue;

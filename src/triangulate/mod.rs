@@ -14,7 +14,7 @@ pub use tangent_delaunay::{vote_triangles, SampleSet, TangentDelaunayParams, Vot
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
-use crate::quality::is_degenerate_triangle;
+use crate::geometry::triangle::is_degenerate_triangle;
 
 /// Parameters of [`triangulate`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

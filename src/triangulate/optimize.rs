@@ -28,8 +28,8 @@ use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 use super::refine::starting_at;
+use crate::geometry::triangle::{triangle_angles_deg, triangle_q};
 use crate::mesh::TriMesh;
-use crate::quality::{triangle_angles_deg, triangle_q};
 use crate::surface::mesh_projection::MeshSurface;
 
 /// Parameters of [`optimize`].
@@ -782,7 +782,8 @@ fn collapse_short(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quality::{check_invariants, topology, triangle_quality};
+    use crate::check::{check_invariants, topology};
+    use crate::report::triangle_quality;
 
     /// An `n × n` grid of squares of side `h` in the plane z = 0.
     fn grid(n: usize, h: f64) -> TriMesh {

@@ -13,7 +13,7 @@ use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 use super::cleanup::{Builder, FaceSource, BLOCKED};
-use crate::quality::triangle_angles_deg;
+use crate::geometry::triangle::triangle_angles_deg;
 use crate::spatial::StaticTree;
 
 /// Parameters of the refinement.

@@ -9,8 +9,9 @@
 use glam::DVec3;
 use serde::Serialize;
 
+use crate::geometry::self_intersection::intersecting_pairs;
+use crate::geometry::triangle_intersection::triangles_intersect;
 use crate::mesh::TriMesh;
-use crate::self_intersection::{intersecting_pairs, triangles_intersect};
 
 /// Parameters of [`untangle`]. Lengths are in units of σ_p.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -72,7 +73,7 @@ pub fn untangle(
     let mut stats = UntangleStats::default();
     let mut moved = vec![false; mesh.positions.len()];
     let margin = params.margin * sigma_p;
-    let mut pairs = intersecting_pairs(mesh);
+    let mut pairs = intersecting_pairs(&mesh.positions, &mesh.triangles);
     stats.pairs_before = pairs.len();
     let mut scale = 1.0;
     while !pairs.is_empty() && stats.rounds < params.max_rounds {
@@ -92,7 +93,7 @@ pub fn untangle(
         for &(v, d) in &moves {
             mesh.positions[v] += d;
         }
-        let after = intersecting_pairs(mesh);
+        let after = intersecting_pairs(&mesh.positions, &mesh.triangles);
         if after.len() < pairs.len() {
             for &(v, _) in &moves {
                 moved[v] = true;
@@ -203,8 +204,8 @@ fn round_moves(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check::check_invariants;
     use crate::mesh::test_meshes::grid;
-    use crate::quality::check_invariants;
 
     #[test]
     fn a_dent_through_a_nearby_sheet_is_pulled_back_and_a_clean_mesh_is_left_alone() {
@@ -219,7 +220,7 @@ mod tests {
             .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
         let poke = off as usize + 3 * 7 + 3;
         m.positions[poke].z = -0.3;
-        assert!(!intersecting_pairs(&m).is_empty());
+        assert!(!intersecting_pairs(&m.positions, &m.triangles).is_empty());
         let fixed = vec![false; m.positions.len()];
         let s = untangle(&mut m, &fixed, 1.0, &UntangleParams::default());
         assert!(s.pairs_before > 0 && s.pairs_after == 0, "{s:?}");
@@ -260,6 +261,9 @@ mod tests {
         let fixed = vec![false; m.positions.len()];
         let s = untangle(&mut m, &fixed, 1.0, &UntangleParams::default());
         assert!(s.pairs_after <= s.pairs_before, "{s:?}");
-        assert_eq!(s.pairs_after, intersecting_pairs(&m).len());
+        assert_eq!(
+            s.pairs_after,
+            intersecting_pairs(&m.positions, &m.triangles).len()
+        );
     }
 }

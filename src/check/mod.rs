@@ -1,0 +1,12 @@
+//! Checks of a mesh: its combinatorial topology, the invariants every output must keep (typed
+//! [`Violation`]s), and its self-intersections. These read meshes and never feed the
+//! triangulation.
+
+mod invariants;
+mod self_intersection;
+mod topology;
+
+pub(crate) use invariants::check_all;
+pub use invariants::{check_invariants, Violation};
+pub use self_intersection::{self_intersections, SelfIntersections};
+pub use topology::{topology, Topology};

@@ -1,0 +1,280 @@
+//! Two-sided Metro-style distance between two surfaces: Hausdorff, RMS and mean.
+//!
+//! Source: P. Cignoni, C. Rocchini, R. Scopigno. *Metro: Measuring Error on Simplified
+//! Surfaces*. Computer Graphics Forum 17(2), 1998, as used for Table 2 of Öztireli et al. 2010.
+
+use glam::DVec3;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::error::Result;
+use crate::geometry::morton::{morton_code, morton_scale};
+use crate::geometry::tolerance::SEARCH_BOUND_SLACK;
+use crate::mesh::TriMesh;
+use crate::surface::MeshSurface;
+
+/// Two-sided distance between two surfaces A and B, in the units of the meshes given (the
+/// pipeline passes bbox-100 units, Sec. 7 of the paper, so that numbers compare with its
+/// Table 2).
+///
+/// Metro-style (Cignoni et al. 1998): each side is sampled ([`surface_samples`]: every referenced
+/// vertex plus `samples_per_side` area-weighted uniform random points on its faces; no extra
+/// samples along edges), and each sample's distance to the *other* surface is the exact
+/// point-to-triangle-mesh distance (closest point through a BVH).
+///
+/// - `forward_hausdorff` = max over samples a of A of d(a, B); `backward_hausdorff` = max over
+///   samples b of B of d(b, A); `hausdorff` = the larger of the two (the symmetric Hausdorff
+///   distance, estimated from below by sampling; exact at the sampled points).
+/// - `forward_rms` = sqrt(mean over A's samples of d(a, B)²), `backward_rms` likewise; `rms` =
+///   the larger of the two (our convention: the worse side, as the symmetric Hausdorff distance
+///   does; Metro prints each side's RMS and the paper's Table 2 does not say which it
+///   reports).
+/// - `mean` = the mean of d over all samples of both sides together.
+///
+/// Vertices and random points weigh equally in the means; with `samples_per_side` well above the
+/// vertex count the means approach the area-weighted means of the surface.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SurfaceDistance {
+    /// max(forward_hausdorff, backward_hausdorff).
+    pub hausdorff: f64,
+    /// max(forward_rms, backward_rms).
+    pub rms: f64,
+    /// Mean distance over all samples of both sides.
+    pub mean: f64,
+    /// max over A's samples of the distance to B.
+    pub forward_hausdorff: f64,
+    /// max over B's samples of the distance to A.
+    pub backward_hausdorff: f64,
+    /// Root mean square over A's samples of the distance to B.
+    pub forward_rms: f64,
+    /// Root mean square over B's samples of the distance to A.
+    pub backward_rms: f64,
+    /// Random face samples drawn on each side (the vertices are sampled in addition).
+    pub samples_per_side: usize,
+}
+
+/// The seed of side B's samples, derived from the caller's seed so the two sides draw different
+/// streams.
+const SECOND_SIDE_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// The sample points of one side of [`surface_distance`]: every vertex used by a face (in index
+/// order, finite ones only), then `random` points drawn uniformly by area on the faces: a face is
+/// chosen with probability proportional to its area (inverse CDF over the running sum of areas),
+/// then a point uniformly in it (`a + r1 (b−a) + r2 (c−a)`, `(r1, r2)` reflected into the
+/// triangle when `r1 + r2 > 1`). Three `f64` draws per point from `ChaCha8Rng::seed_from_u64(seed)`:
+/// deterministic across platforms and runs. Faces with an out-of-range index or non-finite
+/// corner have no weight; if no face has area, only vertices are returned.
+pub fn surface_samples(mesh: &TriMesh, random: usize, seed: u64) -> Vec<DVec3> {
+    let n = mesh.positions.len();
+    let mut used = vec![false; n];
+    for t in &mesh.triangles {
+        for &i in t {
+            if (i as usize) < n {
+                used[i as usize] = true;
+            }
+        }
+    }
+    let mut points: Vec<DVec3> = mesh
+        .positions
+        .iter()
+        .zip(&used)
+        .filter(|(p, &u)| u && p.is_finite())
+        .map(|(p, _)| *p)
+        .collect();
+
+    let mut cumulative = Vec::with_capacity(mesh.triangles.len());
+    let mut total = 0.0;
+    let mut last_with_area = None;
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        let area = if t.iter().all(|&i| (i as usize) < n) {
+            let a = mesh.face_area(f);
+            if a.is_finite() {
+                a
+            } else {
+                0.0
+            }
+        } else {
+            0.0
+        };
+        if area > 0.0 {
+            last_with_area = Some(f);
+        }
+        total += area;
+        cumulative.push(total);
+    }
+    let Some(last_with_area) = last_with_area else {
+        return points;
+    };
+    if !(total.is_finite() && total > 0.0) {
+        return points;
+    }
+    points.reserve(random);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    for _ in 0..random {
+        let u = rng.random::<f64>() * total;
+        // The first face whose running sum exceeds u: it has positive area.
+        let f = cumulative.partition_point(|&c| c <= u).min(last_with_area);
+        let [a, b, c] = mesh.corners(f);
+        let mut r1 = rng.random::<f64>();
+        let mut r2 = rng.random::<f64>();
+        if r1 + r2 > 1.0 {
+            r1 = 1.0 - r1;
+            r2 = 1.0 - r2;
+        }
+        points.push(a + r1 * (b - a) + r2 * (c - a));
+    }
+    points
+}
+
+/// Points per sequential run of [`distances_to`].
+const QUERY_CHUNK: usize = 512;
+
+/// The distance from each of `points` to `surface` (`None` for a non-finite point), in the order
+/// of `points`.
+///
+/// The queries run in Morton (Z-curve) order of the points, in fixed chunks of
+/// [`QUERY_CHUNK`] spread over the rayon pool; within a chunk each query is bounded by the
+/// distance from its point to the previous query's closest point (an upper bound on the answer,
+/// since that closest point lies on the surface), which prunes most of the BVH. The bound only
+/// prunes, it never changes the minimum found, and the chunking does not depend on the thread
+/// count, so the result is deterministic.
+fn distances_to(points: &[DVec3], surface: &MeshSurface) -> Vec<Option<f64>> {
+    let finite = || points.iter().filter(|p| p.is_finite());
+    let lo = finite().fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
+    let hi = finite().fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
+    let scale = morton_scale((hi - lo).max_element());
+    let mut order: Vec<(u64, u32)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let code = if p.is_finite() {
+                morton_code((*p - lo) * scale)
+            } else {
+                u64::MAX
+            };
+            (code, i as u32)
+        })
+        .collect();
+    order.sort_unstable();
+
+    let sorted: Vec<Option<f64>> = order
+        .par_chunks(QUERY_CHUNK)
+        .flat_map_iter(|chunk| {
+            let mut previous: Option<DVec3> = None;
+            chunk.iter().map(move |&(_, i)| {
+                let p = points[i as usize];
+                let bounded = previous.and_then(|q| {
+                    // Strictly above the answer (the search keeps only closer candidates).
+                    let bound = (p - q).length() * (1.0 + SEARCH_BOUND_SLACK) + f64::MIN_POSITIVE;
+                    surface.closest_point_within(p, bound)
+                });
+                let found = bounded.or_else(|| surface.closest_point(p));
+                previous = found.map(|s| s.position);
+                found.map(|s| s.distance)
+            })
+        })
+        .collect();
+    let mut out = vec![None; points.len()];
+    for (&(_, i), d) in order.iter().zip(sorted) {
+        out[i as usize] = d;
+    }
+    out
+}
+
+/// max, sum of squares, sum and count of the distances from `points` to `surface`
+/// ([`distances_to`]), reduced sequentially in the order of `points`. Points with no closest
+/// point (non-finite) are skipped.
+fn one_side(points: &[DVec3], surface: &MeshSurface) -> (f64, f64, f64, usize) {
+    let mut max = 0.0f64;
+    let mut sum_sq = 0.0;
+    let mut sum = 0.0;
+    let mut count = 0;
+    for d in distances_to(points, surface).into_iter().flatten() {
+        max = max.max(d);
+        sum_sq += d * d;
+        sum += d;
+        count += 1;
+    }
+    (max, sum_sq, sum, count)
+}
+
+/// The two-sided Metro-style distance between meshes `a` and `b` (see [`SurfaceDistance`]), in
+/// their units (the pipeline passes bbox-100 units). `samples_per_side` random points are drawn
+/// on each side in addition to its vertices ([`surface_samples`]; side A from `seed`, side B from
+/// a seed derived from it), so a fixed seed gives the same result on every run. Distances are
+/// computed in parallel (rayon) and reduced in a fixed order.
+///
+/// # Runtime
+/// One BVH build per mesh, then one closest-point query per sample. The queries run in Morton
+/// order in fixed chunks, each bounded by the previous query's answer (see `distances_to` in the
+/// source), about 1.5× faster than unordered queries. Measured in the test profile on a shared
+/// 2-core machine: two 81,920-face spheres, 100k random samples plus the vertices on each side,
+/// 0.25–0.35 s (plus 0.12–0.15 s for the two BVH builds); the 96,966-face horse against a
+/// shifted copy in bbox-100 units, 0.2 s (plus 0.11 s).
+///
+/// # Errors
+/// [`crate::Error::InvalidMesh`] when either mesh cannot be searched ([`MeshSurface::new`]: no
+/// triangle of non-zero area, an index out of range, a non-finite coordinate).
+///
+/// Source: Metro (Cignoni, Rocchini, Scopigno 1998), as used for Table 2 of Öztireli et al. 2010.
+pub fn surface_distance(
+    a: &TriMesh,
+    b: &TriMesh,
+    samples_per_side: usize,
+    seed: u64,
+) -> Result<SurfaceDistance> {
+    let (sa, sb) = rayon::join(|| MeshSurface::new(a), || MeshSurface::new(b));
+    let (sa, sb) = (sa?, sb?);
+    Ok(surface_distance_with(
+        a,
+        &sa,
+        b,
+        &sb,
+        samples_per_side,
+        seed,
+    ))
+}
+
+/// [`surface_distance`] with prebuilt search structures: `a_surface` must be built from `a` and
+/// `b_surface` from `b` (samples are drawn on `a` and `b`, distances measured to the other's
+/// surface). Use it to compare several meshes with one input without rebuilding its BVH. If a
+/// side has no sample at all, its terms are 0.
+pub fn surface_distance_with(
+    a: &TriMesh,
+    a_surface: &MeshSurface,
+    b: &TriMesh,
+    b_surface: &MeshSurface,
+    samples_per_side: usize,
+    seed: u64,
+) -> SurfaceDistance {
+    let (pa, pb) = rayon::join(
+        || surface_samples(a, samples_per_side, seed),
+        || surface_samples(b, samples_per_side, seed ^ SECOND_SIDE_SEED),
+    );
+    let (fwd, bwd) = rayon::join(|| one_side(&pa, b_surface), || one_side(&pb, a_surface));
+    let rms = |(_, sum_sq, _, n): (f64, f64, f64, usize)| {
+        if n == 0 {
+            0.0
+        } else {
+            (sum_sq / n as f64).sqrt()
+        }
+    };
+    let (forward_rms, backward_rms) = (rms(fwd), rms(bwd));
+    let total = fwd.3 + bwd.3;
+    SurfaceDistance {
+        hausdorff: fwd.0.max(bwd.0),
+        rms: forward_rms.max(backward_rms),
+        mean: if total == 0 {
+            0.0
+        } else {
+            (fwd.2 + bwd.2) / total as f64
+        },
+        forward_hausdorff: fwd.0,
+        backward_hausdorff: bwd.0,
+        forward_rms,
+        backward_rms,
+        samples_per_side,
+    }
+}

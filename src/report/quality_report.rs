@@ -1,0 +1,289 @@
+//! Everything the pipeline reports about an output mesh, printed as a table or saved as JSON.
+
+use std::fmt;
+
+use serde::Serialize;
+
+#[cfg(doc)]
+use super::distance::surface_distance;
+use super::distance::SurfaceDistance;
+use super::triangle_quality::{triangle_quality, TriangleQuality};
+use crate::check::{check_all, SelfIntersections, Topology, Violation};
+#[cfg(doc)]
+use crate::check::{check_invariants, self_intersections, topology};
+use crate::mesh::TriMesh;
+
+/// The wall-clock time of one pipeline stage.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StageTime {
+    /// The stage's name (`read`, `normalize`, `linear scan`, ...).
+    pub stage: String,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// Everything the pipeline reports about an output mesh: the Table 1 triangle measures, its
+/// topology, optionally the input's topology and the distance to the input, stage timings, notes
+/// and free-form extra values (e.g. `sigma_p`). Printed as a table by `Display`, saved as JSON by
+/// [`QualityReport::to_json`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct QualityReport {
+    /// Table 1 measures of the output ([`triangle_quality`]).
+    pub triangles: TriangleQuality,
+    /// Topology of the output ([`topology`]).
+    pub topology: Topology,
+    /// Pairs of non-adjacent output faces that intersect ([`self_intersections`]).
+    pub self_intersections: SelfIntersections,
+    /// The output's violated invariants ([`check_invariants`]), one per kind; empty when all
+    /// hold. Serialized with a `kind` tag and the variant's fields.
+    pub invariant_violations: Vec<Violation>,
+    /// Distance between output (side A, "forward") and input (side B), in bbox-100 units
+    /// ([`surface_distance`]); `None` when not measured.
+    pub distance: Option<SurfaceDistance>,
+    /// Topology of the input, for comparison; `None` when not given.
+    pub input_topology: Option<Topology>,
+    /// Per-stage wall-clock times, in pipeline order.
+    pub stages: Vec<StageTime>,
+    /// Free-text remarks (warnings, repairs made, targets not reached).
+    pub notes: Vec<String>,
+    /// Extra named values (parameters such as `sigma_p`, counts), printed and serialized in
+    /// serde_json's map order (sorted by key unless its `preserve_order` feature is on).
+    pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+impl QualityReport {
+    /// The report of `mesh` with its triangle measures and topology; no distance, input
+    /// topology, stages, notes or extras yet.
+    pub fn new(mesh: &TriMesh) -> Self {
+        let (topology, crossings, violations) = check_all(mesh);
+        QualityReport {
+            triangles: triangle_quality(mesh),
+            invariant_violations: violations,
+            self_intersections: crossings,
+            topology,
+            distance: None,
+            input_topology: None,
+            stages: Vec::new(),
+            notes: Vec::new(),
+            extra: serde_json::Map::new(),
+        }
+    }
+
+    /// Appends a stage time (seconds of wall-clock time).
+    pub fn push_stage(&mut self, stage: impl Into<String>, seconds: f64) {
+        self.stages.push(StageTime {
+            stage: stage.into(),
+            seconds,
+        });
+    }
+
+    /// Runs `f`, appends its wall-clock time as stage `stage`, and returns its result.
+    pub fn time_stage<T>(&mut self, stage: impl Into<String>, f: impl FnOnce() -> T) -> T {
+        let start = std::time::Instant::now();
+        let out = f();
+        self.push_stage(stage, start.elapsed().as_secs_f64());
+        out
+    }
+
+    /// The sum of the stage times, in seconds.
+    pub fn total_seconds(&self) -> f64 {
+        self.stages.iter().map(|s| s.seconds).sum()
+    }
+
+    /// The report as pretty-printed JSON (field names as in the structs; `genus: null` where
+    /// undefined, `distance: null` where not measured).
+    pub fn to_json(&self) -> String {
+        // Serializing plain structs, strings and a JSON map cannot fail (non-finite floats are
+        // written as null).
+        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    }
+}
+
+/// A row of the printed topology block: its label and how to read the value.
+type TopologyRow = (&'static str, fn(&Topology) -> String);
+
+/// Width of the label column of the printed report.
+const LABEL: usize = 34;
+/// Width of a value column of the printed report.
+const VALUE: usize = 12;
+
+impl fmt::Display for QualityReport {
+    /// A fixed-width table: "Triangles (Table 1)" (angles with 2 decimals, Q with 4, percentages
+    /// with 2), "Topology" (the input's beside it when present), "Distance to input (bbox-100
+    /// units)" (4 decimals), "Time" (per stage and total, seconds), then extras and notes.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let t = &self.triangles;
+        writeln!(f, "Triangles (Table 1)")?;
+        let row = |f: &mut fmt::Formatter<'_>, label: &str, value: String| {
+            writeln!(f, "  {label:<LABEL$}{value:>VALUE$}")
+        };
+        row(f, "faces measured", t.faces_measured.to_string())?;
+        row(f, "θmin (deg)", format!("{:.2}", t.theta_min))?;
+        row(f, "θmin,ave (deg)", format!("{:.2}", t.theta_min_ave))?;
+        row(f, "Qmin", format!("{:.4}", t.q_min))?;
+        row(f, "Qave", format!("{:.4}", t.q_ave))?;
+        row(
+            f,
+            "%θ<30 (% of triangles)",
+            format!("{:.2}", t.pct_theta_below_30),
+        )?;
+        row(f, "P30 (% of angles)", format!("{:.2}", t.p30))?;
+
+        writeln!(f)?;
+        let input = self.input_topology.as_ref();
+        if input.is_some() {
+            writeln!(
+                f,
+                "{:<w$}{:>VALUE$}{:>VALUE$}",
+                "Topology",
+                "output",
+                "input",
+                w = LABEL + 2
+            )?;
+        } else {
+            writeln!(f, "Topology")?;
+        }
+        let topo_rows: [TopologyRow; 14] = [
+            ("vertices (referenced)", |t| t.vertices.to_string()),
+            ("faces", |t| t.faces.to_string()),
+            ("edges", |t| t.edges.to_string()),
+            ("Euler characteristic", |t| {
+                t.euler_characteristic.to_string()
+            }),
+            ("genus", |t| {
+                t.genus.map_or("-".to_string(), |g| g.to_string())
+            }),
+            ("components", |t| t.components.to_string()),
+            ("boundary edges", |t| t.boundary_edges.to_string()),
+            ("boundary loops", |t| t.boundary_loops.to_string()),
+            ("non-manifold edges", |t| t.non_manifold_edges.to_string()),
+            ("non-manifold vertices", |t| {
+                t.non_manifold_vertices.to_string()
+            }),
+            ("inconsistently oriented edges", |t| {
+                t.inconsistent_orientation_edges.to_string()
+            }),
+            ("degenerate faces", |t| t.degenerate_faces.to_string()),
+            ("duplicate faces", |t| t.duplicate_faces.to_string()),
+            ("unreferenced vertices", |t| {
+                t.unreferenced_vertices.to_string()
+            }),
+        ];
+        for (label, get) in topo_rows {
+            match input {
+                Some(inp) => writeln!(
+                    f,
+                    "  {label:<LABEL$}{:>VALUE$}{:>VALUE$}",
+                    get(&self.topology),
+                    get(inp)
+                )?,
+                None => row(f, label, get(&self.topology))?,
+            }
+        }
+
+        writeln!(f)?;
+        writeln!(f, "Invariants")?;
+        row(
+            f,
+            "self-intersecting face pairs",
+            self.self_intersections.pairs.to_string(),
+        )?;
+        if self.invariant_violations.is_empty() {
+            writeln!(
+                f,
+                "  all hold (manifold, consistently oriented, no degenerate, duplicate or intersecting faces)"
+            )?;
+        } else {
+            for v in &self.invariant_violations {
+                writeln!(f, "  VIOLATED: {v}")?;
+            }
+        }
+
+        writeln!(f)?;
+        writeln!(f, "Distance to input (bbox-100 units)")?;
+        match &self.distance {
+            Some(d) => {
+                row(f, "Hausdorff", format!("{:.4}", d.hausdorff))?;
+                row(f, "RMS (worse side)", format!("{:.4}", d.rms))?;
+                row(f, "mean", format!("{:.4}", d.mean))?;
+                row(
+                    f,
+                    "Hausdorff output→input",
+                    format!("{:.4}", d.forward_hausdorff),
+                )?;
+                row(
+                    f,
+                    "Hausdorff input→output",
+                    format!("{:.4}", d.backward_hausdorff),
+                )?;
+                row(f, "RMS output→input", format!("{:.4}", d.forward_rms))?;
+                row(f, "RMS input→output", format!("{:.4}", d.backward_rms))?;
+                row(f, "random samples per side", d.samples_per_side.to_string())?;
+            }
+            None => writeln!(f, "  (not measured)")?,
+        }
+
+        writeln!(f)?;
+        writeln!(f, "Time (s)")?;
+        for s in &self.stages {
+            row(f, &s.stage, format!("{:.3}", s.seconds))?;
+        }
+        row(f, "total", format!("{:.3}", self.total_seconds()))?;
+
+        if !self.extra.is_empty() {
+            writeln!(f)?;
+            writeln!(f, "Extra")?;
+            for (k, v) in &self.extra {
+                let v = match v {
+                    serde_json::Value::String(s) => s.clone(),
+                    other => other.to_string(),
+                };
+                row(f, k, v)?;
+            }
+        }
+        if !self.notes.is_empty() {
+            writeln!(f)?;
+            writeln!(f, "Notes")?;
+            for n in &self.notes {
+                writeln!(f, "  - {n}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::topology;
+    use glam::DVec3;
+
+    #[test]
+    fn display_has_every_block() {
+        let m = TriMesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]);
+        let mut r = QualityReport::new(&m);
+        r.input_topology = Some(topology(&m));
+        r.push_stage("triangulate", 0.25);
+        r.notes.push("a note".into());
+        r.extra.insert("sigma_p".into(), serde_json::json!(1.5));
+        let s = r.to_string();
+        for needle in [
+            "Triangles (Table 1)",
+            "45.00",
+            "Topology",
+            "input",
+            "Distance to input (bbox-100 units)",
+            "(not measured)",
+            "Time (s)",
+            "total",
+            "sigma_p",
+            "- a note",
+        ] {
+            assert!(s.contains(needle), "missing {needle:?} in\n{s}");
+        }
+        let json: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
+        assert_eq!(json["topology"]["genus"], serde_json::json!(0));
+        assert_eq!(json["extra"]["sigma_p"], serde_json::json!(1.5));
+        assert!(json["distance"].is_null());
+    }
+}
