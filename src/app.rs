@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use crate::error::{Error, Result};
 use crate::io::{read_mesh, write_mesh};
-use crate::pipeline::{remesh, Density, RemeshParams};
+use crate::pipeline::{remesh, RemeshParams};
 use crate::report::{surface_distance, surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
 
@@ -21,7 +21,7 @@ pub struct RemeshJob {
     pub input: PathBuf,
     /// Output mesh (.obj, .ply, .glb), format by extension.
     pub output: PathBuf,
-    /// Pipeline parameters; `Density::Points(0)` means "as many as the input has vertices".
+    /// Pipeline parameters (`Density::InputVertices`: as many as the input has vertices).
     pub params: RemeshParams,
     /// Whether to measure the distance to the input (Hausdorff, RMS).
     pub measure_distance: bool,
@@ -56,9 +56,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     let (input, stats) = read_mesh(&job.input)?;
     let read_seconds = t.elapsed().as_secs_f64();
     let mut params = job.params;
-    if params.density == Density::Points(0) {
-        params.density = Density::Points(input.vertex_count());
-    }
+    params.density = params.density.resolve(&input);
     let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
     on_stage("check");
     let t = Instant::now();

@@ -32,6 +32,27 @@ pub enum Density {
     Points(usize),
     /// This sigma_p, bbox-100 units.
     SigmaP(f64),
+    /// As many output vertices as the input has vertices (the command line's default); resolved
+    /// to [`Density::Points`] by [`Density::resolve`].
+    InputVertices,
+}
+
+impl Density {
+    /// The density for `input`: [`Density::InputVertices`] becomes `Points` of the input's
+    /// vertex count; the others stay as they are.
+    pub fn resolve(self, input: &TriMesh) -> Density {
+        match self {
+            Density::InputVertices => Density::Points(input.vertex_count()),
+            other => other,
+        }
+    }
+}
+
+/// [`Density`] resolved for one input: a vertex count or sigma_p.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Target {
+    Points(usize),
+    SigmaP(f64),
 }
 
 /// Output samples per unit of sigma_p^-2 area: a linear scan with epsilon = 0.5 followed by
@@ -205,20 +226,25 @@ pub fn remesh(
 ) -> Result<RemeshOutput> {
     let mut timer = Timer::new();
     let normalization = validate_input(input)?;
-    match params.density {
-        Density::Points(n) if n < 4 => {
+    let density = match params.density {
+        Density::Points(n) => Target::Points(n),
+        Density::SigmaP(s) => Target::SigmaP(s),
+        Density::InputVertices => Target::Points(input.vertex_count()),
+    };
+    match density {
+        Target::Points(n) if n < 4 => {
             return Err(Error::InvalidParameter {
                 name: "--points",
                 message: format!("at least 4 points are needed for a closed surface, got {n}"),
             })
         }
-        Density::Points(n) if n > MAX_POINTS => {
+        Target::Points(n) if n > MAX_POINTS => {
             return Err(Error::InvalidParameter {
                 name: "--points",
                 message: format!("{n} is more than the {MAX_POINTS} points this remesher holds in memory; for larger point sets use `remesh simplify`"),
             })
         }
-        Density::SigmaP(s) if !(s.is_finite() && s > 0.0) => {
+        Target::SigmaP(s) if !(s.is_finite() && s > 0.0) => {
             return Err(Error::InvalidParameter {
                 name: "--sigma-p",
                 message: format!("must be a positive number, got {s}"),
@@ -236,9 +262,9 @@ pub fn remesh(
     timer.lap("normalize");
 
     on_stage("candidates");
-    let expected = match params.density {
-        Density::Points(n) => n as f64,
-        Density::SigmaP(s) => SAMPLES_PER_SIGMA2 * area / (s * s),
+    let expected = match density {
+        Target::Points(n) => n as f64,
+        Target::SigmaP(s) => SAMPLES_PER_SIGMA2 * area / (s * s),
     };
     let pool_size = (params.candidates_per_sample * expected)
         .ceil()
@@ -273,13 +299,13 @@ pub fn remesh(
     // parts thinner than the sampling), so when the output's vertex count misses the target by
     // more than the search tolerance, the search runs again for a target raised by the
     // shortfall (at most twice).
-    let mut goal = match params.density {
-        Density::Points(n) => n,
-        Density::SigmaP(_) => 0,
+    let mut goal = match density {
+        Target::Points(n) => n,
+        Target::SigmaP(_) => 0,
     };
-    let mut start = match params.density {
-        Density::Points(n) => (SAMPLES_PER_SIGMA2 * area / n as f64).sqrt(),
-        Density::SigmaP(s) => s,
+    let mut start = match density {
+        Target::Points(n) => (SAMPLES_PER_SIGMA2 * area / n as f64).sqrt(),
+        Target::SigmaP(s) => s,
     };
     let mut full_history = Vec::new();
     let mut attempt = 0;
@@ -291,42 +317,42 @@ pub fn remesh(
             let r = linear_scan(&kernel, &pool, &b.samples, &params.linear_scan);
             Ok((r.samples.len(), (r, b.edges)))
         };
-        let (sigma_p, target_reached, search_history, (scan_result, boundary_edges)) =
-            match params.density {
-                Density::SigmaP(s) => {
-                    let (count, value) = scan(s)?;
-                    (s, true, vec![(s, count)], value)
-                }
-                Density::Points(_) => {
-                    let search = TargetCountParams {
-                        tolerance: params.count_tolerance,
-                        ..TargetCountParams::new(goal)
-                    };
-                    let mut failure = None;
-                    let r = find_sigma_p(&search, start, |s| match scan(s) {
-                        Ok(v) => v,
-                        Err(e) => {
-                            failure = Some(e);
+        let (sigma_p, target_reached, search_history, (scan_result, boundary_edges)) = match density
+        {
+            Target::SigmaP(s) => {
+                let (count, value) = scan(s)?;
+                (s, true, vec![(s, count)], value)
+            }
+            Target::Points(_) => {
+                let search = TargetCountParams {
+                    tolerance: params.count_tolerance,
+                    ..TargetCountParams::new(goal)
+                };
+                let mut failure = None;
+                let r = find_sigma_p(&search, start, |s| match scan(s) {
+                    Ok(v) => v,
+                    Err(e) => {
+                        failure = Some(e);
+                        (
+                            0,
                             (
-                                0,
-                                (
-                                    LinearScanResult {
-                                        samples: vec![],
-                                        initial: 0,
-                                        rejected_by_nearest: 0,
-                                        measured: 0,
-                                    },
-                                    vec![],
-                                ),
-                            )
-                        }
-                    });
-                    if let Some(e) = failure {
-                        return Err(e);
+                                LinearScanResult {
+                                    samples: vec![],
+                                    initial: 0,
+                                    rejected_by_nearest: 0,
+                                    measured: 0,
+                                },
+                                vec![],
+                            ),
+                        )
                     }
-                    (r.sigma_p, r.reached, r.history, r.value)
+                });
+                if let Some(e) = failure {
+                    return Err(e);
                 }
-            };
+                (r.sigma_p, r.reached, r.history, r.value)
+            }
+        };
         timer.lap("linear scan");
 
         on_stage("gradient ascent");
@@ -344,6 +370,7 @@ pub fn remesh(
             &mut samples,
             boundary_count,
             &params.gradient_ascent,
+            params.seed,
         );
         // A face buried only in part can still take a sample onto its buried part (the closest
         // point of the input can lie there): such a sample goes back to where the scan put it.
@@ -415,9 +442,9 @@ pub fn remesh(
         timer.lap("untangle");
         attempt += 1;
         let v = mesh_normalized.vertex_count() as f64;
-        let (done, reached, miss) = match params.density {
-            Density::SigmaP(_) => (true, target_reached, 0.0),
-            Density::Points(n) => {
+        let (done, reached, miss) = match density {
+            Target::SigmaP(_) => (true, target_reached, 0.0),
+            Target::Points(n) => {
                 let miss = n as f64 - v;
                 let done = attempt >= 3
                     || miss.abs() <= params.count_tolerance * n as f64
@@ -433,9 +460,9 @@ pub fn remesh(
                 input_normalized: normalized,
                 normalization,
                 sigma_p,
-                target: match params.density {
-                    Density::Points(n) => Some(n),
-                    Density::SigmaP(_) => None,
+                target: match density {
+                    Target::Points(n) => Some(n),
+                    Target::SigmaP(_) => None,
                 },
                 target_reached: reached,
                 search_history: full_history,

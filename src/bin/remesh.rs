@@ -487,7 +487,7 @@ fn run(cli: Cli) -> Result<(), Error> {
     let density = match (cli.points, cli.sigma_p) {
         (Some(n), None) => Density::Points(n),
         (None, Some(s)) => Density::SigmaP(s),
-        _ => Density::Points(0),
+        _ => Density::InputVertices,
     };
     if cli.points == Some(0) {
         return Err(Error::InvalidParameter {
@@ -505,7 +505,6 @@ fn run(cli: Cli) -> Result<(), Error> {
         ..Default::default()
     };
     params.gradient_ascent.iterations = cli.iterations;
-    params.gradient_ascent.seed = cli.seed;
     if let Some(s) = cli.sigma_n {
         params.sigma_n = s;
     }

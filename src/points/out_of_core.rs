@@ -225,12 +225,11 @@ fn resample_on_rimls(
         .collect();
     let ascent = GradientAscentParams {
         iterations: params.resample,
-        seed: params.seed,
         ..Default::default()
     };
     // Each move's projection gives the surface's normal there (a sample the projection never
     // moved keeps its own).
-    gradient_ascent(kernel, &rimls, &mut moving, 0, &ascent);
+    gradient_ascent(kernel, &rimls, &mut moving, 0, &ascent, params.seed);
     for (p, m) in samples.iter_mut().zip(&moving) {
         p.position = m.position;
         p.normal = m.normal;

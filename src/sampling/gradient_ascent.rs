@@ -30,8 +30,6 @@ pub struct GradientAscentParams {
     /// the start of the sweep, in parallel; that form needs a smaller step (0.25) to converge and
     /// converges more slowly (horse at 8600, 10 sweeps: θmin,ave 50.5 against 52.6).
     pub sequential: bool,
-    /// Seed of the sequential order.
-    pub seed: u64,
     /// Halvings of a step that would lower s (with the neighbours held fixed) before it is taken
     /// anyway (default 0: every step is taken, as in eq. 11). Measured on horse at 8600: no
     /// effect at step 0.5 (every step already raises s), Qave +0.0015 at step 0.75, at twice the
@@ -47,7 +45,6 @@ impl Default for GradientAscentParams {
             max_move: 0.25,
             support_radius: SUPPORT_RADIUS,
             sequential: true,
-            seed: 1,
             backtracking: 0,
         }
     }
@@ -71,7 +68,8 @@ pub struct GradientAscentResult {
 /// Neighbourhoods are found once with a kd-tree and kept for all sweeps (Sec. 6.3). By default
 /// each sweep visits the samples one at a time in a seeded random order, each move seeing the
 /// ones before it (Sec. 6.2); with `sequential = false` all moves of a sweep are computed in
-/// parallel from the positions at its start. Either way the result depends only on the seed.
+/// parallel from the positions at its start. Either way the result depends only on `seed` (the
+/// caller's seed of every random choice: `RemeshParams::seed` in the pipeline).
 ///
 /// The gradient is taken with respect to the position part of x with the sample's normal held
 /// fixed; the projection then gives the new position and the normal of the input triangle it
@@ -82,6 +80,7 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
     samples: &mut [SurfaceSample],
     fixed: usize,
     params: &GradientAscentParams,
+    seed: u64,
 ) -> GradientAscentResult {
     let n = samples.len();
     let fixed = fixed.min(n);
@@ -110,7 +109,7 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
     if params.sequential {
         use rand::seq::SliceRandom;
         use rand::SeedableRng;
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(params.seed);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let mut order: Vec<usize> = (fixed..n).collect();
         let mut embedded: Vec<KernelPoint> = samples
             .iter()
