@@ -224,8 +224,8 @@ pub fn measure_and_gradient(
     for (r, &j) in ws.kept.iter().enumerate() {
         let y = &neighbors[j];
         let w = 4.0 * ws.z[r] * ws.k[r];
-        for c in 0..3 {
-            grad[c] += w * (x.0[c] - y.0[c]);
+        for (g, (xc, yc)) in grad.iter_mut().zip(x.0.iter().zip(&y.0)) {
+            *g += w * (xc - yc);
         }
     }
     ((1.0 - q).clamp(0.0, 1.0), grad)
@@ -621,7 +621,7 @@ mod tests {
             let x = k.embed(p0, DVec3::Z);
             let (_, g) = measure_and_gradient(&k, &x, &pts, &mut ws);
             let h = 1e-6;
-            for c in 0..3 {
+            for (c, &gc) in g.iter().enumerate() {
                 let mut xp = x;
                 let mut xm = x;
                 xp.0[c] += h;
@@ -630,9 +630,8 @@ mod tests {
                     - spectral_measure(&k, &xm, pts.clone(), -1.0, &mut ws).s)
                     / (2.0 * h);
                 assert!(
-                    (fd - g[c]).abs() < 1e-5 * (1.0 + fd.abs()),
-                    "trial {trial} axis {c}: analytic {} finite difference {fd}",
-                    g[c]
+                    (fd - gc).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "trial {trial} axis {c}: analytic {gc} finite difference {fd}"
                 );
             }
         }

@@ -48,6 +48,9 @@ impl Density {
     }
 }
 
+/// A linear scan's result and the boundary edges between its first samples.
+type ScanWithBoundary = (LinearScanResult, Vec<[u32; 2]>);
+
 /// [`Density`] resolved for one input: a vertex count or sigma_p.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Target {
@@ -311,7 +314,7 @@ pub fn remesh(
     let mut attempt = 0;
     let output = loop {
         on_stage("linear scan");
-        let scan = |sigma_p: f64| -> Result<(usize, (LinearScanResult, Vec<[u32; 2]>))> {
+        let scan = |sigma_p: f64| -> Result<(usize, ScanWithBoundary)> {
             let kernel = Kernel::new(sigma_p, params.sigma_n)?;
             let b = sample_boundary(&normalized, &curves, BOUNDARY_SPACING_PER_SIGMA * sigma_p);
             let r = linear_scan(&kernel, &pool, &b.samples, &params.linear_scan);

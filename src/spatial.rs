@@ -200,7 +200,7 @@ impl StaticTree {
                 .query(&arr(p))
                 .within::<SquaredEuclidean<f64>>(radius_2)
                 .execute();
-            out.extend(r.into_iter().map(|q| (q.item as u32, q.distance)));
+            out.extend(r.into_iter().map(|q| (q.item, q.distance)));
         }
     }
 
@@ -212,7 +212,7 @@ impl StaticTree {
             t.query(&arr(p))
                 .within::<SquaredEuclidean<f64>>(radius_2)
                 .unsorted()
-                .visit(|q| out.push((q.item as u32, q.distance)));
+                .visit(|q| out.push((q.item, q.distance)));
         }
     }
 
@@ -226,7 +226,7 @@ impl StaticTree {
             .query(&arr(p))
             .nearest_n::<SquaredEuclidean<f64>>(k)
             .execute();
-        out.extend(r.into_iter().map(|q| (q.item as u32, q.distance)));
+        out.extend(r.into_iter().map(|q| (q.item, q.distance)));
     }
 }
 

@@ -508,7 +508,7 @@ fn gltf_with_several_meshes_and_nested_transforms_equals_its_flattened_obj() {
     });
     // Binary glTF: the header, the JSON chunk (padded with spaces), the BIN chunk.
     let mut json = serde_json::to_string(&gltf).unwrap().into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let mut glb = Vec::new();

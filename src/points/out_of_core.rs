@@ -195,7 +195,7 @@ const RIMLS_POINTS_PER_SAMPLE: usize = 4;
 /// the samples and part of `support` (see [`simplify_out_of_core`]).
 fn resample_on_rimls(
     kernel: &Kernel,
-    samples: &mut Vec<Point>,
+    samples: &mut [Point],
     support: Vec<Point>,
     had_normals: bool,
     params: &OutOfCoreParams,
