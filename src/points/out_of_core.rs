@@ -105,7 +105,7 @@ pub struct OutOfCoreResult {
 /// spectral measure (Sec. 6.2), each move projected onto the RIMLS surface (same sigma_p and
 /// sigma_n) of the samples and the first bucket's points, a uniformly random subset of the input,
 /// so memory stays bounded by a bucket (up to 3 of its points per sample are used, see
-/// [`RIMLS_POINTS_PER_SAMPLE`]). Their normals are then the RIMLS surface's.
+/// `RIMLS_POINTS_PER_SAMPLE`). Their normals are then the RIMLS surface's.
 ///
 /// # Errors
 /// Errors of the PLY reader (naming the file); [`Error::InvalidMesh`] for an empty input or one

@@ -179,7 +179,7 @@ impl LinearScanner {
     }
 
     /// One step of Algorithm 1: adds the point to O and returns true when s(x) > epsilon against
-    /// its neighbours in O (or it has none). Quick tests first (see [`quick_reject`]): the nearest
+    /// its neighbours in O (or it has none). Quick tests first (see `quick_reject`): the nearest
     /// output sample alone (s <= 1 - k(x, x_1)^2), then the few nearest.
     pub fn offer(&mut self, position: DVec3, normal: DVec3) -> bool {
         let kernel = &self.kernel;
