@@ -7,6 +7,9 @@
 //! The pipeline (see `ARCHITECTURE.md`): read → normalize (bbox 100) → candidates → linear scan →
 //! gradient ascent + projection → triangulate → clean up → report → write.
 
+#![warn(missing_docs)]
+#![deny(rustdoc::broken_intra_doc_links)]
+
 pub mod app;
 pub mod check;
 pub mod error;
