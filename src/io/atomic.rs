@@ -95,7 +95,11 @@ impl AtomicFile {
         file.persist(&path).map_err(|e| {
             write_error(
                 &path,
-                format!("cannot rename {} onto it: {}", e.file.path().display(), e.error),
+                format!(
+                    "cannot rename {} onto it: {}",
+                    e.file.path().display(),
+                    e.error
+                ),
             )
         })?;
         Ok(())
@@ -163,7 +167,10 @@ mod tests {
             Err(std::io::Error::other("disk on fire"))
         })
         .unwrap_err();
-        assert!(matches!(&e, Error::Write { path: p, .. } if p == &path), "{e}");
+        assert!(
+            matches!(&e, Error::Write { path: p, .. } if p == &path),
+            "{e}"
+        );
         assert!(e.to_string().contains("disk on fire"), "{e}");
         assert_eq!(std::fs::read(&path).unwrap(), b"old");
         assert_eq!(names(dir.path()), ["out.txt"]);
@@ -198,12 +205,18 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let missing = dir.path().join("no-such-dir").join("out.txt");
         let e = write_atomically(&missing, |w| w.write_all(b"x")).unwrap_err();
-        assert!(matches!(&e, Error::Write { path, .. } if path == &missing), "{e}");
+        assert!(
+            matches!(&e, Error::Write { path, .. } if path == &missing),
+            "{e}"
+        );
         // The target is a directory: the rename fails and the temporary file goes.
         let taken = dir.path().join("taken");
         std::fs::create_dir(&taken).unwrap();
         let e = write_atomically(&taken, |w| w.write_all(b"x")).unwrap_err();
-        assert!(matches!(&e, Error::Write { path, .. } if path == &taken), "{e}");
+        assert!(
+            matches!(&e, Error::Write { path, .. } if path == &taken),
+            "{e}"
+        );
         assert_eq!(names(dir.path()), ["taken"]);
     }
 

@@ -266,7 +266,9 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
     let normals = output_normals(mesh);
     let bytes = match format {
         MeshFormat::Obj => obj::encode(mesh, &normals),
-        MeshFormat::Ply => ply::encode_mesh(mesh, &normals).map_err(|e| write_err(e.to_string()))?,
+        MeshFormat::Ply => {
+            ply::encode_mesh(mesh, &normals).map_err(|e| write_err(e.to_string()))?
+        }
         MeshFormat::Glb => gltf::encode_glb(mesh, &normals).map_err(write_err)?,
         MeshFormat::Gltf => gltf::encode_gltf(mesh, &normals).map_err(write_err)?,
     };

@@ -180,8 +180,8 @@ impl PointReader {
         }
         let slot = |n: &str| names.iter().position(|m| *m == n);
         for (k, name) in ["x", "y", "z"].iter().enumerate() {
-            let i = slot(name)
-                .ok_or_else(|| parse(format!("the vertex element has no `{name}`")))?;
+            let i =
+                slot(name).ok_or_else(|| parse(format!("the vertex element has no `{name}`")))?;
             properties[i].1 = Some(k);
         }
         let normal_slots: Vec<Option<usize>> = ["nx", "ny", "nz"].iter().map(|n| slot(n)).collect();
@@ -526,14 +526,8 @@ impl PlyPointWriter {
             path: path.to_path_buf(),
             message: e.to_string(),
         };
-        let ply = BinaryPlyWriter::new(
-            file,
-            "spectral-remesh point set",
-            count,
-            with_levels,
-            None,
-        )
-        .map_err(write_error)?;
+        let ply = BinaryPlyWriter::new(file, "spectral-remesh point set", count, with_levels, None)
+            .map_err(write_error)?;
         Ok(PlyPointWriter { ply })
     }
 

@@ -9,9 +9,9 @@ use ply_rs_bw::ply::{
     Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
 };
 
-use crate::io::{one_line, read_file, ReadStats};
 use super::{read_header, strip_line_prefix};
 use crate::error::{Error, Result};
+use crate::io::{one_line, read_file, ReadStats};
 use crate::mesh::TriMesh;
 
 /// The names a face element's index list may have.

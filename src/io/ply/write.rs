@@ -49,18 +49,23 @@ impl<W: Write> BinaryPlyWriter<W> {
         vertex.count = count(vertices)?;
         for name in ["x", "y", "z", "nx", "ny", "nz"] {
             let float = PropertyType::Scalar(ScalarType::Float);
-            vertex.properties.add(PropertyDef::new(name.to_string(), float));
+            vertex
+                .properties
+                .add(PropertyDef::new(name.to_string(), float));
         }
         if with_levels {
             let uchar = PropertyType::Scalar(ScalarType::UChar);
-            vertex.properties.add(PropertyDef::new("level".to_string(), uchar));
+            vertex
+                .properties
+                .add(PropertyDef::new("level".to_string(), uchar));
         }
         header.elements.add(vertex);
         if let Some(faces) = faces {
             let mut face = ElementDef::new("face".to_string());
             face.count = count(faces)?;
             let list = PropertyType::List(ScalarType::UChar, ScalarType::Int);
-            face.properties.add(PropertyDef::new("vertex_indices".to_string(), list));
+            face.properties
+                .add(PropertyDef::new("vertex_indices".to_string(), list));
             header.elements.add(face);
         }
         Writer::<DefaultElement>::new().write_header(&mut out, &header)?;
@@ -198,10 +203,19 @@ mod tests {
     fn header_and_records_have_the_announced_layout() {
         let mut w = BinaryPlyWriter::new(Vec::new(), "c", 2, true, Some(1)).unwrap();
         w.vertex([1.0, 2.0, 3.0], [0.0, 0.0, 1.0], Some(1)).unwrap();
-        assert!(w.triangle([0, 1, 0]).is_err(), "a face before the last vertex");
-        assert!(w.vertex([0.0; 3], [0.0; 3], None).is_err(), "a vertex without level");
+        assert!(
+            w.triangle([0, 1, 0]).is_err(),
+            "a face before the last vertex"
+        );
+        assert!(
+            w.vertex([0.0; 3], [0.0; 3], None).is_err(),
+            "a vertex without level"
+        );
         w.vertex([4.0, 5.0, 6.0], [1.0, 0.0, 0.0], Some(2)).unwrap();
-        assert!(w.vertex([0.0; 3], [0.0; 3], Some(3)).is_err(), "one vertex too many");
+        assert!(
+            w.vertex([0.0; 3], [0.0; 3], Some(3)).is_err(),
+            "one vertex too many"
+        );
         w.triangle([0, 1, 1]).unwrap();
         let bytes = w.finish().unwrap();
         let header = "ply\nformat binary_little_endian 1.0\ncomment c\nelement vertex 2\n\
