@@ -655,6 +655,57 @@ mod tests {
     }
 
     #[test]
+    fn bad_ply_headers_are_one_line_errors_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let vertex = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
+        let cases = [
+            ("not ply", "v 0 0 0\n".to_string(), "not a PLY file"),
+            (
+                "face first",
+                format!("ply\nformat ascii 1.0\nelement face 0\n{vertex}end_header\n"),
+                "`vertex` first",
+            ),
+            (
+                "list",
+                format!("ply\nformat ascii 1.0\n{vertex}property list uchar int n\nend_header\n"),
+                "list properties",
+            ),
+            (
+                "no z",
+                "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+                 end_header\n"
+                    .to_string(),
+                "no `z`",
+            ),
+            (
+                "twice",
+                format!(
+                    "ply\nformat binary_little_endian 1.0\n{vertex}property float x\nend_header\n"
+                ),
+                "twice",
+            ),
+            (
+                "no end",
+                format!("ply\nformat ascii 1.0\n{vertex}"),
+                "end_header",
+            ),
+            (
+                "bad format",
+                format!("ply\nformat binary 1.0\n{vertex}end_header\n"),
+                "",
+            ),
+        ];
+        for (name, text, mentions) in cases {
+            let path = dir.path().join(format!("{name}.ply"));
+            std::fs::write(&path, text).unwrap();
+            let err = PointReader::open(&path).err().unwrap().to_string();
+            assert!(err.contains(&format!("{name}.ply")), "{err}");
+            assert!(err.contains(mentions), "{name}: {err}");
+            assert_eq!(err.lines().count(), 1, "{err}");
+        }
+    }
+
+    #[test]
     fn text_point_sets_xyz_and_csv() {
         let dir = tempfile::tempdir().unwrap();
         // .pts: a count line, blanks, comments, four columns (the fourth, intensity, skipped).
