@@ -985,35 +985,6 @@ fn garbage_never_panics() {
     }
 }
 
-/// Writes spot and horse as `.glb` and `.gltf` into `$GLTF_OUT_DIR` for the Khronos validator
-/// (`eval/validate_gltf.mjs`); ignored by default:
-/// `GLTF_OUT_DIR=/tmp/out cargo test --test io -- --ignored write_gltf_for_validator`.
-#[test]
-#[ignore]
-fn write_gltf_for_validator() {
-    let out = PathBuf::from(std::env::var("GLTF_OUT_DIR").expect("set GLTF_OUT_DIR"));
-    fs::create_dir_all(&out).unwrap();
-    for name in ["spot.obj", "horse.ply"] {
-        let (m, _) = read(name);
-        let stem = name.split('.').next().unwrap();
-        for ext in ["glb", "gltf"] {
-            write_mesh(&out.join(format!("{stem}.{ext}")), &m).unwrap();
-        }
-    }
-    // An isolated vertex (normal +Z) and a degenerate triangle.
-    let odd = TriMesh::new(
-        vec![
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::Y,
-            DVec3::splat(5.0),
-            DVec3::new(2.0, 0.0, 0.0),
-        ],
-        vec![[0, 1, 2], [0, 1, 4]],
-    );
-    write_mesh(&out.join("odd.glb"), &odd).unwrap();
-}
-
 #[test]
 fn gltf_extensions_quantized_positions_and_missing_bounds() {
     // Three i16 positions with a byte stride of 8, as KHR_mesh_quantization allows; no
