@@ -1,83 +1,102 @@
-//! Benchmark of issue 2: horse at 8600 points, load to write, with the split per stage.
+//! Benchmarks of the remesh pipeline on the horse (`../shared/data/horse.obj`, 48,485
+//! vertices) at 8600 output points, on `criterion`:
+//! - `horse/remesh 8600` — the whole job as `remesh` runs it: read, remesh, write (no distance
+//!   measurement); about a second per run, so 10 samples; one run's split per stage is
+//!   printed first;
+//! - `horse/linear scan` — the randomized linear scan (Sec. 6.1) of 86,000 surface candidates
+//!   at the sigma_p that leaves about 8600 samples;
+//! - `horse/triangulate` — the triangulation of those samples (tangent-plane Delaunay
+//!   umbrellas merged by votes, then the manifold clean-up).
 //!
-//! `cargo bench --bench horse` (or `-- RUNS MODEL N` to change the defaults 5,
-//! ../shared/data/horse.obj, 8600). Runs the whole job (read, remesh, write; no distance
-//! measurement) RUNS times and prints the median, minimum and maximum of the total and the
-//! median of each stage, in seconds. Wall-clock time on a shared machine is noisy: compare
-//! medians, not single runs.
+//! `cargo bench --bench horse` (a filter picks some: `cargo bench --bench horse -- scan`).
+//! Wall-clock time on a shared machine is noisy: compare runs on the same machine.
 
 use std::path::PathBuf;
-use std::time::Instant;
+use std::time::Duration;
 
+use criterion::{criterion_group, criterion_main, Criterion};
 use spectral_remesh::app::{run_remesh, RemeshJob};
-use spectral_remesh::pipeline::{Density, RemeshParams};
+use spectral_remesh::io::read_mesh;
+use spectral_remesh::kernel::Kernel;
+use spectral_remesh::pipeline::{validate_input, Density, RemeshParams, SAMPLES_PER_SIGMA2};
+use spectral_remesh::sampling::candidates::surface_candidates;
+use spectral_remesh::sampling::linear_scan::{linear_scan, LinearScanParams};
+use spectral_remesh::triangulate::tangent_delaunay::SampleSet;
+use spectral_remesh::triangulate::{triangulate, TriangulateParams};
 
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
+/// Output vertices, as the harness remeshes the horse.
+const POINTS: usize = 8600;
+
+fn horse() -> PathBuf {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/horse.obj");
+    assert!(
+        path.exists(),
+        "{} is missing: the benchmarks need the shared test models",
+        path.display()
+    );
+    path
 }
 
-fn main() {
-    // `cargo bench` passes `--bench`; keep only our positional arguments.
-    let args: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with("--"))
-        .collect();
-    let runs: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(5);
-    let model = args.get(1).map(PathBuf::from).unwrap_or_else(|| {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/horse.obj")
-    });
-    let points: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(8600);
-    if !model.exists() {
-        eprintln!("bench horse: {} not found; skipped", model.display());
-        return;
-    }
-    let dir = std::env::temp_dir().join(format!("spectral-remesh-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temporary directory");
+fn remesh_job(c: &mut Criterion) {
+    let dir = tempfile::tempdir().expect("a temporary directory");
     let job = RemeshJob {
-        input: model.clone(),
-        output: dir.join("out.obj"),
+        input: horse(),
+        output: dir.path().join("out.obj"),
         params: RemeshParams {
-            density: Density::Points(points),
+            density: Density::Points(POINTS),
             ..Default::default()
         },
         strict: false,
         measure_distance: false,
     };
-    let mut totals = Vec::new();
-    let mut stages: Vec<(String, Vec<f64>)> = Vec::new();
-    let mut vertices = 0;
-    for _ in 0..runs {
-        let t = Instant::now();
-        let report = run_remesh(&job, &|_| {}).expect("remesh");
-        totals.push(t.elapsed().as_secs_f64());
-        vertices = report.topology.vertices;
-        for s in &report.stages {
-            match stages.iter_mut().find(|x| x.0 == s.stage) {
-                Some(x) => x.1.push(s.seconds),
-                None => stages.push((s.stage.clone(), vec![s.seconds])),
-            }
-        }
+    // The split per stage of one run, which criterion's total does not show.
+    let report = run_remesh(&job, &|_| {}).expect("remesh");
+    println!("horse/remesh 8600, one run by stage:");
+    for s in &report.stages {
+        println!("  {:<18} {:>7.3} s", s.stage, s.seconds);
     }
-    let _ = std::fs::remove_dir_all(&dir);
-    let (lo, hi) = (
-        totals.iter().copied().fold(f64::INFINITY, f64::min),
-        totals.iter().copied().fold(0.0, f64::max),
-    );
-    println!(
-        "{} --points {points}: {vertices} vertices, {runs} runs",
-        model.display()
-    );
-    println!(
-        "load to write: median {:.3} s (min {lo:.3}, max {hi:.3})",
-        median(&mut totals)
-    );
-    for (name, mut v) in stages {
-        println!("  {name:<18} {:>7.3} s (median)", median(&mut v));
-    }
+    c.bench_function("horse/remesh 8600", |b| {
+        b.iter(|| run_remesh(&job, &|_| {}).expect("remesh"))
+    });
 }
+
+fn stages(c: &mut Criterion) {
+    let (mesh, _) = read_mesh(&horse()).expect("read the horse");
+    let normalized = validate_input(&mesh)
+        .expect("a valid input")
+        .apply_mesh(&mesh);
+    let candidates = surface_candidates(&normalized, 10 * POINTS, 1);
+    let sigma_p = (SAMPLES_PER_SIGMA2 * normalized.area() / POINTS as f64).sqrt();
+    let kernel = Kernel::new(sigma_p, f64::INFINITY).expect("a valid kernel");
+    let params = LinearScanParams::default();
+    c.bench_function("horse/linear scan", |b| {
+        b.iter(|| linear_scan(&kernel, &candidates, &[], &params))
+    });
+
+    let samples = linear_scan(&kernel, &candidates, &[], &params).samples;
+    let positions: Vec<_> = samples.iter().map(|s| s.position).collect();
+    let normals: Vec<_> = samples.iter().map(|s| s.normal).collect();
+    let set = SampleSet {
+        positions: &positions,
+        normals: &normals,
+        boundary_edges: &[],
+    };
+    let params = TriangulateParams::default();
+    c.bench_function("horse/triangulate", |b| {
+        b.iter(|| triangulate(&set, &params))
+    });
+}
+
+fn config() -> Criterion {
+    Criterion::default()
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(12))
+}
+
+criterion_group! {
+    name = benches;
+    config = config();
+    targets = remesh_job, stages
+}
+criterion_main!(benches);

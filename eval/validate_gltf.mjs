@@ -3,6 +3,8 @@
 //
 // Usage:
 //   node eval/validate_gltf.mjs FILE.glb [FILE.gltf ...]
+// or, to write the crate's glTF outputs of spot, horse and an odd mesh and run this on them:
+//   cargo run --release --example validate_gltf -- OUT_DIR
 //
 // Prints, for each file, the counts of errors, warnings, infos and hints and every issue
 // (severity, code, JSON pointer, message). Exit code: 0 when no file has an error, 1 when any

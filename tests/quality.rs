@@ -813,51 +813,6 @@ fn distance_with_prebuilt_surfaces_matches() {
     );
 }
 
-/// Timing on a ~100k-triangle mesh: `cargo test --test quality -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn timing_on_a_large_mesh() {
-    use std::time::Instant;
-    let a = icosphere(6); // 81,920 faces
-    let rot = glam::DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.3);
-    let b = TriMesh::new(
-        a.positions.iter().map(|p| 1.01 * (rot * *p)).collect(),
-        a.triangles.clone(),
-    );
-    let t = Instant::now();
-    let q = triangle_quality(&a);
-    let topo = topology(&a);
-    let inv = check_invariants(&a);
-    println!(
-        "triangle_quality + topology + check_invariants on {} faces: {:.3} s",
-        a.face_count(),
-        t.elapsed().as_secs_f64()
-    );
-    assert!(inv.is_empty() && topo.genus == Some(0) && q.q_min > 0.5);
-    let t = Instant::now();
-    let (sa, sb) = (MeshSurface::new(&a).unwrap(), MeshSurface::new(&b).unwrap());
-    println!(
-        "two BVH builds ({} + {} faces): {:.3} s",
-        a.face_count(),
-        b.face_count(),
-        t.elapsed().as_secs_f64()
-    );
-    let t = Instant::now();
-    let d = surface_distance_with(&a, &sa, &b, &sb, 100_000, 1);
-    println!(
-        "surface_distance_with, 100k random samples + vertices per side: {:.3} s ({d:?})",
-        t.elapsed().as_secs_f64()
-    );
-    let t = Instant::now();
-    let d2 = surface_distance(&a, &a, 100_000, 1).unwrap();
-    println!(
-        "surface_distance (with BVH builds) of the 81,920-face sphere against itself: {:.3} s ({})",
-        t.elapsed().as_secs_f64(),
-        d2.hausdorff
-    );
-    assert!(close(d.backward_hausdorff, 0.01, 1e-3));
-}
-
 // ---------------------------------------------------------------------------------------------
 // The shared test models (../shared/data; see its README)
 // ---------------------------------------------------------------------------------------------

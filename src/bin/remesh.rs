@@ -267,7 +267,7 @@ enum Command {
 
 /// Writes a JSON report atomically (a temporary file beside it, then a rename).
 fn write_report(path: &PathBuf, json: &str) -> Result<(), Error> {
-    spectral_remesh::io::write_atomically(path, json.as_bytes())
+    spectral_remesh::io::write_atomically(path, |w| w.write_all(json.as_bytes()))
 }
 
 /// Writes to standard output. A reader that went away (`remesh ... | head`) is not an error:

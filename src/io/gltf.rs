@@ -2,9 +2,10 @@
 //! writing one mesh as a binary or embedded glTF asset.
 //!
 //! Reading parses and validates the document with `gltf`, loads only its buffers (not its
-//! images), and decodes accessors with our own bounds-checked code: the `gltf` crate's accessor
-//! iterators and importer can panic on some malformed files (a GLB header length below 12, an
-//! accessor of count 0, a buffer URI that is not UTF-8 once percent-decoded).
+//! images: data URIs decoded by `base64`, file paths by `percent-encoding`), and decodes
+//! accessors with our own bounds-checked code: the `gltf` crate's accessor iterators and
+//! importer can panic on some malformed files (a GLB header length below 12, an accessor of
+//! count 0, a buffer URI that is not UTF-8 once percent-decoded).
 
 use std::path::{Path, PathBuf};
 
@@ -12,7 +13,13 @@ use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::buffer::Source;
 use ::gltf::json::validation::{Error as ValidationError, Validate};
 use ::gltf::mesh::Mode;
+use base64::engine::general_purpose::{
+    GeneralPurpose, GeneralPurposeConfig, STANDARD as BASE64_STANDARD,
+};
+use base64::engine::DecodePaddingMode;
+use base64::Engine;
 use glam::{DMat3, DMat4, DVec3};
+use percent_encoding::percent_decode_str;
 use serde_json::json;
 
 use super::{one_line, read_file, ReadStats};
@@ -206,7 +213,7 @@ fn load_buffers(
     path: &Path,
     document: &::gltf::Document,
     mut blob: Option<Vec<u8>>,
-) -> Result<Vec<::gltf::buffer::Data>> {
+) -> Result<Vec<Vec<u8>>> {
     let base = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -214,40 +221,33 @@ fn load_buffers(
     let mut out = Vec::new();
     for buffer in document.buffers() {
         let i = buffer.index();
-        let uri = match buffer.source() {
-            Source::Uri(uri) => {
-                // `gltf` unwraps the percent-decoding of relative URIs into UTF-8.
-                if !uri.contains(':') && std::str::from_utf8(&percent_decode(uri)).is_err() {
-                    return Err(Error::parse(
-                        path,
-                        None,
-                        format!("buffer {i}: URI is not UTF-8 once percent-decoded"),
-                    ));
-                }
-                Some(uri)
+        let (what, data) = match buffer.source() {
+            Source::Bin => (
+                "GLB binary chunk".to_string(),
+                blob.take().ok_or_else(|| {
+                    BufferError::Invalid("the file has no binary chunk".to_string())
+                }),
+            ),
+            Source::Uri(uri) if uri.starts_with("data:") => {
+                ("embedded data URI".to_string(), decode_data_uri(uri))
             }
-            Source::Bin => None,
+            Source::Uri(uri) => (format!("'{}'", one_line(uri)), read_uri(&base, uri)),
         };
-        let data =
-            ::gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(&base), &mut blob)
-                .map_err(|e| {
-                    let what = match uri {
-                        Some(u) if u.starts_with("data:") => "embedded data URI".to_string(),
-                        Some(u) => format!("'{}'", one_line(u)),
-                        None => "GLB binary chunk".to_string(),
-                    };
-                    match e {
-                        ::gltf::Error::Io(io) => Error::io(
-                            path,
-                            std::io::Error::new(io.kind(), format!("buffer {i} ({what}): {io}")),
-                        ),
-                        other => Error::parse(
-                            path,
-                            None,
-                            format!("buffer {i} ({what}): {}", one_line(&other.to_string())),
-                        ),
-                    }
-                })?;
+        let mut data = data.map_err(|e| match e {
+            BufferError::Io(io) => Error::io(
+                path,
+                std::io::Error::new(io.kind(), format!("buffer {i} ({what}): {io}")),
+            ),
+            BufferError::Invalid(message) => Error::parse(
+                path,
+                None,
+                format!("buffer {i} ({what}): {}", one_line(&message)),
+            ),
+        })?;
+        // Padded to four bytes, as the GLB binary chunk is.
+        while data.len() % 4 != 0 {
+            data.push(0);
+        }
         if data.len() < buffer.length() {
             return Err(Error::parse(
                 path,
@@ -264,31 +264,61 @@ fn load_buffers(
     Ok(out)
 }
 
-/// Percent-decoding as the `urlencoding` crate does it (`%` not followed by two hex digits is
-/// kept as it is).
-fn percent_decode(s: &str) -> Vec<u8> {
-    let b = s.as_bytes();
-    let mut out = Vec::with_capacity(b.len());
-    let mut k = 0;
-    while k < b.len() {
-        if b[k] == b'%' && k + 2 < b.len() {
-            let hex = |c: u8| (c as char).to_digit(16);
-            if let (Some(h), Some(l)) = (hex(b[k + 1]), hex(b[k + 2])) {
-                out.push((h * 16 + l) as u8);
-                k += 3;
-                continue;
-            }
-        }
-        out.push(b[k]);
-        k += 1;
+/// Why a buffer could not be loaded: its file could not be read, or its URI or data is bad.
+enum BufferError {
+    Io(std::io::Error),
+    Invalid(String),
+}
+
+/// The bytes of a `data:[<media type>][;base64],<data>` URI (RFC 2397): base64 (padding
+/// optional) or percent-encoded.
+fn decode_data_uri(uri: &str) -> std::result::Result<Vec<u8>, BufferError> {
+    let rest = uri.strip_prefix("data:").unwrap_or(uri);
+    let (media, data) = rest
+        .split_once(',')
+        .ok_or_else(|| BufferError::Invalid("a data URI without a comma".to_string()))?;
+    if media.ends_with(";base64") {
+        BASE64_LENIENT
+            .decode(data)
+            .map_err(|e| BufferError::Invalid(format!("bad base64: {e}")))
+    } else {
+        Ok(percent_decode_str(data).collect())
     }
-    out
+}
+
+/// Standard base64 that accepts data with or without its `=` padding, as writers differ.
+const BASE64_LENIENT: GeneralPurpose = GeneralPurpose::new(
+    &base64::alphabet::STANDARD,
+    GeneralPurposeConfig::new().with_decode_padding_mode(DecodePaddingMode::Indifferent),
+);
+
+/// Reads the file a buffer URI names: a percent-encoded path relative to `base` (the glTF
+/// file's folder) or a `file:` URI. Other schemes (`http:`, ...) are refused.
+fn read_uri(base: &Path, uri: &str) -> std::result::Result<Vec<u8>, BufferError> {
+    let (relative, encoded) = match uri.strip_prefix("file:") {
+        Some(rest) => (false, rest.strip_prefix("//").unwrap_or(rest)),
+        None if uri.contains(':') => {
+            return Err(BufferError::Invalid(
+                "unsupported URI scheme (only data:, file: and relative paths)".to_string(),
+            ))
+        }
+        None => (true, uri),
+    };
+    let decoded = percent_decode_str(encoded)
+        .decode_utf8()
+        .map_err(|_| BufferError::Invalid("URI is not UTF-8 once percent-decoded".to_string()))?;
+    let file = if relative {
+        base.join(&*decoded)
+    } else {
+        PathBuf::from(&*decoded)
+    };
+    std::fs::read(file).map_err(BufferError::Io)
 }
 
 /// The triangles gathered so far in a scene walk.
 struct Walk<'a, 's> {
     path: &'a Path,
-    buffers: &'a [::gltf::buffer::Data],
+    buffers: &'a [Vec<u8>],
     positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
     stats: &'s mut ReadStats,
@@ -409,7 +439,7 @@ impl Walk<'_, '_> {
 /// and sparse substitutions applied.
 fn read_accessor(
     accessor: &::gltf::Accessor,
-    buffers: &[::gltf::buffer::Data],
+    buffers: &[Vec<u8>],
 ) -> std::result::Result<Vec<f64>, String> {
     let a = accessor.index();
     let ty = accessor.data_type();
@@ -509,7 +539,7 @@ fn read_accessor(
 /// The bytes of a buffer view, bounds-checked against its buffer.
 fn view_bytes<'b>(
     view: &::gltf::buffer::View,
-    buffers: &'b [::gltf::buffer::Data],
+    buffers: &'b [Vec<u8>],
 ) -> std::result::Result<&'b [u8], String> {
     let buffer = buffers
         .get(view.buffer().index())
@@ -692,31 +722,64 @@ pub(super) fn encode_gltf(
     let (mut json, bin) = build(mesh, normals)?;
     json["buffers"][0]["uri"] = serde_json::Value::String(format!(
         "data:application/octet-stream;base64,{}",
-        base64(&bin)
+        BASE64_STANDARD.encode(&bin)
     ));
     let mut out = serde_json::to_vec_pretty(&json).map_err(|e| e.to_string())?;
     out.push(b'\n');
     Ok(out)
 }
 
-/// Standard base64 with padding.
-fn base64(data: &[u8]) -> String {
-    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::with_capacity(data.len().div_ceil(3) * 4);
-    for chunk in data.chunks(3) {
-        let b = [
-            chunk[0],
-            chunk.get(1).copied().unwrap_or(0),
-            chunk.get(2).copied().unwrap_or(0),
-        ];
-        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
-        for k in 0..4 {
-            if k <= chunk.len() {
-                out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn invalid(r: std::result::Result<Vec<u8>, BufferError>) -> String {
+        match r {
+            Err(BufferError::Invalid(m)) => m,
+            Err(BufferError::Io(e)) => panic!("an I/O error: {e}"),
+            Ok(b) => panic!("decoded {b:?}"),
         }
     }
-    out
+
+    #[test]
+    fn data_uris_base64_with_or_without_padding_and_percent_encoded() {
+        let ok = |uri: &str| decode_data_uri(uri).ok().unwrap();
+        assert_eq!(
+            ok("data:application/octet-stream;base64,AAEC/w=="),
+            [0, 1, 2, 255]
+        );
+        assert_eq!(
+            ok("data:application/octet-stream;base64,AAEC/w"),
+            [0, 1, 2, 255]
+        );
+        assert_eq!(ok("data:;base64,"), Vec::<u8>::new());
+        assert_eq!(
+            ok("data:application/octet-stream,a%00b%FF"),
+            [b'a', 0, b'b', 255]
+        );
+        assert!(invalid(decode_data_uri("data:;base64,A*==")).contains("base64"));
+        assert!(invalid(decode_data_uri("data:nothing")).contains("comma"));
+    }
+
+    #[test]
+    fn buffer_files_by_percent_encoded_relative_path_or_file_uri() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("a b.bin"), [7u8, 8]).unwrap();
+        let read = |uri: &str| read_uri(dir.path(), uri).ok().unwrap();
+        assert_eq!(read("a%20b.bin"), [7, 8]);
+        let absolute = format!("file://{}/a%20b.bin", dir.path().display());
+        assert_eq!(read(&absolute), [7, 8]);
+        assert!(invalid(read_uri(dir.path(), "%FF%FE.bin")).contains("UTF-8"));
+        assert!(invalid(read_uri(dir.path(), "https://example.org/a.bin")).contains("scheme"));
+        assert!(matches!(
+            read_uri(dir.path(), "missing.bin"),
+            Err(BufferError::Io(_))
+        ));
+    }
+
+    #[test]
+    fn embedded_output_is_standard_padded_base64() {
+        assert_eq!(BASE64_STANDARD.encode([0u8, 1, 2, 255]), "AAEC/w==");
+        assert_eq!(BASE64_STANDARD.encode(b"ab"), "YWI=");
+    }
 }

@@ -6,24 +6,26 @@
 //! the OBJ and glTF versions of a model the same mesh) and drops vertices no triangle uses.
 //!
 //! [`write_mesh`] writes a mesh with angle-weighted vertex normals, atomically: the target is
-//! either replaced by the complete new file or left as it was.
+//! either replaced by the complete new file or left as it was. [`write_atomically`] and
+//! [`AtomicFile`] do that for every file the crate writes.
 //!
 //! No function here panics on a file's content; every failure is an [`Error`] naming the file.
 
+mod atomic;
 mod gltf;
 mod obj;
-mod ply;
+pub(crate) mod ply;
 
 use std::fs;
-use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::Path;
 
 use glam::DVec3;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
+
+pub use atomic::{write_atomically, AtomicFile};
 
 /// A mesh file format, chosen by the file's extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -226,8 +228,8 @@ fn check_content(path: &Path, format: MeshFormat) -> Result<()> {
 ///   POSITION and NORMAL (`f32` VEC3) and `u32` indices.
 /// - `.gltf`: the same glTF 2.0 asset as JSON, its buffer embedded as a base64 data URI.
 ///
-/// The file is written to a temporary file in the target's directory (`.NAME.tmp-PID-N`),
-/// flushed and synced, then renamed onto the target, which an existing file is replaced by.
+/// The file is written atomically ([`write_atomically`]): to a temporary file in the target's
+/// directory, synced, then renamed onto the target, which an existing file is replaced by.
 ///
 /// # Errors
 ///
@@ -264,11 +266,13 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
     let normals = output_normals(mesh);
     let bytes = match format {
         MeshFormat::Obj => obj::encode(mesh, &normals),
-        MeshFormat::Ply => ply::encode(mesh, &normals),
+        MeshFormat::Ply => {
+            ply::encode_mesh(mesh, &normals).map_err(|e| write_err(e.to_string()))?
+        }
         MeshFormat::Glb => gltf::encode_glb(mesh, &normals).map_err(write_err)?,
         MeshFormat::Gltf => gltf::encode_gltf(mesh, &normals).map_err(write_err)?,
     };
-    write_atomically(path, &bytes)
+    write_atomically(path, |w| w.write_all(&bytes))
 }
 
 /// Unit vertex normals for output: [`TriMesh::vertex_normals`], with +Z where that is zero.
@@ -358,51 +362,4 @@ fn one_line(message: &str) -> String {
         out.push(c);
     }
     out.trim_end().to_string()
-}
-
-/// Writes `bytes` to a temporary file beside `path`, syncs it and renames it onto `path`: a
-/// reader never sees a half-written file, and an existing file is replaced only on success. On
-/// failure the temporary file is removed and [`Error::Write`] names `path`.
-///
-/// # Errors
-/// [`Error::Write`] when the directory is missing or not writable, the path names no file, or
-/// writing, syncing or renaming fails.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
-    let write_err = |message: String| Error::Write {
-        path: path.to_path_buf(),
-        message,
-    };
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| write_err("the path names no file".to_string()))?;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(file_name);
-    // The process id keeps concurrent processes apart, the counter concurrent threads.
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    tmp_name.push(format!(
-        ".tmp-{}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let tmp = dir.join(tmp_name);
-
-    let result = (|| -> std::result::Result<(), String> {
-        let mut file = fs::File::create(&tmp)
-            .map_err(|e| format!("cannot create a temporary file in {}: {e}", dir.display()))?;
-        file.write_all(bytes)
-            .and_then(|()| file.flush())
-            .and_then(|()| file.sync_all())
-            .map_err(|e| format!("cannot write {}: {e}", tmp.display()))?;
-        drop(file);
-        fs::rename(&tmp, path).map_err(|e| format!("cannot rename {} onto it: {e}", tmp.display()))
-    })();
-    result.map_err(|message| {
-        // The temporary file may or may not exist, depending on where it failed.
-        let _ = fs::remove_file(&tmp);
-        write_err(message)
-    })
 }

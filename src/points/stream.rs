@@ -1,14 +1,19 @@
 //! Streaming point sets: a reader that hands out points in chunks (so a file of tens of millions
 //! of points never has to be in memory at once) from PLY (the `vertex` element) or from XYZ/CSV
-//! text, and a writer of binary little-endian PLY with normals.
+//! text, and a writer of binary little-endian PLY with normals. PLY headers are read by
+//! `ply-rs-bw` ([`crate::io::ply`]); the payload by the fixed-record decoder here, which reads
+//! a binary vertex record in one pass without per-property dispatch through the parser.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, BufWriter, Read, Write};
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
+use ply_rs_bw::ply::{PropertyType, ScalarType};
 
 use crate::error::{Error, Result};
+use crate::io::ply::{read_header, BinaryPlyWriter};
+use crate::io::AtomicFile;
 
 /// One point of a point set: position and unit normal (`DVec3::ZERO` when the file has none).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,21 +45,22 @@ enum Scalar {
     F64,
 }
 
-impl Scalar {
-    fn parse(name: &str) -> Option<Scalar> {
-        Some(match name {
-            "char" | "int8" => Scalar::I8,
-            "uchar" | "uint8" => Scalar::U8,
-            "short" | "int16" => Scalar::I16,
-            "ushort" | "uint16" => Scalar::U16,
-            "int" | "int32" => Scalar::I32,
-            "uint" | "uint32" => Scalar::U32,
-            "float" | "float32" => Scalar::F32,
-            "double" | "float64" => Scalar::F64,
-            _ => return None,
-        })
+impl From<ScalarType> for Scalar {
+    fn from(ty: ScalarType) -> Scalar {
+        match ty {
+            ScalarType::Char => Scalar::I8,
+            ScalarType::UChar => Scalar::U8,
+            ScalarType::Short => Scalar::I16,
+            ScalarType::UShort => Scalar::U16,
+            ScalarType::Int => Scalar::I32,
+            ScalarType::UInt => Scalar::U32,
+            ScalarType::Float => Scalar::F32,
+            ScalarType::Double => Scalar::F64,
+        }
     }
+}
 
+impl Scalar {
     fn size(self) -> usize {
         match self {
             Scalar::I8 | Scalar::U8 => 1,
@@ -126,98 +132,56 @@ impl PointReader {
         }
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let mut input = BufReader::with_capacity(1 << 20, file);
-        let parse = |line: usize, message: String| Error::Parse {
+        let parse = |message: String| Error::Parse {
             path: path.to_path_buf(),
-            line: Some(line),
+            line: None,
             message,
         };
-        let mut line = String::new();
-        let mut line_number = 0;
-        let next_line = |input: &mut BufReader<File>, line: &mut String, number: &mut usize| {
-            line.clear();
-            *number += 1;
-            let n = input.read_line(line).map_err(|e| Error::io(path, e))?;
-            Ok::<bool, Error>(n > 0)
-        };
-        if !next_line(&mut input, &mut line, &mut line_number)? || line.trim_end() != "ply" {
-            return Err(parse(
-                1,
-                "not a PLY file (the first line is not `ply`)".into(),
-            ));
+        let head = input.fill_buf().map_err(|e| Error::io(path, e))?;
+        if !(head.starts_with(b"ply\n") || head.starts_with(b"ply\r\n")) {
+            return Err(Error::Parse {
+                path: path.to_path_buf(),
+                line: Some(1),
+                message: "not a PLY file (the first line is not `ply`)".into(),
+            });
         }
-        let mut encoding = None;
-        let mut count = None;
-        let mut in_vertex = false;
-        let mut seen_element = false;
-        let mut properties: Vec<(Scalar, Option<usize>)> = Vec::new();
-        let mut names: Vec<String> = Vec::new();
-        loop {
-            if !next_line(&mut input, &mut line, &mut line_number)? {
-                return Err(parse(line_number, "the header has no `end_header`".into()));
+        let mut reader = ply_rs_bw::parser::Reader::new(input);
+        let header = read_header(path, &mut reader)?;
+        // The line before the first payload line (ascii payloads count on from there).
+        let line_number = reader.line().saturating_sub(1);
+        let input = reader.into_inner();
+        let encoding = match header.encoding {
+            ply_rs_bw::ply::Encoding::Ascii => Encoding::Ascii,
+            ply_rs_bw::ply::Encoding::BinaryLittleEndian => Encoding::BinaryLittle,
+            ply_rs_bw::ply::Encoding::BinaryBigEndian => Encoding::BinaryBig,
+        };
+        let vertex = match header.elements.first() {
+            Some((name, vertex)) if name == "vertex" => vertex,
+            Some((name, _)) => {
+                return Err(parse(format!(
+                    "the first element is `{name}`; point sets need `vertex` first"
+                )))
             }
-            let words: Vec<&str> = line.split_whitespace().collect();
-            match words.as_slice() {
-                ["end_header"] => break,
-                ["format", f, _] => {
-                    encoding = Some(match *f {
-                        "ascii" => Encoding::Ascii,
-                        "binary_little_endian" => Encoding::BinaryLittle,
-                        "binary_big_endian" => Encoding::BinaryBig,
-                        other => {
-                            return Err(parse(line_number, format!("unknown format `{other}`")))
-                        }
-                    })
-                }
-                ["comment", ..] | ["obj_info", ..] | [] => {}
-                ["element", name, n] => {
-                    if !seen_element {
-                        if *name != "vertex" {
-                            return Err(parse(
-                                line_number,
-                                format!(
-                                    "the first element is `{name}`; point sets need `vertex` first"
-                                ),
-                            ));
-                        }
-                        count =
-                            Some(n.parse::<u64>().map_err(|_| {
-                                parse(line_number, format!("bad vertex count `{n}`"))
-                            })?);
-                        in_vertex = true;
-                    } else {
-                        in_vertex = false;
-                    }
-                    seen_element = true;
-                }
-                ["property", "list", ..] if in_vertex => {
+            None => return Err(parse("no `vertex` element".into())),
+        };
+        let count = vertex.count as u64;
+        let mut properties: Vec<(Scalar, Option<usize>)> = Vec::new();
+        let mut names: Vec<&str> = Vec::new();
+        for (name, property) in &vertex.properties {
+            match &property.data_type {
+                PropertyType::Scalar(ty) => properties.push((Scalar::from(ty.clone()), None)),
+                PropertyType::List(..) => {
                     return Err(parse(
-                        line_number,
                         "list properties in `vertex` are not supported".into(),
                     ))
                 }
-                ["property", ty, name] if in_vertex => {
-                    let scalar = Scalar::parse(ty).ok_or_else(|| {
-                        parse(line_number, format!("unknown property type `{ty}`"))
-                    })?;
-                    properties.push((scalar, None));
-                    names.push((*name).to_string());
-                }
-                ["property", ..] => {}
-                _ => {
-                    return Err(parse(
-                        line_number,
-                        format!("unexpected header line `{}`", line.trim_end()),
-                    ))
-                }
             }
+            names.push(name);
         }
-        let encoding =
-            encoding.ok_or_else(|| parse(line_number, "the header has no `format` line".into()))?;
-        let count = count.ok_or_else(|| parse(line_number, "no `vertex` element".into()))?;
-        let slot = |n: &str| names.iter().position(|m| m == n);
+        let slot = |n: &str| names.iter().position(|m| *m == n);
         for (k, name) in ["x", "y", "z"].iter().enumerate() {
-            let i = slot(name)
-                .ok_or_else(|| parse(line_number, format!("the vertex element has no `{name}`")))?;
+            let i =
+                slot(name).ok_or_else(|| parse(format!("the vertex element has no `{name}`")))?;
             properties[i].1 = Some(k);
         }
         let normal_slots: Vec<Option<usize>> = ["nx", "ny", "nz"].iter().map(|n| slot(n)).collect();
@@ -238,7 +202,7 @@ impl PointReader {
             record_size,
             has_normals,
             buffer: Vec::new(),
-            line,
+            line: String::new(),
             line_number,
         })
     }
@@ -530,16 +494,12 @@ pub(crate) fn encode_record(p: &Point, out: &mut Vec<u8>) {
 }
 
 /// Writes points with normals as binary little-endian PLY (`x y z nx ny nz`, float32, and with
-/// [`PlyPointWriter::create_with_levels`] a `uchar level`), to a temporary file beside the target
-/// that [`PlyPointWriter::finish`] renames into place: a failure never leaves a partial file at
+/// [`PlyPointWriter::create_with_levels`] a `uchar level`) through the crate's one binary PLY
+/// writer, atomically ([`AtomicFile`]): a temporary file beside the target that
+/// [`PlyPointWriter::finish`] renames into place, so a failure never leaves a partial file at
 /// the target. The count must be known when the file is created.
 pub struct PlyPointWriter {
-    path: PathBuf,
-    temporary: PathBuf,
-    output: BufWriter<File>,
-    count: u64,
-    written: u64,
-    with_levels: bool,
+    ply: BinaryPlyWriter<AtomicFile>,
 }
 
 impl PlyPointWriter {
@@ -561,37 +521,14 @@ impl PlyPointWriter {
     }
 
     fn start(path: &Path, count: u64, with_levels: bool) -> Result<Self> {
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let temporary = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+        let file = AtomicFile::create(path)?;
         let write_error = |e: std::io::Error| Error::Write {
             path: path.to_path_buf(),
             message: e.to_string(),
         };
-        let file = File::create(&temporary).map_err(write_error)?;
-        let mut output = BufWriter::with_capacity(1 << 20, file);
-        write!(
-            output,
-            "ply\nformat binary_little_endian 1.0\ncomment spectral-remesh point set\n\
-             element vertex {count}\nproperty float x\nproperty float y\nproperty float z\n\
-             property float nx\nproperty float ny\nproperty float nz\n{}end_header\n",
-            if with_levels {
-                "property uchar level\n"
-            } else {
-                ""
-            }
-        )
-        .map_err(write_error)?;
-        Ok(PlyPointWriter {
-            path: path.to_path_buf(),
-            temporary,
-            output,
-            count,
-            written: 0,
-            with_levels,
-        })
+        let ply = BinaryPlyWriter::new(file, "spectral-remesh point set", count, with_levels, None)
+            .map_err(write_error)?;
+        Ok(PlyPointWriter { ply })
     }
 
     /// Appends points (to a file made by [`PlyPointWriter::create`]).
@@ -600,9 +537,6 @@ impl PlyPointWriter {
     /// [`Error::Write`] on a write failure, when more points than announced are written, or when
     /// the file has levels.
     pub fn write(&mut self, points: &[Point]) -> Result<()> {
-        if self.with_levels {
-            return Err(self.error("the file has levels: write them with the points".into()));
-        }
         self.append(points, None)
     }
 
@@ -613,27 +547,20 @@ impl PlyPointWriter {
     /// [`Error::Write`] on a write failure, when more points than announced are written, when
     /// the file has no levels, or when `levels` and `points` differ in length.
     pub fn write_levels(&mut self, points: &[Point], levels: &[u8]) -> Result<()> {
-        if !self.with_levels || levels.len() != points.len() {
-            return Err(self.error("levels must come one per point, to a file with levels".into()));
+        if levels.len() != points.len() {
+            return Err(self.error("levels must come one per point".into()));
         }
         self.append(points, Some(levels))
     }
 
     fn append(&mut self, points: &[Point], levels: Option<&[u8]>) -> Result<()> {
-        if self.written + points.len() as u64 > self.count {
-            return Err(self.error(format!("more than the {} points announced", self.count)));
-        }
-        let mut bytes = Vec::with_capacity(points.len() * (RECORD_BYTES + 1));
+        let f32s = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
         for (k, p) in points.iter().enumerate() {
-            encode_record(p, &mut bytes);
-            if let Some(l) = levels {
-                bytes.push(l[k]);
-            }
+            let level = levels.map(|l| l[k]);
+            self.ply
+                .vertex(f32s(p.position), f32s(p.normal), level)
+                .map_err(|e| self.ply.get_ref().error(e.to_string()))?;
         }
-        self.output
-            .write_all(&bytes)
-            .map_err(|e| self.error(e.to_string()))?;
-        self.written += points.len() as u64;
         Ok(())
     }
 
@@ -642,36 +569,17 @@ impl PlyPointWriter {
     /// # Errors
     /// [`Error::Write`] when fewer points than announced were written or the file cannot be
     /// completed; the temporary file is removed.
-    pub fn finish(mut self) -> Result<()> {
-        let result = (|| {
-            if self.written != self.count {
-                return Err(self.error(format!(
-                    "{} points written of the {} announced",
-                    self.written, self.count
-                )));
-            }
-            self.output.flush().map_err(|e| self.error(e.to_string()))?;
-            std::fs::rename(&self.temporary, &self.path).map_err(|e| self.error(e.to_string()))
-        })();
-        if result.is_err() {
-            let _ = std::fs::remove_file(&self.temporary);
-        }
-        result
+    pub fn finish(self) -> Result<()> {
+        let path = self.ply.get_ref().path().to_path_buf();
+        let file = self.ply.finish().map_err(|e| Error::Write {
+            path,
+            message: e.to_string(),
+        })?;
+        file.commit()
     }
 
     fn error(&self, message: String) -> Error {
-        Error::Write {
-            path: self.path.clone(),
-            message,
-        }
-    }
-}
-
-impl Drop for PlyPointWriter {
-    fn drop(&mut self) {
-        // Not finished (an error on the way): leave nothing behind. After a rename this fails
-        // harmlessly.
-        let _ = std::fs::remove_file(&self.temporary);
+        self.ply.get_ref().error(message)
     }
 }
 
@@ -744,6 +652,57 @@ mod tests {
         w.write(&points(2)).unwrap();
         assert!(w.finish().is_err());
         assert!(!short.exists());
+    }
+
+    #[test]
+    fn bad_ply_headers_are_one_line_errors_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let vertex = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
+        let cases = [
+            ("not ply", "v 0 0 0\n".to_string(), "not a PLY file"),
+            (
+                "face first",
+                format!("ply\nformat ascii 1.0\nelement face 0\n{vertex}end_header\n"),
+                "`vertex` first",
+            ),
+            (
+                "list",
+                format!("ply\nformat ascii 1.0\n{vertex}property list uchar int n\nend_header\n"),
+                "list properties",
+            ),
+            (
+                "no z",
+                "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+                 end_header\n"
+                    .to_string(),
+                "no `z`",
+            ),
+            (
+                "twice",
+                format!(
+                    "ply\nformat binary_little_endian 1.0\n{vertex}property float x\nend_header\n"
+                ),
+                "twice",
+            ),
+            (
+                "no end",
+                format!("ply\nformat ascii 1.0\n{vertex}"),
+                "end_header",
+            ),
+            (
+                "bad format",
+                format!("ply\nformat binary 1.0\n{vertex}end_header\n"),
+                "",
+            ),
+        ];
+        for (name, text, mentions) in cases {
+            let path = dir.path().join(format!("{name}.ply"));
+            std::fs::write(&path, text).unwrap();
+            let err = PointReader::open(&path).err().unwrap().to_string();
+            assert!(err.contains(&format!("{name}.ply")), "{err}");
+            assert!(err.contains(mentions), "{name}: {err}");
+            assert_eq!(err.lines().count(), 1, "{err}");
+        }
     }
 
     #[test]

@@ -1,5 +1,4 @@
-//! Stanford PLY: reading with `ply-rs-bw` (ascii and binary of either byte order), writing
-//! binary little endian by hand.
+//! Reading triangle meshes from PLY with `ply-rs-bw` (ascii and binary of either byte order).
 
 use std::io::{BufReader, Cursor};
 use std::path::Path;
@@ -10,8 +9,9 @@ use ply_rs_bw::ply::{
     Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
 };
 
-use super::{one_line, read_file, ReadStats};
+use super::{read_header, strip_line_prefix};
 use crate::error::{Error, Result};
+use crate::io::{one_line, read_file, ReadStats};
 use crate::mesh::TriMesh;
 
 /// The names a face element's index list may have.
@@ -152,13 +152,11 @@ fn check_header(path: &Path, header: &Header) -> Result<Option<&'static str>> {
 
 /// Parses the PLY file at `path`; faces are fan-triangulated, indices checked (naming the face
 /// element).
-pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
+pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let data = read_file(path)?;
     let parser = Parser::<Element>::new();
     let mut reader = Reader::new(BufReader::new(Cursor::new(&data[..])));
-    let header = parser
-        .read_header(&mut reader)
-        .map_err(|e| Error::parse(path, e.line(), one_line(&strip_line_prefix(&e.to_string()))))?;
+    let header = read_header(path, &mut reader)?;
     let face_list = check_header(path, &header)?;
     let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
         // Line numbers mean something only in ascii files.
@@ -203,56 +201,4 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
         }
     }
     Ok(TriMesh::new(positions, triangles))
-}
-
-/// `ply-rs-bw` prefixes messages with "Line N: "; we carry the line separately.
-fn strip_line_prefix(message: &str) -> String {
-    if let Some(rest) = message.strip_prefix("Line ") {
-        if let Some((num, tail)) = rest.split_once(": ") {
-            if num.chars().all(|c| c.is_ascii_digit()) {
-                return tail.to_string();
-            }
-        }
-    }
-    message.to_string()
-}
-
-/// The binary little-endian PLY bytes of `mesh` with `normals`: vertex `x y z nx ny nz` as
-/// `float`, face `list uchar int vertex_indices`. The caller has checked that vertex indices
-/// fit in `i32`.
-pub(super) fn encode(mesh: &TriMesh, normals: &[DVec3]) -> Vec<u8> {
-    let header = format!(
-        "ply\n\
-         format binary_little_endian 1.0\n\
-         comment written by spectral-remesh {}\n\
-         element vertex {}\n\
-         property float x\n\
-         property float y\n\
-         property float z\n\
-         property float nx\n\
-         property float ny\n\
-         property float nz\n\
-         element face {}\n\
-         property list uchar int vertex_indices\n\
-         end_header\n",
-        env!("CARGO_PKG_VERSION"),
-        mesh.positions.len(),
-        mesh.triangles.len()
-    );
-    let mut out =
-        Vec::with_capacity(header.len() + mesh.positions.len() * 24 + mesh.triangles.len() * 13);
-    out.extend_from_slice(header.as_bytes());
-    for (p, n) in mesh.positions.iter().zip(normals) {
-        let n = n.as_vec3().normalize_or(glam::Vec3::Z);
-        for c in p.as_vec3().to_array().into_iter().chain(n.to_array()) {
-            out.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for t in &mesh.triangles {
-        out.push(3);
-        for &i in t {
-            out.extend_from_slice(&(i as i32).to_le_bytes());
-        }
-    }
-    out
 }
