@@ -20,6 +20,7 @@ pub mod sampling;
 pub mod self_intersection;
 pub mod spatial;
 pub mod surface;
+pub mod timing;
 pub mod triangulate;
 
 pub use error::{Error, Result};

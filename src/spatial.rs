@@ -230,6 +230,24 @@ impl StaticTree {
     }
 }
 
+/// The 3D Morton (Z-order) code of `q`, whose coordinates are cell indices in [0, 2^21 - 1]
+/// (values outside are clamped, fractions truncated): the 21 bits of x, y and z interleaved, x
+/// in the lowest bit. Sorting points by it visits them along a Z-curve, so neighbours in the
+/// order are mostly neighbours in space (the linear scan's chunks and the distance queries of
+/// the report run in this order to keep the kd-tree and the BVH in cache).
+pub fn morton_code(q: DVec3) -> u64 {
+    /// The low 21 bits of `x` with two zero bits after each.
+    fn spread(v: f64) -> u64 {
+        let mut x = (v.max(0.0) as u64).min((1 << 21) - 1);
+        x = (x | x << 32) & 0x001f_0000_0000_ffff;
+        x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+        x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+        x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+        (x | x << 2) & 0x1249_2492_4924_9249
+    }
+    spread(q.x) | spread(q.y) << 1 | spread(q.z) << 2
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -339,5 +357,17 @@ mod tests {
                 .fold(f64::INFINITY, f64::min);
             assert!((d - best).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn morton_codes_interleave_the_coordinates() {
+        assert_eq!(morton_code(DVec3::new(1.0, 0.0, 0.0)), 0b001);
+        assert_eq!(morton_code(DVec3::new(0.0, 1.0, 0.0)), 0b010);
+        assert_eq!(morton_code(DVec3::new(0.0, 0.0, 1.0)), 0b100);
+        assert_eq!(morton_code(DVec3::new(3.0, 0.0, 2.0)), 0b101_001);
+        // The top bit of each coordinate and clamping at 2^21 - 1.
+        let top = morton_code(DVec3::splat(4e6));
+        assert_eq!(top, (1u64 << 63) - 1);
+        assert_eq!(morton_code(DVec3::splat(-5.0)), 0);
     }
 }

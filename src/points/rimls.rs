@@ -911,24 +911,11 @@ mod tests {
 
     /// Points drawn uniformly by area on `mesh`, with the index of their face.
     fn surface_samples(mesh: &TriMesh, count: usize, rng: &mut ChaCha8Rng) -> Vec<(DVec3, usize)> {
-        let mut cumulative = Vec::with_capacity(mesh.face_count());
-        let mut total = 0.0;
-        for f in 0..mesh.face_count() {
-            total += mesh.face_area(f);
-            cumulative.push(total);
-        }
+        let faces = crate::sampling::surface_sampler::AreaSampler::new(mesh).unwrap();
         (0..count)
             .map(|_| {
-                let r = rng.random::<f64>() * total;
-                let f = cumulative
-                    .partition_point(|&c| c <= r)
-                    .min(mesh.face_count() - 1);
-                let (mut u, mut v) = (rng.random::<f64>(), rng.random::<f64>());
-                if u + v > 1.0 {
-                    (u, v) = (1.0 - u, 1.0 - v);
-                }
-                let [a, b, c] = mesh.corners(f);
-                (a + u * (b - a) + v * (c - a), f)
+                let s = faces.draw(mesh, rng);
+                (s.position, s.face)
             })
             .collect()
     }
