@@ -8,6 +8,18 @@
 //! 2.5 sigma; with 2.5 sigma <= 1/4 (checked) the distances among those images are the toroidal
 //! ones, so the local kernel matrix is the one of the torus.
 //!
+//! What is the library's and what is not: the kernel, the measure and its gradient
+//! (`measure::measure_and_gradient`, `measure::spectral_measure`), the sigma search
+//! (`sampling::target_count`) and the linear scan itself ([`torus_linear_scan`] drives
+//! `sampling::linear_scan::LinearScanner` with the kept points' periodic images). The gradient
+//! ascent is this module's own ([`torus_gradient_ascent`]): the library's
+//! (`sampling::gradient_ascent`) finds each sample's neighbours once per call in a kd-tree of
+//! absolute positions and moves samples through a surface projection, while on the torus a
+//! moving point wraps across the edges (its neighbours' nearest images change with it) and the
+//! random start needs its neighbourhoods found afresh at every move; giving the library's
+//! ascent a neighbour query per move would change the product's sampler for the sake of this
+//! experiment.
+//!
 //! Two paths, both named in Sec. 7.1:
 //! - [`spectral_from_random`] (the paper's): n uniform random points, then 10 sweeps of gradient
 //!   ascent with sigma = 2.5 r, r = rho / sqrt(2 sqrt(3) n), rho = 0.75 ([`paper_sigma`]).
