@@ -1,7 +1,7 @@
 """Blue noise on the periodic unit square: the paper's Fig. 11 (Sec. 7.1) for our samplers and
-the baselines, all made and measured by `remesh blue-noise`.
+the baselines, all made and measured by `spectral-experiments blue-noise`.
 
-Run through eval/blue_noise (it sets up the venv and builds remesh):
+Run through eval/blue_noise (it sets up the venv and builds spectral-experiments):
 
     eval/blue_noise                          # n = 4096, 10 sets, every method (about 1 minute)
     eval/blue_noise --n 1024 --sets 4        # a quick look
@@ -10,7 +10,7 @@ Run through eval/blue_noise (it sets up the venv and builds remesh):
 Writes eval/results/blue-noise/: per method METHOD.png (a: the first point set, b: the mean
 periodogram, c: radially averaged power and anisotropy), radial.png (every method's radial
 power and anisotropy on one graph), summary.md (the table) and summary.json (its figures).
-The full reports `remesh blue-noise --output` writes (mean periodogram, points, per-set records)
+The full reports `spectral-experiments blue-noise --output` writes (mean periodogram, points, per-set records)
 go to eval/results/blue-noise/json/ (about 1.5 MB each; not committed).
 """
 
@@ -24,10 +24,11 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-REMESH = os.environ.get("REMESH_BIN", str(ROOT / "target" / "release" / "remesh"))
+EXPERIMENTS = os.environ.get(
+    "EXPERIMENTS_BIN", str(ROOT / "target" / "release" / "spectral-experiments"))
 OUT = HERE / "results" / "blue-noise"
 
-# key: (label, remesh blue-noise arguments)
+# key: (label, spectral-experiments blue-noise arguments)
 METHODS = {
     "ours-a": ("ours, path A: random start + 10 sweeps of gradient ascent (paper's setting, step 0.55, "
                "move <= 0.25 sigma)", ["--method", "ours"]),
@@ -56,7 +57,7 @@ def parse_args():
 def run(key, args, out):
     label, extra = METHODS[key]
     path = out / "json" / f"{key}.json"
-    cmd = [REMESH, "blue-noise", *extra, "--n", str(args.n), "--sets", str(args.sets),
+    cmd = [EXPERIMENTS, "blue-noise", *extra, "--n", str(args.n), "--sets", str(args.sets),
            "--seed", str(args.seed), "--output", str(path)]
     t = time.perf_counter()
     r = subprocess.run(cmd, capture_output=True, text=True)
@@ -67,7 +68,7 @@ def run(key, args, out):
     report = json.loads(path.read_text())
     report["wall_s"] = wall
     report["label"] = label
-    report["command"] = "remesh " + " ".join(cmd[1:-2])
+    report["command"] = "spectral-experiments " + " ".join(cmd[1:-2])
     return report
 
 
@@ -204,7 +205,7 @@ def markdown(rows, args):
         "# Blue noise on the periodic unit square (Sec. 7.1, Fig. 11)",
         "",
         f"n = {args.n} points per set, {args.sets} sets per method, seed {args.seed}; every set made and "
-        "measured by `remesh blue-noise` (release build, 2 cores shared with other jobs, so seconds are "
+        "measured by `spectral-experiments blue-noise` (release build, 2 cores shared with other jobs, so seconds are "
         "indicative). Written by `eval/blue_noise`.",
         "",
         "| method | mean rho (min–max) | low-frequency max (< 0.5) | principal peak (freq, power) | "

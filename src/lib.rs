@@ -19,13 +19,12 @@ pub mod kernel;
 pub mod measure;
 pub mod mesh;
 pub mod pipeline;
-pub mod plane;
 pub mod points;
-pub mod reconstruction_eval;
 pub mod report;
 pub mod sampling;
 pub mod spatial;
 pub mod surface;
+pub mod timing;
 pub mod triangulate;
 
 pub use error::{Error, Result};

@@ -238,8 +238,8 @@ pub fn measure_and_gradient(
 ///
 /// Sec. 5 uses them to drop a point x_j from a kernel sum Σ w_i k(·, x_i): the weight w_j moves
 /// to the others as w_i + w_j α_i (the error left is w_j times the orthogonal part, whose squared
-/// norm relative to |φ(x_j)|² is s(x_j)). [`crate::points::subsample::representation_weights`]
-/// does that for every point a subsampler dropped.
+/// norm relative to |φ(x_j)|² is s(x_j)). `representation_weights`
+/// (in the `spectral-experiments` crate) does that for every point a subsampler dropped.
 ///
 /// The neighbours are taken in the order given (nearest first) with the same Cholesky
 /// factorization as [`measure_and_gradient`]; those numerically in the span of the ones before

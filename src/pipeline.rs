@@ -2,8 +2,6 @@
 //! search for a target count) → gradient ascent + projection → triangulate → clean up → back to
 //! model units.
 
-use std::time::Instant;
-
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -20,6 +18,8 @@ use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::sampling::SurfaceSample;
 use crate::surface::winding::BuriedTest;
 use crate::surface::MeshSurface;
+pub use crate::timing::Stage;
+use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, FaceSource, SampleSet, TriangulateParams};
@@ -114,15 +114,6 @@ impl Default for RemeshParams {
     }
 }
 
-/// One timed stage.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Stage {
-    /// Stage name.
-    pub name: &'static str,
-    /// Wall-clock seconds.
-    pub seconds: f64,
-}
-
 /// The output of [`remesh`].
 #[derive(Debug, Clone)]
 pub struct RemeshOutput {
@@ -191,30 +182,6 @@ pub fn validate_input(mesh: &TriMesh) -> Result<Normalization> {
         .ok_or_else(|| Error::invalid_mesh("", "the bounding box has zero size"))
 }
 
-struct Timer {
-    stages: Vec<Stage>,
-    last: Instant,
-}
-
-impl Timer {
-    fn new() -> Self {
-        Timer {
-            stages: Vec::new(),
-            last: Instant::now(),
-        }
-    }
-    /// Ends the current stage; a stage run again (a count correction) adds to its time.
-    fn lap(&mut self, name: &'static str) {
-        let now = Instant::now();
-        let seconds = (now - self.last).as_secs_f64();
-        match self.stages.iter_mut().find(|s| s.name == name) {
-            Some(s) => s.seconds += seconds,
-            None => self.stages.push(Stage { name, seconds }),
-        }
-        self.last = now;
-    }
-}
-
 /// Remeshes `input` (model units): samples its surface with the spectral sampler and
 /// triangulates the samples. `on_stage` is called with each stage's name as it starts (for
 /// progress display).
@@ -227,7 +194,7 @@ pub fn remesh(
     params: &RemeshParams,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<RemeshOutput> {
-    let mut timer = Timer::new();
+    let mut timer = StageTimer::new();
     let normalization = validate_input(input)?;
     let density = match params.density {
         Density::Points(n) => Target::Points(n),
@@ -482,7 +449,7 @@ pub fn remesh(
                 dropped_samples,
                 buried_candidates,
                 buried_samples,
-                stages: std::mem::take(&mut timer.stages),
+                stages: timer.take_stages(),
             };
         }
         full_history.extend(search_history.iter().copied());

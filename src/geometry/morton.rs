@@ -1,5 +1,7 @@
-//! Morton (Z-order) codes of points in 3D: nearby points get nearby codes, so visiting points in
-//! code order keeps spatial queries in cache.
+//! Morton (Z-order) codes of points in 3D. Sorting points by their code visits them along a
+//! Z-curve, so neighbours in the order are mostly neighbours in space: the linear scan's chunks
+//! and the distance queries of the report run in this order to keep the kd-tree and the BVH in
+//! cache.
 
 use glam::DVec3;
 

@@ -3,12 +3,13 @@
 
 use std::path::Path;
 
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::stream::{PlyPointWriter, Point};
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
+use crate::sampling::surface_sampler::{AreaSample, AreaSampler};
 
 /// Points drawn per chunk (bounds the memory of [`write_surface_points`]).
 const CHUNK: usize = 1 << 20;
@@ -80,12 +81,10 @@ pub fn surface_points_with(
     Ok((0..count).map(|_| sampler.draw()).collect())
 }
 
-/// Area-uniform random points on a mesh with interpolated vertex normals.
+/// Area-uniform random points on a mesh ([`AreaSampler`]) with interpolated vertex normals.
 struct SurfaceSampler<'a> {
     mesh: &'a TriMesh,
-    /// Running sums of the face areas (inverse-transform sampling of the face).
-    cumulative: Vec<f64>,
-    total: f64,
+    faces: AreaSampler,
     normals: Vec<glam::DVec3>,
     /// Per face corner, replacing `normals` when set.
     corner_normals: Option<Vec<[glam::DVec3; 3]>>,
@@ -94,23 +93,11 @@ struct SurfaceSampler<'a> {
 
 impl<'a> SurfaceSampler<'a> {
     fn new(mesh: &'a TriMesh, seed: u64) -> Result<Self> {
-        let mut cumulative = Vec::with_capacity(mesh.face_count());
-        let mut total = 0.0;
-        for f in 0..mesh.face_count() {
-            let a = mesh.face_area(f);
-            total += if a.is_finite() { a } else { 0.0 };
-            cumulative.push(total);
-        }
-        if !(total > 0.0) {
-            return Err(Error::invalid_mesh(
-                "",
-                "the mesh has no area to draw points from",
-            ));
-        }
+        let faces = AreaSampler::new(mesh)
+            .ok_or_else(|| Error::invalid_mesh("", "the mesh has no area to draw points from"))?;
         Ok(SurfaceSampler {
             mesh,
-            cumulative,
-            total,
+            faces,
             normals: mesh.vertex_normals(),
             corner_normals: None,
             rng: ChaCha8Rng::seed_from_u64(seed),
@@ -119,23 +106,16 @@ impl<'a> SurfaceSampler<'a> {
 
     fn draw(&mut self) -> Point {
         let mesh = self.mesh;
-        let r = self.rng.random::<f64>() * self.total;
-        let f = self
-            .cumulative
-            .partition_point(|&c| c <= r)
-            .min(mesh.face_count() - 1);
-        let (mut u, mut v) = (self.rng.random::<f64>(), self.rng.random::<f64>());
-        if u + v > 1.0 {
-            u = 1.0 - u;
-            v = 1.0 - v;
-        }
-        let t = mesh.triangles[f];
-        let [a, b, c] = mesh.corners(f);
-        let position = a + u * (b - a) + v * (c - a);
+        let AreaSample {
+            face: f,
+            u,
+            v,
+            position,
+        } = self.faces.draw(mesh, &mut self.rng);
         let w = 1.0 - u - v;
         let [na, nb, nc] = match &self.corner_normals {
             Some(c) => c[f],
-            None => t.map(|i| self.normals[i as usize]),
+            None => mesh.triangles[f].map(|i| self.normals[i as usize]),
         };
         let n = w * na + u * nb + v * nc;
         let normal = n.try_normalize().unwrap_or_else(|| mesh.face_normal(f));

@@ -5,9 +5,7 @@
 pub mod generate;
 pub mod normals;
 pub mod out_of_core;
-pub mod reconstruct;
 pub mod rimls;
 pub mod stream;
-pub mod subsample;
 
 pub use stream::{PlyPointWriter, Point, PointReader};

@@ -32,7 +32,7 @@
 //! weight: the point then counts as m_i coincident points. A subsampled point set carries the
 //! weights of the points it dropped this way (Sec. 5 of the spectral sampling paper: a dropped
 //! point's weight moves to the points that span it; see
-//! [`crate::points::subsample::representation_weights`]).
+//! `representation_weights` in the `spectral-experiments` crate).
 //!
 //! # References
 //! - A. C. Öztireli, G. Guennebaud, M. Gross. *Feature Preserving Point Set Surfaces based on
@@ -433,6 +433,16 @@ impl Rimls {
         self.project_with(x, &mut Vec::new())
     }
 
+    /// f of [`Rimls::value_and_gradient`] at every point of `xs` (`None` outside the support),
+    /// in order, in parallel, reusing each thread's neighbour buffer.
+    pub fn value_all(&self, xs: &[DVec3]) -> Vec<Option<f64>> {
+        xs.par_iter()
+            .map_init(Vec::new, |neighbours, &x| {
+                self.evaluate(x, neighbours).map(|(f, _)| f)
+            })
+            .collect()
+    }
+
     /// [`Rimls::project`] for every point of `xs`, in parallel (rayon); result `i` is the
     /// projection of `xs[i]`, the same whatever the number of threads.
     pub fn project_all(&self, xs: &[DVec3]) -> Vec<Option<(DVec3, DVec3)>> {
@@ -487,23 +497,6 @@ impl Rimls {
             steps,
             converged: f.abs() < threshold,
         })
-    }
-}
-
-impl crate::surface::ImplicitFunction for Rimls {
-    /// f of [`Rimls::value_and_gradient`]; `None` outside the support.
-    fn value(&self, x: DVec3) -> Option<f64> {
-        self.value_and_gradient(x).map(|(f, _)| f)
-    }
-
-    /// [`ImplicitFunction::value`](crate::surface::ImplicitFunction::value) at every point, in
-    /// parallel, reusing each thread's neighbour buffer.
-    fn values(&self, xs: &[DVec3]) -> Vec<Option<f64>> {
-        xs.par_iter()
-            .map_init(Vec::new, |neighbours, &x| {
-                self.evaluate(x, neighbours).map(|(f, _)| f)
-            })
-            .collect()
     }
 }
 
@@ -918,24 +911,11 @@ mod tests {
 
     /// Points drawn uniformly by area on `mesh`, with the index of their face.
     fn surface_samples(mesh: &TriMesh, count: usize, rng: &mut ChaCha8Rng) -> Vec<(DVec3, usize)> {
-        let mut cumulative = Vec::with_capacity(mesh.face_count());
-        let mut total = 0.0;
-        for f in 0..mesh.face_count() {
-            total += mesh.face_area(f);
-            cumulative.push(total);
-        }
+        let faces = crate::sampling::surface_sampler::AreaSampler::new(mesh).unwrap();
         (0..count)
             .map(|_| {
-                let r = rng.random::<f64>() * total;
-                let f = cumulative
-                    .partition_point(|&c| c <= r)
-                    .min(mesh.face_count() - 1);
-                let (mut u, mut v) = (rng.random::<f64>(), rng.random::<f64>());
-                if u + v > 1.0 {
-                    (u, v) = (1.0 - u, 1.0 - v);
-                }
-                let [a, b, c] = mesh.corners(f);
-                (a + u * (b - a) + v * (c - a), f)
+                let s = faces.draw(mesh, rng);
+                (s.position, s.face)
             })
             .collect()
     }

@@ -4,7 +4,7 @@
 //! Surfaces*. Computer Graphics Forum 17(2), 1998, as used for Table 2 of Öztireli et al. 2010.
 
 use glam::DVec3;
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::geometry::morton::{morton_code, morton_scale};
 use crate::geometry::tolerance::SEARCH_BOUND_SLACK;
 use crate::mesh::TriMesh;
+use crate::sampling::surface_sampler::AreaSampler;
 use crate::surface::MeshSurface;
 
 /// Two-sided distance between two surfaces A and B, in the units of the meshes given (the
@@ -60,10 +61,9 @@ pub struct SurfaceDistance {
 const SECOND_SIDE_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
 
 /// The sample points of one side of [`surface_distance`]: every vertex used by a face (in index
-/// order, finite ones only), then `random` points drawn uniformly by area on the faces: a face is
-/// chosen with probability proportional to its area (inverse CDF over the running sum of areas),
-/// then a point uniformly in it (`a + r1 (b−a) + r2 (c−a)`, `(r1, r2)` reflected into the
-/// triangle when `r1 + r2 > 1`). Three `f64` draws per point from `ChaCha8Rng::seed_from_u64(seed)`:
+/// order, finite ones only), then `random` points drawn uniformly by area on the faces
+/// ([`AreaSampler`]: a face with probability proportional to its area, then a point uniformly in
+/// it). Three `f64` draws per point from `ChaCha8Rng::seed_from_u64(seed)`:
 /// deterministic across platforms and runs. Faces with an out-of-range index or non-finite
 /// corner have no weight; if no face has area, only vertices are returned.
 pub fn surface_samples(mesh: &TriMesh, random: usize, seed: u64) -> Vec<DVec3> {
@@ -84,47 +84,11 @@ pub fn surface_samples(mesh: &TriMesh, random: usize, seed: u64) -> Vec<DVec3> {
         .map(|(p, _)| *p)
         .collect();
 
-    let mut cumulative = Vec::with_capacity(mesh.triangles.len());
-    let mut total = 0.0;
-    let mut last_with_area = None;
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        let area = if t.iter().all(|&i| (i as usize) < n) {
-            let a = mesh.face_area(f);
-            if a.is_finite() {
-                a
-            } else {
-                0.0
-            }
-        } else {
-            0.0
-        };
-        if area > 0.0 {
-            last_with_area = Some(f);
-        }
-        total += area;
-        cumulative.push(total);
-    }
-    let Some(last_with_area) = last_with_area else {
+    let Some(faces) = AreaSampler::new(mesh) else {
         return points;
     };
-    if !(total.is_finite() && total > 0.0) {
-        return points;
-    }
-    points.reserve(random);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    for _ in 0..random {
-        let u = rng.random::<f64>() * total;
-        // The first face whose running sum exceeds u: it has positive area.
-        let f = cumulative.partition_point(|&c| c <= u).min(last_with_area);
-        let [a, b, c] = mesh.corners(f);
-        let mut r1 = rng.random::<f64>();
-        let mut r2 = rng.random::<f64>();
-        if r1 + r2 > 1.0 {
-            r1 = 1.0 - r1;
-            r2 = 1.0 - r2;
-        }
-        points.push(a + r1 * (b - a) + r2 * (c - a));
-    }
+    points.extend((0..random).map(|_| faces.draw(mesh, &mut rng).position));
     points
 }
 

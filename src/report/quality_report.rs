@@ -77,14 +77,6 @@ impl QualityReport {
         });
     }
 
-    /// Runs `f`, appends its wall-clock time as stage `stage`, and returns its result.
-    pub fn time_stage<T>(&mut self, stage: impl Into<String>, f: impl FnOnce() -> T) -> T {
-        let start = std::time::Instant::now();
-        let out = f();
-        self.push_stage(stage, start.elapsed().as_secs_f64());
-        out
-    }
-
     /// The sum of the stage times, in seconds.
     pub fn total_seconds(&self) -> f64 {
         self.stages.iter().map(|s| s.seconds).sum()

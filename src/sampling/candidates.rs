@@ -10,6 +10,7 @@ use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::surface_sampler::{point_in_triangle, random_barycentric};
 use super::SurfaceSample;
 use crate::mesh::TriMesh;
 
@@ -36,16 +37,11 @@ pub fn surface_candidates(mesh: &TriMesh, count: usize, seed: u64) -> Vec<Surfac
         if rng.random::<f64>() < expected - m as f64 {
             m += 1;
         }
-        let [p0, p1, p2] = mesh.corners(f);
+        let corners = mesh.corners(f);
         for _ in 0..m {
-            // Uniform on the triangle: reflect the unit square's upper half.
-            let (mut u, mut v): (f64, f64) = (rng.random(), rng.random());
-            if u + v > 1.0 {
-                u = 1.0 - u;
-                v = 1.0 - v;
-            }
+            let (u, v) = random_barycentric(&mut rng);
             out.push(SurfaceSample {
-                position: p0 + u * (p1 - p0) + v * (p2 - p0),
+                position: point_in_triangle(corners, u, v),
                 normal,
                 face: f as u32,
             });

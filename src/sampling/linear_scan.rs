@@ -1,6 +1,7 @@
 //! Simplification by randomized linear scan (Sec. 6.1, Algorithm 1).
 
 use super::SurfaceSample;
+use crate::geometry::morton::morton_code;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{spectral_measure, MeasureWorkspace, DEFAULT_EPSILON};
 use crate::spatial::DynamicTree;
@@ -69,20 +70,6 @@ enum QuickReject {
     Nearest,
     /// The measure over its few nearest output samples is <= epsilon.
     Few,
-}
-
-/// The Morton (Z-order) key of a point with coordinates in [0, 2^21]: the bits of x, y and z
-/// interleaved.
-fn morton_key(q: DVec3) -> u64 {
-    fn spread(v: f64) -> u64 {
-        let mut x = (v.max(0.0) as u64).min((1 << 21) - 1);
-        x = (x | x << 32) & 0x1f00000000ffff;
-        x = (x | x << 16) & 0x1f0000ff0000ff;
-        x = (x | x << 8) & 0x100f00f00f00f00f;
-        x = (x | x << 4) & 0x10c30c30c30c30c3;
-        (x | x << 2) & 0x1249249249249249
-    }
-    spread(q.x) | spread(q.y) << 1 | spread(q.z) << 2
 }
 
 /// Output samples the second quick test uses.
@@ -294,7 +281,7 @@ impl LinearScanner {
         chunk
             .par_iter()
             .enumerate()
-            .map(|(k, c)| (morton_key((c.0 - lo) * scale), k as u32))
+            .map(|(k, c)| (morton_code((c.0 - lo) * scale), k as u32))
             .collect_into_vec(order);
         order.par_sort_unstable();
         let found: Vec<Verdict> = order
@@ -482,17 +469,5 @@ mod tests {
             assert_eq!(by_one, by_batch, "sigma_n {sigma_n}");
             assert_eq!(one.len(), batch.len());
         }
-    }
-
-    #[test]
-    fn morton_keys_interleave_the_coordinates() {
-        assert_eq!(morton_key(DVec3::new(1.0, 0.0, 0.0)), 0b001);
-        assert_eq!(morton_key(DVec3::new(0.0, 1.0, 0.0)), 0b010);
-        assert_eq!(morton_key(DVec3::new(0.0, 0.0, 1.0)), 0b100);
-        assert_eq!(morton_key(DVec3::new(3.0, 0.0, 2.0)), 0b101_001);
-        // The top bit of each coordinate and clamping at 2^21 - 1.
-        let top = morton_key(DVec3::splat(4e6));
-        assert_eq!(top, (1u64 << 63) - 1);
-        assert_eq!(morton_key(DVec3::splat(-5.0)), 0);
     }
 }

@@ -6,6 +6,7 @@ pub mod boundary;
 pub mod candidates;
 pub mod gradient_ascent;
 pub mod linear_scan;
+pub mod surface_sampler;
 pub mod target_count;
 
 use glam::DVec3;

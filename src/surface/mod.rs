@@ -1,12 +1,8 @@
 //! The input surface the samples live on, and projection onto it.
 
-pub mod marching_cubes;
 pub mod mesh_projection;
 pub mod winding;
 
-pub use marching_cubes::{
-    marching_cubes, ImplicitFunction, MarchingCubesParams, MarchingCubesResult,
-};
 pub use mesh_projection::{MeshSurface, SurfacePoint};
 
 use glam::DVec3;

@@ -12,7 +12,7 @@
 //!    resampling"); its count is the target of the others;
 //! 4. each subset's RIMLS surface with the same σ_p, σ_n on the same grid, compared with the
 //!    all-points surface by the Metro-style two-sided distance
-//!    ([`crate::report::surface_distance`]: RMS and Hausdorff, bbox-100 units);
+//!    ([`spectral_remesh::report::surface_distance`]: RMS and Hausdorff, bbox-100 units);
 //! 5. unless [`ReconstructionEvalParams::weighted`] is off, each subset again with the weights of
 //!    the points it dropped as RIMLS masses ([`representation_weights`], Sec. 5: a dropped
 //!    point's weight moves to the kept points that span its φ), the same rule for every
@@ -35,7 +35,7 @@
 //!
 //! The paper's comparison methods (AS, KS: iterative simplification) are not implemented; the
 //! baselines are uniform random, voxel-grid clustering and Poisson-disk subsampling (see
-//! [`crate::points::subsample`]).
+//! [`crate::subsample`]).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -45,25 +45,25 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use crate::check::topology;
-use crate::error::{Error, Result};
-use crate::io::{read_mesh, write_mesh};
-use crate::kernel::Kernel;
-use crate::mesh::{Normalization, TriMesh};
-use crate::points::generate::{surface_points_with, NormalField};
-use crate::points::reconstruct::{
+use crate::reconstruct::{
     clip_to_domain, reconstruct_rimls, reconstruct_rimls_with_masses, ReconstructParams,
     Reconstruction,
 };
-use crate::points::subsample::{
+use crate::subsample::{
     linear_scan_subsample, poisson_disk_subsample_to_count, random_subsample,
     representation_weights, voxel_grid_subsample_to_count, RepresentationParams, Subsampler,
 };
-use crate::points::{PlyPointWriter, Point};
-use crate::report::{surface_distance_with, SurfaceDistance};
-use crate::sampling::linear_scan::LinearScanParams;
-use crate::sampling::target_count::TargetCountParams;
-use crate::surface::MeshSurface;
+use spectral_remesh::check::topology;
+use spectral_remesh::error::{Error, Result};
+use spectral_remesh::io::{read_mesh, write_mesh};
+use spectral_remesh::kernel::Kernel;
+use spectral_remesh::mesh::{Normalization, TriMesh};
+use spectral_remesh::points::generate::{surface_points_with, NormalField};
+use spectral_remesh::points::{PlyPointWriter, Point};
+use spectral_remesh::report::{surface_distance_with, SurfaceDistance};
+use spectral_remesh::sampling::linear_scan::LinearScanParams;
+use spectral_remesh::sampling::target_count::TargetCountParams;
+use spectral_remesh::surface::MeshSurface;
 
 /// Where the input points come from.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -97,7 +97,7 @@ pub struct ReconstructionEvalParams {
     /// Marching-cubes cell in units of σ_p (default 0.5).
     pub cell_per_sigma: f64,
     /// The restricted domain of the reconstructions in the table, in units of σ_p
-    /// ([`crate::points::reconstruct::ReconstructParams::domain`]; default 1.5; 0 for none).
+    /// ([`crate::reconstruct::ReconstructParams::domain`]; default 1.5; 0 for none).
     /// The distances without it are reported too ([`MethodResult::distance_no_domain`]).
     pub domain: f64,
     /// Random samples per side of each distance, on top of the vertices (default 200,000).
@@ -129,8 +129,8 @@ impl Default for ReconstructionEvalParams {
             sigma_n: 0.75,
             source: PointSource::Vertices,
             methods: Subsampler::ALL.to_vec(),
-            cell_per_sigma: crate::points::reconstruct::DEFAULT_CELL_PER_SIGMA,
-            domain: crate::points::reconstruct::DEFAULT_DOMAIN,
+            cell_per_sigma: crate::reconstruct::DEFAULT_CELL_PER_SIGMA,
+            domain: crate::reconstruct::DEFAULT_DOMAIN,
             distance_samples: 200_000,
             count_tolerance: 0.005,
             weighted: true,

@@ -3,14 +3,14 @@
 
 use std::path::{Path, PathBuf};
 
-use spectral_remesh::points::generate::NormalField;
-use spectral_remesh::points::subsample::Subsampler;
-use spectral_remesh::reconstruction_eval::{
+use spectral_experiments::reconstruction_eval::{
     evaluate_model, input_points, read_normalized_outward, PointSource, ReconstructionEvalParams,
 };
+use spectral_experiments::subsample::Subsampler;
+use spectral_remesh::points::generate::NormalField;
 
 fn model(name: &str) -> PathBuf {
-    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/")).join(name)
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/")).join(name)
 }
 
 #[test]

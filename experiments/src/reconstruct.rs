@@ -1,5 +1,5 @@
 //! Surface reconstruction from an oriented point set: the RIMLS surface of the points
-//! ([`super::rimls`]) triangulated by marching cubes ([`crate::surface::marching_cubes`]) on a
+//! ([`spectral_remesh::points::rimls`]) triangulated by marching cubes ([`crate::marching_cubes`]) on a
 //! grid much finer than the kernel, the "densely triangulated implicit function" the paper
 //! measures reconstructions on (Sec. 7.2).
 
@@ -8,11 +8,11 @@ use std::time::Instant;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::rimls::{Rimls, RimlsParams};
-use crate::error::{Error, Result};
-use crate::mesh::TriMesh;
-use crate::spatial::StaticTree;
-use crate::surface::marching_cubes::{marching_cubes, MarchingCubesParams};
+use crate::marching_cubes::{marching_cubes, MarchingCubesParams};
+use spectral_remesh::error::{Error, Result};
+use spectral_remesh::mesh::TriMesh;
+use spectral_remesh::points::rimls::{Rimls, RimlsParams};
+use spectral_remesh::spatial::StaticTree;
 
 /// The grid cell of a reconstruction, in units of σ_p: 0.5 (cell = σ_p/2). The RIMLS surface
 /// varies on the scale of σ_p, so cells of σ_p/2 resolve it. Measured on horse (475k surface
@@ -108,7 +108,7 @@ pub fn reconstruct_rimls(
 
 /// [`reconstruct_rimls`] of points that carry masses (`masses`, one per point, finite, ≥ 0):
 /// the RIMLS surface of [`Rimls::with_masses`]. A subset reconstructed with the weights of the
-/// points it dropped ([`crate::points::subsample::representation_weights`]) follows the
+/// points it dropped ([`crate::subsample::representation_weights`]) follows the
 /// reconstruction of the whole set (Sec. 5 of the paper).
 ///
 /// # Errors
@@ -201,13 +201,13 @@ pub fn clip_to_domain(mesh: &mut TriMesh, positions: &[DVec3], radius: f64) -> u
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::topology;
+    use spectral_remesh::check::topology;
 
     #[test]
     fn a_sampled_sphere_comes_back_closed_and_near_its_radius() {
         // 20,000 points on a sphere of radius 20 (a Fibonacci spiral), exact normals.
         let (r, n) = (20.0, 20_000);
-        let normals = crate::mesh::test_meshes::fibonacci_sphere(n);
+        let normals = crate::test_points::fibonacci_sphere(n);
         let positions: Vec<DVec3> = normals.iter().map(|n| *n * r).collect();
         // Spacing about 0.5; sigma_p 1.
         let params = ReconstructParams::new(1.0, 0.75);

@@ -47,8 +47,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use crate::error::{Error, Result};
-use crate::mesh::TriMesh;
+use spectral_remesh::error::{Error, Result};
+use spectral_remesh::mesh::TriMesh;
+use spectral_remesh::points::rimls::Rimls;
 
 /// An implicit function f: R³ → R whose zero set is a surface, defined (`Some`) near it and
 /// possibly undefined (`None`) elsewhere. Positive on the outside by this crate's convention.
@@ -66,6 +67,18 @@ pub trait ImplicitFunction: Sync {
 impl<F: Fn(DVec3) -> Option<f64> + Sync> ImplicitFunction for F {
     fn value(&self, x: DVec3) -> Option<f64> {
         self(x)
+    }
+}
+
+impl ImplicitFunction for Rimls {
+    /// f of [`Rimls::value_and_gradient`]; `None` outside the support.
+    fn value(&self, x: DVec3) -> Option<f64> {
+        self.value_and_gradient(x).map(|(f, _)| f)
+    }
+
+    /// [`Rimls::value_all`]: in parallel, reusing each thread's neighbour buffer.
+    fn values(&self, xs: &[DVec3]) -> Vec<Option<f64>> {
+        self.value_all(xs)
     }
 }
 
@@ -660,7 +673,7 @@ pub fn marching_cubes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::{check_invariants, topology};
+    use spectral_remesh::check::{check_invariants, topology};
 
     /// Every case's cycles use each crossing edge exactly once and no other edge.
     #[test]
@@ -709,7 +722,7 @@ mod tests {
     }
 
     fn seeds_on_sphere(c: DVec3, r: f64, n: usize) -> Vec<DVec3> {
-        crate::mesh::test_meshes::fibonacci_sphere(n)
+        crate::test_points::fibonacci_sphere(n)
             .into_iter()
             .map(|u| c + r * u)
             .collect()

@@ -2,7 +2,8 @@
 //! the baselines it is compared with, and the measures of Lagae and Dutré 2008 and Ulichney 1987.
 //!
 //! - `torus.rs`: wrapping, toroidal distances, a uniform grid on the torus.
-//! - `spectral.rs`: gradient ascent (eq. 11) and the linear scan (Algorithm 1) on the torus;
+//! - `spectral.rs`: gradient ascent (eq. 11) and the linear scan (Algorithm 1, the library's
+//!   `LinearScanner` with periodic images) on the torus;
 //!   path A (random start) and path B (dense set, scan, then ascent).
 //! - `lloyd.rs`: Lloyd's method with exact periodic Voronoi cells.
 //! - `dart_throwing.rs`: dart throwing to n points at a fixed radius.

@@ -36,6 +36,26 @@ pub fn dist2(a: DVec2, b: DVec2) -> f64 {
     delta(a, b).length_squared()
 }
 
+/// The periodic images `p + (i, j)` (`i, j` in {-1, 0, 1}, not both 0) of `p` in [0, 1)² that
+/// lie within `margin` of the square (in [-margin, 1 + margin)²; `margin` < 1/2): the copies a
+/// neighbour query of radius `margin` from inside the square needs across its edges. None for a
+/// point farther than `margin` from every edge, up to 3 near a corner.
+pub fn periodic_images(p: DVec2, margin: f64) -> impl Iterator<Item = DVec2> {
+    // The shifts of each coordinate that keep its image within the margin.
+    let shifts = |x: f64| {
+        [
+            (-1.0, x - 1.0 >= -margin),
+            (0.0, true),
+            (1.0, x + 1.0 < 1.0 + margin),
+        ]
+    };
+    let (sx, sy) = (shifts(p.x), shifts(p.y));
+    sx.into_iter()
+        .flat_map(move |(dx, ok_x)| sy.into_iter().map(move |(dy, ok_y)| (dx, dy, ok_x && ok_y)))
+        .filter(|&(dx, dy, ok)| ok && (dx, dy) != (0.0, 0.0))
+        .map(move |(dx, dy, _)| p + DVec2::new(dx, dy))
+}
+
 /// A uniform grid of `cells × cells` square cells over the torus, holding point indices. A query
 /// of radius `r <= cell side` visits the 3 × 3 block of cells around the query's cell (wrapping
 /// around the edges), so it finds every point within toroidal distance r. Points can move
@@ -197,5 +217,25 @@ mod tests {
             grid.relocate(i as u32, p);
         }
         check(&grid, &moved, &mut rng);
+    }
+
+    #[test]
+    fn periodic_images_are_the_copies_near_the_square() {
+        let m = 0.1;
+        let count = |p: DVec2| periodic_images(p, m).count();
+        assert_eq!(count(DVec2::new(0.5, 0.5)), 0);
+        assert_eq!(count(DVec2::new(0.05, 0.5)), 1);
+        assert_eq!(count(DVec2::new(0.95, 0.02)), 3);
+        let images: Vec<DVec2> = periodic_images(DVec2::new(0.95, 0.5), m).collect();
+        assert_eq!(images, [DVec2::new(-0.050000000000000044, 0.5)]);
+        // Every image is within the margin of the square and is a copy of the point.
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..1000 {
+            let p = DVec2::new(rng.random(), rng.random());
+            for q in periodic_images(p, m) {
+                assert!(q.min_element() >= -m && q.max_element() < 1.0 + m, "{q}");
+                assert!(delta(p, q).length() < 1e-12 && (q - p).length() > 0.99);
+            }
+        }
     }
 }

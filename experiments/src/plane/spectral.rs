@@ -8,6 +8,18 @@
 //! 2.5 sigma; with 2.5 sigma <= 1/4 (checked) the distances among those images are the toroidal
 //! ones, so the local kernel matrix is the one of the torus.
 //!
+//! What is the library's and what is not: the kernel, the measure and its gradient
+//! (`measure::measure_and_gradient`, `measure::spectral_measure`), the sigma search
+//! (`sampling::target_count`) and the linear scan itself ([`torus_linear_scan`] drives
+//! `sampling::linear_scan::LinearScanner` with the kept points' periodic images). The gradient
+//! ascent is this module's own ([`torus_gradient_ascent`]): the library's
+//! (`sampling::gradient_ascent`) finds each sample's neighbours once per call in a kd-tree of
+//! absolute positions and moves samples through a surface projection, while on the torus a
+//! moving point wraps across the edges (its neighbours' nearest images change with it) and the
+//! random start needs its neighbourhoods found afresh at every move; giving the library's
+//! ascent a neighbour query per move would change the product's sampler for the sake of this
+//! experiment.
+//!
 //! Two paths, both named in Sec. 7.1:
 //! - [`spectral_from_random`] (the paper's): n uniform random points, then 10 sweeps of gradient
 //!   ascent with sigma = 2.5 r, r = rho / sqrt(2 sqrt(3) n), rho = 0.75 ([`paper_sigma`]).
@@ -20,11 +32,14 @@ use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::torus::{delta, wrap, TorusGrid};
-use crate::error::{Error, Result};
-use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
-use crate::measure::{measure_and_gradient, spectral_measure, MeasureWorkspace, DEFAULT_EPSILON};
-use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
+use super::torus::{delta, periodic_images, wrap, TorusGrid};
+use spectral_remesh::error::{Error, Result};
+use spectral_remesh::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
+use spectral_remesh::measure::{
+    measure_and_gradient, spectral_measure, MeasureWorkspace, DEFAULT_EPSILON,
+};
+use spectral_remesh::sampling::linear_scan::{LinearScanParams, LinearScanner};
+use spectral_remesh::sampling::target_count::{find_sigma_p, TargetCountParams};
 
 /// The largest support radius (2.5 sigma, in units of the square's side) the torus samplers
 /// accept: up to 1/4, two neighbours of a point are at most 1/2 apart, so the distance between
@@ -258,9 +273,15 @@ impl Default for TorusScanParams {
 
 /// Algorithm 1 on the torus: visits `candidates` in the order given (pass them in random order;
 /// uniform random points already are) and keeps a candidate when its measure s (eq. 9) against
-/// the kept points within the support radius exceeds epsilon, or when it has none. The
-/// neighbours are taken nearest first and the evaluation stops once s <= epsilon (Sec. 6.1,
-/// iterative inversion eq. 10). Returns the kept points in the order kept.
+/// the kept points within the support radius exceeds epsilon, or when it has none. Returns the
+/// kept points in the order kept.
+///
+/// The scan is the library's ([`LinearScanner::offer`]: quick rejections by the nearest and the
+/// few nearest kept points, then eq. 10 over the neighbours nearest first, stopping once
+/// s <= epsilon) on the points (x, y, 0): every kept point enters it with its periodic images
+/// that lie within the support radius of the square ([`periodic_images`]). With 2.5 sigma <= 1/4
+/// (checked) a candidate in the square sees each kept point at most once, as the image nearest
+/// to it: its neighbourhood is the toroidal one.
 ///
 /// Units: positions in [0, 1)² (wrapped), sigma in units of the square's side.
 ///
@@ -280,25 +301,22 @@ pub fn torus_linear_scan(
     }
     let kernel = Kernel::new(sigma, f64::INFINITY)?;
     let r = params.support_radius * sigma;
-    let mut grid = TorusGrid::new(r, usize::MAX);
+    let mut scanner = LinearScanner::new(
+        &kernel,
+        &LinearScanParams {
+            epsilon: params.epsilon,
+            support_radius: params.support_radius,
+        },
+    );
+    let plane = |p: DVec2| DVec3::new(p.x, p.y, 0.0);
     let mut kept: Vec<DVec2> = Vec::new();
-    let (mut ws, mut near, mut nb) = (MeasureWorkspace::new(), Vec::new(), Vec::new());
-    let origin = kernel.embed(DVec3::ZERO, DVec3::Z);
     for &c in candidates {
         let p = wrap(c);
-        gather(&kernel, &grid, &kept, p, u32::MAX, r, &mut near, &mut nb);
-        let accept = nb.is_empty()
-            || spectral_measure(
-                &kernel,
-                &origin,
-                nb.iter().copied(),
-                params.epsilon,
-                &mut ws,
-            )
-            .s > params.epsilon;
-        if accept {
-            grid.insert(kept.len() as u32, p);
+        if scanner.offer(plane(p), DVec3::Z) {
             kept.push(p);
+            for q in periodic_images(p, r) {
+                scanner.insert(plane(q), DVec3::Z);
+            }
         }
     }
     Ok(kept)
@@ -524,5 +542,46 @@ mod tests {
         assert!(r.mean_s.last() > r.mean_s.first(), "{:?}", r.mean_s);
         assert!(normalized_poisson_disk_radius(&pts) > rho0);
         assert!(r.mean_move.last() < r.mean_move.first());
+    }
+
+    /// Algorithm 1 on the torus written out directly: every kept point, toroidal differences,
+    /// the measure over all neighbours within the support radius, nearest first.
+    fn brute_force_scan(candidates: &[DVec2], sigma: f64) -> Vec<DVec2> {
+        let kernel = Kernel::new(sigma, f64::INFINITY).unwrap();
+        let r = SUPPORT_RADIUS * sigma;
+        let origin = kernel.embed(DVec3::ZERO, DVec3::Z);
+        let mut ws = MeasureWorkspace::new();
+        let mut kept: Vec<DVec2> = Vec::new();
+        for &c in candidates {
+            let p = wrap(c);
+            let mut near: Vec<(f64, KernelPoint)> = kept
+                .iter()
+                .map(|&q| delta(p, q))
+                .filter(|d| d.length_squared() <= r * r)
+                .map(|d| {
+                    let x = kernel.embed(DVec3::new(d.x, d.y, 0.0), DVec3::Z);
+                    (d.length_squared(), x)
+                })
+                .collect();
+            near.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let s = spectral_measure(&kernel, &origin, near.iter().map(|n| n.1), -1.0, &mut ws).s;
+            if near.is_empty() || s > DEFAULT_EPSILON {
+                kept.push(p);
+            }
+        }
+        kept
+    }
+
+    #[test]
+    fn linear_scan_makes_the_decisions_of_the_brute_force_scan() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let n = 300;
+        let sigma = paper_sigma(n, PAPER_RHO);
+        let candidates = uniform_random(20 * n, &mut rng);
+        let fast = torus_linear_scan(&candidates, sigma, &TorusScanParams::default()).unwrap();
+        let slow = brute_force_scan(&candidates, sigma);
+        assert_eq!(fast, slow);
+        // Kept points near the edges have neighbours across them.
+        assert!(fast.iter().any(|p| p.x < 0.01) && fast.iter().any(|p| p.x > 0.99));
     }
 }

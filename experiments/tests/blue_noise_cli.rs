@@ -1,4 +1,4 @@
-//! Runs `remesh blue-noise` and checks its JSON report: the shapes a plotting script relies on,
+//! Runs `spectral-experiments blue-noise` and checks its JSON report: the shapes a plotting script relies on,
 //! the same seed giving the same sets, and bad parameters giving a one-line usage error.
 
 use std::path::Path;
@@ -7,14 +7,14 @@ use std::process::Command;
 use serde_json::Value;
 
 fn run(args: &[&str], out: &Path) -> Value {
-    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+    let o = Command::new(env!("CARGO_BIN_EXE_spectral-experiments"))
         .arg("blue-noise")
         .args(args)
         .arg("--output")
         .arg(out)
         .arg("-q")
         .output()
-        .expect("run remesh");
+        .expect("run spectral-experiments");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap()
 }
@@ -58,11 +58,11 @@ fn blue_noise_writes_a_report_with_plottable_shapes_and_repeats_for_a_seed() {
 fn too_few_points_for_the_kernel_is_a_usage_error() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.json");
-    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+    let o = Command::new(env!("CARGO_BIN_EXE_spectral-experiments"))
         .args(["blue-noise", "--method", "ours", "--n", "30", "--output"])
         .arg(&out)
         .output()
-        .expect("run remesh");
+        .expect("run spectral-experiments");
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(err.trim().lines().count(), 1, "{err}");

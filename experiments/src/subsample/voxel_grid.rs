@@ -3,7 +3,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
+use spectral_remesh::sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
 
 /// Clusters `positions` (any units; `voxel` in the same) by the cubic voxel of side `voxel` they
 /// fall in (the grid anchored at the points' bounding-box minimum minus `offset · voxel`, each
@@ -110,7 +110,7 @@ mod tests {
         // 100,000 points on a sphere of radius 10 (a Fibonacci spiral). (On an axis-aligned
         // plane the count is a coarse step function of the size and may miss the tolerance.)
         let n = 100_000;
-        let positions: Vec<DVec3> = crate::mesh::test_meshes::fibonacci_sphere(n)
+        let positions: Vec<DVec3> = crate::test_points::fibonacci_sphere(n)
             .into_iter()
             .map(|u| 10.0 * u)
             .collect();
