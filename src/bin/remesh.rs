@@ -1,5 +1,6 @@
-//! `remesh`: the command line. Parses flags into a validated job, calls the library, prints the
-//! report, and maps errors to exit codes (2 usage, 3 input, 4 output, 1 internal).
+//! `remesh`: the command line. Parses flags into a validated [`Config`], runs it with one library
+//! call per subcommand, prints, and maps errors to exit codes (2 usage, 3 input, 4 output,
+//! 1 internal). All work lives in the library (`spectral_remesh::app`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -7,7 +8,10 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use spectral_remesh::app::{run_quality, run_remesh, RemeshJob};
+use spectral_remesh::app::{
+    catch_panics, run_points, run_quality, run_remesh, run_simplify, write_report, PointsJob,
+    RemeshJob, SimplifyDensity, SimplifyJob,
+};
 use spectral_remesh::pipeline::{Density, RemeshParams};
 use spectral_remesh::Error;
 
@@ -153,9 +157,183 @@ enum Command {
     },
 }
 
-/// Writes a JSON report atomically (a temporary file beside it, then a rename).
-fn write_report(path: &PathBuf, json: &str) -> Result<(), Error> {
-    spectral_remesh::io::write_atomically(path, |w| w.write_all(json.as_bytes()))
+/// A validated command: what to run and how to print it.
+enum Config {
+    Remesh {
+        job: RemeshJob,
+        report: Option<PathBuf>,
+        quiet: bool,
+    },
+    Quality {
+        mesh: PathBuf,
+        reference: Option<PathBuf>,
+        seed: u64,
+        json: bool,
+        report: Option<PathBuf>,
+    },
+    Simplify {
+        job: SimplifyJob,
+        quiet: bool,
+    },
+    Points(PointsJob),
+}
+
+/// The flags as a [`Config`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for flags that clap's own checks let through but that make no job.
+fn config(cli: Cli) -> Result<Config, Error> {
+    match cli.command {
+        Some(Command::Quality {
+            mesh,
+            reference,
+            json,
+            report,
+            seed,
+        }) => Ok(Config::Quality {
+            mesh,
+            reference,
+            seed,
+            json,
+            report,
+        }),
+        Some(Command::Simplify {
+            input,
+            output,
+            points,
+            sigma_p,
+            levels,
+            sigma_n,
+            resample,
+            seed,
+            viewpoint,
+            quiet,
+        }) => {
+            let density = match (points, sigma_p, levels) {
+                (Some(n), _, _) => SimplifyDensity::Points(n),
+                (_, Some(s), _) => SimplifyDensity::SigmaP(s),
+                (_, _, Some(l)) => SimplifyDensity::Levels(l),
+                _ => {
+                    return Err(Error::InvalidParameter {
+                        name: "--points",
+                        message: "give --points N, --sigma-p S or --levels S1,S2,...".into(),
+                    })
+                }
+            };
+            let job = SimplifyJob {
+                input,
+                output,
+                density,
+                sigma_n,
+                resample,
+                seed,
+                viewpoint: viewpoint.map(glam::DVec3::from),
+            };
+            Ok(Config::Simplify { job, quiet })
+        }
+        Some(Command::Points {
+            mesh,
+            output,
+            count,
+            seed,
+        }) => Ok(Config::Points(PointsJob {
+            mesh,
+            output,
+            count,
+            seed,
+        })),
+        None => {
+            let (Some(input), Some(output)) = (cli.input, cli.output) else {
+                return Err(Error::InvalidParameter {
+                    name: "INPUT OUTPUT",
+                    message: "both are required (see --help)".into(),
+                });
+            };
+            let density = match (cli.points, cli.sigma_p) {
+                (Some(n), None) => Density::Points(n),
+                (None, Some(s)) => Density::SigmaP(s),
+                _ => Density::InputVertices,
+            };
+            let mut params = RemeshParams {
+                density,
+                seed: cli.seed,
+                ..Default::default()
+            };
+            params.gradient_ascent.iterations = cli.iterations;
+            if let Some(s) = cli.sigma_n {
+                params.sigma_n = s;
+            }
+            let job = RemeshJob {
+                input,
+                output,
+                params,
+                measure_distance: !cli.no_distance,
+                strict: cli.strict,
+            };
+            Ok(Config::Remesh {
+                job,
+                report: cli.report,
+                quiet: cli.quiet,
+            })
+        }
+    }
+}
+
+/// Runs a [`Config`]: one library call, then what it prints and the JSON report.
+fn execute(config: Config) -> Result<(), Error> {
+    match config {
+        Config::Remesh { job, report, quiet } => {
+            let bar = progress(quiet);
+            let result = run_remesh(&job, &|stage: &str| bar.set_message(stage.to_string()));
+            bar.finish_and_clear();
+            let r = result?;
+            if !quiet {
+                emit(&format!(
+                    "{} -> {}\n{r}",
+                    job.input.display(),
+                    job.output.display()
+                ));
+            }
+            report.map_or(Ok(()), |p| write_report(&p, &r))
+        }
+        Config::Quality {
+            mesh,
+            reference,
+            seed,
+            json,
+            report,
+        } => {
+            let r = run_quality(&mesh, reference.as_deref(), seed)?;
+            emit(&if json {
+                format!("{}\n", r.to_json())
+            } else {
+                r.to_string()
+            });
+            report.map_or(Ok(()), |p| write_report(&p, &r))
+        }
+        Config::Simplify { job, quiet } => {
+            let summary = run_simplify(&job)?;
+            if !quiet {
+                emit(&summary.to_string());
+            }
+            Ok(())
+        }
+        Config::Points(job) => run_points(&job),
+    }
+}
+
+/// A spinner with the current stage on standard error, or a hidden one.
+fn progress(quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    b.set_style(
+        ProgressStyle::with_template("{spinner} {msg} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    b.enable_steady_tick(Duration::from_millis(120));
+    b
 }
 
 /// Writes to standard output. A reader that went away (`remesh ... | head`) is not an error:
@@ -164,128 +342,6 @@ fn emit(text: &str) {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     let _ = out.write_all(text.as_bytes()).and_then(|_| out.flush());
-}
-
-fn run(cli: Cli) -> Result<(), Error> {
-    if let Some(Command::Simplify {
-        input,
-        output,
-        points,
-        sigma_p,
-        levels,
-        sigma_n,
-        resample,
-        seed,
-        viewpoint,
-        quiet,
-    }) = &cli.command
-    {
-        let density = match (points, sigma_p, levels) {
-            (Some(n), _, _) => PointDensity::Points(*n),
-            (_, Some(s), _) => PointDensity::SigmaP(*s),
-            (_, _, Some(l)) => PointDensity::Levels(l.clone()),
-            _ => {
-                return Err(Error::InvalidParameter {
-                    name: "--points",
-                    message: "give --points N, --sigma-p S or --levels S1,S2,...".into(),
-                })
-            }
-        };
-        return run_simplify(
-            input, output, density, *sigma_n, *resample, *seed, *viewpoint, *quiet,
-        );
-    }
-    if let Some(Command::Points {
-        mesh,
-        output,
-        count,
-        seed,
-    }) = &cli.command
-    {
-        let (m, _) = spectral_remesh::io::read_mesh(mesh)?;
-        return spectral_remesh::points::generate::write_surface_points(&m, *count, *seed, output);
-    }
-    if let Some(Command::Quality {
-        mesh,
-        reference,
-        json,
-        report,
-        seed,
-    }) = cli.command
-    {
-        let r = run_quality(&mesh, reference.as_deref(), seed)?;
-        if json {
-            emit(&format!("{}\n", r.to_json()));
-        } else {
-            emit(&r.to_string());
-        }
-        if let Some(p) = report {
-            write_report(&p, &r.to_json())?;
-        }
-        return Ok(());
-    }
-    let (Some(input), Some(output)) = (cli.input, cli.output) else {
-        return Err(Error::InvalidParameter {
-            name: "INPUT OUTPUT",
-            message: "both are required (see --help)".into(),
-        });
-    };
-    let density = match (cli.points, cli.sigma_p) {
-        (Some(n), None) => Density::Points(n),
-        (None, Some(s)) => Density::SigmaP(s),
-        _ => Density::InputVertices,
-    };
-    if cli.points == Some(0) {
-        return Err(Error::InvalidParameter {
-            name: "--points",
-            message: "must be at least 4".into(),
-        });
-    }
-    if std::env::var_os("REMESH_INJECT_PANIC").is_some() {
-        // For the test of the panic path (tests/bad_input.rs): a bug's way out, on demand.
-        panic!("injected by REMESH_INJECT_PANIC");
-    }
-    let mut params = RemeshParams {
-        density,
-        seed: cli.seed,
-        ..Default::default()
-    };
-    params.gradient_ascent.iterations = cli.iterations;
-    if let Some(s) = cli.sigma_n {
-        params.sigma_n = s;
-    }
-    let job = RemeshJob {
-        input,
-        output,
-        params,
-        measure_distance: !cli.no_distance,
-        strict: cli.strict,
-    };
-    let bar = if cli.quiet {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-        b.set_style(
-            ProgressStyle::with_template("{spinner} {msg} {elapsed}")
-                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-        );
-        b.enable_steady_tick(Duration::from_millis(120));
-        b
-    };
-    let result = run_remesh(&job, &|stage: &str| bar.set_message(stage.to_string()));
-    bar.finish_and_clear();
-    let report = result?;
-    if !cli.quiet {
-        emit(&format!(
-            "{} -> {}\n{report}",
-            job.input.display(),
-            job.output.display()
-        ));
-    }
-    if let Some(p) = cli.report {
-        write_report(&p, &report.to_json())?;
-    }
-    Ok(())
 }
 
 fn parse_point(s: &str) -> Result<[f64; 3], String> {
@@ -300,164 +356,11 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
     }
 }
 
-/// The output density of `remesh simplify`.
-enum PointDensity {
-    Points(usize),
-    SigmaP(f64),
-    Levels(Vec<f64>),
-}
-
-#[allow(clippy::too_many_arguments)]
-fn run_simplify(
-    input: &std::path::Path,
-    output: &std::path::Path,
-    density: PointDensity,
-    sigma_n: Option<f64>,
-    resample: usize,
-    seed: u64,
-    viewpoint: Option<[f64; 3]>,
-    quiet: bool,
-) -> Result<(), Error> {
-    use spectral_remesh::points::normals::Orientation;
-    use spectral_remesh::points::out_of_core::{
-        simplify_out_of_core, simplify_progressive, OutOfCoreParams,
-    };
-    use spectral_remesh::points::PlyPointWriter;
-    if matches!(density, PointDensity::Points(0)) {
-        return Err(Error::InvalidParameter {
-            name: "--points",
-            message: "must be at least 1".into(),
-        });
-    }
-    let orientation = match viewpoint {
-        Some([x, y, z]) => Orientation::Viewpoint(glam::DVec3::new(x, y, z)),
-        None => Orientation::SpanningTree,
-    };
-    let params = OutOfCoreParams {
-        resample,
-        orientation,
-        target: match density {
-            PointDensity::Points(n) => Some(n),
-            _ => None,
-        },
-        sigma_p: match density {
-            PointDensity::SigmaP(s) => s,
-            _ => 1.0,
-        },
-        sigma_n: sigma_n.unwrap_or(f64::INFINITY),
-        seed,
-        ..Default::default()
-    };
-    let t = std::time::Instant::now();
-    if sigma_n.is_some_and(f64::is_finite) {
-        let reader = spectral_remesh::points::PointReader::open(input)?;
-        if !reader.has_normals() {
-            return Err(Error::InvalidParameter {
-                name: "--sigma-n",
-                message: format!("{} has no normals; sigma_n needs them", input.display()),
-            });
-        }
-    }
-    let no_normals_note =
-        "; the input has no normals: positions only, normals estimated on the output";
-    if let PointDensity::Levels(levels) = &density {
-        let r = simplify_progressive(input, levels, &params)?;
-        let mut w = PlyPointWriter::create_with_levels(output, r.samples.len() as u64)?;
-        w.write_levels(&r.samples, &r.levels)?;
-        w.finish()?;
-        if !quiet {
-            let mut text = format!(
-                "{} -> {}: {} points -> {} samples in {} nested levels{}\n",
-                input.display(),
-                output.display(),
-                r.input_points,
-                r.samples.len(),
-                r.level_ends.len(),
-                if r.had_normals { "" } else { no_normals_note }
-            );
-            for (l, (&end, s)) in r.level_ends.iter().zip(&r.sigma_p).enumerate() {
-                let start = if l == 0 { 0 } else { r.level_ends[l - 1] };
-                text += &format!(
-                    "  level {}: sigma_p {s:.4}, |P{}| = {end} (+{}), {:.2} s\n",
-                    l + 1,
-                    l + 1,
-                    end - start,
-                    r.seconds[l + 1]
-                );
-            }
-            text += &format!(
-                "seconds: read+bucket {:.2}, total {:.2}\n",
-                r.seconds[0],
-                t.elapsed().as_secs_f64()
-            );
-            emit(&text);
-        }
-        return Ok(());
-    }
-    let r = simplify_out_of_core(input, &params)?;
-    let mut w = PlyPointWriter::create(output, r.samples.len() as u64)?;
-    w.write(&r.samples)?;
-    w.finish()?;
-    if !quiet {
-        emit(&format!(
-            "{} -> {}: {} points -> {} samples, sigma_p {:.4} (bbox-100 units){}; {} rejected by the nearest sample, {} measured\n\
-             seconds: read+bucket {:.2}, sigma_p search {:.2}, scan {:.2}, normals+resample {:.2}, total {:.2}\n",
-            input.display(),
-            output.display(),
-            r.input_points,
-            r.samples.len(),
-            r.sigma_p,
-            if r.had_normals { "" } else { no_normals_note },
-            r.rejected_by_nearest,
-            r.measured,
-            r.seconds[0],
-            r.seconds[1],
-            r.seconds[2],
-            r.seconds[3],
-            t.elapsed().as_secs_f64()
-        ));
-    }
-    Ok(())
-}
-
-/// Where the last panic happened and what it said, kept by the panic hook for `main`.
-static PANIC: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    // A panic is a bug: it still ends in one line and the internal-failure exit code, with
-    // where it happened, instead of the default multi-line message.
-    std::panic::set_hook(Box::new(|info| {
-        let message = info
-            .payload()
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| info.payload().downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown cause".into());
-        let place = info
-            .location()
-            .map(|l| format!(" at {}:{}", l.file(), l.line()))
-            .unwrap_or_default();
-        if let Ok(mut p) = PANIC.lock() {
-            *p = Some(format!("{message}{place}"));
-        }
-    }));
-    match std::panic::catch_unwind(|| run(cli)) {
-        Ok(Ok(())) => ExitCode::SUCCESS,
-        Ok(Err(e)) => {
-            eprintln!("remesh: error: {e}");
-            ExitCode::from(e.exit_code() as u8)
-        }
-        Err(_) => {
-            let what = PANIC
-                .lock()
-                .ok()
-                .and_then(|p| p.clone())
-                .unwrap_or_else(|| "unknown cause".into());
-            let e = Error::Internal {
-                stage: "panic",
-                message: format!("{} (a bug: please report it)", what.replace('\n', " ")),
-            };
+    match catch_panics(|| config(cli).and_then(execute)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
             eprintln!("remesh: error: {e}");
             ExitCode::from(e.exit_code() as u8)
         }

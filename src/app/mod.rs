@@ -1,11 +1,16 @@
 //! The jobs behind the `remesh` command line, as library functions: remesh a file and report on
-//! it, or report on any mesh against a reference.
+//! it, report on any mesh against a reference, simplify a point set out of core, draw points
+//! from a mesh; writing the JSON report, and turning a panic into an error.
+
+mod simplify;
+
+pub use simplify::{run_simplify, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary};
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::io::{read_mesh, write_mesh};
+use crate::io::{read_mesh, write_atomically, write_mesh};
 use crate::pipeline::{remesh, RemeshParams};
 use crate::report::{surface_distance, surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
@@ -236,5 +241,107 @@ fn same_file(a: &Path, b: &Path) -> bool {
     match (a.canonicalize(), b.canonicalize()) {
         (Ok(x), Ok(y)) => x == y,
         _ => false,
+    }
+}
+
+/// A `remesh points` job: `count` points drawn uniformly by area from the mesh in `mesh`, with
+/// normals, written to `output` as binary PLY (streamed).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointsJob {
+    /// The mesh to draw from (.obj, .ply, .gltf, .glb).
+    pub mesh: PathBuf,
+    /// The output point set (.ply).
+    pub output: PathBuf,
+    /// How many points.
+    pub count: u64,
+    /// Seed of the draw.
+    pub seed: u64,
+}
+
+/// Runs a [`PointsJob`].
+///
+/// # Errors
+/// Reading and writing errors naming the file.
+pub fn run_points(job: &PointsJob) -> Result<()> {
+    let (mesh, _) = read_mesh(&job.mesh)?;
+    crate::points::generate::write_surface_points(&mesh, job.count, job.seed, &job.output)
+}
+
+/// Writes `report` as pretty JSON to `path`, atomically (a temporary file beside it, renamed
+/// over the target only when complete).
+///
+/// # Errors
+/// [`Error::Write`] naming `path`.
+pub fn write_report(path: &Path, report: &QualityReport) -> Result<()> {
+    let json = report.to_json();
+    write_atomically(path, |w| w.write_all(json.as_bytes()))
+}
+
+/// Runs `job`, turning a panic (a bug) into an [`Error::Internal`] with stage `panic`, the
+/// panic's message and where it happened, on one line. The process's panic hook is replaced for
+/// the call (the default hook would print several lines) and restored after it.
+///
+/// # Errors
+/// Whatever `job` returns, or the panic as above.
+pub fn catch_panics<T>(job: impl FnOnce() -> Result<T>) -> Result<T> {
+    use std::sync::{Arc, Mutex};
+    let last: Arc<Mutex<Option<String>>> = Arc::default();
+    let seen = Arc::clone(&last);
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown cause".into());
+        let place = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        if let Ok(mut p) = seen.lock() {
+            *p = Some(format!("{message}{place}"));
+        }
+    }));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
+    std::panic::set_hook(previous);
+    result.unwrap_or_else(|_| {
+        let what = last
+            .lock()
+            .ok()
+            .and_then(|p| p.clone())
+            .unwrap_or_else(|| "unknown cause".into());
+        Err(Error::Internal {
+            stage: "panic",
+            message: format!("{} (a bug: please report it)", what.replace('\n', " ")),
+        })
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The panic path, injected: one line with the message and the place, the internal exit code.
+    #[test]
+    fn a_panic_becomes_one_internal_error_line() {
+        let e = catch_panics::<()>(|| panic!("injected\nover two lines")).unwrap_err();
+        let line = e.to_string();
+        assert!(matches!(e, Error::Internal { stage: "panic", .. }), "{e:?}");
+        assert_eq!(e.exit_code(), 1);
+        assert_eq!(line.lines().count(), 1, "{line}");
+        assert!(line.contains("injected over two lines"), "{line}");
+        assert!(line.contains("src/app/mod.rs:"), "{line}");
+        assert!(line.contains("a bug: please report it"), "{line}");
+        // Errors and results pass through.
+        assert_eq!(catch_panics(|| Ok(3)).unwrap(), 3);
+        let e = catch_panics::<()>(|| {
+            Err(Error::InvalidParameter {
+                name: "--points",
+                message: "x".into(),
+            })
+        })
+        .unwrap_err();
+        assert_eq!(e.exit_code(), 2);
     }
 }
