@@ -2,15 +2,20 @@
 //! add the best of the others where they fit, fill the holes that remain, and repair vertices
 //! whose faces do not form one fan.
 //!
-//! Every accepted face must use each directed edge at most once. That single rule keeps every
-//! edge in at most two faces and the orientation consistent. Boundary edges of an open input are
-//! usable in their own direction only, so they stay boundary edges.
+//! The faces are assembled in an [`EditMesh`]: every accepted face must use each directed edge
+//! at most once. That single rule keeps every edge in at most two faces and the orientation
+//! consistent. Boundary edges of an open input are usable in their own direction only (the
+//! other is blocked), so they stay boundary edges.
 
 use glam::{DVec2, DVec3};
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use super::refine::{flip_edges, insert_loose_samples, RefineParams};
+use super::refine::{flip_edges, insert_loose_samples, oriented_quality, RefineParams};
 use super::tangent_delaunay::VotedTriangle;
+use crate::mesh::edit::{EditMesh, SlotPolicy};
+
+/// The mesh being assembled: faces in the order they were made, each with how it came in.
+type Assembly = EditMesh<FaceSource>;
 
 /// Parameters of the assembly.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,90 +64,6 @@ pub struct AssemblyStats {
     pub edge_flips: usize,
 }
 
-pub(super) struct Builder<'a> {
-    pub(super) positions: &'a [DVec3],
-    pub(super) normals: &'a [DVec3],
-    pub(super) faces: Vec<Option<[u32; 3]>>,
-    /// How each face came in (see [`FaceSource`]).
-    pub(super) sources: Vec<FaceSource>,
-    /// Directed edge → face using it (`u32::MAX` for a blocked direction).
-    pub(super) directed: FxHashMap<(u32, u32), u32>,
-}
-
-pub(super) const BLOCKED: u32 = u32::MAX;
-
-impl<'a> Builder<'a> {
-    /// Whether `t` can be added: none of its directed edges is used or blocked, and it is not
-    /// the reverse of an existing face (the two would close on themselves as a flat pillow).
-    pub(super) fn fits(&self, t: [u32; 3]) -> bool {
-        if (0..3).any(|k| self.directed.contains_key(&(t[k], t[(k + 1) % 3]))) {
-            return false;
-        }
-        let reverse = self.directed.get(&(t[1], t[0]));
-        !(reverse.is_some_and(|&f| f != BLOCKED)
-            && reverse == self.directed.get(&(t[2], t[1]))
-            && reverse == self.directed.get(&(t[0], t[2])))
-    }
-
-    /// Adds `t` when it [fits](Builder::fits) and has area (three samples on a line give no
-    /// face: found by the triangulate fuzz target, where a hole of three collinear samples was
-    /// closed by a flat triangle).
-    pub(super) fn add(&mut self, t: [u32; 3], source: FaceSource) -> bool {
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !self.fits(t) {
-            return false;
-        }
-        if crate::quality::is_degenerate_triangle(t.map(|v| self.positions[v as usize])) {
-            return false;
-        }
-        let f = self.faces.len() as u32;
-        for k in 0..3 {
-            self.directed.insert((t[k], t[(k + 1) % 3]), f);
-        }
-        self.faces.push(Some(t));
-        self.sources.push(source);
-        true
-    }
-
-    pub(super) fn remove(&mut self, f: u32) {
-        if let Some(t) = self.faces[f as usize].take() {
-            for k in 0..3 {
-                self.directed.remove(&(t[k], t[(k + 1) % 3]));
-            }
-        }
-    }
-
-    fn has_edge(&self, a: u32, b: u32) -> bool {
-        let used = |x: &(u32, u32)| self.directed.get(x).is_some_and(|&f| f != BLOCKED);
-        used(&(a, b)) || used(&(b, a))
-    }
-
-    /// Quality Q = 6S/(√3 p h) of a triangle, or -1 when its normal opposes the corners'
-    /// normals (a fold).
-    pub(super) fn quality(&self, t: [u32; 3]) -> f64 {
-        let [a, b, c] = t.map(|i| self.positions[i as usize]);
-        let n = (b - a).cross(c - a);
-        let avg = t.iter().map(|&i| self.normals[i as usize]).sum::<DVec3>();
-        if n.dot(avg) <= 0.0 {
-            return -1.0;
-        }
-        crate::quality::triangle_q([a, b, c])
-    }
-
-    /// Half-edges bordering holes: `b → a` for every face edge `a → b` with no face on `b → a`
-    /// and `b → a` not blocked (blocked directions are the outside of input boundaries).
-    fn hole_half_edges(&self) -> Vec<(u32, u32)> {
-        let mut out: Vec<(u32, u32)> = self
-            .directed
-            .iter()
-            .filter(|(_, &f)| f != BLOCKED)
-            .map(|(&(a, b), _)| (b, a))
-            .filter(|e| !self.directed.contains_key(e))
-            .collect();
-        out.sort_unstable();
-        out
-    }
-}
-
 /// How a face of the assembled mesh came in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum FaceSource {
@@ -165,43 +86,37 @@ pub fn assemble(
     boundary_edges: &[[u32; 2]],
     params: &AssemblyParams,
 ) -> (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats) {
-    let mut b = Builder {
-        positions,
-        normals,
-        faces: Vec::with_capacity(2 * positions.len() + 16),
-        sources: Vec::with_capacity(2 * positions.len() + 16),
-        directed: FxHashMap::default(),
-    };
+    let mut b: Assembly = EditMesh::new(positions.to_vec(), SlotPolicy::Append);
     let mut stats = AssemblyStats {
         candidates: voted.len(),
         ..Default::default()
     };
     for &[x, y] in boundary_edges {
-        b.directed.insert((y, x), BLOCKED);
+        b.block_directed_edge(y, x);
     }
     for t in voted
         .iter()
         .filter(|t| t.votes >= 3 && !t.orientation_conflict)
     {
-        if b.add(t.corners, FaceSource::ThreeVotes) {
+        if b.add_face(t.corners, FaceSource::ThreeVotes).is_ok() {
             stats.accepted_three_votes += 1;
         }
     }
     let mut two: Vec<(f64, [u32; 3])> = voted
         .iter()
         .filter(|t| params.two_vote_phase && t.votes == 2 && !t.orientation_conflict)
-        .map(|t| (b.quality(t.corners), t.corners))
+        .map(|t| (oriented_quality(&b, normals, t.corners), t.corners))
         .filter(|x| x.0 > 0.0)
         .collect();
     two.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
     for (_, t) in two {
-        if b.add(t, FaceSource::TwoVotes) {
+        if b.add_face(t, FaceSource::TwoVotes).is_ok() {
             stats.accepted_two_votes += 1;
         }
     }
     for round in 0..6 {
         let mut failed = Vec::new();
-        let (filled, tris, left) = fill_holes(&mut b, params, &mut failed);
+        let (filled, tris, left) = fill_holes(&mut b, normals, params, &mut failed);
         if round < 4 {
             // Grow each hole that could not be closed by the faces around its corners: the
             // larger polygon (with the samples inside it) often has a valid triangulation where
@@ -218,26 +133,20 @@ pub fn assemble(
         }
     }
     if params.refine.insert_loose_samples {
-        stats.samples_inserted = insert_loose_samples(&mut b);
+        stats.samples_inserted = insert_loose_samples(&mut b, normals, FaceSource::Refined);
     }
-    stats.edge_flips = flip_edges(&mut b, &params.refine);
-    let (faces, sources) = b
-        .faces
-        .into_iter()
-        .zip(b.sources)
-        .filter_map(|(f, s)| f.map(|f| (f, s)))
-        .unzip();
+    stats.edge_flips = flip_edges(&mut b, normals, &params.refine, FaceSource::Refined);
+    let (_, faces, sources) = b.into_parts();
     (faces, sources, stats)
 }
 
 /// Removes the faces that touch a corner of any of `holes`. Returns how many were removed.
-fn grow_holes(b: &mut Builder, holes: &[Vec<u32>]) -> usize {
+fn grow_holes(b: &mut Assembly, holes: &[Vec<u32>]) -> usize {
     let corners: FxHashSet<u32> = holes.iter().flatten().copied().collect();
     let mut removed = 0;
-    for f in 0..b.faces.len() {
-        if let Some(t) = b.faces[f] {
-            if t.iter().any(|v| corners.contains(v)) {
-                b.remove(f as u32);
+    for f in 0..b.slots() as u32 {
+        if let Some(t) = b.face(f) {
+            if t.iter().any(|v| corners.contains(v)) && b.remove_face(f).is_ok() {
                 removed += 1;
             }
         }
@@ -268,18 +177,19 @@ fn simple_loops(walk: &[u32]) -> Vec<Vec<u32>> {
 }
 
 fn fill_holes(
-    b: &mut Builder,
+    b: &mut Assembly,
+    normals: &[DVec3],
     params: &AssemblyParams,
     failed: &mut Vec<Vec<u32>>,
 ) -> (usize, usize, usize) {
-    let edges = b.hole_half_edges();
-    let mut referenced = vec![false; b.positions.len()];
-    for t in b.faces.iter().flatten() {
-        for &v in t {
+    let edges = b.boundary_half_edges();
+    let mut referenced = vec![false; b.vertex_count()];
+    for t in b.live_faces().0 {
+        for v in t {
             referenced[v as usize] = true;
         }
     }
-    let mut loose: Vec<u32> = (0..b.positions.len() as u32)
+    let mut loose: Vec<u32> = (0..b.vertex_count() as u32)
         .filter(|&v| !referenced[v as usize])
         .collect();
     let mut from: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
@@ -323,37 +233,23 @@ fn fill_holes(
                 left += 1;
                 continue;
             }
-            let tris = triangulate_hole_with_interior(b, &lp, &loose)
-                .or_else(|| triangulate_polygon(b, &lp, false))
-                .or_else(|| triangulate_polygon(b, &lp, true));
+            let tris = triangulate_hole_with_interior(b, normals, &lp, &loose)
+                .or_else(|| triangulate_polygon(b, normals, &lp, false))
+                .or_else(|| triangulate_polygon(b, normals, &lp, true));
             match tris {
-                Some(tris) => {
-                    let mut ok = true;
-                    let mut done = Vec::new();
-                    for t in tris {
-                        if b.add(t, FaceSource::HoleFill) {
-                            done.push(b.faces.len() as u32 - 1);
-                        } else {
-                            ok = false;
-                            break;
-                        }
-                    }
-                    if ok {
+                Some(tris) => match b.fill_hole(&tris, FaceSource::HoleFill) {
+                    Ok(done) => {
                         filled += 1;
                         added += done.len();
-                        for &f in &done {
-                            for v in b.faces[f as usize].unwrap() {
+                        for t in &tris {
+                            for &v in t {
                                 referenced[v as usize] = true;
                             }
                         }
                         loose.retain(|&v| !referenced[v as usize]);
-                    } else {
-                        for f in done {
-                            b.remove(f);
-                        }
-                        left += 1;
                     }
-                }
+                    Err(_) => left += 1,
+                },
                 None => {
                     failed.push(lp);
                     left += 1
@@ -389,15 +285,20 @@ fn inside_polygon(p: DVec2, poly: &[DVec2]) -> bool {
 /// Newell normal, of its boundary and of the samples that no face uses yet and that lie inside
 /// it. `None` when the hole does not project to a simple polygon, faces away from its corners'
 /// normals, or a triangle would not fit.
-fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Option<Vec<[u32; 3]>> {
+fn triangulate_hole_with_interior(
+    b: &Assembly,
+    normals: &[DVec3],
+    lp: &[u32],
+    loose: &[u32],
+) -> Option<Vec<[u32; 3]>> {
     use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
     let m = lp.len();
-    let pts: Vec<DVec3> = lp.iter().map(|&v| b.positions[v as usize]).collect();
+    let pts: Vec<DVec3> = lp.iter().map(|&v| b.position(v)).collect();
     let newell = (0..m)
         .map(|i| pts[i].cross(pts[(i + 1) % m]))
         .sum::<DVec3>();
     let n = newell.try_normalize()?;
-    let avg_normal = lp.iter().map(|&v| b.normals[v as usize]).sum::<DVec3>();
+    let avg_normal = lp.iter().map(|&v| normals[v as usize]).sum::<DVec3>();
     if n.dot(avg_normal) <= 0.0 {
         return None;
     }
@@ -423,9 +324,9 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
         .iter()
         .copied()
         .filter(|&v| {
-            let p = b.positions[v as usize];
+            let p = b.position(v);
             p.distance_squared(center) <= radius2
-                && b.normals[v as usize].dot(n) > 0.3
+                && normals[v as usize].dot(n) > 0.3
                 && inside_polygon(to2(p), &poly)
         })
         .collect();
@@ -455,7 +356,7 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
         handles.push(h);
     }
     for &v in &interior {
-        let q = to2(b.positions[v as usize]);
+        let q = to2(b.position(v));
         let _ = cdt.insert(V {
             p: Point2::new(q.x, q.y),
             index: v,
@@ -478,7 +379,7 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
             / 3.0;
         if inside_polygon(c2, &poly) {
             let t = vs.map(|h| h.data().index);
-            if !b.fits(t) || b.quality(t) <= 0.0 {
+            if !b.fits(t) || oriented_quality(b, normals, t) <= 0.0 {
                 return None;
             }
             out.push(t);
@@ -496,7 +397,12 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
 /// With `allow_folds`, a triangle facing away from its corners' normals is allowed but scores
 /// below every triangle that does not: at a part thinner than the sampling, where the corners'
 /// normals point to both sides, closing the hole matters more than the shape of its triangles.
-fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec<[u32; 3]>> {
+fn triangulate_polygon(
+    b: &Assembly,
+    normals: &[DVec3],
+    lp: &[u32],
+    allow_folds: bool,
+) -> Option<Vec<[u32; 3]>> {
     let m = lp.len();
     if m == 3 {
         let t = [lp[0], lp[1], lp[2]];
@@ -523,9 +429,9 @@ fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec
             }
             for j in i + 1..k {
                 let t = [lp[i], lp[j], lp[k]];
-                let mut q = b.quality(t);
+                let mut q = oriented_quality(b, normals, t);
                 if q <= 0.0 && allow_folds {
-                    q = 1e-3 * crate::quality::triangle_q(t.map(|v| b.positions[v as usize]));
+                    q = 1e-3 * crate::quality::triangle_q(b.corners(t));
                 }
                 if !(q > 1e-9) {
                     continue;
@@ -558,13 +464,12 @@ fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec
 /// Finds vertices whose faces form more than one edge-connected fan and removes the faces of
 /// all fans but the largest, so that hole filling can rebuild them as one. Returns how many faces
 /// were removed.
-fn repair_pinched_vertices(b: &mut Builder) -> usize {
+fn repair_pinched_vertices(b: &mut Assembly) -> usize {
     let mut around: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
-    for (f, t) in b.faces.iter().enumerate() {
-        if let Some(t) = t {
-            for &v in t {
-                around.entry(v).or_default().push(f as u32);
-            }
+    let (faces, slots) = b.live_faces();
+    for (t, f) in faces.into_iter().zip(slots) {
+        for v in t {
+            around.entry(v).or_default().push(f);
         }
     }
     let mut vertices: Vec<u32> = around.keys().copied().collect();
@@ -576,7 +481,7 @@ fn repair_pinched_vertices(b: &mut Builder) -> usize {
         let mut fan_of: FxHashMap<u32, usize> = FxHashMap::default();
         let mut fans: Vec<Vec<u32>> = Vec::new();
         for &f in faces {
-            if fan_of.contains_key(&f) || b.faces[f as usize].is_none() {
+            if fan_of.contains_key(&f) || b.face(f).is_none() {
                 continue;
             }
             let id = fans.len();
@@ -584,11 +489,14 @@ fn repair_pinched_vertices(b: &mut Builder) -> usize {
             fan_of.insert(f, id);
             let mut k = 0;
             while k < fan.len() {
-                let t = b.faces[fan[k] as usize].unwrap();
+                let Some(t) = b.face(fan[k]) else {
+                    k += 1;
+                    continue;
+                };
                 for &w in t.iter().filter(|&&w| w != v) {
                     for e in [(v, w), (w, v)] {
-                        if let Some(&g) = b.directed.get(&e) {
-                            if g != BLOCKED && !fan_of.contains_key(&g) {
+                        if let Some(g) = b.face_on(e.0, e.1) {
+                            if !fan_of.contains_key(&g) {
                                 fan_of.insert(g, id);
                                 fan.push(g);
                             }
@@ -606,8 +514,10 @@ fn repair_pinched_vertices(b: &mut Builder) -> usize {
             for (i, fan) in fans.iter().enumerate() {
                 if i != keep {
                     for &f in fan {
-                        b.remove(f);
-                        removed += 1;
+                        // A face of a fan is live: fans are found after each removal.
+                        if b.remove_face(f).is_ok() {
+                            removed += 1;
+                        }
                     }
                 }
             }
