@@ -1002,7 +1002,10 @@ mod tests {
         );
         // Interior edge (2,2)–(3,2): vertices 16 and 17, opposite vertices (2,1) and (3,3) with
         // six faces each.
-        assert_eq!(g.collapse_edge(17, 16, DVec3::new(2.5, 2.0, 0.0), ()), Ok(()));
+        assert_eq!(
+            g.collapse_edge(17, 16, DVec3::new(2.5, 2.0, 0.0), ()),
+            Ok(())
+        );
         assert_eq!(g.sanity_check(), Ok(()));
         assert_eq!((live_count(&g), euler(&g)), (70, 1));
         assert_eq!((g.degree(17), g.degree(16)), (0, 8));

@@ -525,3 +525,208 @@ fn repair_pinched_vertices(b: &mut Assembly) -> usize {
     }
     removed
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes::fibonacci_sphere;
+    use crate::mesh::TriMesh;
+    use crate::quality::topology;
+    use crate::triangulate::tangent_delaunay::{vote_triangles, SampleSet, TangentDelaunayParams};
+
+    fn votes(positions: &[DVec3], normals: &[DVec3], boundary: &[[u32; 2]]) -> Vec<VotedTriangle> {
+        let set = SampleSet {
+            positions,
+            normals,
+            boundary_edges: boundary,
+        };
+        vote_triangles(&set, &TangentDelaunayParams::default())
+    }
+
+    /// The assembled faces pass every invariant of the edit mesh.
+    fn assert_sane(positions: &[DVec3], faces: &[[u32; 3]]) {
+        let mesh = TriMesh::new(positions.to_vec(), faces.to_vec());
+        let m: EditMesh = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn samples_of_a_sphere_assemble_into_a_closed_manifold() {
+        let n = 400;
+        let positions = fibonacci_sphere(n);
+        let normals = positions.clone();
+        let voted = votes(&positions, &normals, &[]);
+        let (faces, sources, stats) = assemble(
+            &positions,
+            &normals,
+            &voted,
+            &[],
+            &AssemblyParams::default(),
+        );
+        assert_sane(&positions, &faces);
+        assert_eq!(faces.len(), 2 * n - 4);
+        assert_eq!(sources.len(), faces.len());
+        let mesh = TriMesh::new(positions, faces);
+        let t = topology(&mesh);
+        assert!(t.is_closed_manifold(), "{t:?}");
+        assert_eq!(
+            (t.vertices, t.euler_characteristic, t.components),
+            (n, 2, 1)
+        );
+        // Outward, like the normals.
+        assert!(mesh.signed_volume() > 0.0);
+        assert_eq!(stats.candidates, voted.len());
+        assert!(stats.accepted_three_votes > n, "{stats:?}");
+    }
+
+    #[test]
+    fn a_hole_left_by_the_umbrellas_is_filled_with_the_sample_inside_it() {
+        let n = 400;
+        let positions = fibonacci_sphere(n);
+        let normals = positions.clone();
+        // No candidate uses sample 200: its umbrella and its neighbours' triangles at it are
+        // gone, leaving a hole with 200 loose inside.
+        let voted: Vec<VotedTriangle> = votes(&positions, &normals, &[])
+            .into_iter()
+            .filter(|t| !t.corners.contains(&200))
+            .collect();
+        let (faces, _, stats) = assemble(
+            &positions,
+            &normals,
+            &voted,
+            &[],
+            &AssemblyParams::default(),
+        );
+        assert_sane(&positions, &faces);
+        assert!(
+            stats.holes_filled >= 1 && stats.hole_triangles >= 3,
+            "{stats:?}"
+        );
+        assert_eq!(stats.holes_left, 0);
+        assert!(faces.iter().any(|t| t.contains(&200)));
+        assert_eq!(faces.len(), 2 * n - 4);
+        let t = topology(&TriMesh::new(positions, faces));
+        assert!(
+            t.is_closed_manifold() && t.euler_characteristic == 2,
+            "{t:?}"
+        );
+    }
+
+    /// A jittered `n × n` grid of unit squares in the plane z = 0 and its border as boundary
+    /// edges, counter-clockwise (the surface on their left).
+    fn jittered_grid(n: usize) -> (Vec<DVec3>, Vec<[u32; 2]>) {
+        let mut state = 12345u64;
+        let mut jitter = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.4
+        };
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let on_x = i == 0 || i == n;
+                let on_y = j == 0 || j == n;
+                let dx = if on_x { 0.0 } else { jitter() };
+                let dy = if on_y { 0.0 } else { jitter() };
+                positions.push(DVec3::new(i as f64 + dx, j as f64 + dy, 0.0));
+            }
+        }
+        let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let mut ring = Vec::new();
+        ring.extend((0..n).map(|i| at(i, 0)));
+        ring.extend((0..n).map(|j| at(n, j)));
+        ring.extend((0..n).map(|i| at(n - i, n)));
+        ring.extend((0..n).map(|j| at(0, n - j)));
+        let boundary = (0..ring.len())
+            .map(|k| [ring[k], ring[(k + 1) % ring.len()]])
+            .collect();
+        (positions, boundary)
+    }
+
+    #[test]
+    fn an_open_grid_assembles_into_a_disk_with_its_boundary_kept() {
+        let n = 10;
+        let (positions, boundary) = jittered_grid(n);
+        let normals = vec![DVec3::Z; positions.len()];
+        let voted = votes(&positions, &normals, &boundary);
+        let (faces, _, _) = assemble(
+            &positions,
+            &normals,
+            &voted,
+            &boundary,
+            &AssemblyParams::default(),
+        );
+        assert_sane(&positions, &faces);
+        // A disk on (n + 1)² vertices with 4n boundary vertices: F = 2V − B − 2.
+        let v = (n + 1) * (n + 1);
+        assert_eq!(faces.len(), 2 * v - 4 * n - 2);
+        let t = topology(&TriMesh::new(positions, faces.clone()));
+        assert_eq!(
+            (t.euler_characteristic, t.boundary_loops, t.boundary_edges),
+            (1, 1, 4 * n)
+        );
+        for [a, b] in boundary {
+            assert!(
+                faces
+                    .iter()
+                    .any(|t| (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b)),
+                "boundary edge {a} → {b} not used in its direction"
+            );
+        }
+    }
+
+    #[test]
+    fn a_closed_walk_splits_into_simple_loops() {
+        assert_eq!(
+            simple_loops(&[1, 2, 3, 4, 2, 5]),
+            vec![vec![2, 3, 4], vec![1, 2, 5]]
+        );
+        assert_eq!(simple_loops(&[7, 8, 9]), vec![vec![7, 8, 9]]);
+    }
+
+    #[test]
+    fn the_smaller_fan_at_a_pinched_vertex_is_removed() {
+        let positions = vec![
+            DVec3::ZERO,
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(-1.0, -1.0, 0.0),
+        ];
+        let mut b: Assembly = EditMesh::new(positions, SlotPolicy::Append);
+        for t in [[0, 1, 2], [0, 2, 3], [0, 4, 5]] {
+            assert!(b.add_face(t, FaceSource::ThreeVotes).is_ok());
+        }
+        assert!(matches!(
+            b.sanity_check(),
+            Err(crate::mesh::edit::Violation::NonManifoldVertex { vertex: 0, fans: 2 })
+        ));
+        assert_eq!(repair_pinched_vertices(&mut b), 1);
+        assert_eq!(b.live_faces().0, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(b.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn a_hole_polygon_is_triangulated_for_the_best_smallest_quality() {
+        // A convex pentagon: the max-min triangulation has three triangles of the polygon's
+        // corners, each facing like the normals.
+        let a = std::f64::consts::TAU / 5.0;
+        let positions: Vec<DVec3> = (0..5)
+            .map(|k| DVec3::new((a * k as f64).cos(), (a * k as f64).sin(), 0.0))
+            .collect();
+        let normals = vec![DVec3::Z; 5];
+        let b: Assembly = EditMesh::new(positions, SlotPolicy::Append);
+        let lp = [0, 1, 2, 3, 4];
+        let tris = triangulate_polygon(&b, &normals, &lp, false).expect("a triangulation");
+        assert_eq!(tris.len(), 3);
+        assert!(tris
+            .iter()
+            .all(|&t| oriented_quality(&b, &normals, t) > 0.0));
+        // Facing away from every normal, there is none without folds.
+        let down = vec![-DVec3::Z; 5];
+        assert_eq!(triangulate_polygon(&b, &down, &lp, false), None);
+        assert!(triangulate_polygon(&b, &down, &lp, true).is_some());
+    }
+}
