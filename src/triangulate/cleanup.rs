@@ -514,7 +514,7 @@ fn repair_pinched_vertices(b: &mut Assembly) -> usize {
             for (i, fan) in fans.iter().enumerate() {
                 if i != keep {
                     for &f in fan {
-                        // A face of a fan is live: fans are found after each removal.
+                        // Fans at one vertex are disjoint and hold live faces only.
                         if b.remove_face(f).is_ok() {
                             removed += 1;
                         }

@@ -79,3 +79,73 @@ pub(crate) fn max_min_flips<L: Copy>(
     }
     flips
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::edit::SlotPolicy;
+    use glam::DVec3;
+
+    /// A convex quad 0-3-1-2 split along its long diagonal 0-1, alone or inside a ring 4..=7
+    /// that gives 0 and 1 six faces each.
+    fn quad(with_ring: bool) -> EditMesh<()> {
+        let positions: Vec<DVec3> = [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (1.0, 0.3),
+            (1.0, -0.3),
+            (1.0, 2.0),
+            (1.0, -2.0),
+            (-1.5, 0.0),
+            (3.5, 0.0),
+        ]
+        .iter()
+        .map(|&(x, y)| DVec3::new(x, y, 0.0))
+        .collect();
+        let mut m = EditMesh::new(positions, SlotPolicy::Reuse);
+        let mut faces = vec![[0, 1, 2], [1, 0, 3]];
+        if with_ring {
+            faces.extend([
+                [0, 2, 4],
+                [2, 1, 4],
+                [3, 0, 5],
+                [1, 3, 5],
+                [6, 0, 4],
+                [6, 5, 0],
+                [1, 7, 4],
+                [1, 5, 7],
+            ]);
+        }
+        for t in faces {
+            assert!(m.add_face(t, ()).is_ok());
+        }
+        m
+    }
+
+    #[test]
+    fn the_long_diagonal_is_flipped_and_the_short_one_kept() {
+        let mut m = quad(true);
+        let flip = max_min_candidate(&m, 0, 1).expect("the long diagonal is a candidate");
+        assert_eq!(flip.old, [[0, 1, 2], [1, 0, 3]]);
+        assert_eq!(flip.new, [[0, 3, 2], [1, 2, 3]]);
+        assert_eq!(max_min_flips(&mut m, &[(0, 1)], (), |_, _| true), 1);
+        assert!(m.has_edge(2, 3) && !m.has_edge(0, 1));
+        // Flipping back would lower the smallest angle.
+        assert_eq!(max_min_candidate(&m, 2, 3), None);
+        assert_eq!(max_min_flips(&mut m, &[(2, 3)], (), |_, _| true), 0);
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn no_candidate_at_a_vertex_of_three_faces_or_when_the_guard_says_no() {
+        // Alone, 0 and 1 have two faces each: a flip would leave them with one.
+        let m = quad(false);
+        assert_eq!(max_min_candidate(&m, 0, 1), None);
+        let mut m = quad(true);
+        assert_eq!(max_min_flips(&mut m, &[(0, 1)], (), |_, _| false), 0);
+        assert!(m.has_edge(0, 1));
+        // A boundary edge is never a candidate.
+        assert_eq!(max_min_candidate(&m, 6, 0), None);
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+}

@@ -651,6 +651,13 @@ mod tests {
         assert!(t.is_manifold() && t.euler_characteristic == 1 && t.components == 1);
         let problems = check_invariants(mesh);
         assert!(problems.is_empty(), "{problems:?}");
+        assert_sane(mesh);
+    }
+
+    /// The mesh passes every invariant of the edit mesh.
+    fn assert_sane(mesh: &TriMesh) {
+        let m: EditMesh = EditMesh::from_trimesh(mesh, |_| (), SlotPolicy::Reuse);
+        assert_eq!(m.sanity_check(), Ok(()));
     }
 
     fn no_cover() -> OptimizeParams {
@@ -698,6 +705,7 @@ mod tests {
         assert_eq!(mesh.positions[3], original[3]);
         assert_eq!(mesh.positions[3 * 7 + 3], original[3 * 7 + 3]);
         assert_eq!(topology(&mesh).boundary_edges, 24);
+        assert_sane(&mesh);
     }
 
     #[test]
@@ -795,5 +803,6 @@ mod tests {
             "{:?}",
             check_invariants(&mesh)
         );
+        assert_sane(&mesh);
     }
 }

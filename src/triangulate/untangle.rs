@@ -235,6 +235,8 @@ mod tests {
             check_invariants(&m)
         );
         assert!(s.max_displacement < 0.6, "{s:?}");
+        let edited: EditMesh = EditMesh::from_trimesh(&m, |_| (), SlotPolicy::Reuse);
+        assert_eq!(edited.sanity_check(), Ok(()));
         // A fixed vertex stays when its partner can give way.
         let mut m2 = m.clone();
         m2.positions[poke].z = -0.3;
