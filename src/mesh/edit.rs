@@ -627,10 +627,10 @@ impl<L: Copy> EditMesh<L> {
                 face: f,
             });
         }
-        for v in 0..n {
+        for (v, faces) in around.iter().enumerate() {
             let mut listed = self.around[v].clone();
             listed.sort_unstable();
-            if listed != around[v] {
+            if &listed != faces {
                 return Err(Violation::VertexFaces { vertex: v as u32 });
             }
             let fans = self.fans_at(v as u32);

@@ -433,7 +433,7 @@ fn triangulate_polygon(
                 if q <= 0.0 && allow_folds {
                     q = 1e-3 * crate::quality::triangle_q(b.corners(t));
                 }
-                if !(q > 1e-9) {
+                if q.is_nan() || q <= 1e-9 {
                     continue;
                 }
                 let v = best[idx(i, j)].min(best[idx(j, k)]).min(q);
@@ -444,7 +444,8 @@ fn triangulate_polygon(
             }
         }
     }
-    if !(best[idx(0, m - 1)] > 0.0) {
+    let whole = best[idx(0, m - 1)];
+    if whole.is_nan() || whole <= 0.0 {
         return None;
     }
     let mut out = Vec::with_capacity(m - 2);
@@ -496,8 +497,8 @@ fn repair_pinched_vertices(b: &mut Assembly) -> usize {
                 for &w in t.iter().filter(|&&w| w != v) {
                     for e in [(v, w), (w, v)] {
                         if let Some(g) = b.face_on(e.0, e.1) {
-                            if !fan_of.contains_key(&g) {
-                                fan_of.insert(g, id);
+                            if let std::collections::hash_map::Entry::Vacant(e) = fan_of.entry(g) {
+                                e.insert(id);
                                 fan.push(g);
                             }
                         }

@@ -264,7 +264,7 @@ fn cover(
             })
             .collect();
         // (new face, the old face it comes from), and the edge to split (`None`: the face).
-        let (plan, split): (Vec<([u32; 3], [u32; 3])>, Option<(u32, u32)>) = if outside.is_empty() {
+        let (plan, split): (SplitPlan, Option<(u32, u32)>) = if outside.is_empty() {
             // Inside the face: split it in three.
             let [a, b, c] = t;
             (vec![([a, b, v], t), ([b, c, v], t), ([c, a, v], t)], None)
@@ -329,6 +329,9 @@ fn cover(
     }
     added
 }
+
+/// The faces a split makes: (new face, the old face it comes from).
+type SplitPlan = Vec<([u32; 3], [u32; 3])>;
 
 /// The distance from `p` to the segment `a`–`b`.
 fn segment_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
