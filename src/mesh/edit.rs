@@ -200,7 +200,11 @@ impl<L: Copy> EditMesh<L> {
 
     /// The mesh of `mesh`'s vertices and faces, face `f` in slot `f` with label `label(f)`. The
     /// faces are taken as they are (no operator checks; [`EditMesh::sanity_check`] tells whether
-    /// they are manifold and consistently oriented). Indices must be in range.
+    /// they are manifold and consistently oriented; where two faces use the same directed edge,
+    /// the table names the later one).
+    ///
+    /// # Panics
+    /// When a face has an index out of range ([`TriMesh::check_indices`] finds those first).
     pub fn from_trimesh(mesh: &TriMesh, label: impl Fn(u32) -> L, policy: SlotPolicy) -> Self {
         let mut m = EditMesh::new(mesh.positions.clone(), policy);
         m.faces.reserve(mesh.triangles.len());
@@ -1156,5 +1160,101 @@ mod tests {
             flat.sanity_check(),
             Err(Violation::DegenerateFace { face: 0 })
         );
+    }
+
+    /// The octahedron with every face split in four `level` times, on the unit sphere.
+    fn octasphere(level: usize) -> EditMesh<()> {
+        let o = octahedron(SlotPolicy::Reuse);
+        let mut positions = o.positions().to_vec();
+        let mut faces = o.live_faces().0;
+        for _ in 0..level {
+            let mut mid: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+            let mut next = Vec::new();
+            for t in faces {
+                let mut m = [0u32; 3];
+                for k in 0..3 {
+                    let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                    m[k] = *mid.entry((a, b)).or_insert_with(|| {
+                        let p = (positions[a as usize] + positions[b as usize]).normalize();
+                        positions.push(p);
+                        (positions.len() - 1) as u32
+                    });
+                }
+                next.extend([
+                    [t[0], m[0], m[2]],
+                    [t[1], m[1], m[0]],
+                    [t[2], m[2], m[1]],
+                    m,
+                ]);
+            }
+            faces = next;
+        }
+        EditMesh::from_trimesh(&TriMesh::new(positions, faces), |_| (), SlotPolicy::Reuse)
+    }
+
+    /// Seeded random sequences of every operator on a sphere: each either refuses (the mesh
+    /// unchanged) or keeps every invariant and the Euler characteristic 2.
+    #[test]
+    fn random_operator_sequences_keep_every_invariant() {
+        for policy in [SlotPolicy::Reuse, SlotPolicy::Append] {
+            let mut m = octasphere(2);
+            m.policy = policy;
+            assert_eq!((m.live_faces().0.len(), euler(&m)), (128, 2));
+            let mut state = 1u64;
+            let mut next = |n: usize| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 33) as usize) % n
+            };
+            let mut done = [0usize; 5];
+            for _ in 0..1500 {
+                let (_, slots) = m.live_faces();
+                let f = slots[next(slots.len())];
+                let t = m.face(f).unwrap_or_else(|| unreachable!());
+                let k = next(3);
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let before = (m.live_faces().0.len(), m.vertex_count());
+                let op = next(5);
+                let ok = match op {
+                    0 => m.flip_edge(a, b, ()).is_ok(),
+                    1 => {
+                        let p = m.corners(t).iter().sum::<DVec3>().normalize();
+                        let v = m.add_vertex(p);
+                        let ok = m.split_face(f, v, ()).is_ok();
+                        if !ok {
+                            m.pop_vertex();
+                        }
+                        ok
+                    }
+                    2 => {
+                        let v = m.add_vertex((m.position(a) + m.position(b)).normalize());
+                        let ok = m.split_edge(a, b, v, ()).is_ok();
+                        if !ok {
+                            m.pop_vertex();
+                        }
+                        ok
+                    }
+                    3 => {
+                        let p = (m.position(a) + m.position(b)).normalize();
+                        m.collapse_edge(a, b, p, ()).is_ok()
+                    }
+                    _ => {
+                        let p = m.position(a) + 0.01 * (m.position(b) - m.position(a));
+                        m.relocate_vertex(a, p.normalize()).is_ok()
+                    }
+                };
+                if ok {
+                    done[op] += 1;
+                } else {
+                    assert_eq!(before, (m.live_faces().0.len(), m.vertex_count()));
+                }
+                assert_eq!(m.sanity_check(), Ok(()), "after operator {op} on {a}-{b}");
+                assert_eq!(euler(&m), 2);
+            }
+            // Every operator ran, and some refusals happened too.
+            assert!(done.iter().all(|&d| d > 50), "{done:?}");
+            assert!(done.iter().sum::<usize>() < 1500, "{done:?}");
+        }
     }
 }
