@@ -4,6 +4,7 @@
 //! triangulation's guarantees.
 
 use glam::DVec3;
+use spectral_remesh::mesh::edit::{EditMesh, SlotPolicy};
 use spectral_remesh::quality::topology;
 use spectral_remesh::triangulate::{triangulate, SampleSet, TriangulateParams};
 use spectral_remesh::TriMesh;
@@ -72,4 +73,7 @@ pub fn assert_triangulation_is_clean(positions: Vec<DVec3>, normals: &[DVec3]) {
     assert_eq!(t.inconsistent_orientation_edges, 0, "{t:?}");
     assert_eq!(t.degenerate_faces, 0, "{t:?}");
     assert_eq!(t.duplicate_faces, 0, "{t:?}");
+    // The edit mesh's invariants (the same, plus its own tables).
+    let edit: EditMesh = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+    assert_eq!(edit.sanity_check(), Ok(()));
 }
