@@ -375,7 +375,9 @@ impl<L: Copy> EditMesh<L> {
     }
 
     /// Why `t` could not be added, if it could not: a repeated or out-of-range corner, a directed
-    /// edge used or blocked, the reverse of an existing face, or no area.
+    /// edge used or blocked, the reverse of an existing face, or no area (three samples on a
+    /// line: found by the triangulate fuzz target, where a hole of three collinear samples was
+    /// closed by a flat triangle).
     pub fn check_new_face(&self, t: [u32; 3]) -> Result<(), EditError> {
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
             return Err(EditError::RepeatedCorner { face: t });
