@@ -5,6 +5,7 @@
 
 use glam::DVec3;
 use spectral_remesh::check::{check_invariants, Violation};
+use spectral_remesh::mesh::edit::{EditMesh, SlotPolicy};
 use spectral_remesh::triangulate::untangle::{untangle, UntangleParams};
 use spectral_remesh::triangulate::{triangulate, SampleSet, TriangulateParams};
 use spectral_remesh::TriMesh;
@@ -81,6 +82,9 @@ pub fn assert_triangulation_is_clean(positions: Vec<DVec3>, normals: &[DVec3]) {
             })
             .sum::<usize>()
     };
+    // The edit mesh's invariants (the same, plus its own tables).
+    let edit: EditMesh = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+    assert_eq!(edit.sanity_check(), Ok(()));
     let violations = check_invariants(&mesh);
     let structural: Vec<&Violation> = violations
         .iter()

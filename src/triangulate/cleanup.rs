@@ -2,15 +2,20 @@
 //! add the best of the others where they fit, fill the holes that remain, and repair vertices
 //! whose faces do not form one fan.
 //!
-//! Every accepted face must use each directed edge at most once. That single rule keeps every
-//! edge in at most two faces and the orientation consistent. Boundary edges of an open input are
-//! usable in their own direction only, so they stay boundary edges.
+//! The faces are assembled in an [`EditMesh`]: every accepted face must use each directed edge
+//! at most once. That single rule keeps every edge in at most two faces and the orientation
+//! consistent. Boundary edges of an open input are usable in their own direction only (the
+//! other is blocked), so they stay boundary edges.
 
 use glam::{DVec2, DVec3};
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use super::refine::{flip_edges, insert_loose_samples, RefineParams};
+use super::refine::{flip_edges, insert_loose_samples, oriented_quality, RefineParams};
 use super::tangent_delaunay::VotedTriangle;
+use crate::mesh::edit::{EditMesh, SlotPolicy};
+
+/// The mesh being assembled: faces in the order they were made, each with how it came in.
+type Assembly = EditMesh<FaceSource>;
 
 /// Parameters of the assembly.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,91 +64,6 @@ pub struct AssemblyStats {
     pub edge_flips: usize,
 }
 
-pub(super) struct Builder<'a> {
-    pub(super) positions: &'a [DVec3],
-    pub(super) normals: &'a [DVec3],
-    pub(super) faces: Vec<Option<[u32; 3]>>,
-    /// How each face came in (see [`FaceSource`]).
-    pub(super) sources: Vec<FaceSource>,
-    /// Directed edge → face using it (`u32::MAX` for a blocked direction).
-    pub(super) directed: FxHashMap<(u32, u32), u32>,
-}
-
-pub(super) const BLOCKED: u32 = u32::MAX;
-
-impl<'a> Builder<'a> {
-    /// Whether `t` can be added: none of its directed edges is used or blocked, and it is not
-    /// the reverse of an existing face (the two would close on themselves as a flat pillow).
-    pub(super) fn fits(&self, t: [u32; 3]) -> bool {
-        if (0..3).any(|k| self.directed.contains_key(&(t[k], t[(k + 1) % 3]))) {
-            return false;
-        }
-        let reverse = self.directed.get(&(t[1], t[0]));
-        !(reverse.is_some_and(|&f| f != BLOCKED)
-            && reverse == self.directed.get(&(t[2], t[1]))
-            && reverse == self.directed.get(&(t[0], t[2])))
-    }
-
-    /// Adds `t` when it [fits](Builder::fits) and has area (three samples on a line give no
-    /// face: found by the triangulate fuzz target, where a hole of three collinear samples was
-    /// closed by a flat triangle).
-    pub(super) fn add(&mut self, t: [u32; 3], source: FaceSource) -> bool {
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !self.fits(t) {
-            return false;
-        }
-        if crate::geometry::triangle::is_degenerate_triangle(t.map(|v| self.positions[v as usize]))
-        {
-            return false;
-        }
-        let f = self.faces.len() as u32;
-        for k in 0..3 {
-            self.directed.insert((t[k], t[(k + 1) % 3]), f);
-        }
-        self.faces.push(Some(t));
-        self.sources.push(source);
-        true
-    }
-
-    pub(super) fn remove(&mut self, f: u32) {
-        if let Some(t) = self.faces[f as usize].take() {
-            for k in 0..3 {
-                self.directed.remove(&(t[k], t[(k + 1) % 3]));
-            }
-        }
-    }
-
-    fn has_edge(&self, a: u32, b: u32) -> bool {
-        let used = |x: &(u32, u32)| self.directed.get(x).is_some_and(|&f| f != BLOCKED);
-        used(&(a, b)) || used(&(b, a))
-    }
-
-    /// Quality Q = 6S/(√3 p h) of a triangle, or -1 when its normal opposes the corners'
-    /// normals (a fold).
-    pub(super) fn quality(&self, t: [u32; 3]) -> f64 {
-        let [a, b, c] = t.map(|i| self.positions[i as usize]);
-        let n = (b - a).cross(c - a);
-        let avg = t.iter().map(|&i| self.normals[i as usize]).sum::<DVec3>();
-        if n.dot(avg) <= 0.0 {
-            return -1.0;
-        }
-        crate::geometry::triangle::triangle_q([a, b, c])
-    }
-
-    /// Half-edges bordering holes: `b → a` for every face edge `a → b` with no face on `b → a`
-    /// and `b → a` not blocked (blocked directions are the outside of input boundaries).
-    fn hole_half_edges(&self) -> Vec<(u32, u32)> {
-        let mut out: Vec<(u32, u32)> = self
-            .directed
-            .iter()
-            .filter(|(_, &f)| f != BLOCKED)
-            .map(|(&(a, b), _)| (b, a))
-            .filter(|e| !self.directed.contains_key(e))
-            .collect();
-        out.sort_unstable();
-        out
-    }
-}
-
 /// How a face of the assembled mesh came in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum FaceSource {
@@ -166,43 +86,37 @@ pub fn assemble(
     boundary_edges: &[[u32; 2]],
     params: &AssemblyParams,
 ) -> (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats) {
-    let mut b = Builder {
-        positions,
-        normals,
-        faces: Vec::with_capacity(2 * positions.len() + 16),
-        sources: Vec::with_capacity(2 * positions.len() + 16),
-        directed: FxHashMap::default(),
-    };
+    let mut b: Assembly = EditMesh::new(positions.to_vec(), SlotPolicy::Append);
     let mut stats = AssemblyStats {
         candidates: voted.len(),
         ..Default::default()
     };
     for &[x, y] in boundary_edges {
-        b.directed.insert((y, x), BLOCKED);
+        b.block_directed_edge(y, x);
     }
     for t in voted
         .iter()
         .filter(|t| t.votes >= 3 && !t.orientation_conflict)
     {
-        if b.add(t.corners, FaceSource::ThreeVotes) {
+        if b.add_face(t.corners, FaceSource::ThreeVotes).is_ok() {
             stats.accepted_three_votes += 1;
         }
     }
     let mut two: Vec<(f64, [u32; 3])> = voted
         .iter()
         .filter(|t| params.two_vote_phase && t.votes == 2 && !t.orientation_conflict)
-        .map(|t| (b.quality(t.corners), t.corners))
+        .map(|t| (oriented_quality(&b, normals, t.corners), t.corners))
         .filter(|x| x.0 > 0.0)
         .collect();
     two.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
     for (_, t) in two {
-        if b.add(t, FaceSource::TwoVotes) {
+        if b.add_face(t, FaceSource::TwoVotes).is_ok() {
             stats.accepted_two_votes += 1;
         }
     }
     for round in 0..6 {
         let mut failed = Vec::new();
-        let (filled, tris, left) = fill_holes(&mut b, params, &mut failed);
+        let (filled, tris, left) = fill_holes(&mut b, normals, params, &mut failed);
         if round < 4 {
             // Grow each hole that could not be closed by the faces around its corners: the
             // larger polygon (with the samples inside it) often has a valid triangulation where
@@ -219,26 +133,20 @@ pub fn assemble(
         }
     }
     if params.refine.insert_loose_samples {
-        stats.samples_inserted = insert_loose_samples(&mut b);
+        stats.samples_inserted = insert_loose_samples(&mut b, normals, FaceSource::Refined);
     }
-    stats.edge_flips = flip_edges(&mut b, &params.refine);
-    let (faces, sources) = b
-        .faces
-        .into_iter()
-        .zip(b.sources)
-        .filter_map(|(f, s)| f.map(|f| (f, s)))
-        .unzip();
+    stats.edge_flips = flip_edges(&mut b, normals, &params.refine, FaceSource::Refined);
+    let (_, faces, sources) = b.into_parts();
     (faces, sources, stats)
 }
 
 /// Removes the faces that touch a corner of any of `holes`. Returns how many were removed.
-fn grow_holes(b: &mut Builder, holes: &[Vec<u32>]) -> usize {
+fn grow_holes(b: &mut Assembly, holes: &[Vec<u32>]) -> usize {
     let corners: FxHashSet<u32> = holes.iter().flatten().copied().collect();
     let mut removed = 0;
-    for f in 0..b.faces.len() {
-        if let Some(t) = b.faces[f] {
-            if t.iter().any(|v| corners.contains(v)) {
-                b.remove(f as u32);
+    for f in 0..b.slots() as u32 {
+        if let Some(t) = b.face(f) {
+            if t.iter().any(|v| corners.contains(v)) && b.remove_face(f).is_ok() {
                 removed += 1;
             }
         }
@@ -269,18 +177,19 @@ fn simple_loops(walk: &[u32]) -> Vec<Vec<u32>> {
 }
 
 fn fill_holes(
-    b: &mut Builder,
+    b: &mut Assembly,
+    normals: &[DVec3],
     params: &AssemblyParams,
     failed: &mut Vec<Vec<u32>>,
 ) -> (usize, usize, usize) {
-    let edges = b.hole_half_edges();
-    let mut referenced = vec![false; b.positions.len()];
-    for t in b.faces.iter().flatten() {
-        for &v in t {
+    let edges = b.boundary_half_edges();
+    let mut referenced = vec![false; b.vertex_count()];
+    for t in b.live_faces().0 {
+        for v in t {
             referenced[v as usize] = true;
         }
     }
-    let mut loose: Vec<u32> = (0..b.positions.len() as u32)
+    let mut loose: Vec<u32> = (0..b.vertex_count() as u32)
         .filter(|&v| !referenced[v as usize])
         .collect();
     let mut from: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
@@ -324,37 +233,23 @@ fn fill_holes(
                 left += 1;
                 continue;
             }
-            let tris = triangulate_hole_with_interior(b, &lp, &loose)
-                .or_else(|| triangulate_polygon(b, &lp, false))
-                .or_else(|| triangulate_polygon(b, &lp, true));
+            let tris = triangulate_hole_with_interior(b, normals, &lp, &loose)
+                .or_else(|| triangulate_polygon(b, normals, &lp, false))
+                .or_else(|| triangulate_polygon(b, normals, &lp, true));
             match tris {
-                Some(tris) => {
-                    let mut ok = true;
-                    let mut done = Vec::new();
-                    for t in tris {
-                        if b.add(t, FaceSource::HoleFill) {
-                            done.push(b.faces.len() as u32 - 1);
-                        } else {
-                            ok = false;
-                            break;
-                        }
-                    }
-                    if ok {
+                Some(tris) => match b.fill_hole(&tris, FaceSource::HoleFill) {
+                    Ok(done) => {
                         filled += 1;
                         added += done.len();
-                        for &f in &done {
-                            for v in b.faces[f as usize].unwrap() {
+                        for t in &tris {
+                            for &v in t {
                                 referenced[v as usize] = true;
                             }
                         }
                         loose.retain(|&v| !referenced[v as usize]);
-                    } else {
-                        for f in done {
-                            b.remove(f);
-                        }
-                        left += 1;
                     }
-                }
+                    Err(_) => left += 1,
+                },
                 None => {
                     failed.push(lp);
                     left += 1
@@ -390,15 +285,20 @@ fn inside_polygon(p: DVec2, poly: &[DVec2]) -> bool {
 /// Newell normal, of its boundary and of the samples that no face uses yet and that lie inside
 /// it. `None` when the hole does not project to a simple polygon, faces away from its corners'
 /// normals, or a triangle would not fit.
-fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Option<Vec<[u32; 3]>> {
+fn triangulate_hole_with_interior(
+    b: &Assembly,
+    normals: &[DVec3],
+    lp: &[u32],
+    loose: &[u32],
+) -> Option<Vec<[u32; 3]>> {
     use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
     let m = lp.len();
-    let pts: Vec<DVec3> = lp.iter().map(|&v| b.positions[v as usize]).collect();
+    let pts: Vec<DVec3> = lp.iter().map(|&v| b.position(v)).collect();
     let newell = (0..m)
         .map(|i| pts[i].cross(pts[(i + 1) % m]))
         .sum::<DVec3>();
     let n = newell.try_normalize()?;
-    let avg_normal = lp.iter().map(|&v| b.normals[v as usize]).sum::<DVec3>();
+    let avg_normal = lp.iter().map(|&v| normals[v as usize]).sum::<DVec3>();
     if n.dot(avg_normal) <= 0.0 {
         return None;
     }
@@ -424,9 +324,9 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
         .iter()
         .copied()
         .filter(|&v| {
-            let p = b.positions[v as usize];
+            let p = b.position(v);
             p.distance_squared(center) <= radius2
-                && b.normals[v as usize].dot(n) > 0.3
+                && normals[v as usize].dot(n) > 0.3
                 && inside_polygon(to2(p), &poly)
         })
         .collect();
@@ -456,7 +356,7 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
         handles.push(h);
     }
     for &v in &interior {
-        let q = to2(b.positions[v as usize]);
+        let q = to2(b.position(v));
         let _ = cdt.insert(V {
             p: Point2::new(q.x, q.y),
             index: v,
@@ -479,7 +379,7 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
             / 3.0;
         if inside_polygon(c2, &poly) {
             let t = vs.map(|h| h.data().index);
-            if !b.fits(t) || b.quality(t) <= 0.0 {
+            if !b.fits(t) || oriented_quality(b, normals, t) <= 0.0 {
                 return None;
             }
             out.push(t);
@@ -497,7 +397,12 @@ fn triangulate_hole_with_interior(b: &Builder, lp: &[u32], loose: &[u32]) -> Opt
 /// With `allow_folds`, a triangle facing away from its corners' normals is allowed but scores
 /// below every triangle that does not: at a part thinner than the sampling, where the corners'
 /// normals point to both sides, closing the hole matters more than the shape of its triangles.
-fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec<[u32; 3]>> {
+fn triangulate_polygon(
+    b: &Assembly,
+    normals: &[DVec3],
+    lp: &[u32],
+    allow_folds: bool,
+) -> Option<Vec<[u32; 3]>> {
     let m = lp.len();
     if m == 3 {
         let t = [lp[0], lp[1], lp[2]];
@@ -524,12 +429,11 @@ fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec
             }
             for j in i + 1..k {
                 let t = [lp[i], lp[j], lp[k]];
-                let mut q = b.quality(t);
+                let mut q = oriented_quality(b, normals, t);
                 if q <= 0.0 && allow_folds {
-                    q = 1e-3
-                        * crate::geometry::triangle::triangle_q(t.map(|v| b.positions[v as usize]));
+                    q = 1e-3 * crate::geometry::triangle::triangle_q(b.corners(t));
                 }
-                if !(q > 1e-9) {
+                if q.is_nan() || q <= 1e-9 {
                     continue;
                 }
                 let v = best[idx(i, j)].min(best[idx(j, k)]).min(q);
@@ -540,7 +444,8 @@ fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec
             }
         }
     }
-    if !(best[idx(0, m - 1)] > 0.0) {
+    let whole = best[idx(0, m - 1)];
+    if whole.is_nan() || whole <= 0.0 {
         return None;
     }
     let mut out = Vec::with_capacity(m - 2);
@@ -560,13 +465,12 @@ fn triangulate_polygon(b: &Builder, lp: &[u32], allow_folds: bool) -> Option<Vec
 /// Finds vertices whose faces form more than one edge-connected fan and removes the faces of
 /// all fans but the largest, so that hole filling can rebuild them as one. Returns how many faces
 /// were removed.
-fn repair_pinched_vertices(b: &mut Builder) -> usize {
+fn repair_pinched_vertices(b: &mut Assembly) -> usize {
     let mut around: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
-    for (f, t) in b.faces.iter().enumerate() {
-        if let Some(t) = t {
-            for &v in t {
-                around.entry(v).or_default().push(f as u32);
-            }
+    let (faces, slots) = b.live_faces();
+    for (t, f) in faces.into_iter().zip(slots) {
+        for v in t {
+            around.entry(v).or_default().push(f);
         }
     }
     let mut vertices: Vec<u32> = around.keys().copied().collect();
@@ -578,7 +482,7 @@ fn repair_pinched_vertices(b: &mut Builder) -> usize {
         let mut fan_of: FxHashMap<u32, usize> = FxHashMap::default();
         let mut fans: Vec<Vec<u32>> = Vec::new();
         for &f in faces {
-            if fan_of.contains_key(&f) || b.faces[f as usize].is_none() {
+            if fan_of.contains_key(&f) || b.face(f).is_none() {
                 continue;
             }
             let id = fans.len();
@@ -586,12 +490,15 @@ fn repair_pinched_vertices(b: &mut Builder) -> usize {
             fan_of.insert(f, id);
             let mut k = 0;
             while k < fan.len() {
-                let t = b.faces[fan[k] as usize].unwrap();
+                let Some(t) = b.face(fan[k]) else {
+                    k += 1;
+                    continue;
+                };
                 for &w in t.iter().filter(|&&w| w != v) {
                     for e in [(v, w), (w, v)] {
-                        if let Some(&g) = b.directed.get(&e) {
-                            if g != BLOCKED && !fan_of.contains_key(&g) {
-                                fan_of.insert(g, id);
+                        if let Some(g) = b.face_on(e.0, e.1) {
+                            if let std::collections::hash_map::Entry::Vacant(e) = fan_of.entry(g) {
+                                e.insert(id);
                                 fan.push(g);
                             }
                         }
@@ -608,12 +515,219 @@ fn repair_pinched_vertices(b: &mut Builder) -> usize {
             for (i, fan) in fans.iter().enumerate() {
                 if i != keep {
                     for &f in fan {
-                        b.remove(f);
-                        removed += 1;
+                        // Fans at one vertex are disjoint and hold live faces only.
+                        if b.remove_face(f).is_ok() {
+                            removed += 1;
+                        }
                     }
                 }
             }
         }
     }
     removed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::topology;
+    use crate::mesh::test_meshes::fibonacci_sphere;
+    use crate::mesh::TriMesh;
+    use crate::triangulate::tangent_delaunay::{vote_triangles, SampleSet, TangentDelaunayParams};
+
+    fn votes(positions: &[DVec3], normals: &[DVec3], boundary: &[[u32; 2]]) -> Vec<VotedTriangle> {
+        let set = SampleSet {
+            positions,
+            normals,
+            boundary_edges: boundary,
+        };
+        vote_triangles(&set, &TangentDelaunayParams::default())
+    }
+
+    /// The assembled faces pass every invariant of the edit mesh.
+    fn assert_sane(positions: &[DVec3], faces: &[[u32; 3]]) {
+        let mesh = TriMesh::new(positions.to_vec(), faces.to_vec());
+        let m: EditMesh = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn samples_of_a_sphere_assemble_into_a_closed_manifold() {
+        let n = 400;
+        let positions = fibonacci_sphere(n);
+        let normals = positions.clone();
+        let voted = votes(&positions, &normals, &[]);
+        let (faces, sources, stats) = assemble(
+            &positions,
+            &normals,
+            &voted,
+            &[],
+            &AssemblyParams::default(),
+        );
+        assert_sane(&positions, &faces);
+        assert_eq!(faces.len(), 2 * n - 4);
+        assert_eq!(sources.len(), faces.len());
+        let mesh = TriMesh::new(positions, faces);
+        let t = topology(&mesh);
+        assert!(t.is_closed_manifold(), "{t:?}");
+        assert_eq!(
+            (t.vertices, t.euler_characteristic, t.components),
+            (n, 2, 1)
+        );
+        // Outward, like the normals.
+        assert!(mesh.signed_volume() > 0.0);
+        assert_eq!(stats.candidates, voted.len());
+        assert!(stats.accepted_three_votes > n, "{stats:?}");
+    }
+
+    #[test]
+    fn a_hole_left_by_the_umbrellas_is_filled_with_the_sample_inside_it() {
+        let n = 400;
+        let positions = fibonacci_sphere(n);
+        let normals = positions.clone();
+        // No candidate uses sample 200: its umbrella and its neighbours' triangles at it are
+        // gone, leaving a hole with 200 loose inside.
+        let voted: Vec<VotedTriangle> = votes(&positions, &normals, &[])
+            .into_iter()
+            .filter(|t| !t.corners.contains(&200))
+            .collect();
+        let (faces, _, stats) = assemble(
+            &positions,
+            &normals,
+            &voted,
+            &[],
+            &AssemblyParams::default(),
+        );
+        assert_sane(&positions, &faces);
+        assert!(
+            stats.holes_filled >= 1 && stats.hole_triangles >= 3,
+            "{stats:?}"
+        );
+        assert_eq!(stats.holes_left, 0);
+        assert!(faces.iter().any(|t| t.contains(&200)));
+        assert_eq!(faces.len(), 2 * n - 4);
+        let t = topology(&TriMesh::new(positions, faces));
+        assert!(
+            t.is_closed_manifold() && t.euler_characteristic == 2,
+            "{t:?}"
+        );
+    }
+
+    /// A jittered `n × n` grid of unit squares in the plane z = 0 and its border as boundary
+    /// edges, counter-clockwise (the surface on their left).
+    fn jittered_grid(n: usize) -> (Vec<DVec3>, Vec<[u32; 2]>) {
+        let mut state = 12345u64;
+        let mut jitter = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.4
+        };
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let on_x = i == 0 || i == n;
+                let on_y = j == 0 || j == n;
+                let dx = if on_x { 0.0 } else { jitter() };
+                let dy = if on_y { 0.0 } else { jitter() };
+                positions.push(DVec3::new(i as f64 + dx, j as f64 + dy, 0.0));
+            }
+        }
+        let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let mut ring = Vec::new();
+        ring.extend((0..n).map(|i| at(i, 0)));
+        ring.extend((0..n).map(|j| at(n, j)));
+        ring.extend((0..n).map(|i| at(n - i, n)));
+        ring.extend((0..n).map(|j| at(0, n - j)));
+        let boundary = (0..ring.len())
+            .map(|k| [ring[k], ring[(k + 1) % ring.len()]])
+            .collect();
+        (positions, boundary)
+    }
+
+    #[test]
+    fn an_open_grid_assembles_into_a_disk_with_its_boundary_kept() {
+        let n = 10;
+        let (positions, boundary) = jittered_grid(n);
+        let normals = vec![DVec3::Z; positions.len()];
+        let voted = votes(&positions, &normals, &boundary);
+        let (faces, _, _) = assemble(
+            &positions,
+            &normals,
+            &voted,
+            &boundary,
+            &AssemblyParams::default(),
+        );
+        assert_sane(&positions, &faces);
+        // A disk on (n + 1)² vertices with 4n boundary vertices: F = 2V − B − 2.
+        let v = (n + 1) * (n + 1);
+        assert_eq!(faces.len(), 2 * v - 4 * n - 2);
+        let t = topology(&TriMesh::new(positions, faces.clone()));
+        assert_eq!(
+            (t.euler_characteristic, t.boundary_loops, t.boundary_edges),
+            (1, 1, 4 * n)
+        );
+        for [a, b] in boundary {
+            assert!(
+                faces
+                    .iter()
+                    .any(|t| (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b)),
+                "boundary edge {a} → {b} not used in its direction"
+            );
+        }
+    }
+
+    #[test]
+    fn a_closed_walk_splits_into_simple_loops() {
+        assert_eq!(
+            simple_loops(&[1, 2, 3, 4, 2, 5]),
+            vec![vec![2, 3, 4], vec![1, 2, 5]]
+        );
+        assert_eq!(simple_loops(&[7, 8, 9]), vec![vec![7, 8, 9]]);
+    }
+
+    #[test]
+    fn the_smaller_fan_at_a_pinched_vertex_is_removed() {
+        let positions = vec![
+            DVec3::ZERO,
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(-1.0, -1.0, 0.0),
+        ];
+        let mut b: Assembly = EditMesh::new(positions, SlotPolicy::Append);
+        for t in [[0, 1, 2], [0, 2, 3], [0, 4, 5]] {
+            assert!(b.add_face(t, FaceSource::ThreeVotes).is_ok());
+        }
+        assert!(matches!(
+            b.sanity_check(),
+            Err(crate::mesh::edit::Violation::NonManifoldVertex { vertex: 0, fans: 2 })
+        ));
+        assert_eq!(repair_pinched_vertices(&mut b), 1);
+        assert_eq!(b.live_faces().0, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(b.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn a_hole_polygon_is_triangulated_for_the_best_smallest_quality() {
+        // A convex pentagon: the max-min triangulation has three triangles of the polygon's
+        // corners, each facing like the normals.
+        let a = std::f64::consts::TAU / 5.0;
+        let positions: Vec<DVec3> = (0..5)
+            .map(|k| DVec3::new((a * k as f64).cos(), (a * k as f64).sin(), 0.0))
+            .collect();
+        let normals = vec![DVec3::Z; 5];
+        let b: Assembly = EditMesh::new(positions, SlotPolicy::Append);
+        let lp = [0, 1, 2, 3, 4];
+        let tris = triangulate_polygon(&b, &normals, &lp, false).expect("a triangulation");
+        assert_eq!(tris.len(), 3);
+        assert!(tris
+            .iter()
+            .all(|&t| oriented_quality(&b, &normals, t) > 0.0));
+        // Facing away from every normal, there is none without folds.
+        let down = vec![-DVec3::Z; 5];
+        assert_eq!(triangulate_polygon(&b, &down, &lp, false), None);
+        assert!(triangulate_polygon(&b, &down, &lp, true).is_some());
+    }
 }

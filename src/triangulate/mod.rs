@@ -2,6 +2,7 @@
 //! manifold clean-up.
 
 pub mod cleanup;
+mod flip;
 pub mod optimize;
 pub mod refine;
 pub mod tangent_delaunay;

@@ -25,10 +25,10 @@ use glam::DVec3;
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 use rayon::prelude::*;
-use rustc_hash::FxHashMap;
 
-use super::refine::starting_at;
+use super::flip::max_min_flips;
 use crate::geometry::triangle::{triangle_angles_deg, triangle_q};
+use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::mesh_projection::MeshSurface;
 
@@ -90,157 +90,49 @@ pub struct OptimizeStats {
     pub moves: usize,
 }
 
-/// A triangle mesh open to local edits: faces with directed-edge and vertex-face look-ups.
-struct EditMesh {
-    positions: Vec<DVec3>,
-    faces: Vec<[u32; 3]>,
-    /// Directed edge → the face that has it.
-    edge: FxHashMap<(u32, u32), u32>,
-    /// Vertex → the faces around it.
-    around: Vec<Vec<u32>>,
-    /// Faces removed by a collapse are kept as dead slots so face indices stay valid.
-    alive: Vec<bool>,
-    /// Whether the face in each slot is still the input's face of the same index.
-    original: Vec<bool>,
+/// The mesh being optimized: each face labelled with the index of the input face it still is
+/// (`None` once an operation made or changed it).
+type Mesh = EditMesh<Option<u32>>;
+
+fn normal(m: &Mesh, t: [u32; 3]) -> DVec3 {
+    let [a, b, c] = m.corners(t);
+    (b - a).cross(c - a).normalize_or_zero()
 }
 
-impl EditMesh {
-    fn new(mesh: &TriMesh) -> Self {
-        let mut m = EditMesh {
-            positions: mesh.positions.clone(),
-            faces: Vec::with_capacity(mesh.triangles.len()),
-            edge: FxHashMap::default(),
-            around: vec![Vec::new(); mesh.positions.len()],
-            alive: Vec::with_capacity(mesh.triangles.len()),
-            original: Vec::new(),
-        };
-        for &t in &mesh.triangles {
-            m.push(t);
-        }
-        m.original = vec![true; m.faces.len()];
-        m
-    }
+fn min_angle(m: &Mesh, t: [u32; 3]) -> f64 {
+    let a = triangle_angles_deg(m.corners(t));
+    a[0].min(a[1]).min(a[2])
+}
 
-    fn corners(&self, t: [u32; 3]) -> [DVec3; 3] {
-        t.map(|i| self.positions[i as usize])
-    }
+fn q(m: &Mesh, t: [u32; 3]) -> f64 {
+    triangle_q(m.corners(t))
+}
 
-    fn push(&mut self, t: [u32; 3]) -> u32 {
-        let f = self.faces.len() as u32;
-        self.faces.push(t);
-        self.alive.push(true);
-        self.original.push(false);
-        self.link(f);
-        f
-    }
+/// The shape score the operations maximize at their worst face: Q and the smallest angle, each
+/// relative to a good level (Q 0.6, 30°), whichever is lower.
+fn score(m: &Mesh, t: [u32; 3]) -> f64 {
+    (q(m, t) / 0.6).min(min_angle(m, t) / 30.0)
+}
 
-    fn link(&mut self, f: u32) {
-        let t = self.faces[f as usize];
-        for k in 0..3 {
-            self.edge.insert((t[k], t[(k + 1) % 3]), f);
-            self.around[t[k] as usize].push(f);
-        }
-    }
+/// Whether `t` is one of the triangles the operations work on.
+fn is_poor(m: &Mesh, t: [u32; 3], params: &OptimizeParams) -> bool {
+    q(m, t) < params.q_below || min_angle(m, t) < params.theta_below_deg
+}
 
-    fn unlink(&mut self, f: u32) {
-        let t = self.faces[f as usize];
-        for k in 0..3 {
-            if self.edge.get(&(t[k], t[(k + 1) % 3])) == Some(&f) {
-                self.edge.remove(&(t[k], t[(k + 1) % 3]));
-            }
-            self.around[t[k] as usize].retain(|&g| g != f);
-        }
-    }
+/// The face in slot `f`, which must be live.
+fn face(m: &Mesh, f: u32) -> [u32; 3] {
+    m.face(f)
+        .unwrap_or_else(|| unreachable!("face {f} is live"))
+}
 
-    fn replace(&mut self, f: u32, t: [u32; 3]) {
-        self.original[f as usize] = false;
-        self.unlink(f);
-        self.faces[f as usize] = t;
-        self.link(f);
-    }
-
-    fn has_edge(&self, a: u32, b: u32) -> bool {
-        self.edge.contains_key(&(a, b)) || self.edge.contains_key(&(b, a))
-    }
-
-    fn normal(&self, t: [u32; 3]) -> DVec3 {
-        let [a, b, c] = self.corners(t);
-        (b - a).cross(c - a).normalize_or_zero()
-    }
-
-    fn min_angle(&self, t: [u32; 3]) -> f64 {
-        let a = triangle_angles_deg(self.corners(t));
-        a[0].min(a[1]).min(a[2])
-    }
-
-    fn q(&self, t: [u32; 3]) -> f64 {
-        triangle_q(self.corners(t))
-    }
-
-    /// The shape score the operations maximize at their worst face: Q and the smallest angle,
-    /// each relative to a good level (Q 0.6, 30°), whichever is lower.
-    fn score(&self, t: [u32; 3]) -> f64 {
-        (self.q(t) / 0.6).min(self.min_angle(t) / 30.0)
-    }
-
-    /// Whether `t` is one of the triangles the operations work on.
-    fn is_poor(&self, t: [u32; 3], params: &OptimizeParams) -> bool {
-        self.q(t) < params.q_below || self.min_angle(t) < params.theta_below_deg
-    }
-
-    fn distance_to_faces(&self, faces: &[u32], p: DVec3) -> f64 {
-        faces
-            .iter()
-            .map(|&f| {
-                let [a, b, c] = self.corners(self.faces[f as usize]);
-                Triangle::new(a, b, c).distance_to_local_point(p, true)
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// Whether `v` is on a boundary edge.
-    fn on_boundary(&self, v: u32) -> bool {
-        self.around[v as usize].iter().any(|&f| {
-            let t = self.faces[f as usize];
-            (0..3).any(|k| !self.edge.contains_key(&(t[(k + 1) % 3], t[k])))
+fn distance_to_faces(m: &Mesh, faces: &[u32], p: DVec3) -> f64 {
+    faces
+        .iter()
+        .map(|&f| {
+            let [a, b, c] = m.corners(face(m, f));
+            Triangle::new(a, b, c).distance_to_local_point(p, true)
         })
-    }
-
-    /// The vertices sharing a face with `v`, sorted.
-    fn ring(&self, v: u32) -> Vec<u32> {
-        let mut r: Vec<u32> = self.around[v as usize]
-            .iter()
-            .flat_map(|&f| self.faces[f as usize])
-            .filter(|&u| u != v)
-            .collect();
-        r.sort_unstable();
-        r.dedup();
-        r
-    }
-
-    fn kill(&mut self, f: u32) {
-        self.unlink(f);
-        self.alive[f as usize] = false;
-    }
-
-    /// The live faces and, for each, its slot.
-    fn live(&self) -> (Vec<[u32; 3]>, Vec<u32>) {
-        (0..self.faces.len() as u32)
-            .filter(|&f| self.alive[f as usize])
-            .map(|f| (self.faces[f as usize], f))
-            .unzip()
-    }
-
-    /// The mesh, and for each of its faces the index of the input face it still is (`None` for
-    /// a new or changed face).
-    fn into_mesh(self) -> (TriMesh, Vec<Option<u32>>) {
-        let (faces, slots) = self.live();
-        let origin = slots
-            .iter()
-            .map(|&f| self.original[f as usize].then_some(f))
-            .collect();
-        (TriMesh::new(self.positions, faces), origin)
-    }
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Optimizes `mesh` (bbox-100 units, edge-manifold and consistently oriented) against `surface`
@@ -267,16 +159,16 @@ pub fn optimize(
         ..*params
     };
     let mut stats = OptimizeStats::default();
-    let mut m = EditMesh::new(mesh);
+    let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
     let mut fixed = fixed.to_vec();
-    fixed.resize(m.positions.len(), false);
+    fixed.resize(m.vertex_count(), false);
     let short = params.short_edge_ratio * median_edge_length(&m);
     let mut watch = None;
     for round in 0..params.cover_rounds.max(1) {
         if params.cover_distance.is_finite() {
             let added = cover(&mut m, cover_points, &mut watch, params);
             // Covering vertices stay where they are.
-            fixed.resize(m.positions.len(), true);
+            fixed.resize(m.vertex_count(), true);
             stats.covered += added;
             if added == 0 && round > 0 {
                 break;
@@ -297,8 +189,8 @@ pub fn optimize(
             break;
         }
     }
-    let (result, origin) = m.into_mesh();
-    *mesh = result;
+    let (positions, faces, origin) = m.into_parts();
+    *mesh = TriMesh::new(positions, faces);
     (stats, origin)
 }
 
@@ -307,13 +199,13 @@ pub fn optimize(
 /// carries, from the first round to the next, the points worth looking at again. Returns how
 /// many were inserted.
 fn cover(
-    m: &mut EditMesh,
+    m: &mut Mesh,
     points: &[DVec3],
     watch: &mut Option<Vec<u32>>,
     params: &OptimizeParams,
 ) -> usize {
-    let (live, slot) = m.live();
-    let current = TriMesh::new(m.positions.clone(), live);
+    let (live, slot) = m.live_faces();
+    let current = TriMesh::new(m.positions().to_vec(), live);
     let Ok(output) = MeshSurface::new(&current) else {
         return 0;
     };
@@ -351,10 +243,10 @@ fn cover(
         })
         .collect();
     far.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-    let mut touched = vec![false; m.faces.len()];
+    let mut touched = vec![false; m.slots()];
     let mut added = 0;
     for (_, i, f) in far {
-        let t = m.faces[f as usize];
+        let t = face(m, f);
         // One insertion per face and its neighbours per round: the next round sees the result.
         if touched[f as usize] {
             continue;
@@ -363,6 +255,7 @@ fn cover(
         let [pa, pb, pc] = m.corners(t);
         let n = (pb - pa).cross(pc - pa);
         let corner = [pa, pb, pc];
+        let v = m.vertex_count() as u32;
         // Which side of each edge k (corner k → k+1) p is on, in the face's plane.
         let outside: Vec<usize> = (0..3)
             .filter(|&k| {
@@ -370,15 +263,11 @@ fn cover(
                 (y - x).cross(p - x).dot(n) <= 0.0
             })
             .collect();
-        let v = m.positions.len() as u32;
-        let plan: Vec<(Option<u32>, [u32; 3], [u32; 3])> = if outside.is_empty() {
+        // (new face, the old face it comes from), and the edge to split (`None`: the face).
+        let (plan, split): (SplitPlan, Option<(u32, u32)>) = if outside.is_empty() {
             // Inside the face: split it in three.
             let [a, b, c] = t;
-            vec![
-                (Some(f), [a, b, v], t),
-                (None, [b, c, v], t),
-                (None, [c, a, v], t),
-            ]
+            (vec![([a, b, v], t), ([b, c, v], t), ([c, a, v], t)], None)
         } else {
             // Beyond an edge (or a corner: the nearer of its two edges): split that edge and
             // the face across it.
@@ -391,43 +280,48 @@ fn cover(
                 .unwrap_or(&outside[0]);
             let (x, y, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
             // A boundary edge stays as the boundary samples made it.
-            let Some(&g) = m.edge.get(&(y, x)) else {
+            let Some(g) = m.face_on(y, x) else {
                 continue;
             };
             if touched[g as usize] {
                 continue;
             }
-            let u = m.faces[g as usize];
+            let u = face(m, g);
             let d = starting_at(u, y)[2];
-            vec![
-                (Some(f), [x, v, c], t),
-                (None, [v, y, c], t),
-                (Some(g), [y, v, d], u),
-                (None, [v, x, d], u),
-            ]
+            (
+                vec![
+                    ([x, v, c], t),
+                    ([v, y, c], t),
+                    ([y, v, d], u),
+                    ([v, x, d], u),
+                ],
+                Some((x, y)),
+            )
         };
         // Every new face must face the way the face it comes from did.
-        m.positions.push(p);
+        let at = |u: u32| if u == v { p } else { m.position(u) };
+        let unit = |t: [u32; 3]| {
+            let [a, b, c] = t.map(at);
+            (b - a).cross(c - a).normalize_or_zero()
+        };
         let fits = plan
             .iter()
-            .all(|&(_, new, old)| m.normal(new).dot(m.normal(old)) > 0.0);
+            .all(|&(new, old)| unit(new).dot(normal(m, old)) > 0.0);
         if !fits {
-            m.positions.pop();
             continue;
         }
-        m.around.push(Vec::new());
-        let t_all: Vec<u32> = plan.iter().flat_map(|x| x.1).collect();
-        for (slot, new, _) in plan {
-            match slot {
-                Some(g) => m.replace(g, new),
-                None => {
-                    m.push(new);
-                }
-            }
+        m.add_vertex(p);
+        let done = match split {
+            None => m.split_face(f, v, None).map(|_| ()),
+            Some((x, y)) => m.split_edge(x, y, v, None).map(|_| ()),
+        };
+        if done.is_err() {
+            m.pop_vertex();
+            continue;
         }
-        touched.resize(m.faces.len(), true);
-        for &u in &t_all {
-            for &g in &m.around[u as usize] {
+        touched.resize(m.slots(), true);
+        for &u in plan.iter().flat_map(|x| x.0.iter()) {
+            for &g in m.faces_around(u) {
                 touched[g as usize] = true;
             }
         }
@@ -435,6 +329,9 @@ fn cover(
     }
     added
 }
+
+/// The faces a split makes: (new face, the old face it comes from).
+type SplitPlan = Vec<([u32; 3], [u32; 3])>;
 
 /// The distance from `p` to the segment `a`–`b`.
 fn segment_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
@@ -448,26 +345,27 @@ fn segment_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
 }
 
 /// The vertices of the faces with Q below `q_below`, sorted.
-fn poor_vertices(m: &EditMesh, params: &OptimizeParams) -> Vec<u32> {
+fn poor_vertices(m: &Mesh, params: &OptimizeParams) -> Vec<u32> {
     let mut v: Vec<u32> = m
-        .faces
-        .iter()
-        .zip(&m.alive)
-        .filter(|&(&t, &alive)| alive && m.is_poor(t, params))
-        .flat_map(|(t, _)| t.iter().copied())
+        .live_faces()
+        .0
+        .into_iter()
+        .filter(|&t| is_poor(m, t, params))
+        .flatten()
         .collect();
     v.sort_unstable();
     v.dedup();
     v
 }
 
-/// Max-min angle flips of the edges of the faces around poor triangles' vertices, where the new
-/// faces stay within `max_offset` of the surface. Returns the number of flips.
-fn flip_poor(m: &mut EditMesh, surface: &MeshSurface, params: &OptimizeParams) -> usize {
+/// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around poor triangles'
+/// vertices, where the new faces face the way the old ones did and stay within `max_offset` of
+/// the surface. Returns the number of flips.
+fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &OptimizeParams) -> usize {
     let mut edges: Vec<(u32, u32)> = Vec::new();
     for v in poor_vertices(m, params) {
-        for &f in &m.around[v as usize] {
-            let t = m.faces[f as usize];
+        for &f in m.faces_around(v) {
+            let t = face(m, f);
             for k in 0..3 {
                 let (x, y) = (t[k], t[(k + 1) % 3]);
                 edges.push((x.min(y), x.max(y)));
@@ -476,73 +374,39 @@ fn flip_poor(m: &mut EditMesh, surface: &MeshSurface, params: &OptimizeParams) -
     }
     edges.sort_unstable();
     edges.dedup();
-    let mut flips = 0;
-    for (x, y) in edges {
-        let (Some(&f1), Some(&f2)) = (m.edge.get(&(x, y)), m.edge.get(&(y, x))) else {
-            continue;
-        };
-        let t1 = starting_at(m.faces[f1 as usize], x); // [x, y, c]
-        let t2 = starting_at(m.faces[f2 as usize], y); // [y, x, d]
-        if t1[1] != y || t2[1] != x {
-            continue;
-        }
-        let (c, d) = (t1[2], t2[2]);
-        if c == d
-            || m.has_edge(c, d)
-            || m.around[x as usize].len() <= 3
-            || m.around[y as usize].len() <= 3
-        {
-            continue;
-        }
-        let new1 = [x, d, c];
-        let new2 = [y, c, d];
-        let old = m.min_angle(t1).min(m.min_angle(t2));
-        let new = m.min_angle(new1).min(m.min_angle(new2));
-        if new <= old + 1e-6 {
-            continue;
-        }
+    max_min_flips(m, &edges, None, |m, flip| {
+        let [t1, t2] = flip.old;
+        let [new1, new2] = flip.new;
+        let (x, y, c, d) = (t1[0], t1[1], t1[2], t2[2]);
         // The new faces must face the way the old ones did and stay on the surface.
-        let (n1, n2) = (m.normal(t1), m.normal(t2));
-        let (m1, m2) = (m.normal(new1), m.normal(new2));
+        let (n1, n2) = (normal(m, t1), normal(m, t2));
+        let (m1, m2) = (normal(m, new1), normal(m, new2));
         let mean_old = n1 + n2;
         if m1.dot(mean_old) <= 0.0 || m2.dot(mean_old) <= 0.0 || m1.dot(m2) < 0.0 {
-            continue;
+            return false;
         }
-        let (px, py, pc, pd) = (
-            m.positions[x as usize],
-            m.positions[y as usize],
-            m.positions[c as usize],
-            m.positions[d as usize],
-        );
+        let (px, py, pc, pd) = (m.position(x), m.position(y), m.position(c), m.position(d));
         let Some(new_mid) = surface.closest_point(0.5 * (pc + pd)) else {
-            continue;
+            return false;
         };
         if new_mid.distance > params.max_offset {
-            continue;
+            return false;
         }
         let Some(old_mid) = surface.closest_point(0.5 * (px + py)) else {
-            continue;
+            return false;
         };
         let tri_dist = |t: [u32; 3], p: DVec3| {
             let [a, b, c] = m.corners(t);
             Triangle::new(a, b, c).distance_to_local_point(p, true)
         };
-        if tri_dist(new1, old_mid.position).min(tri_dist(new2, old_mid.position))
-            > params.max_offset
-        {
-            continue;
-        }
-        m.replace(f1, new1);
-        m.replace(f2, new2);
-        flips += 1;
-    }
-    flips
+        tri_dist(new1, old_mid.position).min(tri_dist(new2, old_mid.position)) <= params.max_offset
+    })
 }
 
 /// One sweep of relaxation over the vertices of poor triangles (see the module documentation).
 /// Returns the number of moves.
 fn relax_poor(
-    m: &mut EditMesh,
+    m: &mut Mesh,
     surface: &MeshSurface,
     fixed: &[bool],
     params: &OptimizeParams,
@@ -554,45 +418,42 @@ fn relax_poor(
         if fixed.get(v as usize).copied().unwrap_or(false) {
             continue;
         }
-        let faces = m.around[v as usize].clone();
+        let faces = m.faces_around(v).to_vec();
         if faces.is_empty() {
             continue;
         }
         // A vertex on a boundary edge stays.
-        if m.on_boundary(v) {
+        if m.is_boundary_vertex(v) {
             continue;
         }
-        let old_normals: Vec<DVec3> = faces
-            .iter()
-            .map(|&f| m.normal(m.faces[f as usize]))
-            .collect();
-        let worst_q = |m: &EditMesh| {
+        let old_normals: Vec<DVec3> = faces.iter().map(|&f| normal(m, face(m, f))).collect();
+        let worst_q = |m: &Mesh| {
             faces
                 .iter()
-                .map(|&f| m.score(m.faces[f as usize]))
+                .map(|&f| score(m, face(m, f)))
                 .fold(f64::INFINITY, f64::min)
         };
         ring.clear();
         for &f in &faces {
-            ring.extend(m.faces[f as usize].iter().filter(|&&u| u != v));
+            ring.extend(face(m, f).iter().filter(|&&u| u != v));
         }
         ring.sort_unstable();
         ring.dedup();
         let centroid = ring
             .iter()
-            .map(|&u| m.positions[u as usize])
+            .map(|&u| m.position(u))
             .fold(DVec3::ZERO, |a, b| a + b)
             / ring.len() as f64;
-        let old = m.positions[v as usize];
+        let old = m.position(v);
         // Targets: the centroid, and for each poor face the apex of the equilateral triangle on
         // the edge opposite v (in the face's plane, on v's side).
         let mut targets = vec![centroid];
         for &f in &faces {
-            let t = starting_at(m.faces[f as usize], v);
-            if !m.is_poor(t, params) {
+            let t = starting_at(face(m, f), v);
+            if !is_poor(m, t, params) {
                 continue;
             }
-            let (pb, pc) = (m.positions[t[1] as usize], m.positions[t[2] as usize]);
+            let (pb, pc) = (m.position(t[1]), m.position(t[2]));
             let mid = 0.5 * (pb + pc);
             let e = pc - pb;
             let height = old - mid;
@@ -610,19 +471,22 @@ fn relax_poor(
             let Some(sp) = surface.closest_point(old.lerp(target, t)) else {
                 continue;
             };
-            m.positions[v as usize] = sp.position;
+            if m.relocate_vertex(v, sp.position).is_err() {
+                continue;
+            }
             let turned = faces
                 .iter()
                 .zip(&old_normals)
-                .any(|(&f, &n0)| m.normal(m.faces[f as usize]).dot(n0) < cos_turn);
+                .any(|(&f, &n0)| normal(m, face(m, f)).dot(n0) < cos_turn);
             let q = worst_q(m);
-            if !turned && q > best.0 + 1e-9 && m.distance_to_faces(&faces, old) <= params.max_offset
+            if !turned
+                && q > best.0 + 1e-9
+                && distance_to_faces(m, &faces, old) <= params.max_offset
             {
                 best = (q, sp.position);
             }
         }
-        m.positions[v as usize] = best.1;
-        if best.1 != old {
+        if m.relocate_vertex(v, best.1).is_ok() && best.1 != old {
             moves += 1;
         }
     }
@@ -630,8 +494,8 @@ fn relax_poor(
 }
 
 /// The median edge length of the live faces (0 for an empty mesh).
-fn median_edge_length(m: &EditMesh) -> f64 {
-    let (live, _) = m.live();
+fn median_edge_length(m: &Mesh) -> f64 {
+    let (live, _) = m.live_faces();
     let mut lengths: Vec<f64> = live
         .iter()
         .flat_map(|t| {
@@ -654,7 +518,7 @@ fn median_edge_length(m: &EditMesh) -> f64 {
 /// by more than `max_normal_turn_deg`, and leaves both old positions within `collapse_offset` of
 /// the new faces. Returns the number of collapses.
 fn collapse_short(
-    m: &mut EditMesh,
+    m: &mut Mesh,
     surface: &MeshSurface,
     fixed: &[bool],
     short: f64,
@@ -662,13 +526,13 @@ fn collapse_short(
 ) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let mut edges: Vec<(f64, u32, u32)> = Vec::new();
-    for (f, t) in m.faces.iter().enumerate() {
-        if !m.alive[f] || !m.is_poor(*t, params) {
+    for t in m.live_faces().0 {
+        if !is_poor(m, t, params) {
             continue;
         }
         for k in 0..3 {
             let (x, y) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
-            let l = m.positions[x as usize].distance(m.positions[y as usize]);
+            let l = m.position(x).distance(m.position(y));
             if l < short {
                 edges.push((l, x, y));
             }
@@ -679,28 +543,26 @@ fn collapse_short(
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
     let mut collapses = 0;
     for (_, a, b) in edges {
-        let (Some(&f1), Some(&f2)) = (m.edge.get(&(a, b)), m.edge.get(&(b, a))) else {
+        let Ok((f1, f2, c, d)) = m.edge_faces(a, b) else {
             continue;
         };
-        let (pa, pb) = (m.positions[a as usize], m.positions[b as usize]);
+        let (pa, pb) = (m.position(a), m.position(b));
         if pa.distance(pb) >= short {
             continue;
         }
-        let c = starting_at(m.faces[f1 as usize], a)[2];
-        let d = starting_at(m.faces[f2 as usize], b)[2];
         let (ra, rb) = (m.ring(a), m.ring(b));
         let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
         if c == d
             || common.len() != 2
             || !common.contains(&c)
             || !common.contains(&d)
-            || m.around[c as usize].len() <= 3
-            || m.around[d as usize].len() <= 3
+            || m.degree(c) <= 3
+            || m.degree(d) <= 3
         {
             continue;
         }
-        let keep_a = is_fixed(a) || m.on_boundary(a);
-        let keep_b = is_fixed(b) || m.on_boundary(b);
+        let keep_a = is_fixed(a) || m.is_boundary_vertex(a);
+        let keep_b = is_fixed(b) || m.is_boundary_vertex(b);
         // (removed, kept, position of the kept vertex)
         let mut options: Vec<(u32, u32, DVec3)> = Vec::new();
         match (keep_a, keep_b) {
@@ -716,9 +578,10 @@ fn collapse_short(
             }
         }
         // The faces that change: all around a and b but f1 and f2.
-        let mut involved: Vec<u32> = m.around[a as usize]
+        let mut involved: Vec<u32> = m
+            .faces_around(a)
             .iter()
-            .chain(&m.around[b as usize])
+            .chain(m.faces_around(b))
             .copied()
             .filter(|&g| g != f1 && g != f2)
             .collect();
@@ -727,27 +590,26 @@ fn collapse_short(
         let before = involved
             .iter()
             .chain([&f1, &f2])
-            .map(|&g| m.score(m.faces[g as usize]))
+            .map(|&g| score(m, face(m, g)))
             .fold(f64::INFINITY, f64::min);
-        let old_normals: Vec<DVec3> = involved
-            .iter()
-            .map(|&g| m.normal(m.faces[g as usize]))
-            .collect();
+        let old_normals: Vec<DVec3> = involved.iter().map(|&g| normal(m, face(m, g))).collect();
         let mut best: Option<(f64, u32, u32, DVec3)> = None;
         for (removed, kept, q) in options {
-            let saved = m.positions[kept as usize];
-            m.positions[kept as usize] = q;
+            let saved = m.position(kept);
+            if m.relocate_vertex(kept, q).is_err() {
+                continue;
+            }
             let new_faces: Vec<[u32; 3]> = involved
                 .iter()
-                .map(|&g| m.faces[g as usize].map(|u| if u == removed { kept } else { u }))
+                .map(|&g| face(m, g).map(|u| if u == removed { kept } else { u }))
                 .collect();
             let turned = new_faces
                 .iter()
                 .zip(&old_normals)
-                .any(|(&t, &n0)| m.normal(t).dot(n0) < cos_turn);
+                .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
             let worst = new_faces
                 .iter()
-                .map(|&t| m.score(t))
+                .map(|&t| score(m, t))
                 .fold(f64::INFINITY, f64::min);
             let dist = |p: DVec3| {
                 new_faces
@@ -759,7 +621,8 @@ fn collapse_short(
                     .fold(f64::INFINITY, f64::min)
             };
             let near = dist(pa) <= params.collapse_offset && dist(pb) <= params.collapse_offset;
-            m.positions[kept as usize] = saved;
+            // The old position was finite: restoring it cannot fail.
+            let _ = m.relocate_vertex(kept, saved);
             if !turned && near && worst > before + 1e-9 && best.is_none_or(|b| worst > b.0) {
                 best = Some((worst, removed, kept, q));
             }
@@ -767,14 +630,9 @@ fn collapse_short(
         let Some((_, removed, kept, q)) = best else {
             continue;
         };
-        m.kill(f1);
-        m.kill(f2);
-        for g in m.around[removed as usize].clone() {
-            let t = m.faces[g as usize].map(|u| if u == removed { kept } else { u });
-            m.replace(g, t);
+        if m.collapse_edge(removed, kept, q, None).is_ok() {
+            collapses += 1;
         }
-        m.positions[kept as usize] = q;
-        collapses += 1;
     }
     collapses
 }
@@ -797,6 +655,13 @@ mod tests {
         assert!(t.is_manifold() && t.euler_characteristic == 1 && t.components == 1);
         let problems = check_invariants(mesh);
         assert!(problems.is_empty(), "{problems:?}");
+        assert_sane(mesh);
+    }
+
+    /// The mesh passes every invariant of the edit mesh.
+    fn assert_sane(mesh: &TriMesh) {
+        let m: EditMesh = EditMesh::from_trimesh(mesh, |_| (), SlotPolicy::Reuse);
+        assert_eq!(m.sanity_check(), Ok(()));
     }
 
     fn no_cover() -> OptimizeParams {
@@ -844,6 +709,7 @@ mod tests {
         assert_eq!(mesh.positions[3], original[3]);
         assert_eq!(mesh.positions[3 * 7 + 3], original[3 * 7 + 3]);
         assert_eq!(topology(&mesh).boundary_edges, 24);
+        assert_sane(&mesh);
     }
 
     #[test]
@@ -941,5 +807,6 @@ mod tests {
             "{:?}",
             check_invariants(&mesh)
         );
+        assert_sane(&mesh);
     }
 }

@@ -236,3 +236,96 @@ pub fn same_orientation(a: [u32; 3], b: [u32; 3]) -> bool {
         None => false,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use spade::DelaunayTriangulation;
+
+    /// A jittered `n × n` grid of unit spacing in the plane z = 0 (fixed seed).
+    fn jittered_grid(n: usize) -> Vec<DVec3> {
+        let mut state = 7u64;
+        let mut jitter = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.5
+        };
+        let mut out = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                out.push(DVec3::new(i as f64 + jitter(), j as f64 + jitter(), 0.0));
+            }
+        }
+        out
+    }
+
+    /// Oracle: on a flat jittered grid, the triangles with three votes away from the border are
+    /// exactly the triangles of the global 2D Delaunay triangulation there, oriented like the
+    /// normals (counter-clockwise seen from +z).
+    #[test]
+    fn votes_on_a_flat_grid_give_the_delaunay_triangles() {
+        let n = 14;
+        let positions = jittered_grid(n);
+        let normals = vec![DVec3::Z; positions.len()];
+        let set = SampleSet {
+            positions: &positions,
+            normals: &normals,
+            boundary_edges: &[],
+        };
+        let voted = vote_triangles(&set, &TangentDelaunayParams::default());
+        let deep = |t: [u32; 3]| {
+            t.iter().all(|&v| {
+                let p = positions[v as usize];
+                p.x > 3.0 && p.x < n as f64 - 4.0 && p.y > 3.0 && p.y < n as f64 - 4.0
+            })
+        };
+        let mut dt: DelaunayTriangulation<Point2<f64>> = DelaunayTriangulation::new();
+        for p in &positions {
+            dt.insert(Point2::new(p.x, p.y)).expect("finite points");
+        }
+        let mut global: Vec<[u32; 3]> = dt
+            .inner_faces()
+            .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+            .filter(|&t| deep(t))
+            .collect();
+        let mut local: Vec<[u32; 3]> = voted
+            .iter()
+            .filter(|t| t.votes == 3 && deep(t.corners))
+            .map(|t| {
+                assert!(!t.orientation_conflict);
+                t.corners
+            })
+            .collect();
+        assert!(global.len() > 50, "{}", global.len());
+        // Same triangles, same orientation: compare rotated to start at the smallest corner.
+        let canonical = |t: [u32; 3]| {
+            let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+        };
+        global = global.into_iter().map(canonical).collect();
+        local = local.into_iter().map(canonical).collect();
+        global.sort_unstable();
+        local.sort_unstable();
+        assert_eq!(local, global);
+    }
+
+    #[test]
+    fn orientation_is_the_cyclic_order() {
+        assert!(same_orientation([1, 2, 3], [2, 3, 1]));
+        assert!(same_orientation([1, 2, 3], [3, 1, 2]));
+        assert!(!same_orientation([1, 2, 3], [1, 3, 2]));
+        assert!(!same_orientation([1, 2, 3], [4, 5, 6]));
+    }
+
+    #[test]
+    fn the_tangent_basis_is_orthonormal() {
+        for n in [DVec3::Z, DVec3::X, DVec3::new(1.0, -2.0, 0.5).normalize()] {
+            let (u, v) = tangent_basis(n);
+            assert!(u.dot(n).abs() < 1e-12 && v.dot(n).abs() < 1e-12 && u.dot(v).abs() < 1e-12);
+            assert!((u.length() - 1.0).abs() < 1e-12 && (v.length() - 1.0).abs() < 1e-12);
+            // Right-handed: u × v = n.
+            assert!(u.cross(v).distance(n) < 1e-12);
+        }
+    }
+}

@@ -4,13 +4,14 @@
 //! the tail's root inside the rump; horse: a fin on the tail; beetle: its legs), or where two of
 //! its sheets lie closer than the chords of the output bend away from them, faces of the output
 //! cross. This stage moves the vertices of each crossing pair just out of the other face's plane
-//! until no pair is left.
+//! until no pair is left (vertex relocations of an [`EditMesh`]; the connectivity stays).
 
 use glam::DVec3;
 use serde::Serialize;
 
 use crate::geometry::self_intersection::intersecting_pairs;
 use crate::geometry::triangle_intersection::triangles_intersect;
+use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 
 /// Parameters of [`untangle`]. Lengths are in units of σ_p.
@@ -70,8 +71,10 @@ pub fn untangle(
     params: &UntangleParams,
 ) -> UntangleStats {
     let start = mesh.positions.clone();
+    let mut m: EditMesh = EditMesh::from_trimesh(mesh, |_| (), SlotPolicy::Reuse);
+    let triangles = m.live_faces().0;
     let mut stats = UntangleStats::default();
-    let mut moved = vec![false; mesh.positions.len()];
+    let mut moved = vec![false; m.vertex_count()];
     let margin = params.margin * sigma_p;
     let mut pairs = intersecting_pairs(&mesh.positions, &mesh.triangles);
     stats.pairs_before = pairs.len();
@@ -79,7 +82,8 @@ pub fn untangle(
     while !pairs.is_empty() && stats.rounds < params.max_rounds {
         stats.rounds += 1;
         let moves = round_moves(
-            mesh,
+            &m,
+            &triangles,
             &pairs,
             fixed,
             margin,
@@ -88,22 +92,23 @@ pub fn untangle(
         if moves.is_empty() {
             break;
         }
-        let saved: Vec<(usize, DVec3)> =
-            moves.iter().map(|&(v, _)| (v, mesh.positions[v])).collect();
+        let saved: Vec<(u32, DVec3)> = moves.iter().map(|&(v, _)| (v, m.position(v))).collect();
+        let mut relocated = true;
         for &(v, d) in &moves {
-            mesh.positions[v] += d;
+            relocated &= m.relocate_vertex(v, m.position(v) + d).is_ok();
         }
-        let after = intersecting_pairs(&mesh.positions, &mesh.triangles);
-        if after.len() < pairs.len() {
+        let current = m.to_trimesh();
+        let after = intersecting_pairs(&current.positions, &current.triangles);
+        if relocated && after.len() < pairs.len() {
             for &(v, _) in &moves {
-                moved[v] = true;
+                moved[v as usize] = true;
             }
             pairs = after;
             scale = 1.0;
         } else {
             // Never worse: undo, and try shorter moves next round (three halvings at most).
             for (v, p) in saved {
-                mesh.positions[v] = p;
+                let _ = m.relocate_vertex(v, p);
             }
             scale *= 0.5;
             if scale < 0.1 {
@@ -111,6 +116,7 @@ pub fn untangle(
             }
         }
     }
+    mesh.positions = m.positions().to_vec();
     stats.pairs_after = pairs.len();
     stats.vertices_moved = moved.iter().filter(|&&m| m).count();
     stats.max_displacement = mesh
@@ -127,16 +133,17 @@ pub fn untangle(
 /// order against the positions as moved so far (a pair an earlier move already separated is
 /// skipped), so one move of a vertex poking through a sheet resolves all its pairs.
 fn round_moves(
-    mesh: &TriMesh,
+    m: &EditMesh,
+    triangles: &[[u32; 3]],
     pairs: &[[u32; 2]],
     fixed: &[bool],
     margin: f64,
     max_step: f64,
-) -> Vec<(usize, DVec3)> {
+) -> Vec<(u32, DVec3)> {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
-    let mut positions = mesh.positions.clone();
-    let mut total = vec![DVec3::ZERO; mesh.positions.len()];
-    let corners = |p: &[DVec3], f: u32| mesh.triangles[f as usize].map(|v| p[v as usize]);
+    let mut positions = m.positions().to_vec();
+    let mut total = vec![DVec3::ZERO; positions.len()];
+    let corners = |p: &[DVec3], f: u32| triangles[f as usize].map(|v| p[v as usize]);
     for &[f, g] in pairs {
         if !triangles_intersect(corners(&positions, f), corners(&positions, g)) {
             continue;
@@ -148,7 +155,7 @@ fn round_moves(
         let option = |a: u32, b: u32, back: bool| -> Option<(f64, Vec<(u32, DVec3)>)> {
             let [p, q, r] = corners(&positions, b);
             let n = (q - p).cross(r - p).try_normalize()?;
-            let needs: Vec<(u32, f64)> = mesh.triangles[a as usize]
+            let needs: Vec<(u32, f64)> = triangles[a as usize]
                 .iter()
                 .map(|&v| (v, margin - n.dot(positions[v as usize] - p)))
                 .filter(|&(_, need)| need > 0.0)
@@ -158,7 +165,7 @@ fn round_moves(
                 return None;
             }
             let moves: Vec<(u32, DVec3)> = if back {
-                mesh.triangles[b as usize]
+                triangles[b as usize]
                     .iter()
                     .map(|&v| (v, -n * deepest.min(max_step)))
                     .collect()
@@ -197,7 +204,7 @@ fn round_moves(
         .iter()
         .enumerate()
         .filter(|(_, d)| **d != DVec3::ZERO)
-        .map(|(v, &d)| (v, d))
+        .map(|(v, &d)| (v as u32, d))
         .collect()
 }
 
@@ -230,6 +237,8 @@ mod tests {
             check_invariants(&m)
         );
         assert!(s.max_displacement < 0.6, "{s:?}");
+        let edited: EditMesh = EditMesh::from_trimesh(&m, |_| (), SlotPolicy::Reuse);
+        assert_eq!(edited.sanity_check(), Ok(()));
         // A fixed vertex stays when its partner can give way.
         let mut m2 = m.clone();
         m2.positions[poke].z = -0.3;
