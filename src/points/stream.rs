@@ -1,7 +1,7 @@
 //! Streaming point sets: a reader that hands out points in chunks (so a file of tens of millions
 //! of points never has to be in memory at once) from PLY (the `vertex` element) or from XYZ/CSV
 //! text, and a writer of binary little-endian PLY with normals. PLY headers are read by
-//! `ply-rs-bw` ([`crate::io::ply`]); the payload by the fixed-record decoder here, which reads
+//! `ply-rs-bw` (`io::ply`); the payload by the fixed-record decoder here, which reads
 //! a binary vertex record in one pass without per-property dispatch through the parser.
 
 use std::fs::File;
@@ -702,6 +702,44 @@ mod tests {
             assert!(err.contains(&format!("{name}.ply")), "{err}");
             assert!(err.contains(mentions), "{name}: {err}");
             assert_eq!(err.lines().count(), 1, "{err}");
+        }
+    }
+
+    /// Corrupted headers and cut files: an error naming the file or a result, never a panic.
+    #[test]
+    fn corrupted_point_files_never_panic() {
+        let dir = tempfile::tempdir().unwrap();
+        let source = dir.path().join("source.ply");
+        let mut w = PlyPointWriter::create_with_levels(&source, 20).unwrap();
+        w.write_levels(&points(20), &[1; 20]).unwrap();
+        w.finish().unwrap();
+        let bytes = std::fs::read(&source).unwrap();
+        let header_len = 250.min(bytes.len());
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state as usize
+        };
+        for round in 0..200 {
+            let mut b = bytes[..(next() % bytes.len()).max(1)].to_vec();
+            for _ in 0..round % 4 {
+                let at = next() % header_len.min(b.len());
+                b[at] = [b' ', b'\n', b'0', b'x', 0xff, next() as u8][next() % 6];
+            }
+            let path = dir.path().join(format!("c{round}.ply"));
+            std::fs::write(&path, &b).unwrap();
+            let result = PointReader::open(&path).and_then(|mut r| {
+                let mut chunk = Vec::new();
+                while r.read_chunk(&mut chunk, 7)? > 0 {}
+                Ok(())
+            });
+            if let Err(e) = result {
+                let message = e.to_string();
+                assert!(message.contains(&format!("c{round}.ply")), "{message}");
+                assert_eq!(message.lines().count(), 1, "{message}");
+            }
         }
     }
 
