@@ -616,6 +616,43 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
+    /// Two writers of one point file at once (the same process, so the same process id, which
+    /// named the temporary file before): each finishes its own file, and the target is one of
+    /// the two, complete.
+    #[test]
+    fn two_writers_of_one_target_do_not_collide() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.ply");
+        let sets: Vec<Vec<Point>> = (0..2)
+            .map(|k| {
+                let mut p = points(50_000);
+                p.iter_mut().for_each(|q| q.position.y = k as f64);
+                p
+            })
+            .collect();
+        let barrier = std::sync::Barrier::new(2);
+        std::thread::scope(|s| {
+            for set in &sets {
+                let (path, barrier) = (&path, &barrier);
+                s.spawn(move || {
+                    let mut w = PlyPointWriter::create(path, set.len() as u64).unwrap();
+                    barrier.wait();
+                    for chunk in set.chunks(1000) {
+                        w.write(chunk).unwrap();
+                    }
+                    w.finish().unwrap();
+                });
+            }
+        });
+        let mut r = PointReader::open(&path).unwrap();
+        let (mut all, mut chunk) = (Vec::new(), Vec::new());
+        while r.read_chunk(&mut chunk, 4096).unwrap() > 0 {
+            all.extend_from_slice(&chunk);
+        }
+        assert!(sets.contains(&all), "a mixed or partial file");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
     #[test]
     fn ascii_without_normals_and_extra_properties() {
         let dir = tempfile::tempdir().unwrap();
