@@ -1,7 +1,7 @@
 //! Streaming point sets: a reader that hands out points in chunks (so a file of tens of millions
 //! of points never has to be in memory at once) from PLY (the `vertex` element) or from XYZ/CSV
 //! text, and a writer of binary little-endian PLY with normals. PLY headers are read by
-//! `ply-rs-bw` ([`crate::io::ply`]); the payload by the fixed-record decoder here, which reads
+//! `ply-rs-bw` (`io::ply`); the payload by the fixed-record decoder here, which reads
 //! a binary vertex record in one pass without per-property dispatch through the parser.
 
 use std::fs::File;
@@ -616,6 +616,43 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
+    /// Two writers of one point file at once (the same process, so the same process id, which
+    /// named the temporary file before): each finishes its own file, and the target is one of
+    /// the two, complete.
+    #[test]
+    fn two_writers_of_one_target_do_not_collide() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.ply");
+        let sets: Vec<Vec<Point>> = (0..2)
+            .map(|k| {
+                let mut p = points(50_000);
+                p.iter_mut().for_each(|q| q.position.y = k as f64);
+                p
+            })
+            .collect();
+        let barrier = std::sync::Barrier::new(2);
+        std::thread::scope(|s| {
+            for set in &sets {
+                let (path, barrier) = (&path, &barrier);
+                s.spawn(move || {
+                    let mut w = PlyPointWriter::create(path, set.len() as u64).unwrap();
+                    barrier.wait();
+                    for chunk in set.chunks(1000) {
+                        w.write(chunk).unwrap();
+                    }
+                    w.finish().unwrap();
+                });
+            }
+        });
+        let mut r = PointReader::open(&path).unwrap();
+        let (mut all, mut chunk) = (Vec::new(), Vec::new());
+        while r.read_chunk(&mut chunk, 4096).unwrap() > 0 {
+            all.extend_from_slice(&chunk);
+        }
+        assert!(sets.contains(&all), "a mixed or partial file");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
     #[test]
     fn ascii_without_normals_and_extra_properties() {
         let dir = tempfile::tempdir().unwrap();
@@ -702,6 +739,44 @@ mod tests {
             assert!(err.contains(&format!("{name}.ply")), "{err}");
             assert!(err.contains(mentions), "{name}: {err}");
             assert_eq!(err.lines().count(), 1, "{err}");
+        }
+    }
+
+    /// Corrupted headers and cut files: an error naming the file or a result, never a panic.
+    #[test]
+    fn corrupted_point_files_never_panic() {
+        let dir = tempfile::tempdir().unwrap();
+        let source = dir.path().join("source.ply");
+        let mut w = PlyPointWriter::create_with_levels(&source, 20).unwrap();
+        w.write_levels(&points(20), &[1; 20]).unwrap();
+        w.finish().unwrap();
+        let bytes = std::fs::read(&source).unwrap();
+        let header_len = 250.min(bytes.len());
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state as usize
+        };
+        for round in 0..200 {
+            let mut b = bytes[..(next() % bytes.len()).max(1)].to_vec();
+            for _ in 0..round % 4 {
+                let at = next() % header_len.min(b.len());
+                b[at] = [b' ', b'\n', b'0', b'x', 0xff, next() as u8][next() % 6];
+            }
+            let path = dir.path().join(format!("c{round}.ply"));
+            std::fs::write(&path, &b).unwrap();
+            let result = PointReader::open(&path).and_then(|mut r| {
+                let mut chunk = Vec::new();
+                while r.read_chunk(&mut chunk, 7)? > 0 {}
+                Ok(())
+            });
+            if let Err(e) = result {
+                let message = e.to_string();
+                assert!(message.contains(&format!("c{round}.ply")), "{message}");
+                assert_eq!(message.lines().count(), 1, "{message}");
+            }
         }
     }
 
