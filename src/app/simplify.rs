@@ -155,7 +155,7 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
     Ok(SimplifySummary {
         input: job.input.clone(),
         output: job.output.clone(),
-        input_points: input_points as u64,
+        input_points,
         samples,
         had_normals,
         detail,

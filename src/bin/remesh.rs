@@ -160,7 +160,7 @@ enum Command {
 /// A validated command: what to run and how to print it.
 enum Config {
     Remesh {
-        job: RemeshJob,
+        job: Box<RemeshJob>,
         report: Option<PathBuf>,
         quiet: bool,
     },
@@ -271,7 +271,7 @@ fn config(cli: Cli) -> Result<Config, Error> {
                 strict: cli.strict,
             };
             Ok(Config::Remesh {
-                job,
+                job: Box::new(job),
                 report: cli.report,
                 quiet: cli.quiet,
             })

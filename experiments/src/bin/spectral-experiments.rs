@@ -3,7 +3,7 @@
 //! Table 2). Parses flags, calls the experiments crate, writes the reports, and maps errors to
 //! the exit codes of `remesh` (2 usage, 3 input, 4 output, 1 internal).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -141,7 +141,7 @@ enum Command {
 }
 
 /// Writes a JSON report atomically (a temporary file beside it, then a rename).
-fn write_report(path: &PathBuf, json: &str) -> Result<(), Error> {
+fn write_report(path: &Path, json: &str) -> Result<(), Error> {
     spectral_remesh::io::write_atomically(path, |w| w.write_all(json.as_bytes()))
 }
 
