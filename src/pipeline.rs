@@ -15,9 +15,9 @@ use crate::sampling::gradient_ascent::{
 };
 use crate::sampling::linear_scan::{linear_scan, LinearScanParams, LinearScanResult};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
-use crate::sampling::SurfaceSample;
 use crate::surface::winding::BuriedTest;
 use crate::surface::MeshSurface;
+use crate::surface::SurfaceSample;
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};

@@ -31,7 +31,7 @@ use crate::mesh::{Aabb, Normalization};
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentParams};
 use crate::sampling::linear_scan::{LinearScanParams, LinearScanner};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
-use crate::sampling::SurfaceSample;
+use crate::surface::SurfaceSample;
 
 /// Parameters of [`simplify_out_of_core`].
 #[derive(Debug, Clone, PartialEq)]

@@ -502,8 +502,8 @@ impl Rimls {
 
 impl crate::surface::Projection for Rimls {
     /// [`Rimls::project`]; `face` is 0.
-    fn project(&self, p: DVec3) -> Option<crate::sampling::SurfaceSample> {
-        Rimls::project(self, p).map(|(position, normal)| crate::sampling::SurfaceSample {
+    fn project(&self, p: DVec3) -> Option<crate::surface::SurfaceSample> {
+        Rimls::project(self, p).map(|(position, normal)| crate::surface::SurfaceSample {
             position,
             normal,
             face: 0,

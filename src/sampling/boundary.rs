@@ -8,8 +8,8 @@
 
 use rustc_hash::FxHashMap;
 
-use super::SurfaceSample;
 use crate::mesh::TriMesh;
+use crate::surface::SurfaceSample;
 
 /// One boundary curve of a mesh: input vertex indices in order, the surface on the left (the
 /// direction the boundary edges have in their faces).

@@ -11,8 +11,8 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::surface_sampler::{point_in_triangle, random_barycentric};
-use super::SurfaceSample;
 use crate::mesh::TriMesh;
+use crate::surface::SurfaceSample;
 
 /// Draws about `count` points uniformly by area on `mesh` (bbox-100 units), each with its face's
 /// unit normal, in a random visit order; deterministic for a given `seed`. Degenerate (zero-area)

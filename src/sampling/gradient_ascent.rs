@@ -3,11 +3,11 @@
 
 use rayon::prelude::*;
 
-use super::SurfaceSample;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
 use crate::spatial::StaticTree;
 use crate::surface::Projection;
+use crate::surface::SurfaceSample;
 
 /// Parameters of the gradient ascent.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,10 +1,10 @@
 //! Simplification by randomized linear scan (Sec. 6.1, Algorithm 1).
 
-use super::SurfaceSample;
 use crate::geometry::morton::morton_code;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{spectral_measure, MeasureWorkspace, DEFAULT_EPSILON};
 use crate::spatial::DynamicTree;
+use crate::surface::SurfaceSample;
 use glam::DVec3;
 use rayon::prelude::*;
 

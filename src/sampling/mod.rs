@@ -8,17 +8,3 @@ pub mod gradient_ascent;
 pub mod linear_scan;
 pub mod surface_sampler;
 pub mod target_count;
-
-use glam::DVec3;
-
-/// A point on the input surface: position (bbox-100 units), the unit normal of the input
-/// triangle it lies on (the n of the kernel's x = [p/sigma_p, n/sigma_n]), and that triangle.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SurfaceSample {
-    /// Position, bbox-100 units.
-    pub position: DVec3,
-    /// Unit normal of the input surface at `position`.
-    pub normal: DVec3,
-    /// Index of the input triangle `position` lies on.
-    pub face: u32,
-}

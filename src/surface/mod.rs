@@ -7,7 +7,17 @@ pub use mesh_projection::{MeshSurface, SurfacePoint};
 
 use glam::DVec3;
 
-use crate::sampling::SurfaceSample;
+/// A point on the input surface: position (bbox-100 units), the unit normal of the input
+/// triangle it lies on (the n of the kernel's x = [p/sigma_p, n/sigma_n]), and that triangle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceSample {
+    /// Position, bbox-100 units.
+    pub position: DVec3,
+    /// Unit normal of the input surface at `position`.
+    pub normal: DVec3,
+    /// Index of the input triangle `position` lies on.
+    pub face: u32,
+}
 
 /// A surface samples are projected onto after each gradient-ascent move (Sec. 6.2): the input
 /// mesh ([`MeshSurface`], closest point) or the RIMLS surface of a point set
