@@ -22,7 +22,7 @@ use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::normals::{estimate_normals, Orientation};
+use super::normals::{estimate_normals, NormalOrientation};
 use super::rimls::{Rimls, RimlsParams};
 use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -54,7 +54,7 @@ pub struct OutOfCoreParams {
     /// surface of the input (default 0: none; see [`simplify_out_of_core`]).
     pub resample: usize,
     /// How normals estimated for an input without them are oriented.
-    pub orientation: Orientation,
+    pub orientation: NormalOrientation,
 }
 
 impl Default for OutOfCoreParams {
@@ -68,7 +68,7 @@ impl Default for OutOfCoreParams {
             seed: 1,
             temp_dir: None,
             resample: 0,
-            orientation: Orientation::SpanningTree,
+            orientation: NormalOrientation::SpanningTree,
         }
     }
 }
@@ -174,7 +174,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
 }
 
 /// PCA normals for points without them (10 neighbours), oriented by `orientation`.
-fn estimate_sample_normals(points: &mut [Point], orientation: Orientation) {
+fn estimate_sample_normals(points: &mut [Point], orientation: NormalOrientation) {
     let positions: Vec<DVec3> = points.iter().map(|p| p.position).collect();
     for (p, n) in points
         .iter_mut()
