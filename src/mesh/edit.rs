@@ -1,19 +1,5 @@
-//! An editable triangle mesh: faces in slots, a directed-edge table and vertex–face lists, and
-//! the local operators every stage that changes a triangulation uses (the assembly's hole filling
-//! and refinement, the optimizer, untangling): edge flip, edge split, face split, edge collapse
-//! (with the link condition), vertex relocation, face removal and hole filling. Each operator
-//! checks that its result keeps the invariants [`EditMesh::sanity_check`] verifies and refuses
-//! (with an [`EditError`], the mesh unchanged) when it would not.
-//!
-//! The representation is the directed-edge one (Campagna, Kobbelt, Seidel, "Directed edges — a
-//! scalable representation for triangle meshes", J. Graphics Tools 3(4), 1998,
-//! doi:10.1080/10867651.1998.10487494) with a hash map from directed edge to face instead of
-//! implicit half-edge indices, so faces can come and go in any order. Every directed edge is used
-//! by at most one face: that single rule keeps every edge in at most two faces and the
-//! orientation consistent.
-//!
-//! Some directed edges can be *blocked*: no face may use them (the outside of an open input's
-//! boundary, so that its boundary edges stay boundary edges).
+//! The editable triangle mesh ([`EditMesh`]) with the local operators every stage that changes a
+//! triangulation uses; its representation and rules are described on [`EditMesh`].
 
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -164,9 +150,25 @@ pub fn starting_at(t: [u32; 3], v: u32) -> [u32; 3] {
     }
 }
 
-/// An editable triangle mesh (see the module documentation). Faces live in slots `0..slots()`;
-/// a removed face leaves a dead slot, so face indices stay valid. Each face carries a label of
-/// type `L` (where it came from), given by whoever makes it.
+/// An editable triangle mesh: faces in slots, a directed-edge table and vertex–face lists, and
+/// the local operators every stage that changes a triangulation uses (the assembly's hole filling
+/// and refinement, the optimizer, untangling): edge flip, edge split, face split, edge collapse
+/// (with the link condition), vertex relocation, face removal and hole filling. Each operator
+/// checks that its result keeps the invariants [`EditMesh::sanity_check`] verifies and refuses
+/// (with an [`EditError`], the mesh unchanged) when it would not.
+///
+/// The representation is the directed-edge one (Campagna, Kobbelt, Seidel, "Directed edges — a
+/// scalable representation for triangle meshes", J. Graphics Tools 3(4), 1998,
+/// doi:10.1080/10867651.1998.10487494) with a hash map from directed edge to face instead of
+/// implicit half-edge indices, so faces can come and go in any order. Every directed edge is used
+/// by at most one face: that single rule keeps every edge in at most two faces and the
+/// orientation consistent.
+///
+/// Some directed edges can be *blocked*: no face may use them (the outside of an open input's
+/// boundary, so that its boundary edges stay boundary edges).
+///
+/// Faces live in slots `0..slots()`; a removed face leaves a dead slot, so face indices stay
+/// valid. Each face carries a label of type `L` (where it came from), given by whoever makes it.
 #[derive(Debug, Clone)]
 pub struct EditMesh<L: Copy = ()> {
     positions: Vec<DVec3>,

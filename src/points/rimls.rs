@@ -341,7 +341,8 @@ impl Rimls {
     /// the surface), after the robust refitting of the RIMLS paper's Algorithm 1: at most
     /// `max_refit` reweightings, stopping early when ∇f changes by less than `tolerance`.
     ///
-    /// `None` when `x` is not finite or no point lies within `support_radius_sigma_p · σ_p` of it.
+    /// `None` when `x` is not finite or no point lies within `support_radius_sigma_p · σ_p` of
+    /// it.
     pub fn value_and_gradient(&self, x: DVec3) -> Option<(f64, DVec3)> {
         let mut neighbours = Vec::new();
         self.evaluate(x, &mut neighbours)
@@ -423,8 +424,8 @@ impl Rimls {
     /// turns 9 (σ_n = 0.75) and 58 (σ_n = ∞) of 3000 projections that had not converged in 20
     /// steps into none.
     ///
-    /// `None` when an iterate leaves the support (no point within `support_radius_sigma_p · σ_p`), or
-    /// ∇f vanishes.
+    /// `None` when an iterate leaves the support (no point within `support_radius_sigma_p · σ_p`),
+    /// or ∇f vanishes.
     pub fn project(&self, x: DVec3) -> Option<(DVec3, DVec3)> {
         self.project_detailed(x).map(|p| (p.position, p.normal))
     }

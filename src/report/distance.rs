@@ -64,8 +64,9 @@ const SECOND_SIDE_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
 /// order, finite ones only), then `random` points drawn uniformly by area on the faces
 /// (the crate's one area-uniform sampler: a face with probability proportional to its area,
 /// then a point uniformly in it). Three `f64` draws per point from
-/// `ChaCha8Rng::seed_from_u64(seed)`: deterministic across platforms and runs. Faces with an out-of-range index or non-finite
-/// corner have no weight; if no face has area, only vertices are returned.
+/// `ChaCha8Rng::seed_from_u64(seed)`: deterministic across platforms and runs. Faces with an
+/// out-of-range index or non-finite corner have no weight; if no face has area, only vertices
+/// are returned.
 pub fn surface_samples(mesh: &TriMesh, random: usize, seed: u64) -> Vec<DVec3> {
     let n = mesh.positions.len();
     let mut used = vec![false; n];

@@ -42,9 +42,9 @@ pub struct StageTime {
 /// | invariants every triangulation must keep | [`check_invariants`] | this project (STYLE.md, practice 7) |
 ///
 /// # Determinism
-/// Every function of the report returns the same numbers for the same input on every run and every thread
-/// count: reductions run sequentially in index order, random samples come from a seeded ChaCha8
-/// stream, and no output depends on hash-map iteration order.
+/// Every function of the report returns the same numbers for the same input on every run and
+/// every thread count: reductions run sequentially in index order, random samples come from a
+/// seeded ChaCha8 stream, and no output depends on hash-map iteration order.
 ///
 /// # References
 /// - A. C. Öztireli, M. Alexa, M. Gross. *Spectral Sampling of Manifolds*. ACM Trans. Graph.

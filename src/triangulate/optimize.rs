@@ -2,24 +2,7 @@
 //! spectral sampling cannot resolve (tips and rims thinner than the sample spacing) are mended
 //! with the input surface at hand.
 //!
-//! Four local operations, each kept only when it keeps the mesh near the input surface (see the
-//! offsets in [`OptimizeParams`]):
-//! - **Cover:** an input-surface point farther than `cover_distance_sigma_p` · sigma_p from the
-//!   mesh (the tip of an ear or a horn that the samples around it cut off) becomes a vertex: it
-//!   splits the face it is closest to, or the edge it lies beyond. This bounds the one-sided (input → output)
-//!   Hausdorff distance.
-//! - **Collapse:** a short edge of a poor triangle merges its ends (link condition kept).
-//! - **Flip:** an edge near a poor triangle is flipped when that raises the smaller minimum angle
-//!   of its two faces (Lawson's max-min rule) and the new faces stay on the surface.
-//! - **Relax:** a vertex of a poor triangle moves towards the centroid of its neighbours or the
-//!   apex of an equilateral triangle on a poor face's far edge, projected back onto the surface,
-//!   when that raises the worst shape score min(Q / 0.6, θmin / 30°) of its faces and turns none
-//!   of them much (Laplacian smoothing with projection, as in Botsch & Kobbelt 2004, Sec. 3,
-//!   restricted to the poor triangles).
-//!
-//! Everything else stays as the sampler and the tangent-plane Delaunay left it. On horse at 8600
-//! about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
-//! spacing).
+//! The operations and their guards are described on [`optimize`].
 
 use glam::DVec3;
 use parry3d_f64::query::PointQuery;
@@ -178,11 +161,32 @@ fn distance_to_faces(m: &Mesh, faces: &[u32], p: DVec3) -> f64 {
 /// Optimizes `mesh` (bbox-100 units, edge-manifold and consistently oriented) against `surface`
 /// (the input, same units): covers the input points of `cover_points` that are farther than
 /// `params.cover_distance_sigma_p` · `sigma_p` from it, then flips edges and relaxes vertices
-/// around the triangles with Q below `params.q_below` (see the module documentation). Vertices with `fixed[v]`
-/// (boundary samples) do not move; boundary edges are not flipped. New vertices are appended,
-/// so existing indices stay valid; vertices merged away by a collapse are left unreferenced.
+/// around the triangles with Q below `params.q_below`. Vertices with `fixed[v]` (boundary
+/// samples) do not move; boundary edges are not flipped. New vertices are appended, so
+/// existing indices stay valid; vertices merged away by a collapse are left unreferenced.
 /// Returns what was done and, for each face of the result, the index of the face of `mesh` it
 /// still is (`None` for a new or changed face). Deterministic.
+///
+/// # Operations
+///
+/// Four local operations, each kept only when it keeps the mesh near the input surface (see the
+/// offsets in [`OptimizeParams`]):
+/// - **Cover:** an input-surface point farther than `cover_distance_sigma_p` · sigma_p from the
+///   mesh (the tip of an ear or a horn that the samples around it cut off) becomes a vertex: it
+///   splits the face it is closest to, or the edge it lies beyond. This bounds the one-sided
+///   (input → output) Hausdorff distance.
+/// - **Collapse:** a short edge of a poor triangle merges its ends (link condition kept).
+/// - **Flip:** an edge near a poor triangle is flipped when that raises the smaller minimum angle
+///   of its two faces (Lawson's max-min rule) and the new faces stay on the surface.
+/// - **Relax:** a vertex of a poor triangle moves towards the centroid of its neighbours or the
+///   apex of an equilateral triangle on a poor face's far edge, projected back onto the surface,
+///   when that raises the worst shape score min(Q / 0.6, θmin / 30°) of its faces and turns none
+///   of them much (Laplacian smoothing with projection, as in Botsch & Kobbelt 2004, Sec. 3,
+///   restricted to the poor triangles).
+///
+/// Everything else stays as the sampler and the tangent-plane Delaunay left it. On horse at 8600
+/// about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
+/// spacing).
 pub fn optimize(
     mesh: &mut TriMesh,
     surface: &MeshSurface,
@@ -432,7 +436,7 @@ fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &Limits) -> usize {
     })
 }
 
-/// One sweep of relaxation over the vertices of poor triangles (see the module documentation).
+/// One sweep of relaxation over the vertices of poor triangles (see [`optimize`]).
 /// Returns the number of moves.
 fn relax_poor(m: &mut Mesh, surface: &MeshSurface, fixed: &[bool], params: &Limits) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();

@@ -58,7 +58,8 @@ pub struct UntangleStats {
 /// they are; at most `max_step_sigma_p · σ_p` per round). A move of a vertex marked in `fixed`
 /// (a boundary sample) counts as four times as long, so those move only when nothing else
 /// separates the pair. A round that does not lower the number of crossing pairs is undone and
-/// tried again with moves half as long (never worse than before). Connectivity is unchanged; faces that cross nothing do not move.
+/// tried again with moves half as long (never worse than before). Connectivity is unchanged;
+/// faces that cross nothing do not move.
 ///
 /// The moves are local and small where the output merely grazes itself, and they press the
 /// crossing sheet onto the other where the input itself passes through itself (the output then
