@@ -15,14 +15,11 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use spectral_remesh::app::{run_remesh, RemeshJob};
-use spectral_remesh::io::read_mesh;
-use spectral_remesh::kernel::Kernel;
-use spectral_remesh::pipeline::{validate_input, Density, RemeshParams, SAMPLES_PER_SIGMA2};
-use spectral_remesh::sampling::candidates::surface_candidates;
-use spectral_remesh::sampling::linear_scan::{linear_scan, LinearScanParams};
-use spectral_remesh::triangulate::tangent_delaunay::SampleSet;
-use spectral_remesh::triangulate::{triangulate, TriangulateParams};
+use spectral_remesh::{
+    linear_scan, read_mesh, run_remesh, surface_candidates, triangulate, validate_input, Density,
+    Kernel, LinearScanParams, RemeshJob, RemeshParams, SampleSet, TriangulateParams,
+    SAMPLES_PER_SIGMA2,
+};
 
 /// Output vertices, as the harness remeshes the horse.
 const POINTS: usize = 8600;

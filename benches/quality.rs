@@ -9,9 +9,9 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DQuat, DVec3};
-use spectral_remesh::check::{check_invariants, topology};
-use spectral_remesh::report::{surface_distance_with, triangle_quality};
-use spectral_remesh::{MeshSurface, TriMesh};
+use spectral_remesh::{
+    check_invariants, surface_distance_with, topology, triangle_quality, MeshSurface, TriMesh,
+};
 
 #[path = "../tests/common/mod.rs"]
 mod common;

@@ -13,8 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 use glam::DVec3;
-use spectral_remesh::io::{read_mesh, write_mesh};
-use spectral_remesh::TriMesh;
+use spectral_remesh::{read_mesh, write_mesh, TriMesh};
 
 fn write_files(out: &Path) -> Result<Vec<PathBuf>, spectral_remesh::Error> {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");

@@ -1,32 +1,205 @@
 //! # spectral-remesh
 //!
-//! Spectral sampling and remeshing of triangle meshes, after *Spectral Sampling of Manifolds*
-//! (A. C. Öztireli, M. Alexa, M. Gross, ACM Trans. Graph. 29(6), SIGGRAPH Asia 2010,
-//! doi:10.1145/1882261.1866190).
+//! Spectral sampling and remeshing of triangle meshes and point sets, after *Spectral Sampling
+//! of Manifolds* (Öztireli, Alexa, Gross 2010): the samples are placed by the spectral measure
+//! s(x) of a Gaussian kernel over positions and normals, then triangulated.
 //!
-//! The pipeline (see `ARCHITECTURE.md`): read → normalize (bbox 100) → candidates → linear scan →
-//! gradient ascent + projection → triangulate → clean up → report → write.
+//! # The pipeline
+//!
+//! [`remesh`] runs the whole of it on a mesh in memory; [`run_remesh`] adds reading, writing and
+//! the report, as the `remesh` command line does. Each stage is also public on its own:
+//!
+//! ```text
+//! read_mesh                      OBJ, PLY, glTF → TriMesh (model units)
+//!   │
+//! validate_input, Normalization  → bbox 100 (every length below in bbox-100 units)
+//!   │
+//! surface_candidates             area-uniform random candidates on the input (MeshSurface)
+//!   + sample_boundary            samples on the boundary curves, kept fixed
+//!   │
+//! linear_scan                    keep a candidate when s(x) > epsilon (Sec. 6.1, eq. 10);
+//!   (find_sigma_p)               sigma_p searched for a target count (Sec. 6.3)
+//!   │
+//! gradient_ascent                move each sample up the gradient of s, projected back onto
+//!   │                            the input (Sec. 6.2, eq. 11; Projection)
+//!   │
+//! triangulate                    tangent-plane Delaunay umbrellas, merged by votes
+//!   (vote_triangles, assemble)   then cleaned up into a manifold mesh (holes filled, flips)
+//!   │
+//! optimize                       local operations against the input surface (cover, collapse,
+//!   │                            flip, relax)
+//! untangle                       move apart faces that still cross
+//!   │
+//! check_invariants, topology,    manifold, oriented, no degenerate or duplicate face; counts;
+//!   self_intersections           crossing faces
+//!   │
+//! QualityReport                  Table 1's triangle measures (triangle_quality), Hausdorff and
+//!   │                            RMS distance to the input (surface_distance), stage times
+//! write_mesh, write_report       back to model units, written atomically
+//! ```
+//!
+//! Point sets take a second path: [`PointReader`] → [`simplify_out_of_core`] (the randomized
+//! linear scan in buckets, Sec. 6.4) → [`PlyPointWriter`], with [`estimate_normals`] for inputs
+//! without normals and the [`Rimls`] surface to resample on.
+//!
+//! # Example
+//!
+//! Remesh a sphere to about 300 vertices and check the result:
+//!
+//! ```
+//! use spectral_remesh::{check_invariants, remesh, topology, Density, RemeshParams, TriMesh};
+//!
+//! // An octahedron subdivided three times and pushed onto the unit sphere.
+//! let mut mesh = TriMesh::new(
+//!     vec![
+//!         [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
+//!         [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0],
+//!     ]
+//!     .into_iter()
+//!     .map(glam::DVec3::from)
+//!     .collect(),
+//!     vec![
+//!         [0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
+//!         [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5],
+//!     ],
+//! );
+//! for _ in 0..3 {
+//!     let mut faces = Vec::new();
+//!     for [a, b, c] in mesh.triangles.clone() {
+//!         let mut mid = |u: u32, v: u32| {
+//!             let p = (mesh.positions[u as usize] + mesh.positions[v as usize]).normalize();
+//!             mesh.positions.push(p);
+//!             (mesh.positions.len() - 1) as u32
+//!         };
+//!         let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+//!         faces.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+//!     }
+//!     mesh.triangles = faces;
+//! }
+//! // Midpoints were added once per face: weld the copies.
+//! mesh.weld_identical_positions();
+//!
+//! let params = RemeshParams {
+//!     density: Density::Points(300),
+//!     ..RemeshParams::default()
+//! };
+//! let output = remesh(&mesh, &params, &|_stage| {})?;
+//! assert!(check_invariants(&output.mesh).is_empty());
+//! let t = topology(&output.mesh);
+//! assert!(t.is_closed_manifold());
+//! assert_eq!(t.euler_characteristic, 2);
+//! assert!((output.mesh.vertex_count() as f64 - 300.0).abs() <= 3.0);
+//! # Ok::<(), spectral_remesh::Error>(())
+//! ```
+//!
+//! # Units
+//!
+//! Meshes are read and written in their own (model) units; the pipeline works in bbox-100 units
+//! (the input scaled so that its bounding box's longest side is 100, [`Normalization`]). Lengths
+//! given relative to the kernel width sigma_p say so in their name (`*_sigma_p`); kernel-space
+//! quantities (a support radius of 2.5, the ascent's step) are in kernel units, x =
+//! [p/sigma_p, n/sigma_n] ([`Kernel`]).
+//!
+//! # References
+//!
+//! A. C. Öztireli, M. Alexa, M. Gross. *Spectral Sampling of Manifolds*. ACM Trans. Graph. 29(6),
+//! 2010 (SIGGRAPH Asia). doi:10.1145/1882261.1866190. Section and equation numbers in these docs
+//! are the paper's.
 
 #![warn(missing_docs)]
 #![deny(rustdoc::broken_intra_doc_links)]
 
-pub mod app;
-pub mod check;
-pub mod error;
+mod app;
+mod check;
+mod error;
 pub mod geometry;
-pub mod io;
-pub mod kernel;
-pub mod measure;
-pub mod mesh;
-pub mod pipeline;
-pub mod points;
-pub mod report;
-pub mod sampling;
-pub mod spatial;
-pub mod surface;
-pub mod timing;
-pub mod triangulate;
+mod io;
+mod kernel;
+mod measure;
+mod mesh;
+mod pipeline;
+mod points;
+mod report;
+mod sampling;
+mod spatial;
+mod surface;
+mod timing;
+mod triangulate;
 
+// Errors: one enum for the whole crate.
 pub use error::{Error, Result};
+
+// Reading and writing meshes (OBJ, PLY, glTF), atomically.
+pub use io::{read_mesh, write_atomically, write_mesh, AtomicFile, MeshFormat, ReadStats};
+
+// The meshes: the indexed triangle mesh, its normalization to bbox 100, and the editable
+// directed-edge mesh with its local operators.
+pub use mesh::edit::{EditError, EditMesh, EditViolation, SlotPolicy};
 pub use mesh::{Aabb, Normalization, TriMesh};
-pub use surface::{MeshSurface, SurfacePoint};
+
+// The pipeline in one call.
+pub use pipeline::{
+    remesh, validate_input, Density, RemeshOutput, RemeshParams, BOUNDARY_SPACING_PER_SIGMA,
+    MAX_POINTS, SAMPLES_PER_SIGMA2,
+};
+pub use timing::Stage;
+
+// The input surface: closest points, projection, and the test for its self-buried parts.
+pub use surface::winding::BuriedTest;
+pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceSample};
+
+// Sampling stages: candidates and boundary samples, the linear scan (and the sigma_p search for
+// a count), the gradient ascent.
+pub use sampling::boundary::{boundary_curves, sample_boundary, BoundaryCurve, BoundarySamples};
+pub use sampling::candidates::surface_candidates;
+pub use sampling::gradient_ascent::{gradient_ascent, GradientAscentParams, GradientAscentResult};
+pub use sampling::linear_scan::{linear_scan, LinearScanParams, LinearScanResult, LinearScanner};
+pub use sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
+
+// Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
+// optimization against the input, the separation of crossing faces.
+pub use triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
+pub use triangulate::untangle::{untangle, UntangleParams, UntangleStats};
+pub use triangulate::{
+    assemble, triangulate, vote_triangles, AssemblyParams, AssemblyStats, FaceSource, RefineParams,
+    SampleSet, TangentDelaunayParams, TriangulateParams, VotedTriangle,
+};
+
+// The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).
+pub use kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
+pub use measure::{
+    measure_and_gradient, projection_coefficients, spectral_measure, IncrementalInverse, Measure,
+    MeasureWorkspace, Push, DEFAULT_EPSILON,
+};
+
+// A kd-tree over fixed points (neighbourhoods of the measure).
+pub use spatial::StaticTree;
+
+// Checks of a mesh: invariants (typed violations), topology, self-intersections.
+pub use check::{
+    check_invariants, self_intersections, topology, SelfIntersections, Topology, Violation,
+};
+
+// The quality report: Table 1's triangle measures, Metro-style distances, stage times.
+pub use report::{
+    surface_distance, surface_distance_with, surface_samples, triangle_quality, QualityReport,
+    StageTime, SurfaceDistance, TriangleQuality,
+};
+
+// Point sets: streaming reading and writing, points drawn from a mesh, normal estimation, the
+// out-of-core linear scan, the RIMLS surface.
+pub use points::generate::{
+    surface_points, surface_points_with, write_surface_points, NormalField,
+};
+pub use points::normals::{estimate_normals, NormalOrientation};
+pub use points::out_of_core::{
+    simplify_out_of_core, simplify_progressive, OutOfCoreParams, OutOfCoreResult, ProgressiveResult,
+};
+pub use points::rimls::{Rimls, RimlsParams, RimlsProjection};
+pub use points::{PlyPointWriter, Point, PointReader};
+
+// The jobs of the `remesh` command line: files in, files and report out.
+pub use app::{
+    catch_panics, run_points, run_quality, run_remesh, run_simplify, write_report, PointsJob,
+    RemeshJob, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary, DISTANCE_SAMPLES,
+};

@@ -70,13 +70,9 @@ impl DynamicTree {
     }
 
     /// Number of points.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.len
-    }
-
-    /// Whether the tree is empty.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
     }
 
     /// Adds point `p` with index `index`. A point the kd-tree cannot take (a bucket of exact
@@ -87,11 +83,6 @@ impl DynamicTree {
             self.overflow.push((q, index));
         }
         self.len += 1;
-    }
-
-    /// Points held outside the kd-tree (see [`DynamicTree::add`]).
-    pub fn overflow_len(&self) -> usize {
-        self.overflow.len()
     }
 
     /// The nearest point to `p` as `(index, squared distance)`; `None` when empty.

@@ -1,12 +1,11 @@
-//! Integration tests of `spectral_remesh::io`: the shared test models, round trips through every
-//! output format, and malformed inputs.
+//! Integration tests of the crate's mesh reading and writing (`read_mesh`, `write_mesh`): the
+//! shared test models, round trips through every output format, and malformed inputs.
 
 use std::fs;
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use spectral_remesh::io::{read_mesh, write_mesh, MeshFormat, ReadStats};
-use spectral_remesh::{Error, TriMesh};
+use spectral_remesh::{read_mesh, write_mesh, Error, MeshFormat, ReadStats, TriMesh};
 
 fn model(name: &str) -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/")).join(name)

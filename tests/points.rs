@@ -4,14 +4,10 @@ use std::path::Path;
 
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
-use spectral_remesh::kernel::Kernel;
-use spectral_remesh::points::generate::write_surface_points;
-use spectral_remesh::points::out_of_core::{
-    simplify_out_of_core, simplify_progressive, OutOfCoreParams,
+use spectral_remesh::{
+    simplify_out_of_core, simplify_progressive, write_surface_points, Kernel, LinearScanParams,
+    LinearScanner, OutOfCoreParams, PointReader, StaticTree,
 };
-use spectral_remesh::points::PointReader;
-use spectral_remesh::sampling::linear_scan::{LinearScanParams, LinearScanner};
-use spectral_remesh::spatial::StaticTree;
 
 fn nearest_neighbour_stats(points: &[glam::DVec3]) -> (f64, f64, f64) {
     let tree = StaticTree::new(points);
@@ -33,7 +29,7 @@ fn nearest_neighbour_stats(points: &[glam::DVec3]) -> (f64, f64, f64) {
 fn out_of_core_scan_matches_the_in_memory_scan() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("spot-200k.ply");
-    let (mesh, _) = spectral_remesh::io::read_mesh(
+    let (mesh, _) = spectral_remesh::read_mesh(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/spot.obj"),
     )
     .unwrap();
@@ -88,8 +84,8 @@ fn out_of_core_scan_matches_the_in_memory_scan() {
 /// 90°), and the flipped count among the vertices where the mesh resolves its surface: the
 /// normals of the vertex's 10 nearest vertices are all within 60° of its own.
 fn normal_agreement(name: &str) -> (f64, usize, usize) {
-    use spectral_remesh::points::normals::{estimate_normals, Orientation};
-    let (mesh, _) = spectral_remesh::io::read_mesh(
+    use spectral_remesh::{estimate_normals, NormalOrientation};
+    let (mesh, _) = spectral_remesh::read_mesh(
         &Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../shared/data")
             .join(name),
@@ -102,7 +98,7 @@ fn normal_agreement(name: &str) -> (f64, usize, usize) {
         1.0
     };
     let truth: Vec<_> = mesh.vertex_normals().iter().map(|n| *n * sign).collect();
-    let estimated = estimate_normals(&mesh.positions, 10, Orientation::SpanningTree);
+    let estimated = estimate_normals(&mesh.positions, 10, NormalOrientation::SpanningTree);
     let mut angles: Vec<f64> = truth
         .iter()
         .zip(&estimated)
@@ -165,7 +161,7 @@ fn no_estimated_normal_is_flipped_on_horse() {
 fn progressive_levels_are_nested_complete_scans() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("spot-200k.ply");
-    let (mesh, _) = spectral_remesh::io::read_mesh(
+    let (mesh, _) = spectral_remesh::read_mesh(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/spot.obj"),
     )
     .unwrap();
@@ -242,7 +238,7 @@ fn progressive_levels_are_nested_complete_scans() {
 fn horse_at_8600_out_of_core_matches_in_memory() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("horse-1M.ply");
-    let (mesh, _) = spectral_remesh::io::read_mesh(
+    let (mesh, _) = spectral_remesh::read_mesh(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/horse.obj"),
     )
     .unwrap();
@@ -304,7 +300,7 @@ fn horse_at_8600_out_of_core_matches_in_memory() {
 fn resampling_on_rimls_evens_the_spacing_and_stays_on_the_surface() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("spot-200k.ply");
-    let (mesh, _) = spectral_remesh::io::read_mesh(
+    let (mesh, _) = spectral_remesh::read_mesh(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/spot.obj"),
     )
     .unwrap();
@@ -321,7 +317,7 @@ fn resampling_on_rimls_evens_the_spacing_and_stays_on_the_surface() {
     let (scan, resampled) = (run(0), run(10));
     assert_eq!(scan.samples.len(), resampled.samples.len());
     let norm = scan.normalization;
-    let scaled = |r: &spectral_remesh::points::out_of_core::OutOfCoreResult| -> Vec<_> {
+    let scaled = |r: &spectral_remesh::OutOfCoreResult| -> Vec<_> {
         r.samples.iter().map(|p| norm.apply(p.position)).collect()
     };
     let (_, min0, cv0) = nearest_neighbour_stats(&scaled(&scan));

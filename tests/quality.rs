@@ -1,10 +1,11 @@
 //! The quality report on meshes built in code, with exact expected numbers.
 
 use glam::DVec3;
-use spectral_remesh::check::{check_invariants, topology, Topology, Violation};
-use spectral_remesh::geometry::triangle::triangle_angles_deg;
-use spectral_remesh::report::*;
-use spectral_remesh::{MeshSurface, TriMesh};
+use spectral_remesh::{
+    check_invariants, geometry::triangle_angles_deg, surface_distance, surface_distance_with,
+    surface_samples, topology, triangle_quality, MeshSurface, QualityReport, Topology, TriMesh,
+    TriangleQuality, Violation,
+};
 
 mod common;
 use common::{icosahedron, icosphere, orient_outward};
@@ -818,7 +819,7 @@ fn distance_with_prebuilt_surfaces_matches() {
 // ---------------------------------------------------------------------------------------------
 
 /// A minimal OBJ reader for these tests only (`v` lines and the vertex index of `f` corners,
-/// polygons fanned); the crate's reader lives in `spectral_remesh::io`.
+/// polygons fanned); the crate's reader lives in `spectral_remesh::read_mesh`.
 /// Panics when the file is missing: the shared models are part of the test setup.
 fn read_obj_for_test(name: &str) -> TriMesh {
     let path = format!("{}/../shared/data/{name}", env!("CARGO_MANIFEST_DIR"));

@@ -157,8 +157,8 @@ fn spot_obj_and_glb_give_the_same_closed_manifold() {
     }
     // The .glb holds the same surface in f32: the outputs have the same faces and positions that
     // agree to f32 precision (bbox-100 scale).
-    let (ma, _) = spectral_remesh::io::read_mesh(&out_a).unwrap();
-    let (mb, _) = spectral_remesh::io::read_mesh(&out_b).unwrap();
+    let (ma, _) = spectral_remesh::read_mesh(&out_a).unwrap();
+    let (mb, _) = spectral_remesh::read_mesh(&out_b).unwrap();
     assert_eq!(ma.triangles, mb.triangles);
     let diag = ma.bbox().unwrap().diagonal();
     for (p, q) in ma.positions.iter().zip(&mb.positions) {
@@ -380,7 +380,7 @@ fn bad_input_is_a_one_line_error_with_a_nonzero_exit_and_no_output() {
 
 #[test]
 fn points_subcommand_writes_a_point_set_on_the_surface() {
-    use spectral_remesh::points::PointReader;
+    use spectral_remesh::PointReader;
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("spot-points.ply");
     let status = Command::new(env!("CARGO_BIN_EXE_remesh"))
@@ -397,7 +397,7 @@ fn points_subcommand_writes_a_point_set_on_the_surface() {
     let mut pts = Vec::new();
     assert_eq!(r.read_chunk(&mut pts, 5000).unwrap(), 2000);
     // On the surface: each point within float precision of the input mesh.
-    let (mesh, _) = spectral_remesh::io::read_mesh(&shared("spot.obj")).unwrap();
+    let (mesh, _) = spectral_remesh::read_mesh(&shared("spot.obj")).unwrap();
     let surface = spectral_remesh::MeshSurface::new(&mesh).unwrap();
     for p in &pts {
         let sp = surface.closest_point(p.position).unwrap();
@@ -413,12 +413,12 @@ fn points_subcommand_writes_a_point_set_on_the_surface() {
 
 #[test]
 fn simplify_a_point_set_without_normals_estimates_outward_normals() {
-    use spectral_remesh::points::PointReader;
+    use spectral_remesh::PointReader;
     let dir = tempfile::tempdir().unwrap();
-    let (mesh, _) = spectral_remesh::io::read_mesh(&shared("spot.obj")).unwrap();
+    let (mesh, _) = spectral_remesh::read_mesh(&shared("spot.obj")).unwrap();
     // Dense points without normals: 40k surface points, written as ascii PLY with x y z only.
     let dense = dir.path().join("dense.ply");
-    spectral_remesh::points::generate::write_surface_points(&mesh, 40_000, 2, &dense).unwrap();
+    spectral_remesh::write_surface_points(&mesh, 40_000, 2, &dense).unwrap();
     let mut r = PointReader::open(&dense).unwrap();
     let mut pts = Vec::new();
     r.read_chunk(&mut pts, 100_000).unwrap();
@@ -464,11 +464,11 @@ fn simplify_a_point_set_without_normals_estimates_outward_normals() {
 
 #[test]
 fn simplify_levels_from_xyz_text_writes_a_level_attribute() {
-    use spectral_remesh::points::PointReader;
+    use spectral_remesh::PointReader;
     let dir = tempfile::tempdir().unwrap();
-    let (mesh, _) = spectral_remesh::io::read_mesh(&shared("spot.obj")).unwrap();
+    let (mesh, _) = spectral_remesh::read_mesh(&shared("spot.obj")).unwrap();
     let dense = dir.path().join("dense.ply");
-    spectral_remesh::points::generate::write_surface_points(&mesh, 30_000, 4, &dense).unwrap();
+    spectral_remesh::write_surface_points(&mesh, 30_000, 4, &dense).unwrap();
     let mut pts = Vec::new();
     PointReader::open(&dense)
         .unwrap()

@@ -47,9 +47,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use spectral_remesh::error::{Error, Result};
-use spectral_remesh::mesh::TriMesh;
-use spectral_remesh::points::rimls::Rimls;
+use spectral_remesh::{Error, Result, Rimls, TriMesh};
 
 /// An implicit function f: R³ → R whose zero set is a surface, defined (`Some`) near it and
 /// possibly undefined (`None`) elsewhere. Positive on the outside by this crate's convention.
@@ -673,7 +671,7 @@ pub fn marching_cubes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use spectral_remesh::check::{check_invariants, topology};
+    use spectral_remesh::{check_invariants, topology};
 
     /// Every case's cycles use each crossing edge exactly once and no other edge.
     #[test]

@@ -1,5 +1,5 @@
 //! Surface reconstruction from an oriented point set: the RIMLS surface of the points
-//! ([`spectral_remesh::points::rimls`]) triangulated by marching cubes ([`crate::marching_cubes`]) on a
+//! ([`spectral_remesh::Rimls`]) triangulated by marching cubes ([`crate::marching_cubes`]) on a
 //! grid much finer than the kernel, the "densely triangulated implicit function" the paper
 //! measures reconstructions on (Sec. 7.2).
 
@@ -9,10 +9,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::marching_cubes::{marching_cubes, MarchingCubesParams};
-use spectral_remesh::error::{Error, Result};
-use spectral_remesh::mesh::TriMesh;
-use spectral_remesh::points::rimls::{Rimls, RimlsParams};
-use spectral_remesh::spatial::StaticTree;
+use spectral_remesh::{Error, Result, Rimls, RimlsParams, StaticTree, TriMesh};
 
 /// The grid cell of a reconstruction, in units of σ_p: 0.5 (cell = σ_p/2). The RIMLS surface
 /// varies on the scale of σ_p, so cells of σ_p/2 resolve it. Measured on horse (475k surface
@@ -201,7 +198,7 @@ pub fn clip_to_domain(mesh: &mut TriMesh, positions: &[DVec3], radius: f64) -> u
 #[cfg(test)]
 mod tests {
     use super::*;
-    use spectral_remesh::check::topology;
+    use spectral_remesh::topology;
 
     #[test]
     fn a_sampled_sphere_comes_back_closed_and_near_its_radius() {

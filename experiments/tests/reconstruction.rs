@@ -7,7 +7,7 @@ use spectral_experiments::reconstruction_eval::{
     evaluate_model, input_points, read_normalized_outward, PointSource, ReconstructionEvalParams,
 };
 use spectral_experiments::subsample::Subsampler;
-use spectral_remesh::points::generate::NormalField;
+use spectral_remesh::NormalField;
 
 fn model(name: &str) -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/")).join(name)

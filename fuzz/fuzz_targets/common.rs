@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use spectral_remesh::io::read_mesh;
+use spectral_remesh::read_mesh;
 
 /// A file of this process in shared memory (or the temp folder), with extension `ext`.
 pub fn scratch(ext: &str) -> PathBuf {

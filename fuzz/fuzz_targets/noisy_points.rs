@@ -4,11 +4,10 @@
 //! triangulation's guarantees.
 
 use glam::DVec3;
-use spectral_remesh::check::{check_invariants, Violation};
-use spectral_remesh::mesh::edit::{EditMesh, SlotPolicy};
-use spectral_remesh::triangulate::untangle::{untangle, UntangleParams};
-use spectral_remesh::triangulate::{triangulate, SampleSet, TriangulateParams};
-use spectral_remesh::TriMesh;
+use spectral_remesh::{
+    check_invariants, triangulate, untangle, EditMesh, SampleSet, SlotPolicy, TriMesh,
+    TriangulateParams, UntangleParams, Violation,
+};
 
 /// Numbers in [0, 1) from the bytes, two bytes each (0x5a once they run out).
 struct Bytes<'a>(&'a [u8], usize);

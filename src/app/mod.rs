@@ -30,16 +30,16 @@ pub struct RemeshJob {
     pub params: RemeshParams,
     /// Whether to measure the distance to the input (Hausdorff, RMS).
     pub measure_distance: bool,
-    /// Whether a violated output invariant ([`crate::check::check_invariants`]: manifold,
-    /// oriented, no degenerate, duplicate or intersecting faces) is an error, with nothing
-    /// written, rather than a line of the report.
+    /// Whether a violated output invariant ([`check_invariants`](crate::check_invariants):
+    /// manifold, oriented, no degenerate, duplicate or intersecting faces) is an error, with
+    /// nothing written, rather than a line of the report.
     pub strict: bool,
 }
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
 ///
-/// The output's invariants ([`crate::check::check_invariants`]) are checked before it is
-/// written; violations go into the report ([`QualityReport::invariant_violations`] and a note).
+/// The output's invariants ([`check_invariants`](crate::check_invariants)) are checked before it
+/// is written; violations go into the report ([`QualityReport::invariant_violations`] and a note).
 ///
 /// # Errors
 /// Whatever reading, the pipeline or writing return, each naming the file concerned; an

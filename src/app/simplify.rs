@@ -8,7 +8,7 @@ use std::time::Instant;
 use glam::DVec3;
 
 use crate::error::{Error, Result};
-use crate::points::normals::Orientation;
+use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{simplify_out_of_core, simplify_progressive, OutOfCoreParams};
 use crate::points::{PlyPointWriter, PointReader};
 
@@ -110,8 +110,8 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
     let params = OutOfCoreParams {
         resample: job.resample,
         orientation: match job.viewpoint {
-            Some(v) => Orientation::Viewpoint(v),
-            None => Orientation::SpanningTree,
+            Some(v) => NormalOrientation::Viewpoint(v),
+            None => NormalOrientation::SpanningTree,
         },
         target: match job.density {
             SimplifyDensity::Points(n) => Some(n),

@@ -1,6 +1,6 @@
 //! `remesh`: the command line. Parses flags into a validated [`Config`], runs it with one library
 //! call per subcommand, prints, and maps errors to exit codes (2 usage, 3 input, 4 output,
-//! 1 internal). All work lives in the library (`spectral_remesh::app`).
+//! 1 internal). All work lives in the library (`spectral_remesh::run_remesh` and the other jobs).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -8,12 +8,10 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use spectral_remesh::app::{
-    catch_panics, run_points, run_quality, run_remesh, run_simplify, write_report, PointsJob,
-    RemeshJob, SimplifyDensity, SimplifyJob,
+use spectral_remesh::{
+    catch_panics, run_points, run_quality, run_remesh, run_simplify, write_report, Density, Error,
+    PointsJob, RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob,
 };
-use spectral_remesh::pipeline::{Density, RemeshParams};
-use spectral_remesh::Error;
 
 const EXAMPLES: &str = "\
 Examples:

@@ -1,9 +1,19 @@
 //! Geometry primitives: triangle measures, exact predicates, Morton codes, and the one module of
 //! tolerances. Nothing here knows of meshes as structures or of the pipeline: functions take
 //! points, triangles as corner arrays, or indexed triangles as slices.
+//!
+//! A public namespace of its own (`spectral_remesh::geometry::triangle_q`, ...): these are small
+//! building blocks under the pipeline's stages, not stages, and read best with the prefix.
 
-pub mod morton;
-pub mod self_intersection;
-pub mod tolerance;
-pub mod triangle;
-pub mod triangle_intersection;
+pub(crate) mod morton;
+pub(crate) mod self_intersection;
+pub(crate) mod tolerance;
+pub(crate) mod triangle;
+pub(crate) mod triangle_intersection;
+
+pub use self_intersection::{intersecting_pairs, intersecting_pairs_counted};
+pub use tolerance::{
+    BURIED_OFFSET, DEGENERATE_AREA_TOLERANCE, SEARCH_BOUND_SLACK, SINGULAR_TOLERANCE,
+};
+pub use triangle::{is_degenerate_face, is_degenerate_triangle, triangle_angles_deg, triangle_q};
+pub use triangle_intersection::{segment_meets_triangle, triangles_intersect};

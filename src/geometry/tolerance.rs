@@ -18,8 +18,8 @@ pub const DEGENERATE_AREA_TOLERANCE: f64 = 1e-12;
 pub const SINGULAR_TOLERANCE: f64 = 1e-9;
 
 /// How far in front of the surface a point is tested for being buried inside the input's own
-/// solid (`surface::BuriedTest`), bbox-100 units: far below any sampling spacing, far above
-/// rounding.
+/// solid ([`BuriedTest`](crate::BuriedTest)), bbox-100 units: far below any sampling spacing,
+/// far above rounding.
 pub const BURIED_OFFSET: f64 = 1e-3;
 
 /// The relative slack on a distance bound used only to prune a closest-point search (the bound

@@ -29,7 +29,7 @@ pub fn is_degenerate_triangle(p: [DVec3; 3]) -> bool {
 /// Whether the indexed triangle `t` over `positions` is degenerate: it repeats a vertex index, or
 /// its corners fail [`is_degenerate_triangle`]. A triangle with an out-of-range index is not
 /// judged here (it is `false` unless it also repeats an index); the invariant check
-/// (`check::check_invariants`) reports such faces.
+/// ([`check_invariants`](crate::check_invariants)) reports such faces.
 pub fn is_degenerate_face(positions: &[DVec3], t: [u32; 3]) -> bool {
     if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
         return true;

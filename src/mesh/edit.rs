@@ -1,19 +1,5 @@
-//! An editable triangle mesh: faces in slots, a directed-edge table and vertex–face lists, and
-//! the local operators every stage that changes a triangulation uses (the assembly's hole filling
-//! and refinement, the optimizer, untangling): edge flip, edge split, face split, edge collapse
-//! (with the link condition), vertex relocation, face removal and hole filling. Each operator
-//! checks that its result keeps the invariants [`EditMesh::sanity_check`] verifies and refuses
-//! (with an [`EditError`], the mesh unchanged) when it would not.
-//!
-//! The representation is the directed-edge one (Campagna, Kobbelt, Seidel, "Directed edges — a
-//! scalable representation for triangle meshes", J. Graphics Tools 3(4), 1998,
-//! doi:10.1080/10867651.1998.10487494) with a hash map from directed edge to face instead of
-//! implicit half-edge indices, so faces can come and go in any order. Every directed edge is used
-//! by at most one face: that single rule keeps every edge in at most two faces and the
-//! orientation consistent.
-//!
-//! Some directed edges can be *blocked*: no face may use them (the outside of an open input's
-//! boundary, so that its boundary edges stay boundary edges).
+//! The editable triangle mesh ([`EditMesh`]) with the local operators every stage that changes a
+//! triangulation uses; its representation and rules are described on [`EditMesh`].
 
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -99,7 +85,7 @@ pub enum EditError {
 
 /// An invariant that [`EditMesh::sanity_check`] found broken.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Violation {
+pub enum EditViolation {
     /// A live face repeats a vertex or has an index out of range.
     BadFace {
         /// The slot.
@@ -164,9 +150,25 @@ pub fn starting_at(t: [u32; 3], v: u32) -> [u32; 3] {
     }
 }
 
-/// An editable triangle mesh (see the module documentation). Faces live in slots `0..slots()`;
-/// a removed face leaves a dead slot, so face indices stay valid. Each face carries a label of
-/// type `L` (where it came from), given by whoever makes it.
+/// An editable triangle mesh: faces in slots, a directed-edge table and vertex–face lists, and
+/// the local operators every stage that changes a triangulation uses (the assembly's hole filling
+/// and refinement, the optimizer, untangling): edge flip, edge split, face split, edge collapse
+/// (with the link condition), vertex relocation, face removal and hole filling. Each operator
+/// checks that its result keeps the invariants [`EditMesh::sanity_check`] verifies and refuses
+/// (with an [`EditError`], the mesh unchanged) when it would not.
+///
+/// The representation is the directed-edge one (Campagna, Kobbelt, Seidel, "Directed edges — a
+/// scalable representation for triangle meshes", J. Graphics Tools 3(4), 1998,
+/// doi:10.1080/10867651.1998.10487494) with a hash map from directed edge to face instead of
+/// implicit half-edge indices, so faces can come and go in any order. Every directed edge is used
+/// by at most one face: that single rule keeps every edge in at most two faces and the
+/// orientation consistent.
+///
+/// Some directed edges can be *blocked*: no face may use them (the outside of an open input's
+/// boundary, so that its boundary edges stay boundary edges).
+///
+/// Faces live in slots `0..slots()`; a removed face leaves a dead slot, so face indices stay
+/// valid. Each face carries a label of type `L` (where it came from), given by whoever makes it.
 #[derive(Debug, Clone)]
 pub struct EditMesh<L: Copy = ()> {
     positions: Vec<DVec3>,
@@ -587,7 +589,7 @@ impl<L: Copy> EditMesh<L> {
     /// edge is in at most two faces, oriented oppositely); no face uses a blocked direction; no
     /// two faces have the same three vertices; the faces around every vertex form one fan; the
     /// vertex–face lists match the faces. Returns the first violation found.
-    pub fn sanity_check(&self) -> Result<(), Violation> {
+    pub fn sanity_check(&self) -> Result<(), EditViolation> {
         let n = self.positions.len();
         let mut used: FxHashMap<(u32, u32), u32> = FxHashMap::default();
         let mut vertex_sets: FxHashMap<[u32; 3], u32> = FxHashMap::default();
@@ -598,37 +600,37 @@ impl<L: Copy> EditMesh<L> {
             }
             let f = f as u32;
             if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || t.iter().any(|&v| v as usize >= n) {
-                return Err(Violation::BadFace {
+                return Err(EditViolation::BadFace {
                     face: f,
                     corners: t,
                 });
             }
             if is_degenerate_triangle(self.corners(t)) {
-                return Err(Violation::DegenerateFace { face: f });
+                return Err(EditViolation::DegenerateFace { face: f });
             }
             for k in 0..3 {
                 let e = (t[k], t[(k + 1) % 3]);
                 let table = self.face_on(e.0, e.1);
                 if used.insert(e, f).is_some() || table != Some(f) {
-                    return Err(Violation::DirectedEdge {
+                    return Err(EditViolation::DirectedEdge {
                         edge: [e.0, e.1],
                         table,
                         face: f,
                     });
                 }
                 if self.blocked.contains(&e) {
-                    return Err(Violation::BlockedEdgeUsed { edge: [e.0, e.1] });
+                    return Err(EditViolation::BlockedEdgeUsed { edge: [e.0, e.1] });
                 }
                 around[t[k] as usize].push(f);
             }
             let mut key = t;
             key.sort_unstable();
             if let Some(g) = vertex_sets.insert(key, f) {
-                return Err(Violation::DuplicateFace { faces: [g, f] });
+                return Err(EditViolation::DuplicateFace { faces: [g, f] });
             }
         }
         if let Some((&(a, b), &f)) = self.edge.iter().find(|(e, _)| !used.contains_key(e)) {
-            return Err(Violation::StaleEdge {
+            return Err(EditViolation::StaleEdge {
                 edge: [a, b],
                 face: f,
             });
@@ -637,11 +639,11 @@ impl<L: Copy> EditMesh<L> {
             let mut listed = self.around[v].clone();
             listed.sort_unstable();
             if &listed != faces {
-                return Err(Violation::VertexFaces { vertex: v as u32 });
+                return Err(EditViolation::VertexFaces { vertex: v as u32 });
             }
             let fans = self.fans_at(v as u32);
             if fans > 1 {
-                return Err(Violation::NonManifoldVertex {
+                return Err(EditViolation::NonManifoldVertex {
                     vertex: v as u32,
                     fans,
                 });

@@ -14,7 +14,7 @@ use crate::spatial::StaticTree;
 
 /// How normals are oriented after the plane fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Orientation {
+pub enum NormalOrientation {
     /// Propagated along the minimum spanning tree of the k-nearest-neighbour graph, weights
     /// 1 − |n_i · n_j| (Hoppe 1992), leaving out edges more than 30° off both ends' tangent
     /// planes (across a part thinner than the neighbourhood), each connected part seeded at its highest point (largest
@@ -27,7 +27,7 @@ pub enum Orientation {
 /// Unit normals of `points` (any units): the least-variance direction of each point's `k`
 /// nearest neighbours (itself included), oriented as `orientation` says. `k` below 3 is taken
 /// as 3. Deterministic.
-pub fn estimate_normals(points: &[DVec3], k: usize, orientation: Orientation) -> Vec<DVec3> {
+pub fn estimate_normals(points: &[DVec3], k: usize, orientation: NormalOrientation) -> Vec<DVec3> {
     let k = k.max(3);
     let tree = StaticTree::new(points);
     let (mut normals, neighbors): (Vec<DVec3>, Vec<Vec<u32>>) = points
@@ -41,14 +41,16 @@ pub fn estimate_normals(points: &[DVec3], k: usize, orientation: Orientation) ->
         })
         .unzip();
     match orientation {
-        Orientation::Viewpoint(v) => {
+        NormalOrientation::Viewpoint(v) => {
             for (n, &p) in normals.iter_mut().zip(points) {
                 if n.dot(v - p) < 0.0 {
                     *n = -*n;
                 }
             }
         }
-        Orientation::SpanningTree => orient_by_spanning_tree(points, &mut normals, &neighbors),
+        NormalOrientation::SpanningTree => {
+            orient_by_spanning_tree(points, &mut normals, &neighbors)
+        }
     }
     normals
 }
@@ -182,12 +184,12 @@ mod tests {
             .into_iter()
             .map(|u| DVec3::new(u.x, u.z, u.y) * 3.0)
             .collect();
-        let normals = estimate_normals(&points, 12, Orientation::SpanningTree);
+        let normals = estimate_normals(&points, 12, NormalOrientation::SpanningTree);
         for (p, n) in points.iter().zip(&normals) {
             assert!(n.dot(p.normalize()) > 0.99, "{p:?} {n:?}");
         }
         // A viewpoint inside turns them all inward.
-        let inward = estimate_normals(&points, 12, Orientation::Viewpoint(DVec3::ZERO));
+        let inward = estimate_normals(&points, 12, NormalOrientation::Viewpoint(DVec3::ZERO));
         assert!(inward.iter().zip(&points).all(|(n, p)| n.dot(*p) < 0.0));
     }
 }

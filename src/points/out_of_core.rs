@@ -1,16 +1,7 @@
 //! Out-of-core simplification of a point set by the randomized linear scan (Sec. 6.1,
 //! Algorithm 1): memory bounded by the output set plus a fixed buffer, not by the input.
 //!
-//! Two passes over the data:
-//! 1. The input is streamed once: its bounding box is taken (for the bbox-100 frame of Sec. 7) and
-//!    every point goes to one of `B` temporary bucket files chosen at random (a bucket shuffle:
-//!    the visit order is random without the input ever being in memory).
-//! 2. Each bucket in turn is loaded (about `bucket_points` points), shuffled, and streamed
-//!    through the linear scan, whose output set O lives in one dynamic kd-tree.
-//!
-//! With `--points N` the sigma_p is found first on the first bucket alone: a uniformly random
-//! subset as dense as the output needs gives the same count (the count depends on sigma_p and the
-//! surface, not on the input's density).
+//! The two passes are described on [`simplify_out_of_core`].
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -22,7 +13,7 @@ use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::normals::{estimate_normals, Orientation};
+use super::normals::{estimate_normals, NormalOrientation};
 use super::rimls::{Rimls, RimlsParams};
 use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -54,7 +45,7 @@ pub struct OutOfCoreParams {
     /// surface of the input (default 0: none; see [`simplify_out_of_core`]).
     pub resample: usize,
     /// How normals estimated for an input without them are oriented.
-    pub orientation: Orientation,
+    pub orientation: NormalOrientation,
 }
 
 impl Default for OutOfCoreParams {
@@ -68,7 +59,7 @@ impl Default for OutOfCoreParams {
             seed: 1,
             temp_dir: None,
             resample: 0,
-            orientation: Orientation::SpanningTree,
+            orientation: NormalOrientation::SpanningTree,
         }
     }
 }
@@ -96,8 +87,19 @@ pub struct OutOfCoreResult {
 }
 
 /// Simplifies the point set in the file `input` (PLY or XYZ/CSV, see [`PointReader`]) out of
-/// core (see the module documentation). Peak memory: the output set, two buckets, and a 1 MiB
-/// write buffer per bucket.
+/// core: memory bounded by the output set plus a fixed buffer, not by the input. Peak memory:
+/// the output set, two buckets, and a 1 MiB write buffer per bucket.
+///
+/// Two passes over the data:
+/// 1. The input is streamed once: its bounding box is taken (for the bbox-100 frame of Sec. 7) and
+///    every point goes to one of `B` temporary bucket files chosen at random (a bucket shuffle:
+///    the visit order is random without the input ever being in memory).
+/// 2. Each bucket in turn is loaded (about `bucket_points` points), shuffled, and streamed
+///    through the linear scan, whose output set O lives in one dynamic kd-tree.
+///
+/// With `--points N` the sigma_p is found first on the first bucket alone: a uniformly random
+/// subset as dense as the output needs gives the same count (the count depends on sigma_p and the
+/// surface, not on the input's density).
 ///
 /// The samples always have unit normals: for an input without them, normals are estimated on
 /// the output (PCA over 10 neighbours, oriented by `params.orientation`). With
@@ -174,7 +176,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
 }
 
 /// PCA normals for points without them (10 neighbours), oriented by `orientation`.
-fn estimate_sample_normals(points: &mut [Point], orientation: Orientation) {
+fn estimate_sample_normals(points: &mut [Point], orientation: NormalOrientation) {
     let positions: Vec<DVec3> = points.iter().map(|p| p.position).collect();
     for (p, n) in points
         .iter_mut()
@@ -339,7 +341,7 @@ pub fn simplify_progressive(
     })
 }
 
-/// The input, bucket-shuffled into temporary files (pass 1 of the module documentation).
+/// The input, bucket-shuffled into temporary files (pass 1 of [`simplify_out_of_core`]).
 struct Buckets {
     dir: tempfile::TempDir,
     /// Number of bucket files.

@@ -25,8 +25,9 @@
 //! The kernel is the one of the spectral sampling paper (Öztireli, Alexa, Gross 2010, Sec. 3,
 //! [`crate::kernel`]): k(x, y) = exp(-|x - y|²) with x = [p/σ_p, n/σ_n], so the spatial weight is
 //! φ = exp(-|x - p_i|²/σ_p²) and the normal term exp(-|∇f - n_i|²/σ_n²) uses the same σ_n
-//! (σ_n = ∞ turns it off: positions only). φ is cut off at `support_radius · σ_p` and shifted down
-//! by its value there, so that f stays continuous when a point enters or leaves the support.
+//! (σ_n = ∞ turns it off: positions only). φ is cut off at `support_radius_sigma_p · σ_p` and
+//! shifted down by its value there, so that f stays continuous when a point enters or leaves the
+//! support.
 //!
 //! A point may carry a mass m_i ≥ 0 ([`Rimls::with_masses`]; 1 by default) that multiplies its
 //! weight: the point then counts as m_i coincident points. A subsampled point set carries the
@@ -80,9 +81,9 @@ pub struct RimlsParams {
     /// default of the Ponca library's RIMLS.
     pub sigma_r: f64,
     /// Radius of the neighbourhood, in units of σ_p (> 0): points farther than
-    /// `support_radius · σ_p` are ignored. Default 3: the Gaussian is exp(-9) ≈ 1.2e-4 there,
-    /// and φ is the Gaussian minus that value.
-    pub support_radius: f64,
+    /// `support_radius_sigma_p · σ_p` are ignored. Default 3: the Gaussian is exp(-9) ≈ 1.2e-4
+    /// there, and φ is the Gaussian minus that value.
+    pub support_radius_sigma_p: f64,
     /// Robust refitting iterations after the first (unweighted) fit (RIMLS paper, Algorithm 1).
     /// 0 gives plain implicit MLS. Default 3, as in MeshLab's RIMLS. On fandisk near sharp
     /// edges (σ_p = 1, σ_n = 0.75) 1, 3 and 10 gave a mean distance to the true surface of
@@ -103,7 +104,7 @@ impl Default for RimlsParams {
             sigma_p: 1.0,
             sigma_n: 0.75,
             sigma_r: 0.5,
-            support_radius: 3.0,
+            support_radius_sigma_p: 3.0,
             max_refit: 3,
             max_projection_steps: 20,
             tolerance: 1e-5,
@@ -147,12 +148,12 @@ impl RimlsParams {
                 format!("must be positive (or infinite), got {}", self.sigma_r),
             );
         }
-        if !(self.support_radius.is_finite() && self.support_radius > 0.0) {
+        if !(self.support_radius_sigma_p.is_finite() && self.support_radius_sigma_p > 0.0) {
             return bad(
-                "support_radius",
+                "support_radius_sigma_p",
                 format!(
                     "must be a positive finite number, got {}",
-                    self.support_radius
+                    self.support_radius_sigma_p
                 ),
             );
         }
@@ -200,7 +201,7 @@ pub struct Rimls {
     inv_sigma_n2: f64,
     /// 1/(σ_r σ_p)² (0 for σ_r = ∞).
     inv_sigma_r2: f64,
-    /// exp(-support_radius²): the Gaussian's value at the cut-off, subtracted from φ.
+    /// exp(-support_radius_sigma_p²): the Gaussian's value at the cut-off, subtracted from φ.
     tail: f64,
 }
 
@@ -264,7 +265,7 @@ impl Rimls {
             }
         }
         let tree = StaticTree::new(&positions);
-        let support = params.support_radius * params.sigma_p;
+        let support = params.support_radius_sigma_p * params.sigma_p;
         Ok(Rimls {
             positions,
             normals: unit,
@@ -274,7 +275,7 @@ impl Rimls {
             inv_sigma_p2: 1.0 / (params.sigma_p * params.sigma_p),
             inv_sigma_n2: 1.0 / (params.sigma_n * params.sigma_n),
             inv_sigma_r2: 1.0 / (params.sigma_r * params.sigma_r * params.sigma_p * params.sigma_p),
-            tail: (-params.support_radius * params.support_radius).exp(),
+            tail: (-params.support_radius_sigma_p * params.support_radius_sigma_p).exp(),
             params,
         })
     }
@@ -340,7 +341,8 @@ impl Rimls {
     /// the surface), after the robust refitting of the RIMLS paper's Algorithm 1: at most
     /// `max_refit` reweightings, stopping early when ∇f changes by less than `tolerance`.
     ///
-    /// `None` when `x` is not finite or no point lies within `support_radius · σ_p` of it.
+    /// `None` when `x` is not finite or no point lies within `support_radius_sigma_p · σ_p` of
+    /// it.
     pub fn value_and_gradient(&self, x: DVec3) -> Option<(f64, DVec3)> {
         let mut neighbours = Vec::new();
         self.evaluate(x, &mut neighbours)
@@ -422,8 +424,8 @@ impl Rimls {
     /// turns 9 (σ_n = 0.75) and 58 (σ_n = ∞) of 3000 projections that had not converged in 20
     /// steps into none.
     ///
-    /// `None` when an iterate leaves the support (no point within `support_radius · σ_p`), or
-    /// ∇f vanishes.
+    /// `None` when an iterate leaves the support (no point within `support_radius_sigma_p · σ_p`),
+    /// or ∇f vanishes.
     pub fn project(&self, x: DVec3) -> Option<(DVec3, DVec3)> {
         self.project_detailed(x).map(|p| (p.position, p.normal))
     }
@@ -653,7 +655,7 @@ mod tests {
             RimlsParams::new(1.0, f64::NAN),
             RimlsParams { sigma_r: 0.0, ..ok },
             RimlsParams {
-                support_radius: f64::INFINITY,
+                support_radius_sigma_p: f64::INFINITY,
                 ..ok
             },
             RimlsParams {

@@ -62,10 +62,11 @@ const SECOND_SIDE_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
 
 /// The sample points of one side of [`surface_distance`]: every vertex used by a face (in index
 /// order, finite ones only), then `random` points drawn uniformly by area on the faces
-/// ([`AreaSampler`]: a face with probability proportional to its area, then a point uniformly in
-/// it). Three `f64` draws per point from `ChaCha8Rng::seed_from_u64(seed)`:
-/// deterministic across platforms and runs. Faces with an out-of-range index or non-finite
-/// corner have no weight; if no face has area, only vertices are returned.
+/// (the crate's one area-uniform sampler: a face with probability proportional to its area,
+/// then a point uniformly in it). Three `f64` draws per point from
+/// `ChaCha8Rng::seed_from_u64(seed)`: deterministic across platforms and runs. Faces with an
+/// out-of-range index or non-finite corner have no weight; if no face has area, only vertices
+/// are returned.
 pub fn surface_samples(mesh: &TriMesh, random: usize, seed: u64) -> Vec<DVec3> {
     let n = mesh.positions.len();
     let mut used = vec![false; n];

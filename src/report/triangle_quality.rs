@@ -41,7 +41,7 @@ pub struct TriangleQuality {
     pub p30: f64,
     /// The number of triangles measured: all faces except those with a vertex index out of range
     /// or a corner with a non-finite coordinate (those have no geometry to measure;
-    /// [`check_invariants`](crate::check::check_invariants) reports them).
+    /// [`check_invariants`](crate::check_invariants) reports them).
     pub faces_measured: usize,
 }
 

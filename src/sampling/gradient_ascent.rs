@@ -22,7 +22,7 @@ pub struct GradientAscentParams {
     pub step: f64,
     /// Largest move of one sample in one sweep, in units of sigma_p (default 0.25): a guard
     /// against a sample jumping across a thin part of the model.
-    pub max_move: f64,
+    pub max_move_sigma_p: f64,
     /// Neighbourhood radius in kernel units (default 2.5, Sec. 6.3).
     pub support_radius: f64,
     /// Move samples one at a time in a seeded random order, each seeing the moves before it
@@ -42,7 +42,7 @@ impl Default for GradientAscentParams {
         GradientAscentParams {
             iterations: 10,
             step: 0.55,
-            max_move: 0.25,
+            max_move_sigma_p: 0.25,
             support_radius: SUPPORT_RADIUS,
             sequential: true,
             backtracking: 0,
@@ -229,7 +229,7 @@ fn move_one<S: Projection + ?Sized>(
     // Kernel units to position units: Δp = sigma_p · step · ∇_x s.
     let mut delta = glam::DVec3::new(g[0], g[1], g[2]) * (params.step * sigma_p);
     let len = delta.length();
-    let max_move = params.max_move * sigma_p;
+    let max_move = params.max_move_sigma_p * sigma_p;
     if len > max_move {
         delta *= max_move / len;
     }

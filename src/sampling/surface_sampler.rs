@@ -93,6 +93,7 @@ impl AreaSampler {
     }
 
     /// The total weighted area (the mesh's units squared).
+    #[cfg(test)]
     pub fn total_area(&self) -> f64 {
         self.total
     }

@@ -21,7 +21,7 @@ pub struct SurfaceSample {
 
 /// A surface samples are projected onto after each gradient-ascent move (Sec. 6.2): the input
 /// mesh ([`MeshSurface`], closest point) or the RIMLS surface of a point set
-/// ([`crate::points::rimls::Rimls`], Newton projection).
+/// ([`Rimls`](crate::Rimls), Newton projection).
 pub trait Projection: Sync {
     /// The projection of `p` (bbox-100 units) with the surface's unit normal there and, on a
     /// mesh, the triangle it lies on (0 elsewhere); `None` when `p` cannot be projected.

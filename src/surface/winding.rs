@@ -176,7 +176,7 @@ impl<'a> BuriedTest<'a> {
     /// The test for `mesh` (bbox-100 units), or `None` when no point of it can be buried: it
     /// does not intersect itself ([`self_intersections`]). `points` is how many points will be
     /// tested: an open mesh is tested with the generalized winding number, O(F) per point, and
-    /// gets `None` when F · points exceeds [`MAX_OPEN_WORK`].
+    /// gets `None` when F · points exceeds `MAX_OPEN_WORK` (4e8).
     pub fn new(mesh: &'a TriMesh, points: usize) -> Option<Self> {
         if self_intersections(mesh).pairs == 0 {
             return None;

@@ -702,7 +702,7 @@ mod tests {
         }
         assert!(matches!(
             b.sanity_check(),
-            Err(crate::mesh::edit::Violation::NonManifoldVertex { vertex: 0, fans: 2 })
+            Err(crate::mesh::edit::EditViolation::NonManifoldVertex { vertex: 0, fans: 2 })
         ));
         assert_eq!(repair_pinched_vertices(&mut b), 1);
         assert_eq!(b.live_faces().0, vec![[0, 1, 2], [0, 2, 3]]);

@@ -2,24 +2,7 @@
 //! spectral sampling cannot resolve (tips and rims thinner than the sample spacing) are mended
 //! with the input surface at hand.
 //!
-//! Four local operations, each kept only when it keeps the mesh near the input surface (see the
-//! offsets in [`OptimizeParams`]):
-//! - **Cover:** an input-surface point farther than `cover_distance` from the mesh (the tip of an
-//!   ear or a horn that the samples around it cut off) becomes a vertex: it splits the face it is
-//!   closest to, or the edge it lies beyond. This bounds the one-sided (input → output)
-//!   Hausdorff distance.
-//! - **Collapse:** a short edge of a poor triangle merges its ends (link condition kept).
-//! - **Flip:** an edge near a poor triangle is flipped when that raises the smaller minimum angle
-//!   of its two faces (Lawson's max-min rule) and the new faces stay on the surface.
-//! - **Relax:** a vertex of a poor triangle moves towards the centroid of its neighbours or the
-//!   apex of an equilateral triangle on a poor face's far edge, projected back onto the surface,
-//!   when that raises the worst shape score min(Q / 0.6, θmin / 30°) of its faces and turns none
-//!   of them much (Laplacian smoothing with projection, as in Botsch & Kobbelt 2004, Sec. 3,
-//!   restricted to the poor triangles).
-//!
-//! Everything else stays as the sampler and the tangent-plane Delaunay left it. On horse at 8600
-//! about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
-//! spacing).
+//! The operations and their guards are described on [`optimize`].
 
 use glam::DVec3;
 use parry3d_f64::query::PointQuery;
@@ -47,10 +30,10 @@ pub struct OptimizeParams {
     /// sigma_p (default 0.1): a moved vertex's old position must stay within it of its faces; a
     /// flipped edge's midpoint (on the surface) within it of the new faces, and the new edge's
     /// midpoint within it of the surface.
-    pub max_offset: f64,
+    pub max_offset_sigma_p: f64,
     /// Input-surface points farther than this from the mesh become vertices, in units of sigma_p
     /// (default 0.42; `f64::INFINITY` turns covering off).
-    pub cover_distance: f64,
+    pub cover_distance_sigma_p: f64,
     /// Rounds of covering at most (default 3).
     pub cover_rounds: usize,
     /// Edges of poor triangles shorter than this fraction of the median edge length are
@@ -58,7 +41,7 @@ pub struct OptimizeParams {
     pub short_edge_ratio: f64,
     /// Largest distance a collapse may put between the removed vertex's position and the mesh, in
     /// units of sigma_p (default 0.25).
-    pub collapse_offset: f64,
+    pub collapse_offset_sigma_p: f64,
 }
 
 impl Default for OptimizeParams {
@@ -68,11 +51,51 @@ impl Default for OptimizeParams {
             theta_below_deg: 35.0,
             sweeps: 6,
             max_normal_turn_deg: 45.0,
-            max_offset: 0.1,
-            cover_distance: 0.42,
+            max_offset_sigma_p: 0.1,
+            cover_distance_sigma_p: 0.42,
             cover_rounds: 3,
             short_edge_ratio: 0.5,
-            collapse_offset: 0.25,
+            collapse_offset_sigma_p: 0.25,
+        }
+    }
+}
+
+/// [`OptimizeParams`] with its lengths resolved to bbox-100 units for one sigma_p: what the
+/// operations read.
+#[derive(Debug, Clone, Copy)]
+struct Limits {
+    /// [`OptimizeParams::q_below`].
+    q_below: f64,
+    /// [`OptimizeParams::theta_below_deg`], degrees.
+    theta_below_deg: f64,
+    /// [`OptimizeParams::sweeps`].
+    sweeps: usize,
+    /// [`OptimizeParams::max_normal_turn_deg`], degrees.
+    max_normal_turn_deg: f64,
+    /// [`OptimizeParams::max_offset_sigma_p`] · sigma_p, bbox-100 units.
+    max_offset: f64,
+    /// [`OptimizeParams::cover_distance_sigma_p`] · sigma_p, bbox-100 units.
+    cover_distance: f64,
+    /// [`OptimizeParams::cover_rounds`].
+    cover_rounds: usize,
+    /// [`OptimizeParams::short_edge_ratio`].
+    short_edge_ratio: f64,
+    /// [`OptimizeParams::collapse_offset_sigma_p`] · sigma_p, bbox-100 units.
+    collapse_offset: f64,
+}
+
+impl Limits {
+    fn new(params: &OptimizeParams, sigma_p: f64) -> Self {
+        Limits {
+            q_below: params.q_below,
+            theta_below_deg: params.theta_below_deg,
+            sweeps: params.sweeps,
+            max_normal_turn_deg: params.max_normal_turn_deg,
+            max_offset: params.max_offset_sigma_p * sigma_p,
+            cover_distance: params.cover_distance_sigma_p * sigma_p,
+            cover_rounds: params.cover_rounds,
+            short_edge_ratio: params.short_edge_ratio,
+            collapse_offset: params.collapse_offset_sigma_p * sigma_p,
         }
     }
 }
@@ -115,7 +138,7 @@ fn score(m: &Mesh, t: [u32; 3]) -> f64 {
 }
 
 /// Whether `t` is one of the triangles the operations work on.
-fn is_poor(m: &Mesh, t: [u32; 3], params: &OptimizeParams) -> bool {
+fn is_poor(m: &Mesh, t: [u32; 3], params: &Limits) -> bool {
     q(m, t) < params.q_below || min_angle(m, t) < params.theta_below_deg
 }
 
@@ -137,12 +160,33 @@ fn distance_to_faces(m: &Mesh, faces: &[u32], p: DVec3) -> f64 {
 
 /// Optimizes `mesh` (bbox-100 units, edge-manifold and consistently oriented) against `surface`
 /// (the input, same units): covers the input points of `cover_points` that are farther than
-/// `params.cover_distance` from it, then flips edges and relaxes vertices around the triangles
-/// with Q below `params.q_below` (see the module documentation). Vertices with `fixed[v]`
-/// (boundary samples) do not move; boundary edges are not flipped. New vertices are appended,
-/// so existing indices stay valid; vertices merged away by a collapse are left unreferenced.
+/// `params.cover_distance_sigma_p` · `sigma_p` from it, then flips edges and relaxes vertices
+/// around the triangles with Q below `params.q_below`. Vertices with `fixed[v]` (boundary
+/// samples) do not move; boundary edges are not flipped. New vertices are appended, so
+/// existing indices stay valid; vertices merged away by a collapse are left unreferenced.
 /// Returns what was done and, for each face of the result, the index of the face of `mesh` it
 /// still is (`None` for a new or changed face). Deterministic.
+///
+/// # Operations
+///
+/// Four local operations, each kept only when it keeps the mesh near the input surface (see the
+/// offsets in [`OptimizeParams`]):
+/// - **Cover:** an input-surface point farther than `cover_distance_sigma_p` · sigma_p from the
+///   mesh (the tip of an ear or a horn that the samples around it cut off) becomes a vertex: it
+///   splits the face it is closest to, or the edge it lies beyond. This bounds the one-sided
+///   (input → output) Hausdorff distance.
+/// - **Collapse:** a short edge of a poor triangle merges its ends (link condition kept).
+/// - **Flip:** an edge near a poor triangle is flipped when that raises the smaller minimum angle
+///   of its two faces (Lawson's max-min rule) and the new faces stay on the surface.
+/// - **Relax:** a vertex of a poor triangle moves towards the centroid of its neighbours or the
+///   apex of an equilateral triangle on a poor face's far edge, projected back onto the surface,
+///   when that raises the worst shape score min(Q / 0.6, θmin / 30°) of its faces and turns none
+///   of them much (Laplacian smoothing with projection, as in Botsch & Kobbelt 2004, Sec. 3,
+///   restricted to the poor triangles).
+///
+/// Everything else stays as the sampler and the tangent-plane Delaunay left it. On horse at 8600
+/// about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
+/// spacing).
 pub fn optimize(
     mesh: &mut TriMesh,
     surface: &MeshSurface,
@@ -151,13 +195,7 @@ pub fn optimize(
     sigma_p: f64,
     params: &OptimizeParams,
 ) -> (OptimizeStats, Vec<Option<u32>>) {
-    // Distances in bbox-100 units from here on.
-    let params = &OptimizeParams {
-        max_offset: params.max_offset * sigma_p,
-        cover_distance: params.cover_distance * sigma_p,
-        collapse_offset: params.collapse_offset * sigma_p,
-        ..*params
-    };
+    let params = &Limits::new(params, sigma_p);
     let mut stats = OptimizeStats::default();
     let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
     let mut fixed = fixed.to_vec();
@@ -198,12 +236,7 @@ pub fn optimize(
 /// farthest first and at most one per face, each split into the face nearest to it. `watch`
 /// carries, from the first round to the next, the points worth looking at again. Returns how
 /// many were inserted.
-fn cover(
-    m: &mut Mesh,
-    points: &[DVec3],
-    watch: &mut Option<Vec<u32>>,
-    params: &OptimizeParams,
-) -> usize {
+fn cover(m: &mut Mesh, points: &[DVec3], watch: &mut Option<Vec<u32>>, params: &Limits) -> usize {
     let (live, slot) = m.live_faces();
     let current = TriMesh::new(m.positions().to_vec(), live);
     let Ok(output) = MeshSurface::new(&current) else {
@@ -345,7 +378,7 @@ fn segment_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
 }
 
 /// The vertices of the faces with Q below `q_below`, sorted.
-fn poor_vertices(m: &Mesh, params: &OptimizeParams) -> Vec<u32> {
+fn poor_vertices(m: &Mesh, params: &Limits) -> Vec<u32> {
     let mut v: Vec<u32> = m
         .live_faces()
         .0
@@ -361,7 +394,7 @@ fn poor_vertices(m: &Mesh, params: &OptimizeParams) -> Vec<u32> {
 /// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around poor triangles'
 /// vertices, where the new faces face the way the old ones did and stay within `max_offset` of
 /// the surface. Returns the number of flips.
-fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &OptimizeParams) -> usize {
+fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &Limits) -> usize {
     let mut edges: Vec<(u32, u32)> = Vec::new();
     for v in poor_vertices(m, params) {
         for &f in m.faces_around(v) {
@@ -403,14 +436,9 @@ fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &OptimizeParams) -> us
     })
 }
 
-/// One sweep of relaxation over the vertices of poor triangles (see the module documentation).
+/// One sweep of relaxation over the vertices of poor triangles (see [`optimize`]).
 /// Returns the number of moves.
-fn relax_poor(
-    m: &mut Mesh,
-    surface: &MeshSurface,
-    fixed: &[bool],
-    params: &OptimizeParams,
-) -> usize {
+fn relax_poor(m: &mut Mesh, surface: &MeshSurface, fixed: &[bool], params: &Limits) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let mut moves = 0;
     let mut ring: Vec<u32> = Vec::new();
@@ -522,7 +550,7 @@ fn collapse_short(
     surface: &MeshSurface,
     fixed: &[bool],
     short: f64,
-    params: &OptimizeParams,
+    params: &Limits,
 ) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let mut edges: Vec<(f64, u32, u32)> = Vec::new();
@@ -666,7 +694,7 @@ mod tests {
 
     fn no_cover() -> OptimizeParams {
         OptimizeParams {
-            cover_distance: f64::INFINITY,
+            cover_distance_sigma_p: f64::INFINITY,
             ..Default::default()
         }
     }

@@ -20,17 +20,17 @@ pub struct UntangleParams {
     /// Rounds at most (each: find every crossing pair, then move). Default 30.
     pub max_rounds: usize,
     /// How far past the other face's plane a moved vertex goes (> 0; σ_p units). Default 0.01.
-    pub margin: f64,
+    pub margin_sigma_p: f64,
     /// The longest move of a vertex in one round (σ_p units). Default 0.25.
-    pub max_step: f64,
+    pub max_step_sigma_p: f64,
 }
 
 impl Default for UntangleParams {
     fn default() -> Self {
         UntangleParams {
             max_rounds: 30,
-            margin: 0.01,
-            max_step: 0.25,
+            margin_sigma_p: 0.01,
+            max_step_sigma_p: 0.25,
         }
     }
 }
@@ -54,12 +54,12 @@ pub struct UntangleStats {
 /// ([`intersecting_pairs`]) or `params.max_rounds` rounds have run. In a round the crossing pairs
 /// are taken in order; for a pair that still crosses, the shortest of four moves separates it
 /// (for either face: its corners behind the other's plane move along that plane's normal to
-/// `margin · σ_p` in front of it, or the other face moves back along its normal until they
-/// are; at most `max_step · σ_p` per round). A move of a vertex marked in `fixed` (a boundary
-/// sample) counts as four times as long, so those move only when nothing else separates the
-/// pair. A round that does not
-/// lower the number of crossing pairs is undone and tried again with moves half as long (never
-/// worse than before). Connectivity is unchanged; faces that cross nothing do not move.
+/// `margin_sigma_p · σ_p` in front of it, or the other face moves back along its normal until
+/// they are; at most `max_step_sigma_p · σ_p` per round). A move of a vertex marked in `fixed`
+/// (a boundary sample) counts as four times as long, so those move only when nothing else
+/// separates the pair. A round that does not lower the number of crossing pairs is undone and
+/// tried again with moves half as long (never worse than before). Connectivity is unchanged;
+/// faces that cross nothing do not move.
 ///
 /// The moves are local and small where the output merely grazes itself, and they press the
 /// crossing sheet onto the other where the input itself passes through itself (the output then
@@ -75,7 +75,7 @@ pub fn untangle(
     let triangles = m.live_faces().0;
     let mut stats = UntangleStats::default();
     let mut moved = vec![false; m.vertex_count()];
-    let margin = params.margin * sigma_p;
+    let margin = params.margin_sigma_p * sigma_p;
     let mut pairs = intersecting_pairs(&mesh.positions, &mesh.triangles);
     stats.pairs_before = pairs.len();
     let mut scale = 1.0;
@@ -87,7 +87,7 @@ pub fn untangle(
             &pairs,
             fixed,
             margin,
-            scale * params.max_step * sigma_p,
+            scale * params.max_step_sigma_p * sigma_p,
         );
         if moves.is_empty() {
             break;

@@ -11,8 +11,7 @@ use spectral_experiments::reconstruction_eval::{
     evaluate_model, PointSource, ReconstructionEvalParams,
 };
 use spectral_experiments::subsample::Subsampler;
-use spectral_remesh::points::generate::NormalField;
-use spectral_remesh::Error;
+use spectral_remesh::{Error, NormalField};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -142,7 +141,7 @@ enum Command {
 
 /// Writes a JSON report atomically (a temporary file beside it, then a rename).
 fn write_report(path: &Path, json: &str) -> Result<(), Error> {
-    spectral_remesh::io::write_atomically(path, |w| w.write_all(json.as_bytes()))
+    spectral_remesh::write_atomically(path, |w| w.write_all(json.as_bytes()))
 }
 
 /// Writes to standard output. A reader that went away (`... | head`) is not an error: the

@@ -15,7 +15,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::analysis::max_min_distance;
 use super::torus::{dist2, TorusGrid};
-use spectral_remesh::error::{Error, Result};
+use spectral_remesh::{Error, Result};
 
 /// Parameters of dart throwing.
 #[derive(Debug, Clone, Copy, PartialEq)]

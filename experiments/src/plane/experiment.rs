@@ -19,7 +19,7 @@ use super::spectral::{
     spectral_from_dense, spectral_from_random, uniform_random, TorusAscentParams, TorusScanParams,
     PAPER_RHO,
 };
-use spectral_remesh::error::{Error, Result};
+use spectral_remesh::{Error, Result};
 
 /// A point-set generator on the torus.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]

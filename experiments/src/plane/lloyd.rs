@@ -16,7 +16,7 @@ use spade::handles::FixedVertexHandle;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 use super::torus::wrap;
-use spectral_remesh::error::{Error, Result};
+use spectral_remesh::{Error, Result};
 
 /// What Lloyd's method did.
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]

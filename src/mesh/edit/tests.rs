@@ -383,17 +383,17 @@ fn sanity_check_finds_broken_invariants() {
     // Three faces on the edge 0–1 (two of them on the direction 0 → 1).
     assert!(matches!(
         check(vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]]),
-        Err(Violation::DirectedEdge { edge: [0, 1], .. })
+        Err(EditViolation::DirectedEdge { edge: [0, 1], .. })
     ));
     // Two faces on the same vertices, oriented oppositely.
     assert_eq!(
         check(vec![[0, 1, 2], [0, 2, 1]]),
-        Err(Violation::DuplicateFace { faces: [0, 1] })
+        Err(EditViolation::DuplicateFace { faces: [0, 1] })
     );
     // A bow tie: two fans at vertex 0.
     assert_eq!(
         check(vec![[0, 1, 2], [0, 3, 5]]),
-        Err(Violation::NonManifoldVertex { vertex: 0, fans: 2 })
+        Err(EditViolation::NonManifoldVertex { vertex: 0, fans: 2 })
     );
     // A face without area.
     let mut q = p.clone();
@@ -402,7 +402,7 @@ fn sanity_check_finds_broken_invariants() {
         EditMesh::<()>::from_trimesh(&TriMesh::new(q, vec![[0, 1, 2]]), |_| (), SlotPolicy::Reuse);
     assert_eq!(
         flat.sanity_check(),
-        Err(Violation::DegenerateFace { face: 0 })
+        Err(EditViolation::DegenerateFace { face: 0 })
     );
 }
 
