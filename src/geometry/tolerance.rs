@@ -25,3 +25,26 @@ pub const BURIED_OFFSET: f64 = 1e-3;
 /// The relative slack on a distance bound used only to prune a closest-point search (the bound
 /// is made strictly larger than the answer it must not exclude). Dimensionless.
 pub const SEARCH_BOUND_SLACK: f64 = 1e-9;
+
+/// Slack on an angle in radians when a wedge of a tangent-plane umbrella is tested for
+/// containing an edge direction (`triangulate::tangent_delaunay`): an edge exactly on the
+/// wedge's side counts as inside. Dimensionless (radians), far above rounding of `atan2`.
+pub const ANGLE_SLACK: f64 = 1e-9;
+
+/// The least gain in the smaller minimum angle of two triangles, in degrees, for a max-min edge
+/// flip to be taken (`triangulate::flip`): smaller gains are rounding and would let two flips
+/// undo each other forever.
+pub const FLIP_MIN_ANGLE_GAIN_DEG: f64 = 1e-6;
+
+/// The least gain in a quality (a triangle's Q, or a smallest angle in degrees) for a local
+/// move of the optimization to count as an improvement, and the least Q of a triangle the hole
+/// filling accepts. Dimensionless.
+pub const IMPROVEMENT_TOLERANCE: f64 = 1e-9;
+
+/// Below this width of the bracket on log sigma_p, and this difference of log counts between its
+/// ends, the sigma_p search (`sampling::target_count`) stops narrowing it: the bracket is then a
+/// relative width of 1e-9 on sigma_p. Dimensionless (natural logarithms).
+pub const LOG_BRACKET_TOLERANCE: f64 = 1e-9;
+
+/// Two log counts closer than this make no secant (`sampling::target_count`). Dimensionless.
+pub const LOG_COUNT_TOLERANCE: f64 = 1e-12;

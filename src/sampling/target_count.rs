@@ -5,6 +5,8 @@
 //! closest evaluations, kept inside the bracket found so far (bisection in log space when a
 //! secant step leaves it).
 
+use crate::geometry::tolerance::{LOG_BRACKET_TOLERANCE, LOG_COUNT_TOLERANCE};
+
 /// Parameters of the search.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TargetCountParams {
@@ -84,7 +86,7 @@ pub fn find_sigma_p<T>(
         }
         // Next guess: secant across the bracket, or slope -2 from the last point.
         let mut next = match (lo, hi) {
-            (Some(l), Some(h)) if (h.1 - l.1).abs() > 1e-12 => {
+            (Some(l), Some(h)) if (h.1 - l.1).abs() > LOG_COUNT_TOLERANCE => {
                 l.0 + (ln_target - l.1) * (h.0 - l.0) / (h.1 - l.1)
             }
             _ => ln_sigma + 0.5 * (ln_count - ln_target),
@@ -95,7 +97,7 @@ pub fn find_sigma_p<T>(
             if !(next > l.0 + 0.05 * width && next < h.0 - 0.05 * width) {
                 next = 0.5 * (l.0 + h.0);
             }
-            if width.abs() < 1e-9 {
+            if width.abs() < LOG_BRACKET_TOLERANCE {
                 break;
             }
         }

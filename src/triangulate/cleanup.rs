@@ -7,12 +7,18 @@
 //! consistent. Boundary edges of an open input are usable in their own direction only (the
 //! other is blocked), so they stay boundary edges.
 
+use crate::geometry::tolerance::IMPROVEMENT_TOLERANCE;
 use glam::{DVec2, DVec3};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::refine::{flip_edges, insert_loose_samples, oriented_quality, RefineParams};
 use super::tangent_delaunay::VotedTriangle;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
+
+/// The weight of a folded triangle's Q (one turned against the samples' normals) when a hole's
+/// polygon can be closed no other way: far below any unfolded triangle, so folds are the last
+/// resort of the max-min polygon triangulation.
+const FOLD_WEIGHT: f64 = 1e-3;
 
 /// The mesh being assembled: faces in the order they were made, each with how it came in.
 type Assembly = EditMesh<FaceSource>;
@@ -431,9 +437,9 @@ fn triangulate_polygon(
                 let t = [lp[i], lp[j], lp[k]];
                 let mut q = oriented_quality(b, normals, t);
                 if q <= 0.0 && allow_folds {
-                    q = 1e-3 * crate::geometry::triangle::triangle_q(b.corners(t));
+                    q = FOLD_WEIGHT * crate::geometry::triangle::triangle_q(b.corners(t));
                 }
-                if q.is_nan() || q <= 1e-9 {
+                if q.is_nan() || q <= IMPROVEMENT_TOLERANCE {
                     continue;
                 }
                 let v = best[idx(i, j)].min(best[idx(j, k)]).min(q);

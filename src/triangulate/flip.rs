@@ -5,6 +5,7 @@
 //! assembly's refinement: the faces stay nearly coplanar and agree with the samples' normals;
 //! the optimizer: the new faces stay on the input surface).
 
+use crate::geometry::tolerance::FLIP_MIN_ANGLE_GAIN_DEG;
 use crate::geometry::triangle::triangle_angles_deg;
 use crate::mesh::edit::{starting_at, EditMesh};
 
@@ -49,7 +50,7 @@ pub(crate) fn max_min_candidate<L: Copy>(m: &EditMesh<L>, x: u32, y: u32) -> Opt
     let new2 = [y, c, d];
     let old = min_angle(m, t1).min(min_angle(m, t2));
     let new = min_angle(m, new1).min(min_angle(m, new2));
-    if new <= old + 1e-6 {
+    if new <= old + FLIP_MIN_ANGLE_GAIN_DEG {
         return None;
     }
     Some(FlipCandidate {

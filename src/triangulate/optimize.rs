@@ -4,6 +4,7 @@
 //!
 //! The operations and their guards are described on [`optimize`].
 
+use crate::geometry::tolerance::IMPROVEMENT_TOLERANCE;
 use glam::DVec3;
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
@@ -485,8 +486,8 @@ fn relax_poor(m: &mut Mesh, surface: &MeshSurface, fixed: &[bool], params: &Limi
             let mid = 0.5 * (pb + pc);
             let e = pc - pb;
             let height = old - mid;
-            let across =
-                (height - e * (height.dot(e) / e.length_squared().max(1e-300))).normalize_or_zero();
+            let across = (height - e * (height.dot(e) / e.length_squared().max(f64::MIN_POSITIVE)))
+                .normalize_or_zero();
             if across != DVec3::ZERO {
                 targets.push(mid + across * (0.75f64.sqrt() * e.length()));
             }
@@ -508,7 +509,7 @@ fn relax_poor(m: &mut Mesh, surface: &MeshSurface, fixed: &[bool], params: &Limi
                 .any(|(&f, &n0)| normal(m, face(m, f)).dot(n0) < cos_turn);
             let q = worst_q(m);
             if !turned
-                && q > best.0 + 1e-9
+                && q > best.0 + IMPROVEMENT_TOLERANCE
                 && distance_to_faces(m, &faces, old) <= params.max_offset
             {
                 best = (q, sp.position);
@@ -651,7 +652,11 @@ fn collapse_short(
             let near = dist(pa) <= params.collapse_offset && dist(pb) <= params.collapse_offset;
             // The old position was finite: restoring it cannot fail.
             let _ = m.relocate_vertex(kept, saved);
-            if !turned && near && worst > before + 1e-9 && best.is_none_or(|b| worst > b.0) {
+            if !turned
+                && near
+                && worst > before + IMPROVEMENT_TOLERANCE
+                && best.is_none_or(|b| worst > b.0)
+            {
                 best = Some((worst, removed, kept, q));
             }
         }

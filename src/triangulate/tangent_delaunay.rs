@@ -9,6 +9,7 @@
 //! is left. (The approach of Gopi, Krishnan, Silva 2000, "Surface reconstruction based on lower
 //! dimensional localized Delaunay triangulation", and of Boissonnat's tangent-plane methods.)
 
+use crate::geometry::tolerance::ANGLE_SLACK;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
@@ -170,10 +171,10 @@ fn umbrella(
                 let d = set.positions[j as usize] - pi;
                 (d.dot(v).atan2(d.dot(u)) - start).rem_euclid(std::f64::consts::TAU)
             };
-            let limit = (end - start).rem_euclid(std::f64::consts::TAU) + 1e-9;
+            let limit = (end - start).rem_euclid(std::f64::consts::TAU) + ANGLE_SLACK;
             let (s1, s2) = (span(tri[1]), span(tri[2]));
             // Both edges within the wedge, and the triangle turning counter-clockwise in it.
-            let s1 = if s1 > std::f64::consts::TAU - 1e-9 {
+            let s1 = if s1 > std::f64::consts::TAU - ANGLE_SLACK {
                 0.0
             } else {
                 s1
