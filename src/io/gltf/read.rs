@@ -1,11 +1,4 @@
-//! glTF 2.0 (`.gltf` and `.glb`): reading the triangles of a scene with the `gltf` crate, and
-//! writing one mesh as a binary or embedded glTF asset.
-//!
-//! Reading parses and validates the document with `gltf`, loads only its buffers (not its
-//! images: data URIs decoded by `base64`, file paths by `percent-encoding`), and decodes
-//! accessors with our own bounds-checked code: the `gltf` crate's accessor iterators and
-//! importer can panic on some malformed files (a GLB header length below 12, an accessor of
-//! count 0, a buffer URI that is not UTF-8 once percent-decoded).
+//! Reading a glTF 2.0 scene's triangles, in world coordinates.
 
 use std::path::{Path, PathBuf};
 
@@ -13,16 +6,13 @@ use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::buffer::Source;
 use ::gltf::json::validation::{Error as ValidationError, Validate};
 use ::gltf::mesh::Mode;
-use base64::engine::general_purpose::{
-    GeneralPurpose, GeneralPurposeConfig, STANDARD as BASE64_STANDARD,
-};
+use base64::engine::general_purpose::{GeneralPurpose, GeneralPurposeConfig};
 use base64::engine::DecodePaddingMode;
 use base64::Engine;
 use glam::{DMat3, DMat4, DVec3};
 use percent_encoding::percent_decode_str;
-use serde_json::json;
 
-use super::{one_line, read_file, ReadStats};
+use super::super::{one_line, read_file, ReadStats};
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 
@@ -38,7 +28,7 @@ const MAX_VIEWLESS_COMPONENTS: usize = 1 << 24;
 
 /// Parses the glTF or GLB file at `path` into the triangles of its scene, in world
 /// coordinates.
-pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
+pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let data = read_file(path)?;
     let parse_err = |message: String| Error::parse(path, None, message);
     check_glb_header(&data).map_err(parse_err)?;
@@ -606,129 +596,6 @@ fn component(b: &[u8], ty: DataType, normalized: bool) -> f64 {
     }
 }
 
-/// The glTF JSON (without the buffer's `uri`) and binary buffer of `mesh` with `normals`.
-fn build(
-    mesh: &TriMesh,
-    normals: &[DVec3],
-) -> std::result::Result<(serde_json::Value, Vec<u8>), String> {
-    if mesh.positions.is_empty() || mesh.triangles.is_empty() {
-        return Err(format!(
-            "glTF cannot hold an empty mesh ({} vertices, {} triangles)",
-            mesh.positions.len(),
-            mesh.triangles.len()
-        ));
-    }
-    let v = mesh.positions.len();
-    let f = mesh.triangles.len();
-    let pos_bytes = v * 12;
-    let idx_bytes = f * 12;
-    let total = 2 * pos_bytes + idx_bytes;
-    if u32::try_from(total + 4096).is_err() {
-        return Err(format!(
-            "{total} bytes of vertex and index data is too much for glTF"
-        ));
-    }
-    let mut bin = Vec::with_capacity(total);
-    let mut min = glam::Vec3::splat(f32::INFINITY);
-    let mut max = glam::Vec3::splat(f32::NEG_INFINITY);
-    for p in &mesh.positions {
-        let p = p.as_vec3();
-        if !p.is_finite() {
-            return Err(format!("position {p} does not fit in f32"));
-        }
-        min = min.min(p);
-        max = max.max(p);
-        for c in p.to_array() {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for n in normals {
-        let n = n.as_vec3().normalize_or(glam::Vec3::Z);
-        for c in n.to_array() {
-            bin.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for t in &mesh.triangles {
-        for i in t {
-            bin.extend_from_slice(&i.to_le_bytes());
-        }
-    }
-    // f32 bounds written as the f64 of the same value, so they match the data exactly.
-    let bound = |b: glam::Vec3| b.to_array().map(f64::from).to_vec();
-    let json = json!({
-        "asset": { "version": "2.0", "generator": "spectral-remesh" },
-        "scene": 0,
-        "scenes": [ { "nodes": [0] } ],
-        "nodes": [ { "mesh": 0 } ],
-        "meshes": [ {
-            "primitives": [ {
-                "attributes": { "POSITION": 0, "NORMAL": 1 },
-                "indices": 2,
-                "mode": 4
-            } ]
-        } ],
-        "accessors": [
-            { "bufferView": 0, "componentType": 5126, "count": v, "type": "VEC3",
-              "min": bound(min), "max": bound(max) },
-            { "bufferView": 1, "componentType": 5126, "count": v, "type": "VEC3" },
-            { "bufferView": 2, "componentType": 5125, "count": 3 * f, "type": "SCALAR" }
-        ],
-        "bufferViews": [
-            { "buffer": 0, "byteOffset": 0, "byteLength": pos_bytes, "target": 34962 },
-            { "buffer": 0, "byteOffset": pos_bytes, "byteLength": pos_bytes, "target": 34962 },
-            { "buffer": 0, "byteOffset": 2 * pos_bytes, "byteLength": idx_bytes,
-              "target": 34963 }
-        ],
-        "buffers": [ { "byteLength": total } ]
-    });
-    Ok((json, bin))
-}
-
-/// The `.glb` bytes of `mesh`: header, JSON chunk padded with spaces, BIN chunk padded with
-/// zeros.
-pub(super) fn encode_glb(
-    mesh: &TriMesh,
-    normals: &[DVec3],
-) -> std::result::Result<Vec<u8>, String> {
-    let (json, bin) = build(mesh, normals)?;
-    let mut json = serde_json::to_vec(&json).map_err(|e| e.to_string())?;
-    while json.len() % 4 != 0 {
-        json.push(b' ');
-    }
-    let mut bin = bin;
-    while bin.len() % 4 != 0 {
-        bin.push(0);
-    }
-    let total = 12 + 8 + json.len() + 8 + bin.len();
-    let total32 = u32::try_from(total).map_err(|_| format!("{total} bytes is too much for GLB"))?;
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&total32.to_le_bytes());
-    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
-    Ok(out)
-}
-
-/// The `.gltf` (JSON) bytes of `mesh`, its buffer embedded as a base64 data URI.
-pub(super) fn encode_gltf(
-    mesh: &TriMesh,
-    normals: &[DVec3],
-) -> std::result::Result<Vec<u8>, String> {
-    let (mut json, bin) = build(mesh, normals)?;
-    json["buffers"][0]["uri"] = serde_json::Value::String(format!(
-        "data:application/octet-stream;base64,{}",
-        BASE64_STANDARD.encode(&bin)
-    ));
-    let mut out = serde_json::to_vec_pretty(&json).map_err(|e| e.to_string())?;
-    out.push(b'\n');
-    Ok(out)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -775,11 +642,5 @@ mod tests {
             read_uri(dir.path(), "missing.bin"),
             Err(BufferError::Io(_))
         ));
-    }
-
-    #[test]
-    fn embedded_output_is_standard_padded_base64() {
-        assert_eq!(BASE64_STANDARD.encode([0u8, 1, 2, 255]), "AAEC/w==");
-        assert_eq!(BASE64_STANDARD.encode(b"ab"), "YWI=");
     }
 }
