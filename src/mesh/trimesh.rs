@@ -383,6 +383,25 @@ pub(crate) mod test_meshes {
             .collect()
     }
 
+    /// The 8 corners (z = 0) of a convex quad 0-3-1-2 whose long diagonal is 0-1, and of a ring
+    /// 6-5-7-4 around it: triangulated along 0-1 inside the ring, 0 and 1 get six faces each
+    /// (the flip tests' fixture).
+    pub fn quad_in_ring() -> Vec<DVec3> {
+        [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (1.0, 0.3),
+            (1.0, -0.3),
+            (1.0, 2.0),
+            (1.0, -2.0),
+            (-1.5, 0.0),
+            (3.5, 0.0),
+        ]
+        .iter()
+        .map(|&(x, y)| DVec3::new(x, y, 0.0))
+        .collect()
+    }
+
     /// A closed axis-aligned box from `lo` to `hi`, faces outward.
     pub fn cuboid(lo: DVec3, hi: DVec3) -> TriMesh {
         let p = |x: usize, y: usize, z: usize| {

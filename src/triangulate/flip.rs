@@ -90,19 +90,7 @@ mod tests {
     /// A convex quad 0-3-1-2 split along its long diagonal 0-1, alone or inside a ring 4..=7
     /// that gives 0 and 1 six faces each.
     fn quad(with_ring: bool) -> EditMesh<()> {
-        let positions: Vec<DVec3> = [
-            (0.0, 0.0),
-            (2.0, 0.0),
-            (1.0, 0.3),
-            (1.0, -0.3),
-            (1.0, 2.0),
-            (1.0, -2.0),
-            (-1.5, 0.0),
-            (3.5, 0.0),
-        ]
-        .iter()
-        .map(|&(x, y)| DVec3::new(x, y, 0.0))
-        .collect();
+        let positions: Vec<DVec3> = crate::mesh::test_meshes::quad_in_ring();
         let mut m = EditMesh::new(positions, SlotPolicy::Reuse);
         let mut faces = vec![[0, 1, 2], [1, 0, 3]];
         if with_ring {

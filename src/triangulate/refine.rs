@@ -247,19 +247,7 @@ mod tests {
     fn flips_raise_the_smallest_angle_and_keep_the_mesh_manifold() {
         // Convex quad 0-3-1-2 split along its long diagonal 0-1, inside a ring 6-5-7-4 so that
         // 0 and 1 have six faces each.
-        let positions: Vec<DVec3> = [
-            (0.0, 0.0),
-            (2.0, 0.0),
-            (1.0, 0.3),
-            (1.0, -0.3),
-            (1.0, 2.0),
-            (1.0, -2.0),
-            (-1.5, 0.0),
-            (3.5, 0.0),
-        ]
-        .iter()
-        .map(|&(x, y)| DVec3::new(x, y, 0.0))
-        .collect();
+        let positions: Vec<DVec3> = crate::mesh::test_meshes::quad_in_ring();
         let normals = vec![DVec3::Z; positions.len()];
         let mut b = builder(&positions);
         for t in [
