@@ -8,13 +8,20 @@ use crate::geometry::tolerance::IMPROVEMENT_TOLERANCE;
 use glam::DVec3;
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
-use rayon::prelude::*;
 
 use super::flip::max_min_flips;
 use crate::geometry::triangle::{triangle_angles_deg, triangle_q};
 use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::mesh_projection::MeshSurface;
+
+mod collapse;
+mod cover;
+mod relax;
+
+use collapse::collapse_short;
+use cover::cover;
+use relax::{flip_poor, relax_poor};
 
 /// Parameters of [`optimize`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,25 +71,25 @@ impl Default for OptimizeParams {
 /// [`OptimizeParams`] with its lengths resolved to bbox-100 units for one sigma_p: what the
 /// operations read.
 #[derive(Debug, Clone, Copy)]
-struct Limits {
+pub(super) struct Limits {
     /// [`OptimizeParams::q_below`].
-    q_below: f64,
+    pub(super) q_below: f64,
     /// [`OptimizeParams::theta_below_deg`], degrees.
-    theta_below_deg: f64,
+    pub(super) theta_below_deg: f64,
     /// [`OptimizeParams::sweeps`].
-    sweeps: usize,
+    pub(super) sweeps: usize,
     /// [`OptimizeParams::max_normal_turn_deg`], degrees.
-    max_normal_turn_deg: f64,
+    pub(super) max_normal_turn_deg: f64,
     /// [`OptimizeParams::max_offset_sigma_p`] · sigma_p, bbox-100 units.
-    max_offset: f64,
+    pub(super) max_offset: f64,
     /// [`OptimizeParams::cover_distance_sigma_p`] · sigma_p, bbox-100 units.
-    cover_distance: f64,
+    pub(super) cover_distance: f64,
     /// [`OptimizeParams::cover_rounds`].
-    cover_rounds: usize,
+    pub(super) cover_rounds: usize,
     /// [`OptimizeParams::short_edge_ratio`].
-    short_edge_ratio: f64,
+    pub(super) short_edge_ratio: f64,
     /// [`OptimizeParams::collapse_offset_sigma_p`] · sigma_p, bbox-100 units.
-    collapse_offset: f64,
+    pub(super) collapse_offset: f64,
 }
 
 impl Limits {
@@ -116,40 +123,40 @@ pub struct OptimizeStats {
 
 /// The mesh being optimized: each face labelled with the index of the input face it still is
 /// (`None` once an operation made or changed it).
-type Mesh = EditMesh<Option<u32>>;
+pub(super) type Mesh = EditMesh<Option<u32>>;
 
-fn normal(m: &Mesh, t: [u32; 3]) -> DVec3 {
+pub(super) fn normal(m: &Mesh, t: [u32; 3]) -> DVec3 {
     let [a, b, c] = m.corners(t);
     (b - a).cross(c - a).normalize_or_zero()
 }
 
-fn min_angle(m: &Mesh, t: [u32; 3]) -> f64 {
+pub(super) fn min_angle(m: &Mesh, t: [u32; 3]) -> f64 {
     let a = triangle_angles_deg(m.corners(t));
     a[0].min(a[1]).min(a[2])
 }
 
-fn q(m: &Mesh, t: [u32; 3]) -> f64 {
+pub(super) fn q(m: &Mesh, t: [u32; 3]) -> f64 {
     triangle_q(m.corners(t))
 }
 
 /// The shape score the operations maximize at their worst face: Q and the smallest angle, each
 /// relative to a good level (Q 0.6, 30°), whichever is lower.
-fn score(m: &Mesh, t: [u32; 3]) -> f64 {
+pub(super) fn score(m: &Mesh, t: [u32; 3]) -> f64 {
     (q(m, t) / 0.6).min(min_angle(m, t) / 30.0)
 }
 
 /// Whether `t` is one of the triangles the operations work on.
-fn is_poor(m: &Mesh, t: [u32; 3], params: &Limits) -> bool {
+pub(super) fn is_poor(m: &Mesh, t: [u32; 3], params: &Limits) -> bool {
     q(m, t) < params.q_below || min_angle(m, t) < params.theta_below_deg
 }
 
 /// The face in slot `f`, which must be live.
-fn face(m: &Mesh, f: u32) -> [u32; 3] {
+pub(super) fn face(m: &Mesh, f: u32) -> [u32; 3] {
     m.face(f)
         .unwrap_or_else(|| unreachable!("face {f} is live"))
 }
 
-fn distance_to_faces(m: &Mesh, faces: &[u32], p: DVec3) -> f64 {
+pub(super) fn distance_to_faces(m: &Mesh, faces: &[u32], p: DVec3) -> f64 {
     faces
         .iter()
         .map(|&f| {
@@ -233,153 +240,8 @@ pub fn optimize(
     (stats, origin)
 }
 
-/// One round of covering: the points of `points` farther than `cover_distance` from the mesh,
-/// farthest first and at most one per face, each split into the face nearest to it. `watch`
-/// carries, from the first round to the next, the points worth looking at again. Returns how
-/// many were inserted.
-fn cover(m: &mut Mesh, points: &[DVec3], watch: &mut Option<Vec<u32>>, params: &Limits) -> usize {
-    let (live, slot) = m.live_faces();
-    let current = TriMesh::new(m.positions().to_vec(), live);
-    let Ok(output) = MeshSurface::new(&current) else {
-        return 0;
-    };
-    // The points to look at: all of them the first time; then those that could come farther
-    // than the cover distance: a collapse moves the mesh by up to `collapse_offset` from a
-    // surface point, relaxation by less.
-    if watch.is_none() {
-        *watch = Some(
-            points
-                .par_iter()
-                .enumerate()
-                .filter(|(_, &p)| {
-                    output
-                        .closest_point_within(
-                            p,
-                            (params.cover_distance - params.collapse_offset).max(0.0),
-                        )
-                        .is_none()
-                })
-                .map(|(i, _)| i as u32)
-                .collect(),
-        );
-    }
-    let watched = watch.as_deref().unwrap_or_default();
-    let mut far: Vec<(f64, usize, u32)> = watched
-        .par_iter()
-        .filter_map(|&i| {
-            let i = i as usize;
-            let sp = output.closest_point(points[i])?;
-            (sp.distance > params.cover_distance).then_some((
-                sp.distance,
-                i,
-                slot[sp.face as usize],
-            ))
-        })
-        .collect();
-    far.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-    let mut touched = vec![false; m.slots()];
-    let mut added = 0;
-    for (_, i, f) in far {
-        let t = face(m, f);
-        // One insertion per face and its neighbours per round: the next round sees the result.
-        if touched[f as usize] {
-            continue;
-        }
-        let p = points[i];
-        let [pa, pb, pc] = m.corners(t);
-        let n = (pb - pa).cross(pc - pa);
-        let corner = [pa, pb, pc];
-        let v = m.vertex_count() as u32;
-        // Which side of each edge k (corner k → k+1) p is on, in the face's plane.
-        let outside: Vec<usize> = (0..3)
-            .filter(|&k| {
-                let (x, y) = (corner[k], corner[(k + 1) % 3]);
-                (y - x).cross(p - x).dot(n) <= 0.0
-            })
-            .collect();
-        // (new face, the old face it comes from), and the edge to split (`None`: the face).
-        let (plan, split): (SplitPlan, Option<(u32, u32)>) = if outside.is_empty() {
-            // Inside the face: split it in three.
-            let [a, b, c] = t;
-            (vec![([a, b, v], t), ([b, c, v], t), ([c, a, v], t)], None)
-        } else {
-            // Beyond an edge (or a corner: the nearer of its two edges): split that edge and
-            // the face across it.
-            let k = *outside
-                .iter()
-                .min_by(|&&k1, &&k2| {
-                    let d = |k: usize| segment_distance(corner[k], corner[(k + 1) % 3], p);
-                    d(k1).total_cmp(&d(k2))
-                })
-                .unwrap_or(&outside[0]);
-            let (x, y, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
-            // A boundary edge stays as the boundary samples made it.
-            let Some(g) = m.face_on(y, x) else {
-                continue;
-            };
-            if touched[g as usize] {
-                continue;
-            }
-            let u = face(m, g);
-            let d = starting_at(u, y)[2];
-            (
-                vec![
-                    ([x, v, c], t),
-                    ([v, y, c], t),
-                    ([y, v, d], u),
-                    ([v, x, d], u),
-                ],
-                Some((x, y)),
-            )
-        };
-        // Every new face must face the way the face it comes from did.
-        let at = |u: u32| if u == v { p } else { m.position(u) };
-        let unit = |t: [u32; 3]| {
-            let [a, b, c] = t.map(at);
-            (b - a).cross(c - a).normalize_or_zero()
-        };
-        let fits = plan
-            .iter()
-            .all(|&(new, old)| unit(new).dot(normal(m, old)) > 0.0);
-        if !fits {
-            continue;
-        }
-        m.add_vertex(p);
-        let done = match split {
-            None => m.split_face(f, v, None).map(|_| ()),
-            Some((x, y)) => m.split_edge(x, y, v, None).map(|_| ()),
-        };
-        if done.is_err() {
-            m.pop_vertex();
-            continue;
-        }
-        touched.resize(m.slots(), true);
-        for &u in plan.iter().flat_map(|x| x.0.iter()) {
-            for &g in m.faces_around(u) {
-                touched[g as usize] = true;
-            }
-        }
-        added += 1;
-    }
-    added
-}
-
-/// The faces a split makes: (new face, the old face it comes from).
-type SplitPlan = Vec<([u32; 3], [u32; 3])>;
-
-/// The distance from `p` to the segment `a`–`b`.
-fn segment_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 {
-        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + t * ab)
-}
-
 /// The vertices of the faces with Q below `q_below`, sorted.
-fn poor_vertices(m: &Mesh, params: &Limits) -> Vec<u32> {
+pub(super) fn poor_vertices(m: &Mesh, params: &Limits) -> Vec<u32> {
     let mut v: Vec<u32> = m
         .live_faces()
         .0
@@ -390,136 +252,6 @@ fn poor_vertices(m: &Mesh, params: &Limits) -> Vec<u32> {
     v.sort_unstable();
     v.dedup();
     v
-}
-
-/// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around poor triangles'
-/// vertices, where the new faces face the way the old ones did and stay within `max_offset` of
-/// the surface. Returns the number of flips.
-fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &Limits) -> usize {
-    let mut edges: Vec<(u32, u32)> = Vec::new();
-    for v in poor_vertices(m, params) {
-        for &f in m.faces_around(v) {
-            let t = face(m, f);
-            for k in 0..3 {
-                let (x, y) = (t[k], t[(k + 1) % 3]);
-                edges.push((x.min(y), x.max(y)));
-            }
-        }
-    }
-    edges.sort_unstable();
-    edges.dedup();
-    max_min_flips(m, &edges, None, |m, flip| {
-        let [t1, t2] = flip.old;
-        let [new1, new2] = flip.new;
-        let (x, y, c, d) = (t1[0], t1[1], t1[2], t2[2]);
-        // The new faces must face the way the old ones did and stay on the surface.
-        let (n1, n2) = (normal(m, t1), normal(m, t2));
-        let (m1, m2) = (normal(m, new1), normal(m, new2));
-        let mean_old = n1 + n2;
-        if m1.dot(mean_old) <= 0.0 || m2.dot(mean_old) <= 0.0 || m1.dot(m2) < 0.0 {
-            return false;
-        }
-        let (px, py, pc, pd) = (m.position(x), m.position(y), m.position(c), m.position(d));
-        let Some(new_mid) = surface.closest_point(0.5 * (pc + pd)) else {
-            return false;
-        };
-        if new_mid.distance > params.max_offset {
-            return false;
-        }
-        let Some(old_mid) = surface.closest_point(0.5 * (px + py)) else {
-            return false;
-        };
-        let tri_dist = |t: [u32; 3], p: DVec3| {
-            let [a, b, c] = m.corners(t);
-            Triangle::new(a, b, c).distance_to_local_point(p, true)
-        };
-        tri_dist(new1, old_mid.position).min(tri_dist(new2, old_mid.position)) <= params.max_offset
-    })
-}
-
-/// One sweep of relaxation over the vertices of poor triangles (see [`optimize`]).
-/// Returns the number of moves.
-fn relax_poor(m: &mut Mesh, surface: &MeshSurface, fixed: &[bool], params: &Limits) -> usize {
-    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
-    let mut moves = 0;
-    let mut ring: Vec<u32> = Vec::new();
-    for v in poor_vertices(m, params) {
-        if fixed.get(v as usize).copied().unwrap_or(false) {
-            continue;
-        }
-        let faces = m.faces_around(v).to_vec();
-        if faces.is_empty() {
-            continue;
-        }
-        // A vertex on a boundary edge stays.
-        if m.is_boundary_vertex(v) {
-            continue;
-        }
-        let old_normals: Vec<DVec3> = faces.iter().map(|&f| normal(m, face(m, f))).collect();
-        let worst_q = |m: &Mesh| {
-            faces
-                .iter()
-                .map(|&f| score(m, face(m, f)))
-                .fold(f64::INFINITY, f64::min)
-        };
-        ring.clear();
-        for &f in &faces {
-            ring.extend(face(m, f).iter().filter(|&&u| u != v));
-        }
-        ring.sort_unstable();
-        ring.dedup();
-        let centroid = ring
-            .iter()
-            .map(|&u| m.position(u))
-            .fold(DVec3::ZERO, |a, b| a + b)
-            / ring.len() as f64;
-        let old = m.position(v);
-        // Targets: the centroid, and for each poor face the apex of the equilateral triangle on
-        // the edge opposite v (in the face's plane, on v's side).
-        let mut targets = vec![centroid];
-        for &f in &faces {
-            let t = starting_at(face(m, f), v);
-            if !is_poor(m, t, params) {
-                continue;
-            }
-            let (pb, pc) = (m.position(t[1]), m.position(t[2]));
-            let mid = 0.5 * (pb + pc);
-            let e = pc - pb;
-            let height = old - mid;
-            let across = (height - e * (height.dot(e) / e.length_squared().max(f64::MIN_POSITIVE)))
-                .normalize_or_zero();
-            if across != DVec3::ZERO {
-                targets.push(mid + across * (0.75f64.sqrt() * e.length()));
-            }
-        }
-        let mut best = (worst_q(m), old);
-        for (target, t) in targets
-            .iter()
-            .flat_map(|&c| [1.0, 0.5, 0.25].map(|t| (c, t)))
-        {
-            let Some(sp) = surface.closest_point(old.lerp(target, t)) else {
-                continue;
-            };
-            if m.relocate_vertex(v, sp.position).is_err() {
-                continue;
-            }
-            let turned = faces
-                .iter()
-                .zip(&old_normals)
-                .any(|(&f, &n0)| normal(m, face(m, f)).dot(n0) < cos_turn);
-            let q = worst_q(m);
-            if !turned
-                && q > best.0 + IMPROVEMENT_TOLERANCE
-                && distance_to_faces(m, &faces, old) <= params.max_offset
-            {
-                best = (q, sp.position);
-            }
-        }
-        if m.relocate_vertex(v, best.1).is_ok() && best.1 != old {
-            moves += 1;
-        }
-    }
-    moves
 }
 
 /// The median edge length of the live faces (0 for an empty mesh).
@@ -537,137 +269,6 @@ fn median_edge_length(m: &Mesh) -> f64 {
     }
     let mid = lengths.len() / 2;
     *lengths.select_nth_unstable_by(mid, f64::total_cmp).1
-}
-
-/// Collapses the interior edges of poor triangles shorter than `short`, shortest first: one end
-/// merges into the other, at the kept end's position (a fixed end is always the kept one) or at
-/// the surface point nearest the edge's midpoint, whichever leaves the best smallest Q. A
-/// collapse is made only when it keeps the mesh manifold (the link condition: the two ends share
-/// exactly the two opposite vertices), raises the smallest Q of the faces involved, turns no face
-/// by more than `max_normal_turn_deg`, and leaves both old positions within `collapse_offset` of
-/// the new faces. Returns the number of collapses.
-fn collapse_short(
-    m: &mut Mesh,
-    surface: &MeshSurface,
-    fixed: &[bool],
-    short: f64,
-    params: &Limits,
-) -> usize {
-    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
-    let mut edges: Vec<(f64, u32, u32)> = Vec::new();
-    for t in m.live_faces().0 {
-        if !is_poor(m, t, params) {
-            continue;
-        }
-        for k in 0..3 {
-            let (x, y) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
-            let l = m.position(x).distance(m.position(y));
-            if l < short {
-                edges.push((l, x, y));
-            }
-        }
-    }
-    edges.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
-    edges.dedup();
-    let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
-    let mut collapses = 0;
-    for (_, a, b) in edges {
-        let Ok((f1, f2, c, d)) = m.edge_faces(a, b) else {
-            continue;
-        };
-        let (pa, pb) = (m.position(a), m.position(b));
-        if pa.distance(pb) >= short {
-            continue;
-        }
-        let (ra, rb) = (m.ring(a), m.ring(b));
-        let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
-        if c == d
-            || common.len() != 2
-            || !common.contains(&c)
-            || !common.contains(&d)
-            || m.degree(c) <= 3
-            || m.degree(d) <= 3
-        {
-            continue;
-        }
-        let keep_a = is_fixed(a) || m.is_boundary_vertex(a);
-        let keep_b = is_fixed(b) || m.is_boundary_vertex(b);
-        // (removed, kept, position of the kept vertex)
-        let mut options: Vec<(u32, u32, DVec3)> = Vec::new();
-        match (keep_a, keep_b) {
-            (true, true) => continue,
-            (true, false) => options.push((b, a, pa)),
-            (false, true) => options.push((a, b, pb)),
-            (false, false) => {
-                options.push((b, a, pa));
-                options.push((a, b, pb));
-                if let Some(sp) = surface.closest_point(0.5 * (pa + pb)) {
-                    options.push((b, a, sp.position));
-                }
-            }
-        }
-        // The faces that change: all around a and b but f1 and f2.
-        let mut involved: Vec<u32> = m
-            .faces_around(a)
-            .iter()
-            .chain(m.faces_around(b))
-            .copied()
-            .filter(|&g| g != f1 && g != f2)
-            .collect();
-        involved.sort_unstable();
-        involved.dedup();
-        let before = involved
-            .iter()
-            .chain([&f1, &f2])
-            .map(|&g| score(m, face(m, g)))
-            .fold(f64::INFINITY, f64::min);
-        let old_normals: Vec<DVec3> = involved.iter().map(|&g| normal(m, face(m, g))).collect();
-        let mut best: Option<(f64, u32, u32, DVec3)> = None;
-        for (removed, kept, q) in options {
-            let saved = m.position(kept);
-            if m.relocate_vertex(kept, q).is_err() {
-                continue;
-            }
-            let new_faces: Vec<[u32; 3]> = involved
-                .iter()
-                .map(|&g| face(m, g).map(|u| if u == removed { kept } else { u }))
-                .collect();
-            let turned = new_faces
-                .iter()
-                .zip(&old_normals)
-                .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
-            let worst = new_faces
-                .iter()
-                .map(|&t| score(m, t))
-                .fold(f64::INFINITY, f64::min);
-            let dist = |p: DVec3| {
-                new_faces
-                    .iter()
-                    .map(|&t| {
-                        let [x, y, z] = m.corners(t);
-                        Triangle::new(x, y, z).distance_to_local_point(p, true)
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            };
-            let near = dist(pa) <= params.collapse_offset && dist(pb) <= params.collapse_offset;
-            // The old position was finite: restoring it cannot fail.
-            let _ = m.relocate_vertex(kept, saved);
-            if !turned
-                && near
-                && worst > before + IMPROVEMENT_TOLERANCE
-                && best.is_none_or(|b| worst > b.0)
-            {
-                best = Some((worst, removed, kept, q));
-            }
-        }
-        let Some((_, removed, kept, q)) = best else {
-            continue;
-        };
-        if m.collapse_edge(removed, kept, q, None).is_ok() {
-            collapses += 1;
-        }
-    }
-    collapses
 }
 
 #[cfg(test)]

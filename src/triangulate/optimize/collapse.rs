@@ -1,0 +1,139 @@
+//! Collapses of the short edges of poor triangles, under the link condition and guarded against
+//! the input surface.
+
+use glam::DVec3;
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::Triangle;
+
+use super::*;
+
+/// Collapses the interior edges of poor triangles shorter than `short`, shortest first: one end
+/// merges into the other, at the kept end's position (a fixed end is always the kept one) or at
+/// the surface point nearest the edge's midpoint, whichever leaves the best smallest Q. A
+/// collapse is made only when it keeps the mesh manifold (the link condition: the two ends share
+/// exactly the two opposite vertices), raises the smallest Q of the faces involved, turns no face
+/// by more than `max_normal_turn_deg`, and leaves both old positions within `collapse_offset` of
+/// the new faces. Returns the number of collapses.
+pub(super) fn collapse_short(
+    m: &mut Mesh,
+    surface: &MeshSurface,
+    fixed: &[bool],
+    short: f64,
+    params: &Limits,
+) -> usize {
+    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
+    let mut edges: Vec<(f64, u32, u32)> = Vec::new();
+    for t in m.live_faces().0 {
+        if !is_poor(m, t, params) {
+            continue;
+        }
+        for k in 0..3 {
+            let (x, y) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+            let l = m.position(x).distance(m.position(y));
+            if l < short {
+                edges.push((l, x, y));
+            }
+        }
+    }
+    edges.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+    edges.dedup();
+    let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
+    let mut collapses = 0;
+    for (_, a, b) in edges {
+        let Ok((f1, f2, c, d)) = m.edge_faces(a, b) else {
+            continue;
+        };
+        let (pa, pb) = (m.position(a), m.position(b));
+        if pa.distance(pb) >= short {
+            continue;
+        }
+        let (ra, rb) = (m.ring(a), m.ring(b));
+        let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
+        if c == d
+            || common.len() != 2
+            || !common.contains(&c)
+            || !common.contains(&d)
+            || m.degree(c) <= 3
+            || m.degree(d) <= 3
+        {
+            continue;
+        }
+        let keep_a = is_fixed(a) || m.is_boundary_vertex(a);
+        let keep_b = is_fixed(b) || m.is_boundary_vertex(b);
+        // (removed, kept, position of the kept vertex)
+        let mut options: Vec<(u32, u32, DVec3)> = Vec::new();
+        match (keep_a, keep_b) {
+            (true, true) => continue,
+            (true, false) => options.push((b, a, pa)),
+            (false, true) => options.push((a, b, pb)),
+            (false, false) => {
+                options.push((b, a, pa));
+                options.push((a, b, pb));
+                if let Some(sp) = surface.closest_point(0.5 * (pa + pb)) {
+                    options.push((b, a, sp.position));
+                }
+            }
+        }
+        // The faces that change: all around a and b but f1 and f2.
+        let mut involved: Vec<u32> = m
+            .faces_around(a)
+            .iter()
+            .chain(m.faces_around(b))
+            .copied()
+            .filter(|&g| g != f1 && g != f2)
+            .collect();
+        involved.sort_unstable();
+        involved.dedup();
+        let before = involved
+            .iter()
+            .chain([&f1, &f2])
+            .map(|&g| score(m, face(m, g)))
+            .fold(f64::INFINITY, f64::min);
+        let old_normals: Vec<DVec3> = involved.iter().map(|&g| normal(m, face(m, g))).collect();
+        let mut best: Option<(f64, u32, u32, DVec3)> = None;
+        for (removed, kept, q) in options {
+            let saved = m.position(kept);
+            if m.relocate_vertex(kept, q).is_err() {
+                continue;
+            }
+            let new_faces: Vec<[u32; 3]> = involved
+                .iter()
+                .map(|&g| face(m, g).map(|u| if u == removed { kept } else { u }))
+                .collect();
+            let turned = new_faces
+                .iter()
+                .zip(&old_normals)
+                .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
+            let worst = new_faces
+                .iter()
+                .map(|&t| score(m, t))
+                .fold(f64::INFINITY, f64::min);
+            let dist = |p: DVec3| {
+                new_faces
+                    .iter()
+                    .map(|&t| {
+                        let [x, y, z] = m.corners(t);
+                        Triangle::new(x, y, z).distance_to_local_point(p, true)
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let near = dist(pa) <= params.collapse_offset && dist(pb) <= params.collapse_offset;
+            // The old position was finite: restoring it cannot fail.
+            let _ = m.relocate_vertex(kept, saved);
+            if !turned
+                && near
+                && worst > before + IMPROVEMENT_TOLERANCE
+                && best.is_none_or(|b| worst > b.0)
+            {
+                best = Some((worst, removed, kept, q));
+            }
+        }
+        let Some((_, removed, kept, q)) = best else {
+            continue;
+        };
+        if m.collapse_edge(removed, kept, q, None).is_ok() {
+            collapses += 1;
+        }
+    }
+    collapses
+}

@@ -1,0 +1,143 @@
+//! Max-min flips and relaxation of the vertices of poor triangles, guarded against the input
+//! surface.
+
+use glam::DVec3;
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::Triangle;
+
+use super::*;
+
+/// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around poor triangles'
+/// vertices, where the new faces face the way the old ones did and stay within `max_offset` of
+/// the surface. Returns the number of flips.
+pub(super) fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &Limits) -> usize {
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    for v in poor_vertices(m, params) {
+        for &f in m.faces_around(v) {
+            let t = face(m, f);
+            for k in 0..3 {
+                let (x, y) = (t[k], t[(k + 1) % 3]);
+                edges.push((x.min(y), x.max(y)));
+            }
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    max_min_flips(m, &edges, None, |m, flip| {
+        let [t1, t2] = flip.old;
+        let [new1, new2] = flip.new;
+        let (x, y, c, d) = (t1[0], t1[1], t1[2], t2[2]);
+        // The new faces must face the way the old ones did and stay on the surface.
+        let (n1, n2) = (normal(m, t1), normal(m, t2));
+        let (m1, m2) = (normal(m, new1), normal(m, new2));
+        let mean_old = n1 + n2;
+        if m1.dot(mean_old) <= 0.0 || m2.dot(mean_old) <= 0.0 || m1.dot(m2) < 0.0 {
+            return false;
+        }
+        let (px, py, pc, pd) = (m.position(x), m.position(y), m.position(c), m.position(d));
+        let Some(new_mid) = surface.closest_point(0.5 * (pc + pd)) else {
+            return false;
+        };
+        if new_mid.distance > params.max_offset {
+            return false;
+        }
+        let Some(old_mid) = surface.closest_point(0.5 * (px + py)) else {
+            return false;
+        };
+        let tri_dist = |t: [u32; 3], p: DVec3| {
+            let [a, b, c] = m.corners(t);
+            Triangle::new(a, b, c).distance_to_local_point(p, true)
+        };
+        tri_dist(new1, old_mid.position).min(tri_dist(new2, old_mid.position)) <= params.max_offset
+    })
+}
+
+/// One sweep of relaxation over the vertices of poor triangles (see [`optimize`]).
+/// Returns the number of moves.
+pub(super) fn relax_poor(
+    m: &mut Mesh,
+    surface: &MeshSurface,
+    fixed: &[bool],
+    params: &Limits,
+) -> usize {
+    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
+    let mut moves = 0;
+    let mut ring: Vec<u32> = Vec::new();
+    for v in poor_vertices(m, params) {
+        if fixed.get(v as usize).copied().unwrap_or(false) {
+            continue;
+        }
+        let faces = m.faces_around(v).to_vec();
+        if faces.is_empty() {
+            continue;
+        }
+        // A vertex on a boundary edge stays.
+        if m.is_boundary_vertex(v) {
+            continue;
+        }
+        let old_normals: Vec<DVec3> = faces.iter().map(|&f| normal(m, face(m, f))).collect();
+        let worst_q = |m: &Mesh| {
+            faces
+                .iter()
+                .map(|&f| score(m, face(m, f)))
+                .fold(f64::INFINITY, f64::min)
+        };
+        ring.clear();
+        for &f in &faces {
+            ring.extend(face(m, f).iter().filter(|&&u| u != v));
+        }
+        ring.sort_unstable();
+        ring.dedup();
+        let centroid = ring
+            .iter()
+            .map(|&u| m.position(u))
+            .fold(DVec3::ZERO, |a, b| a + b)
+            / ring.len() as f64;
+        let old = m.position(v);
+        // Targets: the centroid, and for each poor face the apex of the equilateral triangle on
+        // the edge opposite v (in the face's plane, on v's side).
+        let mut targets = vec![centroid];
+        for &f in &faces {
+            let t = starting_at(face(m, f), v);
+            if !is_poor(m, t, params) {
+                continue;
+            }
+            let (pb, pc) = (m.position(t[1]), m.position(t[2]));
+            let mid = 0.5 * (pb + pc);
+            let e = pc - pb;
+            let height = old - mid;
+            let across = (height - e * (height.dot(e) / e.length_squared().max(f64::MIN_POSITIVE)))
+                .normalize_or_zero();
+            if across != DVec3::ZERO {
+                targets.push(mid + across * (0.75f64.sqrt() * e.length()));
+            }
+        }
+        let mut best = (worst_q(m), old);
+        for (target, t) in targets
+            .iter()
+            .flat_map(|&c| [1.0, 0.5, 0.25].map(|t| (c, t)))
+        {
+            let Some(sp) = surface.closest_point(old.lerp(target, t)) else {
+                continue;
+            };
+            if m.relocate_vertex(v, sp.position).is_err() {
+                continue;
+            }
+            let turned = faces
+                .iter()
+                .zip(&old_normals)
+                .any(|(&f, &n0)| normal(m, face(m, f)).dot(n0) < cos_turn);
+            let q = worst_q(m);
+            if !turned
+                && q > best.0 + IMPROVEMENT_TOLERANCE
+                && distance_to_faces(m, &faces, old) <= params.max_offset
+            {
+                best = (q, sp.position);
+            }
+        }
+        if m.relocate_vertex(v, best.1).is_ok() && best.1 != old {
+            moves += 1;
+        }
+    }
+    moves
+}
