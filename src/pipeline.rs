@@ -236,6 +236,20 @@ pub fn remesh(
         Target::Points(n) => n as f64,
         Target::SigmaP(s) => SAMPLES_PER_SIGMA2 * area / (s * s),
     };
+    if let Target::SigmaP(s) = density {
+        // The same bound as --points: the candidate pool and the samples must fit in memory.
+        if !(expected <= MAX_POINTS as f64) {
+            let smallest = (SAMPLES_PER_SIGMA2 * area / MAX_POINTS as f64).sqrt();
+            return Err(Error::InvalidParameter {
+                name: "--sigma-p",
+                message: format!(
+                    "sigma_p {s} would give about {expected:.2e} samples on this surface, more \
+                     than the {MAX_POINTS} this remesher holds in memory; the smallest sigma_p \
+                     it takes here is {smallest:.4} (bbox-100 units)"
+                ),
+            });
+        }
+    }
     let pool_size = (params.candidates_per_sample * expected)
         .ceil()
         .clamp(16.0, 2e8) as usize;
@@ -457,5 +471,21 @@ pub fn remesh(
         start = sigma_p * (goal as f64 / new_goal as f64).sqrt();
         goal = new_goal;
     };
+    if output.mesh.triangles.is_empty() {
+        // Too few samples for any triangle to form (a handful of points on a closed surface, or
+        // sigma_p as large as the model): nothing to write.
+        let (name, what) = match density {
+            Target::Points(n) => ("--points", format!("{n} points")),
+            Target::SigmaP(s) => ("--sigma-p", format!("sigma_p {s}")),
+        };
+        return Err(Error::InvalidParameter {
+            name,
+            message: format!(
+                "{what} gave {} samples and no triangle on this surface; ask for more points \
+                 (a smaller sigma_p)",
+                output.samples
+            ),
+        });
+    }
     Ok(output)
 }

@@ -25,6 +25,11 @@
 //! | `--points` 5000 on a single triangle | result within 1%, one boundary loop |
 //! | output in a missing directory, or under a file | output error, nothing written |
 //! | output path equal to the input path | usage error, input untouched |
+//! | `--sigma-p` too small for memory (issue 14) | usage error naming the smallest it takes, at once |
+//! | `--points` or `--sigma-p` giving no triangle (issue 14) | usage error, nothing written (not an empty file) |
+//! | an unsupported output extension (issue 14) | usage error before any work |
+//! | `remesh points` or `simplify` to a non-.ply output (issue 14) | usage error, nothing written |
+//! | `quality --ref` of a reference without area (issue 14) | input error naming the reference |
 //! | an internal failure (a panic) | internal error, one line (injected in `app::catch_panics`'s unit test; the binary runs every job through it) |
 
 use std::path::{Path, PathBuf};
@@ -655,4 +660,111 @@ fn the_input_is_never_the_output() {
     let o = remesh(&[input.to_str().unwrap(), other.to_str().unwrap(), "-q"]);
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(std::fs::read(&input).unwrap(), before);
+}
+
+/// Issue 14, item 6: `--sigma-p 0.01` on spot asked for about 2e8 samples and aborted with a
+/// failed allocation of 11.9 GB and a backtrace; it is now a usage error before any work.
+#[test]
+fn sigma_p_too_small_for_memory_is_a_usage_error_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let input = shared("spot.obj");
+    let t = std::time::Instant::now();
+    let o = remesh(&[
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--sigma-p",
+        "0.01",
+    ]);
+    assert_error(&o, 2, &["--sigma-p", "smallest sigma_p"], &out);
+    assert!(t.elapsed().as_secs_f64() < 10.0, "{:?}", t.elapsed());
+}
+
+/// Issue 14, item 11: `--points 5` and `--sigma-p 1000` said "error: : no triangle ..." with an
+/// empty file name (exit 3), and with `--no-distance` wrote an empty mesh (exit 0).
+#[test]
+fn a_density_that_gives_no_triangle_is_a_usage_error_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let input = shared("spot.obj");
+    for (flag, value) in [("--points", "5"), ("--sigma-p", "1000")] {
+        for extra in [&[][..], &["--no-distance"][..]] {
+            let mut args = vec![input.to_str().unwrap(), out.to_str().unwrap(), flag, value];
+            args.extend_from_slice(extra);
+            let o = remesh(&args);
+            assert_error(&o, 2, &[flag, "no triangle"], &out);
+        }
+    }
+}
+
+/// Issue 14, item 11: an unsupported output extension was an input error (3), found after the
+/// whole remesh; `remesh points … out.obj` wrote PLY bytes under the .obj name.
+#[test]
+fn outputs_of_a_format_the_command_cannot_write_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = shared("spot.obj");
+    let stl = dir.path().join("out.stl");
+    let t = std::time::Instant::now();
+    let o = remesh(&[
+        input.to_str().unwrap(),
+        stl.to_str().unwrap(),
+        "--points",
+        "2000",
+    ]);
+    assert_error(&o, 2, &["out.stl", "unsupported output format"], &stl);
+    // Before the remesh, not after it.
+    assert!(t.elapsed().as_secs_f64() < 10.0, "{:?}", t.elapsed());
+    let points_obj = dir.path().join("points.obj");
+    let o = remesh(&[
+        "points",
+        input.to_str().unwrap(),
+        points_obj.to_str().unwrap(),
+        "--count",
+        "100",
+    ]);
+    assert_error(&o, 2, &["points.obj", ".ply"], &points_obj);
+    // simplify too (its input is checked after the output's format).
+    let ply = dir.path().join("points.ply");
+    let o = remesh(&[
+        "points",
+        input.to_str().unwrap(),
+        ply.to_str().unwrap(),
+        "--count",
+        "100",
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    let simplified = dir.path().join("simplified.xyz");
+    let o = remesh(&[
+        "simplify",
+        ply.to_str().unwrap(),
+        simplified.to_str().unwrap(),
+        "--points",
+        "10",
+    ]);
+    assert_error(&o, 2, &["simplified.xyz", ".ply"], &simplified);
+}
+
+/// Issue 14, item 11: `quality MESH --ref REF` with a reference the distance cannot use named
+/// MESH; each side's error names its own file.
+#[test]
+fn quality_names_the_reference_when_the_reference_is_bad() {
+    let dir = tempfile::tempdir().unwrap();
+    // Three collinear vertices: a face, but no area.
+    let flat = write(
+        dir.path(),
+        "flat-ref.obj",
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+    );
+    let mesh = shared("spot.obj");
+    let o = remesh(&[
+        "quality",
+        mesh.to_str().unwrap(),
+        "--ref",
+        flat.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("flat-ref.obj"), "{err}");
+    assert!(!err.contains("spot.obj"), "{err}");
 }

@@ -10,9 +10,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::io::{read_mesh, write_atomically, write_mesh};
+use crate::io::{read_mesh, write_atomically, write_mesh, MeshFormat};
 use crate::pipeline::{remesh, RemeshParams};
-use crate::report::{surface_distance, surface_distance_with, QualityReport};
+use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
 
 /// Samples per side for the Hausdorff and RMS distances of the report (Metro-style, on top of
@@ -47,6 +47,16 @@ pub struct RemeshJob {
 /// [`Error::Internal`] (stage `invariant check`) naming the violations when the output breaks
 /// an invariant, and then nothing is written.
 pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<QualityReport> {
+    // The output's format is known before any work: an unknown extension is a usage error.
+    if MeshFormat::from_path(&job.output).is_err() {
+        return Err(Error::InvalidParameter {
+            name: "OUTPUT",
+            message: format!(
+                "{}: unsupported output format (expected .obj, .ply, .gltf or .glb)",
+                job.output.display()
+            ),
+        });
+    }
     if same_file(&job.input, &job.output) {
         return Err(Error::InvalidParameter {
             name: "OUTPUT",
@@ -203,8 +213,10 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
 pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<QualityReport> {
     let t = Instant::now();
     let (mesh, _) = read_mesh(path)?;
-    let reference = reference.map(read_mesh).transpose()?.map(|r| r.0);
-    let frame = reference.as_ref().unwrap_or(&mesh);
+    let reference = reference
+        .map(|r| read_mesh(r).map(|(m, _)| (m, r)))
+        .transpose()?;
+    let frame = reference.as_ref().map_or(&mesh, |(r, _)| r);
     let bbox = frame
         .bbox()
         .ok_or_else(|| Error::invalid_mesh(path, "the mesh has no vertices"))?;
@@ -213,13 +225,21 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
     let m = normalization.apply_mesh(&mesh);
     let mut report = QualityReport::new(&m);
     report.push_stage("read and measure", t.elapsed().as_secs_f64());
-    if let Some(r) = &reference {
+    if let Some((r, reference_path)) = &reference {
         let t = Instant::now();
         let rn = normalization.apply_mesh(r);
         report.input_topology = Some(crate::check::topology(&rn));
-        report.distance = Some(
-            surface_distance(&m, &rn, DISTANCE_SAMPLES, seed).map_err(|e| with_path(e, path))?,
-        );
+        // Each side's error names its own file.
+        let sm = MeshSurface::new(&m).map_err(|e| with_path(e, path))?;
+        let sr = MeshSurface::new(&rn).map_err(|e| with_path(e, reference_path))?;
+        report.distance = Some(surface_distance_with(
+            &m,
+            &sm,
+            &rn,
+            &sr,
+            DISTANCE_SAMPLES,
+            seed,
+        ));
         report.push_stage("distance", t.elapsed().as_secs_f64());
     }
     Ok(report)
@@ -263,8 +283,27 @@ pub struct PointsJob {
 /// # Errors
 /// Reading and writing errors naming the file.
 pub fn run_points(job: &PointsJob) -> Result<()> {
+    require_ply_output(&job.output)?;
     let (mesh, _) = read_mesh(&job.mesh)?;
     crate::points::generate::write_surface_points(&mesh, job.count, job.seed, &job.output)
+}
+
+/// Point sets are written as binary PLY only: any other extension of `output` is a usage error
+/// (rather than PLY bytes under another format's name).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `OUTPUT`.
+pub(crate) fn require_ply_output(output: &Path) -> Result<()> {
+    match MeshFormat::from_path(output) {
+        Ok(MeshFormat::Ply) => Ok(()),
+        _ => Err(Error::InvalidParameter {
+            name: "OUTPUT",
+            message: format!(
+                "{}: point sets are written as binary PLY; give the output a .ply extension",
+                output.display()
+            ),
+        }),
+    }
 }
 
 /// Writes `report` as pretty JSON to `path`, atomically (a temporary file beside it, renamed
