@@ -30,6 +30,7 @@
 //! | an unsupported output extension (issue 14) | usage error before any work |
 //! | `remesh points` or `simplify` to a non-.ply output (issue 14) | usage error, nothing written |
 //! | `quality --ref` of a reference without area (issue 14) | input error naming the reference |
+//! | glTF nodes listed as a child twice or by two parents (issue 14) | input error, at once |
 //! | an internal failure (a panic) | internal error, one line (injected in `app::catch_panics`'s unit test; the binary runs every job through it) |
 
 use std::path::{Path, PathBuf};
@@ -767,4 +768,88 @@ fn quality_names_the_reference_when_the_reference_is_bad() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(err.contains("flat-ref.obj"), "{err}");
     assert!(!err.contains("spot.obj"), "{err}");
+}
+
+/// A glTF (JSON, buffer as a data URI) of one triangle mesh (mesh 0) and the given `nodes`
+/// array, whose scene's root is node 0.
+fn gltf_with_nodes(nodes: &str) -> String {
+    use base64::Engine;
+    let mut bin: Vec<u8> = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    for i in [0u32, 1, 2] {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":{nodes},
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+                      "min":[0,0,0],"max":[1,1,0]}},
+                     {{"bufferView":1,"componentType":5125,"count":3,"type":"SCALAR"}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":12}}],
+        "buffers":[{{"byteLength":48,"uri":"data:application/octet-stream;base64,{data}"}}]}}"#
+    )
+}
+
+/// Issue 14, item 7: a 3 KB glTF whose 18 nodes each list their child twice instantiated 2^18
+/// meshes (12.5 GB). A node listed as a child more than once, by one parent or by two, is now an
+/// input error, found before any geometry is read.
+#[test]
+fn gltf_nodes_with_several_parents_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let chain: Vec<String> = (0..18)
+        .map(|i| format!(r#"{{"children":[{0},{0}]}}"#, i + 1))
+        .chain([r#"{"mesh":0}"#.to_string()])
+        .collect();
+    let doubled = write(
+        dir.path(),
+        "doubled.gltf",
+        gltf_with_nodes(&format!("[{}]", chain.join(","))),
+    );
+    let t = std::time::Instant::now();
+    let o = remesh(&[
+        doubled.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--points",
+        "100",
+    ]);
+    assert_error(
+        &o,
+        3,
+        &["doubled.gltf", "node 1", "listed as a child 2 times"],
+        &out,
+    );
+    assert!(t.elapsed().as_secs_f64() < 10.0, "{:?}", t.elapsed());
+    // Two parents of one node.
+    let two = write(
+        dir.path(),
+        "two-parents.gltf",
+        gltf_with_nodes(r#"[{"children":[1,2]},{"children":[3]},{"children":[3]},{"mesh":0}]"#),
+    );
+    let o = remesh(&[
+        two.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--points",
+        "100",
+    ]);
+    assert_error(&o, 3, &["two-parents.gltf", "node 3"], &out);
+    // The same tree without the shared child reads (and is too small to remesh: a usage error
+    // of another kind, not an input error).
+    let tree = write(
+        dir.path(),
+        "tree.gltf",
+        gltf_with_nodes(r#"[{"children":[1]},{"children":[2]},{"mesh":0}]"#),
+    );
+    let o = remesh(&["quality", tree.to_str().unwrap()]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }

@@ -21,6 +21,13 @@ use crate::mesh::TriMesh;
 /// exponentially).
 const MAX_NODE_VISITS: usize = 1 << 20;
 
+/// Largest number of vertices of a scene, over all instances of its meshes: 2^26 (1.5 GiB of
+/// positions), far beyond what the remesher takes as input.
+const MAX_SCENE_VERTICES: usize = 1 << 26;
+
+/// Largest number of triangles of a scene, over all instances of its meshes (2^27).
+const MAX_SCENE_TRIANGLES: usize = 1 << 27;
+
 /// Largest number of components (elements × components per element) of an accessor without a
 /// buffer view (all zeros plus sparse substitutes), which costs memory without costing file
 /// size.
@@ -40,6 +47,21 @@ pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
             ))
         })?;
     validate(&document).map_err(parse_err)?;
+    // The node hierarchy must be a set of trees (glTF 2.0, 3.5.3): a node listed as a child more
+    // than once, by several parents or twice by one, would be instanced once per path, which
+    // multiplies exponentially along a chain.
+    let mut parents = vec![0usize; document.nodes().len()];
+    for node in document.nodes() {
+        for child in node.children() {
+            parents[child.index()] += 1;
+        }
+    }
+    if let Some(i) = parents.iter().position(|&p| p > 1) {
+        return Err(parse_err(format!(
+            "node {i} is listed as a child {} times (the node hierarchy must be a tree)",
+            parents[i]
+        )));
+    }
     let buffers = load_buffers(path, &document, blob)?;
 
     let mut walk = Walk {
@@ -377,6 +399,16 @@ impl Walk<'_, '_> {
             };
             let base = self.positions.len();
             let total = base + count;
+            // Instancing multiplies geometry without growing the file: the scene's vertices and
+            // triangles, over all instances, are bounded.
+            if total > MAX_SCENE_VERTICES
+                || self.triangles.len() + indices.len() / 3 > MAX_SCENE_TRIANGLES
+            {
+                return Err(err(format!(
+                    "the scene's instances add up to more than {MAX_SCENE_VERTICES} vertices or \
+                     {MAX_SCENE_TRIANGLES} triangles"
+                )));
+            }
             if u32::try_from(total).is_err() {
                 return Err(err(format!(
                     "the scene has more than {} vertices",
