@@ -26,7 +26,10 @@ const BUFFER_BYTES: usize = 1 << 20;
 /// Writes through [`std::io::Write`] are buffered; their errors are plain [`std::io::Error`]s,
 /// which [`AtomicFile::error`] turns into an [`Error::Write`] naming the target.
 pub struct AtomicFile {
+    /// The path as given (for messages).
     path: PathBuf,
+    /// Where the file goes: `path`, or the file a symbolic link at `path` points to.
+    target: PathBuf,
     output: BufWriter<NamedTempFile>,
 }
 
@@ -39,9 +42,12 @@ impl AtomicFile {
     /// [`Error::Write`] naming `path` when it names no file or the directory is missing or not
     /// writable.
     pub fn create(path: &Path) -> Result<AtomicFile> {
+        let given = path;
+        let target = write_target(path)?;
+        let path = target.as_path();
         let file_name = path
             .file_name()
-            .ok_or_else(|| write_error(path, "the path names no file".to_string()))?;
+            .ok_or_else(|| write_error(given, "the path names no file".to_string()))?;
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
@@ -58,12 +64,13 @@ impl AtomicFile {
         }
         let file = builder.tempfile_in(dir).map_err(|e| {
             write_error(
-                path,
+                given,
                 format!("cannot create a temporary file in {}: {e}", dir.display()),
             )
         })?;
         Ok(AtomicFile {
-            path: path.to_path_buf(),
+            path: given.to_path_buf(),
+            target,
             output: BufWriter::with_capacity(BUFFER_BYTES, file),
         })
     }
@@ -85,14 +92,18 @@ impl AtomicFile {
     /// [`Error::Write`] naming the target when flushing, syncing or renaming fails; the
     /// temporary file is removed and the target keeps its old content.
     pub fn commit(self) -> Result<()> {
-        let AtomicFile { path, output } = self;
+        let AtomicFile {
+            path,
+            target,
+            output,
+        } = self;
         let file = output
             .into_inner()
             .map_err(|e| write_error(&path, format!("cannot write: {}", e.error())))?;
         file.as_file()
             .sync_all()
             .map_err(|e| write_error(&path, format!("cannot write: {e}")))?;
-        file.persist(&path).map_err(|e| {
+        file.persist(&target).map_err(|e| {
             write_error(
                 &path,
                 format!(
@@ -134,6 +145,48 @@ pub fn write_atomically(
     let mut file = AtomicFile::create(path)?;
     write(&mut file).map_err(|e| file.error(format!("cannot write: {e}")))?;
     file.commit()
+}
+
+/// The file a write to `path` replaces: `path` itself, or, where `path` is a symbolic link
+/// (a chain of them), the file it points to, so the link stays a link and its target gets the
+/// content. Only regular files are replaced: a directory, a FIFO, a socket or a device at the
+/// target (`/dev/null`, `/dev/full`) is refused, since the rename would put a regular file in
+/// its place.
+///
+/// # Errors
+/// [`Error::Write`] naming `path` for a target that is not a regular file, or a link that
+/// cannot be followed.
+fn write_target(path: &Path) -> Result<PathBuf> {
+    let mut target = path.to_path_buf();
+    // Follow a chain of links (a bounded one: a loop is an error).
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&target) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let link = std::fs::read_link(&target)
+                    .map_err(|e| write_error(path, format!("cannot follow the link: {e}")))?;
+                target = match target.parent() {
+                    Some(dir) if link.is_relative() => dir.join(link),
+                    _ => link,
+                };
+            }
+            Ok(m) if !m.file_type().is_file() => {
+                return Err(write_error(
+                    path,
+                    format!(
+                        "{} is not a regular file (a directory, device, FIFO or socket); \
+                         outputs are written as regular files only",
+                        target.display()
+                    ),
+                ));
+            }
+            // A regular file, or nothing yet.
+            _ => return Ok(target),
+        }
+    }
+    Err(write_error(
+        path,
+        "too many levels of symbolic links".to_string(),
+    ))
 }
 
 fn write_error(path: &Path, message: String) -> Error {
@@ -247,5 +300,77 @@ mod tests {
             assert!(contents.contains(&written), "a mixed or partial file");
             assert_eq!(names(dir.path()), ["shared.bin"]);
         }
+    }
+
+    /// Issue 14, item 10: the rename replaced whatever sat at the output path, so a symbolic
+    /// link became a regular file and (as root) `/dev/full` was replaced. A link is now written
+    /// through, and a FIFO or a directory is refused and left as it was.
+    #[cfg(unix)]
+    #[test]
+    fn links_are_written_through_and_special_files_refused() {
+        use std::os::unix::fs::{symlink, FileTypeExt};
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.obj");
+        std::fs::write(&real, "old").unwrap();
+        // A relative link, and a link to that link.
+        let link = dir.path().join("link.obj");
+        symlink("real.obj", &link).unwrap();
+        let link2 = dir.path().join("link2.obj");
+        symlink(&link, &link2).unwrap();
+        write_atomically(&link2, |w| w.write_all(b"new")).unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert!(std::fs::symlink_metadata(&link2)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
+        // A dangling link: its target is created.
+        let dangling = dir.path().join("dangling.obj");
+        symlink("made.obj", &dangling).unwrap();
+        write_atomically(&dangling, |w| w.write_all(b"made")).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("made.obj")).unwrap(),
+            "made"
+        );
+        assert!(std::fs::symlink_metadata(&dangling)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        // A FIFO, directly and through a link: refused, still a FIFO, no temporary file left.
+        let fifo = dir.path().join("fifo.obj");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success(), "mkfifo failed");
+        let to_fifo = dir.path().join("to-fifo.obj");
+        symlink(&fifo, &to_fifo).unwrap();
+        for p in [&fifo, &to_fifo] {
+            let e = write_atomically(p, |w| w.write_all(b"x")).unwrap_err();
+            assert!(matches!(e, Error::Write { .. }), "{e}");
+            assert!(e.to_string().contains("not a regular file"), "{e}");
+        }
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        // A directory.
+        let sub = dir.path().join("sub");
+        std::fs::create_dir(&sub).unwrap();
+        assert!(write_atomically(&sub, |w| w.write_all(b"x")).is_err());
+        assert!(sub.is_dir());
+        assert_eq!(
+            names(dir.path()),
+            [
+                "dangling.obj",
+                "fifo.obj",
+                "link.obj",
+                "link2.obj",
+                "made.obj",
+                "real.obj",
+                "sub",
+                "to-fifo.obj"
+            ]
+        );
     }
 }
