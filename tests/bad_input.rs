@@ -31,6 +31,7 @@
 //! | `remesh points` or `simplify` to a non-.ply output (issue 14) | usage error, nothing written |
 //! | `quality --ref` of a reference without area (issue 14) | input error naming the reference |
 //! | glTF nodes listed as a child twice or by two parents (issue 14) | input error, at once |
+//! | `remesh points --count` above 10^9 (issue 14) | usage error, nothing written |
 //! | an internal failure (a panic) | internal error, one line (injected in `app::catch_panics`'s unit test; the binary runs every job through it) |
 
 use std::path::{Path, PathBuf};
@@ -852,4 +853,25 @@ fn gltf_nodes_with_several_parents_are_refused_at_once() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+/// Issue 14, item 8: `remesh points --count 99999999999` filled the disk at about 11 GB a
+/// minute; counts above the documented limit (10^9) are a usage error before anything is
+/// written.
+#[test]
+fn a_point_count_above_the_limit_is_refused_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("many.ply");
+    let input = shared("spot.obj");
+    let t = std::time::Instant::now();
+    let o = remesh(&[
+        "points",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--count",
+        "99999999999",
+    ]);
+    assert_error(&o, 2, &["--count", "1000000000"], &out);
+    assert!(t.elapsed().as_secs_f64() < 10.0, "{:?}", t.elapsed());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }

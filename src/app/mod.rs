@@ -264,6 +264,10 @@ fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// The most points a [`PointsJob`] draws: 10^9, about 24 GB of binary PLY (a bound on the disk
+/// a careless `--count` can fill).
+pub const MAX_SURFACE_POINTS: u64 = 1_000_000_000;
+
 /// A `remesh points` job: `count` points drawn uniformly by area from the mesh in `mesh`, with
 /// normals, written to `output` as binary PLY (streamed).
 #[derive(Debug, Clone, PartialEq)]
@@ -284,6 +288,16 @@ pub struct PointsJob {
 /// Reading and writing errors naming the file.
 pub fn run_points(job: &PointsJob) -> Result<()> {
     require_ply_output(&job.output)?;
+    if job.count > MAX_SURFACE_POINTS {
+        return Err(Error::InvalidParameter {
+            name: "--count",
+            message: format!(
+                "{} points is more than the {MAX_SURFACE_POINTS} `remesh points` writes (about \
+                 24 bytes each on disk)",
+                job.count
+            ),
+        });
+    }
     let (mesh, _) = read_mesh(&job.mesh)?;
     crate::points::generate::write_surface_points(&mesh, job.count, job.seed, &job.output)
 }
