@@ -215,7 +215,8 @@ fn written_normals(path: &Path) -> Vec<DVec3> {
                 |at: usize| f64::from(f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()));
             (0..nv)
                 .map(|i| {
-                    let at = end + i * 24 + 12;
+                    // x y z as double (24 bytes), then nx ny nz as float.
+                    let at = end + i * 36 + 24;
                     DVec3::new(f(at), f(at + 4), f(at + 8))
                 })
                 .collect()
@@ -248,14 +249,14 @@ fn round_trips_keep_the_mesh() {
             "{ext}: same triangles, same order"
         );
         assert_eq!((s.welded_vertices, s.unreferenced_vertices_removed), (0, 0));
-        if ext == "obj" {
-            assert_eq!(back.positions, spot.positions, "OBJ positions are exact");
+        if ext == "obj" || ext == "ply" {
+            assert_eq!(back.positions, spot.positions, "{ext} positions are exact");
         } else {
+            // f32 offsets from the node translation (the bbox centre rounded to f32).
             for (a, b) in back.positions.iter().zip(&spot.positions) {
-                assert_eq!(
-                    a.as_vec3(),
-                    b.as_vec3(),
-                    "{ext}: positions are the f32 values"
+                assert!(
+                    (*a - *b).abs().max_element() < 1e-6,
+                    "{ext}: positions within f32 precision: {a} vs {b}"
                 );
             }
         }

@@ -492,7 +492,8 @@ fn simplify_levels_from_xyz_text_writes_a_level_attribute() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout = String::from_utf8_lossy(&o.stdout);
-    // The file: a uchar level after the six floats, non-decreasing from 1 to 3.
+    // The file: a uchar level after x y z (double) and nx ny nz (float), non-decreasing from 1
+    // to 3.
     let bytes = std::fs::read(&out).unwrap();
     let end = bytes
         .windows(11)
@@ -502,8 +503,8 @@ fn simplify_levels_from_xyz_text_writes_a_level_attribute() {
     let header = String::from_utf8_lossy(&bytes[..end]);
     assert!(header.contains("property uchar level\n"), "{header}");
     let records = &bytes[end..];
-    assert_eq!(records.len() % 25, 0);
-    let levels: Vec<u8> = records.chunks_exact(25).map(|r| r[24]).collect();
+    assert_eq!(records.len() % 37, 0);
+    let levels: Vec<u8> = records.chunks_exact(37).map(|r| r[36]).collect();
     assert_eq!(levels[0], 1);
     assert_eq!(*levels.last().unwrap(), 3);
     assert!(levels.windows(2).all(|w| w[0] <= w[1]));

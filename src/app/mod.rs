@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::io::{read_mesh, write_atomically, write_mesh, MeshFormat};
+use crate::io::{as_written, read_mesh, write_atomically, write_mesh, MeshFormat};
 use crate::pipeline::{remesh, RemeshParams};
 use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
@@ -39,7 +39,8 @@ pub struct RemeshJob {
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
 ///
 /// The output's invariants ([`check_invariants`](crate::check_invariants)) are checked before it
-/// is written; violations go into the report ([`QualityReport::invariant_violations`] and a note).
+/// is written, on the mesh as the output format stores it (glTF positions rounded to `f32`
+/// relative to the node's translation; OBJ and PLY are exact); violations go into the report ([`QualityReport::invariant_violations`] and a note).
 ///
 /// # Errors
 /// Whatever reading, the pipeline or writing return, each naming the file concerned; an
@@ -48,15 +49,13 @@ pub struct RemeshJob {
 /// an invariant, and then nothing is written.
 pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<QualityReport> {
     // The output's format is known before any work: an unknown extension is a usage error.
-    if MeshFormat::from_path(&job.output).is_err() {
-        return Err(Error::InvalidParameter {
-            name: "OUTPUT",
-            message: format!(
-                "{}: unsupported output format (expected .obj, .ply, .gltf or .glb)",
-                job.output.display()
-            ),
-        });
-    }
+    let format = MeshFormat::from_path(&job.output).map_err(|_| Error::InvalidParameter {
+        name: "OUTPUT",
+        message: format!(
+            "{}: unsupported output format (expected .obj, .ply, .gltf or .glb)",
+            job.output.display()
+        ),
+    })?;
     if same_file(&job.input, &job.output) {
         return Err(Error::InvalidParameter {
             name: "OUTPUT",
@@ -75,7 +74,17 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
     on_stage("check");
     let t = Instant::now();
-    let mut report = QualityReport::new(&out.mesh_normalized);
+    // The report and `--strict` describe the file: the mesh as the format stores it (OBJ and
+    // PLY exactly; glTF in f32 relative to the node's translation), normalized like the input.
+    let written;
+    let checked = match format {
+        MeshFormat::Obj | MeshFormat::Ply => &out.mesh_normalized,
+        MeshFormat::Gltf | MeshFormat::Glb => {
+            written = out.normalization.apply_mesh(&as_written(&out.mesh, format));
+            &written
+        }
+    };
+    let mut report = QualityReport::new(checked);
     let check_seconds = t.elapsed().as_secs_f64();
     if !report.invariant_violations.is_empty() {
         let list = report
@@ -120,10 +129,10 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     if job.measure_distance {
         on_stage("distance");
         let t = Instant::now();
-        let a = MeshSurface::new(&out.mesh_normalized)?;
+        let a = MeshSurface::new(checked)?;
         let b = MeshSurface::new(&out.input_normalized)?;
         report.distance = Some(surface_distance_with(
-            &out.mesh_normalized,
+            checked,
             &a,
             &out.input_normalized,
             &b,

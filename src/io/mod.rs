@@ -222,10 +222,12 @@ fn check_content(path: &Path, format: MeshFormat) -> Result<()> {
 /// - `.obj`: a comment header, `v x y z` and `vn nx ny nz` lines with Rust's shortest
 ///   round-trip formatting of `f64` (reading the file back gives the same coordinates), and
 ///   `f a//a b//b c//c` faces (1-based).
-/// - `.ply`: `binary_little_endian 1.0`, vertex `x y z nx ny nz` as `float` (`f32`), face
-///   `list uchar int vertex_indices`.
+/// - `.ply`: `binary_little_endian 1.0`, vertex `x y z` as `double` (exact) and `nx ny nz` as
+///   `float`, face `list uchar int vertex_indices`.
 /// - `.glb`: binary glTF 2.0 with one scene, one node, one mesh of one triangle primitive:
-///   POSITION and NORMAL (`f32` VEC3) and `u32` indices.
+///   POSITION and NORMAL (`f32` VEC3) and `u32` indices. The node's `translation` is the
+///   bounding box's centre (rounded to `f32`) and positions are stored relative to it, so large
+///   coordinates (UTM, 5e6) keep the precision of the mesh's size.
 /// - `.gltf`: the same glTF 2.0 asset as JSON, its buffer embedded as a base64 data URI.
 ///
 /// The file is written atomically ([`write_atomically`]): to a temporary file in the target's
@@ -273,6 +275,18 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
         MeshFormat::Gltf => gltf::encode_gltf(mesh, &normals).map_err(write_err)?,
     };
     write_atomically(path, |w| w.write_all(&bytes))
+}
+
+/// `mesh` as [`write_mesh`] stores it in `format` and [`read_mesh`] reads it back (vertex and
+/// triangle order kept, before welding): positions exactly as they are for OBJ (shortest
+/// round-trip `f64` text) and PLY (`double`); for glTF (`f32` by the specification), each
+/// position rounded to `f32` relative to the node translation the writer puts at the bounding
+/// box's centre. Checking this mesh, rather than the one in memory, checks the file.
+pub(crate) fn as_written(mesh: &TriMesh, format: MeshFormat) -> TriMesh {
+    match format {
+        MeshFormat::Obj | MeshFormat::Ply => mesh.clone(),
+        MeshFormat::Gltf | MeshFormat::Glb => gltf::as_written(mesh),
+    }
 }
 
 /// Unit vertex normals for output: [`TriMesh::vertex_normals`], with +Z where that is zero.

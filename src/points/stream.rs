@@ -493,7 +493,8 @@ pub(crate) fn encode_record(p: &Point, out: &mut Vec<u8>) {
     }
 }
 
-/// Writes points with normals as binary little-endian PLY (`x y z nx ny nz`, float32, and with
+/// Writes points with normals as binary little-endian PLY (`x y z` as float64, `nx ny nz` as
+/// float32, and with
 /// [`PlyPointWriter::create_with_levels`] a `uchar level`) through the crate's one binary PLY
 /// writer, atomically ([`AtomicFile`]): a temporary file beside the target that
 /// [`PlyPointWriter::finish`] renames into place, so a failure never leaves a partial file at
@@ -558,7 +559,7 @@ impl PlyPointWriter {
         for (k, p) in points.iter().enumerate() {
             let level = levels.map(|l| l[k]);
             self.ply
-                .vertex(f32s(p.position), f32s(p.normal), level)
+                .vertex(p.position.to_array(), f32s(p.normal), level)
                 .map_err(|e| self.ply.get_ref().error(e.to_string()))?;
         }
         Ok(())

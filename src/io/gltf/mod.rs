@@ -11,4 +11,4 @@ mod read;
 mod write;
 
 pub(super) use read::read;
-pub(super) use write::{encode_glb, encode_gltf};
+pub(super) use write::{as_written, encode_glb, encode_gltf};

@@ -8,6 +8,39 @@ use serde_json::json;
 
 use crate::mesh::TriMesh;
 
+/// The translation of the node that places the mesh: the centre of its bounding box rounded to
+/// the nearest `f32` (so that readers which hold node transforms in `f32`, as the `gltf` crate
+/// does, read it exactly). Positions are stored in `f32` relative to it, so their precision
+/// depends on the mesh's size, not on how far from the origin it lies (UTM coordinates, 5e6).
+fn origin(mesh: &TriMesh) -> DVec3 {
+    let (lo, hi) = mesh.positions.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let centre = (0.5 * lo + 0.5 * hi).as_vec3().as_dvec3();
+    if centre.is_finite() {
+        centre
+    } else {
+        DVec3::ZERO
+    }
+}
+
+/// A position as stored: `f32` relative to the node's translation `centre`.
+fn relative(p: DVec3, centre: DVec3) -> glam::Vec3 {
+    (p - centre).as_vec3()
+}
+
+/// `mesh` with its positions as a glTF reader reads them back from [`encode_glb`] or
+/// [`encode_gltf`]: the stored `f32` offsets plus the node's translation, in `f64`.
+pub(crate) fn as_written(mesh: &TriMesh) -> TriMesh {
+    let centre = origin(mesh);
+    let mut out = mesh.clone();
+    for p in &mut out.positions {
+        *p = relative(*p, centre).as_dvec3() + centre;
+    }
+    out
+}
+
 /// The glTF JSON (without the buffer's `uri`) and binary buffer of `mesh` with `normals`.
 fn build(
     mesh: &TriMesh,
@@ -31,10 +64,11 @@ fn build(
         ));
     }
     let mut bin = Vec::with_capacity(total);
+    let centre = origin(mesh);
     let mut min = glam::Vec3::splat(f32::INFINITY);
     let mut max = glam::Vec3::splat(f32::NEG_INFINITY);
     for p in &mesh.positions {
-        let p = p.as_vec3();
+        let p = relative(*p, centre);
         if !p.is_finite() {
             return Err(format!("position {p} does not fit in f32"));
         }
@@ -57,11 +91,16 @@ fn build(
     }
     // f32 bounds written as the f64 of the same value, so they match the data exactly.
     let bound = |b: glam::Vec3| b.to_array().map(f64::from).to_vec();
+    let node = if centre == DVec3::ZERO {
+        json!({ "mesh": 0 })
+    } else {
+        json!({ "mesh": 0, "translation": centre.to_array() })
+    };
     let json = json!({
         "asset": { "version": "2.0", "generator": "spectral-remesh" },
         "scene": 0,
         "scenes": [ { "nodes": [0] } ],
-        "nodes": [ { "mesh": 0 } ],
+        "nodes": [ node ],
         "meshes": [ {
             "primitives": [ {
                 "attributes": { "POSITION": 0, "NORMAL": 1 },

@@ -12,8 +12,8 @@ use ply_rs_bw::writer::Writer;
 use crate::mesh::TriMesh;
 
 /// Writes binary little-endian PLY 1.0 to `W`: the header (by `ply-rs-bw`), then `vertices`
-/// vertex records `x y z nx ny nz` (`float`, 24 bytes) with, when asked for, a `uchar level`
-/// (25 bytes), then `faces` triangles as `list uchar int vertex_indices` (13 bytes each).
+/// vertex records `x y z` (`double`) and `nx ny nz` (`float`), 36 bytes, with, when asked for,
+/// a `uchar level` (37 bytes), then `faces` triangles as `list uchar int vertex_indices` (13 bytes each).
 /// [`BinaryPlyWriter::finish`] checks that exactly the announced counts were written.
 pub(crate) struct BinaryPlyWriter<W: Write> {
     out: W,
@@ -47,11 +47,19 @@ impl<W: Write> BinaryPlyWriter<W> {
         header.comments.push(comment.to_string());
         let mut vertex = ElementDef::new("vertex".to_string());
         vertex.count = count(vertices)?;
-        for name in ["x", "y", "z", "nx", "ny", "nz"] {
-            let float = PropertyType::Scalar(ScalarType::Float);
+        // Positions as `double`: scans and LiDAR live at coordinates (UTM: 5e5, 5e6) where
+        // `float` keeps a few centimetres at best; unit normals lose nothing as `float`.
+        for (name, ty) in [
+            ("x", ScalarType::Double),
+            ("y", ScalarType::Double),
+            ("z", ScalarType::Double),
+            ("nx", ScalarType::Float),
+            ("ny", ScalarType::Float),
+            ("nz", ScalarType::Float),
+        ] {
             vertex
                 .properties
-                .add(PropertyDef::new(name.to_string(), float));
+                .add(PropertyDef::new(name.to_string(), PropertyType::Scalar(ty)));
         }
         if with_levels {
             let uchar = PropertyType::Scalar(ScalarType::UChar);
@@ -86,7 +94,7 @@ impl<W: Write> BinaryPlyWriter<W> {
     /// count or a level where the file has none (or none where it has them).
     pub(crate) fn vertex(
         &mut self,
-        position: [f32; 3],
+        position: [f64; 3],
         normal: [f32; 3],
         level: Option<u8>,
     ) -> std::io::Result<()> {
@@ -103,16 +111,19 @@ impl<W: Write> BinaryPlyWriter<W> {
                 "the file has no levels".to_string()
             }));
         }
-        let mut record = [0u8; 25];
-        for (k, c) in position.into_iter().chain(normal).enumerate() {
-            record[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
+        let mut record = [0u8; 37];
+        for (k, c) in position.into_iter().enumerate() {
+            record[8 * k..8 * k + 8].copy_from_slice(&c.to_le_bytes());
+        }
+        for (k, c) in normal.into_iter().enumerate() {
+            record[24 + 4 * k..28 + 4 * k].copy_from_slice(&c.to_le_bytes());
         }
         let len = match level {
             Some(l) => {
-                record[24] = l;
-                25
+                record[36] = l;
+                37
             }
-            None => 24,
+            None => 36,
         };
         self.out.write_all(&record[..len])?;
         self.vertices_written += 1;
@@ -170,8 +181,8 @@ fn invalid(message: String) -> IoError {
     IoError::new(ErrorKind::InvalidInput, message)
 }
 
-/// The binary little-endian PLY bytes of `mesh` with `normals`: vertex `x y z nx ny nz` as
-/// `float` (normals renormalized in `f32`, +Z where that fails), face
+/// The binary little-endian PLY bytes of `mesh` with `normals`: vertex `x y z` as `double`
+/// (exact), `nx ny nz` as `float` (normals renormalized in `f32`, +Z where that fails), face
 /// `list uchar int vertex_indices`. The caller has checked that vertex indices fit in `i32`.
 ///
 /// # Errors
@@ -179,7 +190,7 @@ fn invalid(message: String) -> IoError {
 pub(crate) fn encode_mesh(mesh: &TriMesh, normals: &[DVec3]) -> std::io::Result<Vec<u8>> {
     let (v, f) = (mesh.positions.len(), mesh.triangles.len());
     let mut out = BinaryPlyWriter::new(
-        Vec::with_capacity(512 + v * 24 + f * 13),
+        Vec::with_capacity(512 + v * 36 + f * 13),
         &format!("written by spectral-remesh {}", env!("CARGO_PKG_VERSION")),
         v as u64,
         false,
@@ -187,7 +198,7 @@ pub(crate) fn encode_mesh(mesh: &TriMesh, normals: &[DVec3]) -> std::io::Result<
     )?;
     for (p, n) in mesh.positions.iter().zip(normals) {
         let n = n.as_vec3().normalize_or(Vec3::Z);
-        out.vertex(p.as_vec3().to_array(), n.to_array(), None)?;
+        out.vertex(p.to_array(), n.to_array(), None)?;
     }
     for t in &mesh.triangles {
         out.triangle(t.map(|i| i as i32))?;
@@ -219,16 +230,17 @@ mod tests {
         w.triangle([0, 1, 1]).unwrap();
         let bytes = w.finish().unwrap();
         let header = "ply\nformat binary_little_endian 1.0\ncomment c\nelement vertex 2\n\
-                      property float x\nproperty float y\nproperty float z\n\
+                      property double x\nproperty double y\nproperty double z\n\
                       property float nx\nproperty float ny\nproperty float nz\n\
                       property uchar level\nelement face 1\n\
                       property list uchar int vertex_indices\nend_header\n";
         assert_eq!(&bytes[..header.len()], header.as_bytes());
         let body = &bytes[header.len()..];
-        assert_eq!(body.len(), 2 * 25 + 13);
-        assert_eq!(body[4..8], 2.0f32.to_le_bytes());
-        assert_eq!((body[24], body[49]), (1, 2));
-        assert_eq!(body[50..55], [3, 0, 0, 0, 0]);
+        assert_eq!(body.len(), 2 * 37 + 13);
+        assert_eq!(body[8..16], 2.0f64.to_le_bytes());
+        assert_eq!(body[32..36], 1.0f32.to_le_bytes());
+        assert_eq!((body[36], body[73]), (1, 2));
+        assert_eq!(body[74..79], [3, 0, 0, 0, 0]);
     }
 
     #[test]
