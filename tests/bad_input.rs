@@ -707,10 +707,19 @@ fn concave_polygon_caps_are_triangulated_without_overlap() {
         // 2 caps of 4 triangles, 6 sides of 2.
         assert_eq!(m.triangles.len(), 20);
         assert_eq!(self_intersections(&m).pairs, 0, "{}", input.display());
-        assert!(check_invariants(&m).is_empty(), "{:?}", check_invariants(&m));
+        assert!(
+            check_invariants(&m).is_empty(),
+            "{:?}",
+            check_invariants(&m)
+        );
         let t = topology(&m);
         assert_eq!(
-            (t.components, t.boundary_edges, t.non_manifold_edges, t.genus),
+            (
+                t.components,
+                t.boundary_edges,
+                t.non_manifold_edges,
+                t.genus
+            ),
             (1, 0, 0, Some(0)),
             "{t:?}"
         );

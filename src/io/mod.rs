@@ -14,8 +14,8 @@
 mod atomic;
 mod gltf;
 mod obj;
-mod polygon;
 pub(crate) mod ply;
+mod polygon;
 
 use std::fs;
 use std::path::Path;

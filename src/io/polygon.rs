@@ -139,18 +139,23 @@ fn constrained(positions: &[DVec3], corners: &[u32]) -> Option<Vec<[u32; 3]>> {
         }
     }
 
-    let mut out = Vec::with_capacity(n - 2);
+    // As corner positions, each triangle starting at its first corner in the polygon's order,
+    // the triangles sorted: a convex quad split like the fan comes out as the fan.
+    let mut out: Vec<[usize; 3]> = Vec::with_capacity(n - 2);
     for face in cdt.inner_faces() {
         match inside[face.fix().index()] {
             Some(true) => {
-                let [a, b, c] = face.vertices().map(|v| corners[v.data().k]);
-                out.push([a, b, c]);
+                let mut t = face.vertices().map(|v| v.data().k);
+                let first = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+                t.rotate_left(first);
+                out.push(t);
             }
             Some(false) => {}
             None => return None,
         }
     }
-    (out.len() == n - 2).then_some(out)
+    out.sort_unstable();
+    (out.len() == n - 2).then(|| out.iter().map(|t| t.map(|k| corners[k])).collect())
 }
 
 #[cfg(test)]
@@ -181,8 +186,7 @@ mod tests {
         let m = poly.len();
         for i in 0..m {
             let (a, c) = (poly[i], poly[(i + 1) % m]);
-            if (a.y > q.y) != (c.y > q.y) && q.x < a.x + (q.y - a.y) * (c.x - a.x) / (c.y - a.y)
-            {
+            if (a.y > q.y) != (c.y > q.y) && q.x < a.x + (q.y - a.y) * (c.x - a.x) / (c.y - a.y) {
                 inside = !inside;
             }
         }
@@ -206,7 +210,10 @@ mod tests {
             total += area;
         }
         let expected = polygon_area_vector(p, corners).z;
-        assert!((total - expected).abs() < 1e-12 * expected, "{total} vs {expected}");
+        assert!(
+            (total - expected).abs() < 1e-12 * expected,
+            "{total} vs {expected}"
+        );
     }
 
     fn xy(points: &[[f64; 2]]) -> Vec<DVec3> {
@@ -216,14 +223,7 @@ mod tests {
     #[test]
     fn concave_polygons_are_covered_exactly_without_overlap() {
         // An L (its reflex corner at index 3, so the fan from 0 would overlap).
-        let l = xy(&[
-            [0., 0.],
-            [2., 0.],
-            [2., 1.],
-            [1., 1.],
-            [1., 2.],
-            [0., 2.],
-        ]);
+        let l = xy(&[[0., 0.], [2., 0.], [2., 1.], [1., 1.], [1., 2.], [0., 2.]]);
         // Start at every corner: some starts make the fan wrong, none may make this wrong.
         for s in 0..6u32 {
             let corners: Vec<u32> = (0..6).map(|k| (k + s) % 6).collect();
@@ -254,14 +254,7 @@ mod tests {
     #[test]
     fn orientation_follows_the_corner_order() {
         // The L in clockwise order: every triangle must be clockwise about +z.
-        let l = xy(&[
-            [0., 0.],
-            [0., 2.],
-            [1., 2.],
-            [1., 1.],
-            [2., 1.],
-            [2., 0.],
-        ]);
+        let l = xy(&[[0., 0.], [0., 2.], [1., 2.], [1., 1.], [2., 1.], [2., 0.]]);
         let corners: Vec<u32> = (0..6).collect();
         let tris = triangulate_polygon(&l, &corners);
         assert_eq!(tris.len(), 4);
@@ -269,10 +262,7 @@ mod tests {
             let [a, b, c] = t.map(|i| l[i as usize]);
             assert!((b - a).cross(c - a).z < 0.0, "{t:?}");
         }
-        let (got, want) = (
-            area_vector(&l, &tris),
-            polygon_area_vector(&l, &corners),
-        );
+        let (got, want) = (area_vector(&l, &tris), polygon_area_vector(&l, &corners));
         assert!((got - want).length() < 1e-12, "{got} vs {want}");
     }
 
@@ -280,14 +270,7 @@ mod tests {
     fn a_warped_polygon_in_a_tilted_plane_is_triangulated() {
         // The L, tilted out of every coordinate plane, with corners moved off the plane by up
         // to 1% of its size.
-        let l = [
-            [0., 0.],
-            [2., 0.],
-            [2., 1.],
-            [1., 1.],
-            [1., 2.],
-            [0., 2.],
-        ];
+        let l = [[0., 0.], [2., 0.], [2., 1.], [1., 1.], [1., 2.], [0., 2.]];
         let (e1, e2) = (
             DVec3::new(1.0, 0.3, -0.2).normalize(),
             DVec3::new(-0.2, 0.5, 1.0).normalize(),
@@ -311,7 +294,11 @@ mod tests {
         }
         // The projected areas add up (triangles do not overlap in the plane).
         let got = area_vector(&p, &tris).dot(want.normalize());
-        assert!((got - want.length()).abs() < 1e-9, "{got} vs {}", want.length());
+        assert!(
+            (got - want.length()).abs() < 1e-9,
+            "{got} vs {}",
+            want.length()
+        );
         // Not the fan, which would cover the reflex corner twice.
         assert_ne!(tris, fan(&corners));
     }
@@ -324,7 +311,10 @@ mod tests {
             (sq.clone(), vec![0, 1, 1, 2, 3]),
             (sq.clone(), vec![0, 1, 2, 0, 3]),
             // Collinear corners: zero area.
-            (xy(&[[0., 0.], [1., 0.], [2., 0.], [3., 0.]]), vec![0, 1, 2, 3]),
+            (
+                xy(&[[0., 0.], [1., 0.], [2., 0.], [3., 0.]]),
+                vec![0, 1, 2, 3],
+            ),
             // All at one point.
             (vec![DVec3::ONE; 4], vec![0, 1, 2, 3]),
             // A bow tie (the boundary crosses itself) and a figure with a touching corner.
@@ -339,10 +329,7 @@ mod tests {
                 vec![0, 1, 2, 3, 4],
             ),
             // Tiny and huge coordinates.
-            (
-                sq.iter().map(|&q| q * 1e-300).collect(),
-                vec![0, 1, 4, 3],
-            ),
+            (sq.iter().map(|&q| q * 1e-300).collect(), vec![0, 1, 4, 3]),
             (sq.iter().map(|&q| q * 1e300).collect(), vec![0, 1, 4, 3]),
         ];
         for (p, corners) in &cases {
