@@ -12,6 +12,7 @@
 //! | face index out of range | input error |
 //! | negative (relative) OBJ indices | result, identical to the positive-index file's |
 //! | quads and n-gons | result, closed genus 0 |
+//! | concave polygons (an L-shaped prism with 6-gon caps), OBJ and PLY | read without overlap; result closed genus 0, no "passes through itself" note |
 //! | degenerate and zero-area faces | result, closed genus 0 |
 //! | duplicate vertices and duplicate faces | result, closed genus 0 |
 //! | non-manifold edges and vertices | result, manifold |
@@ -957,6 +958,98 @@ fn gltf_output_is_recentred_by_a_node_translation() {
         assert!(
             (*a - *b).abs().max_element() <= 1e-6 * b.length(),
             "{a} vs {b}"
+        );
+    }
+}
+
+/// An L-shaped prism (height 1 over the L of the unit squares (0,0), (1,0), (0,1)) as two
+/// concave 6-gon caps and six quad sides: positions and outward faces. The caps start at a
+/// corner whose fan overlaps (the reflex corner is the fan's third corner).
+fn l_prism() -> (Vec<[f64; 3]>, Vec<Vec<usize>>) {
+    let l = [[2., 0.], [2., 1.], [1., 1.], [1., 2.], [0., 2.], [0., 0.]];
+    let mut p = Vec::new();
+    for z in [0.0, 1.0] {
+        for [x, y] in l {
+            p.push([x, y, z]);
+        }
+    }
+    // The L is counter-clockwise about +z: the bottom cap goes the other way.
+    let mut f = vec![(0..6).rev().collect::<Vec<_>>(), (6..12).collect()];
+    for k in 0..6 {
+        let n = (k + 1) % 6;
+        f.push(vec![k, n, n + 6, k + 6]);
+    }
+    (p, f)
+}
+
+#[test]
+fn concave_polygon_caps_are_triangulated_without_overlap() {
+    use spectral_remesh::{check_invariants, read_mesh, self_intersections, topology};
+    let dir = tempfile::tempdir().unwrap();
+    let (p, f) = l_prism();
+    let as_obj = write(dir.path(), "l.obj", obj(&p, &f, false));
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n\
+         property double z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        p.len(),
+        f.len()
+    );
+    for [x, y, z] in &p {
+        ply += &format!("{x} {y} {z}\n");
+    }
+    for face in &f {
+        ply += &format!("{}", face.len());
+        for v in face {
+            ply += &format!(" {v}");
+        }
+        ply += "\n";
+    }
+    let as_ply = write(dir.path(), "l.ply", ply);
+    for input in [&as_obj, &as_ply] {
+        let (m, s) = read_mesh(input).unwrap();
+        assert_eq!(s.polygons_triangulated, 8);
+        // 2 caps of 4 triangles, 6 sides of 2.
+        assert_eq!(m.triangles.len(), 20);
+        assert_eq!(self_intersections(&m).pairs, 0, "{}", input.display());
+        assert!(
+            check_invariants(&m).is_empty(),
+            "{:?}",
+            check_invariants(&m)
+        );
+        let t = topology(&m);
+        assert_eq!(
+            (
+                t.components,
+                t.boundary_edges,
+                t.non_manifold_edges,
+                t.genus
+            ),
+            (1, 0, 0, Some(0)),
+            "{t:?}"
+        );
+        // The volume of the L (3), by the divergence theorem: the caps cover the L once.
+        let volume: f64 = m
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| m.positions[v as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum();
+        assert!((volume - 3.0).abs() < 1e-12, "volume {volume}");
+
+        let out = dir.path().join(format!(
+            "out-{}.obj",
+            input.extension().unwrap().to_str().unwrap()
+        ));
+        let r = assert_result(input, &out, &["--points", "1500"]);
+        assert_closed_genus_0(&r);
+        let notes = r["notes"].as_array().unwrap();
+        assert!(
+            notes
+                .iter()
+                .all(|n| !n.as_str().unwrap().contains("passes through itself")),
+            "{notes:?}"
         );
     }
 }

@@ -471,8 +471,8 @@ fn obj_polygons_relative_indices_and_groups() {
             [0, 1, 2],
             [0, 2, 3],
             [4, 5, 6],
-            [4, 6, 7],
-            [4, 7, 8],
+            [4, 6, 8],
+            [6, 7, 8],
             [1, 5, 2]
         ]
     );
@@ -486,7 +486,7 @@ fn obj_polygons_relative_indices_and_groups() {
 }
 
 #[test]
-fn ascii_ply_polygons_are_fan_triangulated() {
+fn ascii_ply_polygons_are_triangulated() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("poly.ply");
     fs::write(
@@ -522,8 +522,8 @@ fn ascii_ply_polygons_are_fan_triangulated() {
             [0, 1, 2],
             [0, 2, 3],
             [4, 5, 6],
-            [4, 6, 7],
-            [4, 7, 8],
+            [4, 6, 8],
+            [6, 7, 8],
             [1, 5, 2]
         ]
     );

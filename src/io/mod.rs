@@ -15,6 +15,7 @@ mod atomic;
 mod gltf;
 mod obj;
 pub(crate) mod ply;
+mod polygon;
 
 use std::fs;
 use std::path::Path;
@@ -88,7 +89,10 @@ pub struct ReadStats {
     /// three corners (polygons count once each), or for glTF the triangles its triangle,
     /// strip and fan primitives describe.
     pub faces_read: usize,
-    /// Faces with more than three corners, fan-triangulated into `corners - 2` triangles each
+    /// Faces with more than three corners, triangulated into `corners - 2` triangles each: by a
+    /// constrained Delaunay triangulation in the polygon's best-fit plane, so that concave
+    /// polygons are covered without overlap; a polygon that is not simple in that plane (a
+    /// repeated corner, zero area, a boundary crossing itself) is fanned from its first corner
     /// (OBJ and PLY; always 0 for glTF).
     pub polygons_triangulated: usize,
     /// Vertices merged into another one with a bit-identical position
@@ -119,7 +123,8 @@ impl ReadStats {
 /// Reads a triangle mesh from an OBJ, PLY, glTF or GLB file (format by extension), in the
 /// file's units (glTF positions are placed by the scene's node transforms).
 ///
-/// Polygons are fan-triangulated; points and lines are ignored. After parsing, the mesh is
+/// Polygons are triangulated in their best-fit plane (concave ones included, see
+/// [`ReadStats::polygons_triangulated`]); points and lines are ignored. After parsing, the mesh is
 /// checked (every index in range, every coordinate finite), vertices with bit-identical
 /// positions are welded (triangles that collapse are dropped) and vertices no triangle uses are
 /// removed; [`ReadStats`] reports what was found and changed.

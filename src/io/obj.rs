@@ -10,18 +10,23 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use super::polygon::triangulate_polygon;
 use super::{read_file, ReadStats};
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 
 /// Parses the OBJ file at `path` into a mesh with the file's vertices in file order and its
-/// faces fan-triangulated (indices checked against the vertex count, 1-based in messages).
+/// faces triangulated in file order, polygons in their plane ([`triangulate_polygon`]; indices
+/// checked against the vertex count, 1-based in messages).
 pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let data = read_file(path)?;
     let mut positions: Vec<DVec3> = Vec::new();
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
-    // The line of the face each triangle comes from, for error messages.
-    let mut triangle_lines: Vec<usize> = Vec::new();
+    // Every face's corners, one after another, and where each face ends in `face_corners`:
+    // polygons are triangulated once every vertex is read (a face may name a later vertex).
+    let mut face_corners: Vec<u32> = Vec::new();
+    let mut face_ends: Vec<usize> = Vec::new();
+    // The line of each face, for error messages.
+    let mut face_lines: Vec<usize> = Vec::new();
     let mut corners: Vec<u32> = Vec::new();
     // A logical line continued with a trailing backslash, and the line it started on.
     let mut continued: Vec<u8> = Vec::new();
@@ -55,8 +60,9 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
             line,
             line_no,
             &mut positions,
-            &mut triangles,
-            &mut triangle_lines,
+            &mut face_corners,
+            &mut face_ends,
+            &mut face_lines,
             &mut corners,
             stats,
         )?;
@@ -69,8 +75,9 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
             &line,
             continued_from,
             &mut positions,
-            &mut triangles,
-            &mut triangle_lines,
+            &mut face_corners,
+            &mut face_ends,
+            &mut face_lines,
             &mut corners,
             stats,
         )?;
@@ -78,17 +85,26 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
 
     stats.vertices_read = positions.len();
     let n = positions.len() as u64;
-    for (t, tri) in triangles.iter().enumerate() {
-        if let Some(&bad) = tri.iter().find(|&&v| u64::from(v) >= n) {
+    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(face_ends.len());
+    let mut start = 0;
+    for (f, &end) in face_ends.iter().enumerate() {
+        let face = &face_corners[start..end];
+        start = end;
+        if let Some(&bad) = face.iter().find(|&&v| u64::from(v) >= n) {
             return Err(Error::invalid_mesh(
                 path,
                 format!(
                     "face on line {} names vertex {}, but the file has {} vertices",
-                    triangle_lines[t],
+                    face_lines[f],
                     u64::from(bad) + 1,
                     n
                 ),
             ));
+        }
+        if let [a, b, c] = face[..] {
+            triangles.push([a, b, c]);
+        } else {
+            triangles.extend(triangulate_polygon(&positions, face));
         }
     }
     Ok(TriMesh::new(positions, triangles))
@@ -101,8 +117,9 @@ fn parse_line(
     line: &[u8],
     line_no: usize,
     positions: &mut Vec<DVec3>,
-    triangles: &mut Vec<[u32; 3]>,
-    triangle_lines: &mut Vec<usize>,
+    face_corners: &mut Vec<u32>,
+    face_ends: &mut Vec<usize>,
+    face_lines: &mut Vec<usize>,
     corners: &mut Vec<u32>,
     stats: &mut ReadStats,
 ) -> Result<()> {
@@ -158,10 +175,9 @@ fn parse_line(
             if corners.len() > 3 {
                 stats.polygons_triangulated += 1;
             }
-            for k in 1..corners.len() - 1 {
-                triangles.push([corners[0], corners[k], corners[k + 1]]);
-                triangle_lines.push(line_no);
-            }
+            face_corners.extend_from_slice(corners);
+            face_ends.push(face_corners.len());
+            face_lines.push(line_no);
         }
         _ => {}
     }

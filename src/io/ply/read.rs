@@ -11,6 +11,7 @@ use ply_rs_bw::ply::{
 
 use super::{read_header, strip_line_prefix};
 use crate::error::{Error, Result};
+use crate::io::polygon::triangulate_polygon;
 use crate::io::{one_line, read_file, ReadStats};
 use crate::mesh::TriMesh;
 
@@ -150,8 +151,8 @@ fn check_header(path: &Path, header: &Header) -> Result<Option<&'static str>> {
     ))
 }
 
-/// Parses the PLY file at `path`; faces are fan-triangulated, indices checked (naming the face
-/// element).
+/// Parses the PLY file at `path`; polygons are triangulated in their plane
+/// ([`triangulate_polygon`]), indices checked (naming the face element).
 pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let data = read_file(path)?;
     let parser = Parser::<Element>::new();
@@ -174,6 +175,7 @@ pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let n = positions.len() as i64;
 
     let mut triangles = Vec::with_capacity(faces.len());
+    let mut corners: Vec<u32> = Vec::new();
     if face_list.is_some() {
         for (f, face) in faces.iter().enumerate() {
             let idx = &face.indices;
@@ -194,9 +196,12 @@ pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
                 stats.polygons_triangulated += 1;
             }
             // Checked above: 0 <= index <= u32::MAX.
-            let at = |k: usize| idx[k] as u32;
-            for k in 1..idx.len() - 1 {
-                triangles.push([at(0), at(k), at(k + 1)]);
+            if let [a, b, c] = idx[..] {
+                triangles.push([a as u32, b as u32, c as u32]);
+            } else {
+                corners.clear();
+                corners.extend(idx.iter().map(|&i| i as u32));
+                triangles.extend(triangulate_polygon(&positions, &corners));
             }
         }
     }
