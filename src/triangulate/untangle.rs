@@ -97,8 +97,8 @@ pub fn untangle(
         for &(v, d) in &moves {
             relocated &= m.relocate_vertex(v, m.position(v) + d).is_ok();
         }
-        let current = m.to_trimesh();
-        let after = intersecting_pairs(&current.positions, &current.triangles);
+        // Moves change positions only: the faces are still `triangles`.
+        let after = intersecting_pairs(m.positions(), &triangles);
         if relocated && after.len() < pairs.len() {
             for &(v, _) in &moves {
                 moved[v as usize] = true;
