@@ -32,20 +32,8 @@ pub enum Density {
     Points(usize),
     /// This sigma_p, bbox-100 units.
     SigmaP(f64),
-    /// As many output vertices as the input has vertices (the command line's default); resolved
-    /// to [`Density::Points`] by [`Density::resolve`].
+    /// As many output vertices as the input has vertices (the command line's default).
     InputVertices,
-}
-
-impl Density {
-    /// The density for `input`: [`Density::InputVertices`] becomes `Points` of the input's
-    /// vertex count; the others stay as they are.
-    pub fn resolve(self, input: &TriMesh) -> Density {
-        match self {
-            Density::InputVertices => Density::Points(input.vertex_count()),
-            other => other,
-        }
-    }
 }
 
 /// A linear scan's result and the boundary edges between its first samples.

@@ -69,8 +69,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     let t = Instant::now();
     let (input, stats) = read_mesh(&job.input)?;
     let read_seconds = t.elapsed().as_secs_f64();
-    let mut params = job.params;
-    params.density = params.density.resolve(&input);
+    let params = job.params;
     let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
     on_stage("check");
     let t = Instant::now();
