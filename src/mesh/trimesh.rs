@@ -383,11 +383,11 @@ pub(crate) mod test_meshes {
             .collect()
     }
 
-    /// The 8 corners (z = 0) of a convex quad 0-3-1-2 whose long diagonal is 0-1, and of a ring
-    /// 6-5-7-4 around it: triangulated along 0-1 inside the ring, 0 and 1 get six faces each
-    /// (the flip tests' fixture).
-    pub fn quad_in_ring() -> Vec<DVec3> {
-        [
+    /// The flip tests' fixture: the 8 corners (z = 0) of a convex quad 0-3-1-2 whose long
+    /// diagonal is 0-1 and of a ring 6-5-7-4 around it, and the faces: the quad split along 0-1
+    /// (the first two), then the ring's eight, which give 0 and 1 six faces each.
+    pub fn quad_in_ring() -> (Vec<DVec3>, [[u32; 3]; 10]) {
+        let positions: Vec<DVec3> = [
             (0.0, 0.0),
             (2.0, 0.0),
             (1.0, 0.3),
@@ -399,7 +399,20 @@ pub(crate) mod test_meshes {
         ]
         .iter()
         .map(|&(x, y)| DVec3::new(x, y, 0.0))
-        .collect()
+        .collect();
+        let faces = [
+            [0, 1, 2],
+            [1, 0, 3],
+            [0, 2, 4],
+            [2, 1, 4],
+            [3, 0, 5],
+            [1, 3, 5],
+            [6, 0, 4],
+            [6, 5, 0],
+            [1, 7, 4],
+            [1, 5, 7],
+        ];
+        (positions, faces)
     }
 
     /// A closed axis-aligned box from `lo` to `hi`, faces outward.

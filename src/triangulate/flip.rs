@@ -85,27 +85,13 @@ pub(crate) fn max_min_flips<L: Copy>(
 mod tests {
     use super::*;
     use crate::mesh::edit::SlotPolicy;
-    use glam::DVec3;
 
     /// A convex quad 0-3-1-2 split along its long diagonal 0-1, alone or inside a ring 4..=7
     /// that gives 0 and 1 six faces each.
     fn quad(with_ring: bool) -> EditMesh<()> {
-        let positions: Vec<DVec3> = crate::mesh::test_meshes::quad_in_ring();
+        let (positions, faces) = crate::mesh::test_meshes::quad_in_ring();
         let mut m = EditMesh::new(positions, SlotPolicy::Reuse);
-        let mut faces = vec![[0, 1, 2], [1, 0, 3]];
-        if with_ring {
-            faces.extend([
-                [0, 2, 4],
-                [2, 1, 4],
-                [3, 0, 5],
-                [1, 3, 5],
-                [6, 0, 4],
-                [6, 5, 0],
-                [1, 7, 4],
-                [1, 5, 7],
-            ]);
-        }
-        for t in faces {
+        for &t in &faces[..if with_ring { 10 } else { 2 }] {
             assert!(m.add_face(t, ()).is_ok());
         }
         m
