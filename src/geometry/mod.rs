@@ -6,11 +6,13 @@
 //! building blocks under the pipeline's stages, not stages, and read best with the prefix.
 
 pub(crate) mod morton;
+pub(crate) mod plane;
 pub(crate) mod self_intersection;
 pub(crate) mod tolerance;
 pub(crate) mod triangle;
 pub(crate) mod triangle_intersection;
 
+pub use plane::tangent_basis;
 pub use self_intersection::{intersecting_pairs, intersecting_pairs_counted};
 pub use tolerance::{
     BURIED_OFFSET, DEGENERATE_AREA_TOLERANCE, SEARCH_BOUND_SLACK, SINGULAR_TOLERANCE,

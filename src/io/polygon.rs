@@ -15,7 +15,7 @@ use glam::{DVec2, DVec3};
 use spade::handles::FixedFaceHandle;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
 
-use crate::triangulate::tangent_delaunay::tangent_basis;
+use crate::geometry::tangent_basis;
 
 /// The triangles of the polygon whose corners, in order, are `corners` (indices into
 /// `positions`, every one in range), oriented like the polygon's corner order.

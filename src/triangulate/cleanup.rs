@@ -308,7 +308,7 @@ fn triangulate_hole_with_interior(
     if n.dot(avg_normal) <= 0.0 {
         return None;
     }
-    let (u, w) = super::tangent_delaunay::tangent_basis(n);
+    let (u, w) = crate::geometry::tangent_basis(n);
     let center = pts.iter().sum::<DVec3>() / m as f64;
     let to2 = |p: DVec3| DVec2::new((p - center).dot(u), (p - center).dot(w));
     let poly: Vec<DVec2> = pts.iter().map(|&p| to2(p)).collect();

@@ -9,6 +9,7 @@
 //! is left. (The approach of Gopi, Krishnan, Silva 2000, "Surface reconstruction based on lower
 //! dimensional localized Delaunay triangulation", and of Boissonnat's tangent-plane methods.)
 
+use crate::geometry::tangent_basis;
 use crate::geometry::tolerance::ANGLE_SLACK;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -72,14 +73,6 @@ impl HasPosition for LocalVertex {
     fn position(&self) -> Point2<f64> {
         self.p
     }
-}
-
-/// An orthonormal basis (u, v) of the plane orthogonal to unit `n`, with u × v = n.
-pub fn tangent_basis(n: DVec3) -> (DVec3, DVec3) {
-    let a = if n.x.abs() < 0.6 { DVec3::X } else { DVec3::Y };
-    let u = (a - n * n.dot(a)).normalize();
-    let v = n.cross(u);
-    (u, v)
 }
 
 /// The umbrella of sample `i`: the triangles incident to it in the Delaunay triangulation of its
@@ -317,16 +310,5 @@ mod tests {
         assert!(same_orientation([1, 2, 3], [3, 1, 2]));
         assert!(!same_orientation([1, 2, 3], [1, 3, 2]));
         assert!(!same_orientation([1, 2, 3], [4, 5, 6]));
-    }
-
-    #[test]
-    fn the_tangent_basis_is_orthonormal() {
-        for n in [DVec3::Z, DVec3::X, DVec3::new(1.0, -2.0, 0.5).normalize()] {
-            let (u, v) = tangent_basis(n);
-            assert!(u.dot(n).abs() < 1e-12 && v.dot(n).abs() < 1e-12 && u.dot(v).abs() < 1e-12);
-            assert!((u.length() - 1.0).abs() < 1e-12 && (v.length() - 1.0).abs() < 1e-12);
-            // Right-handed: u × v = n.
-            assert!(u.cross(v).distance(n) < 1e-12);
-        }
     }
 }
