@@ -177,7 +177,8 @@ pub use spatial::StaticTree;
 
 // Checks of a mesh: invariants (typed violations), topology, self-intersections.
 pub use check::{
-    check_invariants, self_intersections, topology, SelfIntersections, Topology, Violation,
+    check_invariants, self_intersections, surface_topology, topology, topology_changes,
+    SelfIntersections, Topology, TopologyChange, Violation,
 };
 
 // The quality report: Table 1's triangle measures, Metro-style distances, stage times.

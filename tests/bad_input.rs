@@ -68,15 +68,23 @@ fn assert_error(o: &Output, code: i32, mentions: &[&str], output: &Path) {
     assert!(!output.exists(), "{} was written", output.display());
 }
 
-/// Remeshes `input` to `output` with `--report`, expecting success; returns the report.
+/// Remeshes `input` to `output` with `--report` and `--strict`, expecting success (so the
+/// invariants hold and the topology is the input's); returns the report.
 fn assert_result(input: &Path, output: &Path, extra: &[&str]) -> Value {
+    let r = assert_remeshed(input, output, &[&["--strict"], extra].concat());
+    assert_eq!(r["topology_changes"].as_array().unwrap().len(), 0, "{r}");
+    r
+}
+
+/// Remeshes `input` to `output` with `--report`, expecting success and the output's invariants
+/// to hold; returns the report.
+fn assert_remeshed(input: &Path, output: &Path, extra: &[&str]) -> Value {
     let report = output.with_extension("json");
     let mut args = vec![
         input.to_str().unwrap(),
         output.to_str().unwrap(),
         "-q",
         "--no-distance",
-        "--strict",
         "--report",
         report.to_str().unwrap(),
     ];
@@ -90,7 +98,6 @@ fn assert_result(input: &Path, output: &Path, extra: &[&str]) -> Value {
     );
     assert!(output.exists());
     let r: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
-    // --strict: the invariants hold, or the run would have failed.
     assert_eq!(r["self_intersections"]["pairs"], 0);
     assert_eq!(r["invariant_violations"].as_array().unwrap().len(), 0);
     r
@@ -308,11 +315,10 @@ fn degenerate_zero_area_and_duplicate_faces_and_vertices_are_absorbed() {
     assert_closed_genus_0(&r);
 }
 
-#[test]
-fn non_manifold_inputs_give_manifold_outputs() {
-    let dir = tempfile::tempdir().unwrap();
-    // Two spheres touching at one vertex (a non-manifold vertex) and a fin: a third triangle
-    // on an edge of one of them (a non-manifold edge).
+/// Two icospheres (level 2) touching at one vertex (a non-manifold vertex), and with `fin`, a
+/// third triangle on an edge of the lower one (a non-manifold edge). Its χ is 3 (2 + 2 − 1 for
+/// the shared vertex; the fin adds 1 − 2 + 1 = 0): odd, so no manifold closed output has it.
+fn spheres_touching_at_a_vertex(fin: bool) -> (Vec<[f64; 3]>, Vec<Vec<usize>>) {
     let (p, f) = icosphere(2);
     let top = (0..p.len())
         .max_by(|&a, &b| p[a][2].total_cmp(&p[b][2]))
@@ -338,19 +344,28 @@ fn non_manifold_inputs_give_manifold_outputs() {
             .map(|&i| if i == low { top } else { i + off })
             .collect::<Vec<_>>()
     }));
-    // The fin stands out sideways from the lower sphere's face farthest along -x.
-    let side = f
-        .iter()
-        .min_by(|s, t| {
-            let x = |t: &[usize; 3]| t.iter().map(|&i| p[i][0]).sum::<f64>();
-            x(s).total_cmp(&x(t))
-        })
-        .unwrap();
-    let [a, b, _] = *side;
-    q.push([-2.0, (p[a][1] + p[b][1]) / 2.0, (p[a][2] + p[b][2]) / 2.0]);
-    faces.push(vec![a, b, q.len() - 1]);
+    if fin {
+        // The fin stands out sideways from the lower sphere's face farthest along -x.
+        let side = f
+            .iter()
+            .min_by(|s, t| {
+                let x = |t: &[usize; 3]| t.iter().map(|&i| p[i][0]).sum::<f64>();
+                x(s).total_cmp(&x(t))
+            })
+            .unwrap();
+        let [a, b, _] = *side;
+        q.push([-2.0, (p[a][1] + p[b][1]) / 2.0, (p[a][2] + p[b][2]) / 2.0]);
+        faces.push(vec![a, b, q.len() - 1]);
+    }
+    (q, faces)
+}
+
+#[test]
+fn non_manifold_inputs_give_manifold_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let (q, faces) = spheres_touching_at_a_vertex(true);
     let input = write(dir.path(), "nonmanifold.obj", obj(&q, &faces, false));
-    let r = assert_result(&input, &dir.path().join("nm-out.obj"), &["--points", "600"]);
+    let r = assert_remeshed(&input, &dir.path().join("nm-out.obj"), &["--points", "600"]);
     assert_eq!(topo(&r, "non_manifold_edges"), 0);
     assert_eq!(topo(&r, "non_manifold_vertices"), 0);
     let input_t = &r["input_topology"];
@@ -361,6 +376,64 @@ fn non_manifold_inputs_give_manifold_outputs() {
     assert!(
         input_t["non_manifold_edges"].as_i64().unwrap() >= 1,
         "{input_t}"
+    );
+}
+
+/// Issue 14, item 4: the report compares the output's components, χ and boundary loops with
+/// the input's and lists every difference; `--strict` makes a difference an error. The input
+/// (two spheres sharing a vertex, χ = 3) cannot come out with its own topology: every closed
+/// manifold has an even χ.
+#[test]
+fn a_topology_change_is_a_note_and_under_strict_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let (q, faces) = spheres_touching_at_a_vertex(false);
+    let input = write(dir.path(), "touching.obj", obj(&q, &faces, false));
+    let r = assert_remeshed(&input, &dir.path().join("out.obj"), &["--points", "600"]);
+    assert_eq!(r["input_topology"]["euler_characteristic"], 3, "{r}");
+    let changes = r["topology_changes"].as_array().unwrap();
+    // Exactly the counts that differ, each with both values.
+    for (kind, key) in [
+        ("Components", "components"),
+        ("EulerCharacteristic", "euler_characteristic"),
+        ("BoundaryLoops", "boundary_loops"),
+    ] {
+        let (a, b) = (&r["input_topology"][key], &r["topology"][key]);
+        let listed: Vec<&Value> = changes.iter().filter(|c| c["kind"] == kind).collect();
+        if a == b {
+            assert!(listed.is_empty(), "{kind}: {r}");
+        } else {
+            assert_eq!(listed.len(), 1, "{kind}: {r}");
+            assert_eq!((&listed[0]["input"], &listed[0]["output"]), (a, b));
+        }
+    }
+    assert!(changes.iter().any(|c| c["kind"] == "EulerCharacteristic"));
+    let notes = r["notes"].as_array().unwrap();
+    assert!(
+        notes.iter().any(|n| n
+            .as_str()
+            .unwrap()
+            .contains("topology differs from the input's")
+            && n.as_str().unwrap().contains("where the input has 3")),
+        "{r}"
+    );
+    let strict = dir.path().join("strict.obj");
+    let o = remesh(&[
+        input.to_str().unwrap(),
+        strict.to_str().unwrap(),
+        "--points",
+        "600",
+        "--strict",
+        "-q",
+        "--no-distance",
+    ]);
+    assert_error(
+        &o,
+        1,
+        &[
+            "topology differs from the input's",
+            "not written (--strict)",
+        ],
+        &strict,
     );
 }
 
@@ -403,8 +476,9 @@ fn many_components_including_tiny_ones() {
         &["--points", "400"],
     );
     assert!(topo(&r, "components") >= 1);
-    // The beetle: 33 parts glued along non-manifold edges, open, crossing itself.
-    let r = assert_result(
+    // The beetle: 33 parts glued along non-manifold edges, open, crossing itself (its
+    // topology as a non-manifold complex is not one a manifold output can have: no --strict).
+    let r = assert_remeshed(
         &shared("beetle.obj"),
         &dir.path().join("beetle-out.obj"),
         &[],

@@ -257,16 +257,18 @@ fn cow_at_3000_is_a_closed_manifold() {
 
 /// At seed 1 only: at 3000 points, seeds 2 and 3 leave crossing faces (issue 15).
 #[test]
-fn beetle_comes_out_without_violated_invariants_under_strict() {
+fn beetle_comes_out_without_violated_invariants() {
     // Open, 47 non-manifold edges, 32 pairs of its own faces crossing: at its own vertex count
-    // and at 3000 the output is manifold, oriented and free of self-intersections.
+    // and at 3000 the output is manifold, oriented and free of self-intersections. (Not under
+    // --strict: a non-manifold input's counts are not a manifold output's, so its topology
+    // changes are listed, and --strict would refuse them.)
     let dir = tempfile::tempdir().unwrap();
     for n in [1148, 3000] {
         let (r, out) = run(
             "beetle.obj",
             &format!("beetle-{n}.obj"),
             n,
-            &["--no-distance", "--strict"],
+            &["--no-distance"],
             dir.path(),
         );
         assert_invariants_hold(&r, "beetle");

@@ -31,8 +31,10 @@ pub struct RemeshJob {
     /// Whether to measure the distance to the input (Hausdorff, RMS).
     pub measure_distance: bool,
     /// Whether a violated output invariant ([`check_invariants`](crate::check_invariants):
-    /// manifold, oriented, no degenerate, duplicate or intersecting faces) is an error, with
-    /// nothing written, rather than a line of the report.
+    /// manifold, oriented, no degenerate, duplicate or intersecting faces) or a topology that
+    /// differs from the input's ([`topology_changes`](crate::topology_changes): components,
+    /// Euler characteristic, boundary loops) is an error, with nothing written, rather than a
+    /// note of the report.
     pub strict: bool,
 }
 
@@ -41,12 +43,14 @@ pub struct RemeshJob {
 /// The output's invariants ([`check_invariants`](crate::check_invariants)) are checked before it
 /// is written, on the mesh as the output format stores it (glTF positions rounded to `f32`
 /// relative to the node's translation; OBJ and PLY are exact); violations go into the report ([`QualityReport::invariant_violations`] and a note).
+/// Its topology is compared with the input's; every difference goes into the report
+/// ([`QualityReport::topology_changes`] and a note).
 ///
 /// # Errors
 /// Whatever reading, the pipeline or writing return, each naming the file concerned; an
 /// [`Error::InvalidParameter`] when the output path is the input path; with `job.strict`, an
 /// [`Error::Internal`] (stage `invariant check`) naming the violations when the output breaks
-/// an invariant, and then nothing is written.
+/// an invariant or its topology differs from the input's, and then nothing is written.
 pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<QualityReport> {
     // The output's format is known before any work: an unknown extension is a usage error.
     let format = MeshFormat::from_path(&job.output).map_err(|_| Error::InvalidParameter {
@@ -84,7 +88,17 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         }
     };
     let mut report = QualityReport::new(checked);
+    let input_topology = crate::check::topology(&out.input_normalized);
+    if input_topology.non_manifold_vertices > 0 || input_topology.non_manifold_edges > 0 {
+        report.notes.push(format!(
+            "the input has {} non-manifold vertices and {} non-manifold edges; the sampler works on \
+             the surface as a point set and the output is rebuilt manifold",
+            input_topology.non_manifold_vertices, input_topology.non_manifold_edges
+        ));
+    }
+    report.set_input(&out.input_normalized);
     let check_seconds = t.elapsed().as_secs_f64();
+    let mut refusals = Vec::new();
     if !report.invariant_violations.is_empty() {
         let list = report
             .invariant_violations
@@ -92,18 +106,26 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             .map(|v| v.to_string())
             .collect::<Vec<_>>()
             .join("; ");
-        if job.strict {
-            return Err(Error::Internal {
-                stage: "invariant check",
-                message: format!(
-                    "the output mesh breaks its invariants ({list}); {} was not written (--strict)",
-                    job.output.display()
-                ),
-            });
-        }
+        refusals.push(format!("the output mesh breaks its invariants ({list})"));
         report
             .notes
             .push(format!("the output mesh breaks its invariants: {list}"));
+    }
+    if !report.topology_changes.is_empty() {
+        refusals.push(format!(
+            "the output's topology differs from the input's ({})",
+            report.topology_changes_text()
+        ));
+    }
+    if job.strict && !refusals.is_empty() {
+        return Err(Error::Internal {
+            stage: "invariant check",
+            message: format!(
+                "{}; {} was not written (--strict)",
+                refusals.join("; "),
+                job.output.display()
+            ),
+        });
     }
     on_stage("write");
     let t = Instant::now();
@@ -116,15 +138,6 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     }
     report.push_stage("check (report)", check_seconds);
     report.push_stage("write", write_seconds);
-    let input_topology = crate::check::topology(&out.input_normalized);
-    if input_topology.non_manifold_vertices > 0 || input_topology.non_manifold_edges > 0 {
-        report.notes.push(format!(
-            "the input has {} non-manifold vertices and {} non-manifold edges; the sampler works on \
-             the surface as a point set and the output is rebuilt manifold",
-            input_topology.non_manifold_vertices, input_topology.non_manifold_edges
-        ));
-    }
-    report.input_topology = Some(input_topology);
     if job.measure_distance {
         on_stage("distance");
         let t = Instant::now();
@@ -236,7 +249,7 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
     if let Some((r, reference_path)) = &reference {
         let t = Instant::now();
         let rn = normalization.apply_mesh(r);
-        report.input_topology = Some(crate::check::topology(&rn));
+        report.set_input(&rn);
         // Each side's error names its own file.
         let sm = MeshSurface::new(&m).map_err(|e| with_path(e, path))?;
         let sr = MeshSurface::new(&rn).map_err(|e| with_path(e, reference_path))?;

@@ -73,7 +73,8 @@ struct Cli {
     no_distance: bool,
 
     /// Fail (exit 1, nothing written) when the output breaks an invariant (manifold, oriented,
-    /// no degenerate, duplicate or self-intersecting faces) instead of reporting it.
+    /// no degenerate, duplicate or self-intersecting faces) or its topology (components, Euler
+    /// characteristic, boundary loops) differs from the input's, instead of reporting it.
     #[arg(long)]
     strict: bool,
 

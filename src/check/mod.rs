@@ -5,8 +5,10 @@
 mod invariants;
 mod self_intersection;
 mod topology;
+mod topology_change;
 
 pub(crate) use invariants::check_all;
 pub use invariants::{check_invariants, Violation};
 pub use self_intersection::{self_intersections, SelfIntersections};
 pub use topology::{topology, Topology};
+pub use topology_change::{surface_topology, topology_changes, TopologyChange};

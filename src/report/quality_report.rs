@@ -8,9 +8,12 @@ use serde::Serialize;
 use super::distance::surface_distance;
 use super::distance::SurfaceDistance;
 use super::triangle_quality::{triangle_quality, TriangleQuality};
-use crate::check::{check_all, SelfIntersections, Topology, Violation};
+use crate::check::{
+    check_all, surface_topology, topology, topology_changes, SelfIntersections, Topology,
+    TopologyChange, Violation,
+};
 #[cfg(doc)]
-use crate::check::{check_invariants, self_intersections, topology};
+use crate::check::{check_invariants, self_intersections};
 use crate::mesh::TriMesh;
 
 /// The wall-clock time of one pipeline stage.
@@ -83,6 +86,11 @@ pub struct QualityReport {
     pub distance: Option<SurfaceDistance>,
     /// Topology of the input, for comparison; `None` when not given.
     pub input_topology: Option<Topology>,
+    /// How the output's components, Euler characteristic and boundary loops differ from the
+    /// input surface's ([`topology_changes`], [`QualityReport::set_input`]); empty when they are
+    /// equal or no input is given.
+    /// Serialized with a `kind` tag and the two values.
+    pub topology_changes: Vec<TopologyChange>,
     /// Per-stage wall-clock times, in pipeline order.
     pub stages: Vec<StageTime>,
     /// Free-text remarks (warnings, repairs made, targets not reached).
@@ -104,10 +112,41 @@ impl QualityReport {
             topology,
             distance: None,
             input_topology: None,
+            topology_changes: Vec::new(),
             stages: Vec::new(),
             notes: Vec::new(),
             extra: serde_json::Map::new(),
         }
+    }
+
+    /// Sets the input's topology ([`topology`] of `input`) and compares the output's with its
+    /// surface's ([`surface_topology`]: without zero-area, repeated-index or duplicate faces):
+    /// every difference of components, Euler characteristic and boundary loops goes into
+    /// [`QualityReport::topology_changes`] and, in words, into one note.
+    pub fn set_input(&mut self, input: &TriMesh) {
+        let raw = topology(input);
+        let surface = if raw.degenerate_faces == 0 && raw.duplicate_faces == 0 {
+            raw.clone()
+        } else {
+            surface_topology(input)
+        };
+        self.topology_changes = topology_changes(&surface, &self.topology);
+        if !self.topology_changes.is_empty() {
+            self.notes.push(format!(
+                "the output's topology differs from the input's: {}",
+                self.topology_changes_text()
+            ));
+        }
+        self.input_topology = Some(raw);
+    }
+
+    /// [`QualityReport::topology_changes`] in words, separated by "; ".
+    pub fn topology_changes_text(&self) -> String {
+        self.topology_changes
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join("; ")
     }
 
     /// Appends a stage time (seconds of wall-clock time).
