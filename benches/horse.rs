@@ -45,6 +45,7 @@ fn remesh_job(c: &mut Criterion) {
         },
         strict: false,
         measure_distance: false,
+        max_memory: None,
     };
     // The split per stage of one run, which criterion's total does not show.
     let report = run_remesh(&job, &|_| {}).expect("remesh");

@@ -1127,3 +1127,60 @@ fn concave_polygon_caps_are_triangulated_without_overlap() {
         );
     }
 }
+
+/// Issue 14, item 9: a job whose estimated peak memory is over `--max-memory` is refused at
+/// once (exit 2, one line with the estimate and the limit, nothing written): 5 million points
+/// would otherwise run for many minutes and take about 12 GB. An input file larger than the
+/// limit is refused before it is read. A job within the limit runs.
+#[test]
+fn a_job_over_the_memory_limit_fails_fast_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, f) = icosphere(3);
+    let input = write(dir.path(), "sphere.obj", obj(&p, &tri_faces(&f), false));
+    let out = dir.path().join("out.obj");
+    let arg = |s: &Path| s.to_str().unwrap().to_string();
+    let t = std::time::Instant::now();
+    let o = remesh(&[
+        &arg(&input),
+        &arg(&out),
+        "--points",
+        "5000000",
+        "--max-memory",
+        "1G",
+    ]);
+    assert_error(&o, 2, &["--max-memory", "GB", "1.000 GB"], &out);
+    // A hang guard, not a speed test: the job itself would take many minutes.
+    assert!(t.elapsed().as_secs_f64() < 20.0, "{:?}", t.elapsed());
+    // --sigma-p: the count it gives (the surface's area over sigma_p², about 3.3 million here).
+    let o = remesh(&[
+        &arg(&input),
+        &arg(&out),
+        "--sigma-p",
+        "0.05",
+        "--max-memory",
+        "2GiB",
+    ]);
+    assert_error(&o, 2, &["--max-memory", "points"], &out);
+    // The file alone is larger than the limit.
+    let size = std::fs::metadata(&input).unwrap().len();
+    let o = remesh(&[
+        &arg(&input),
+        &arg(&out),
+        "--points",
+        "400",
+        "--max-memory",
+        &(size - 1).to_string(),
+    ]);
+    assert_error(
+        &o,
+        2,
+        &["--max-memory", "sphere.obj", "cannot be remeshed"],
+        &out,
+    );
+    // Not a size.
+    let o = remesh(&[&arg(&input), &arg(&out), "--max-memory", "lots"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!out.exists());
+    // Within the limit.
+    assert_result(&input, &out, &["--points", "400", "--max-memory", "1G"]);
+}

@@ -2,8 +2,10 @@
 //! it, report on any mesh against a reference, simplify a point set out of core, draw points
 //! from a mesh; writing the JSON report, and turning a panic into an error.
 
+mod memory;
 mod simplify;
 
+pub use memory::{estimate_remesh_bytes, parse_bytes, physical_memory};
 pub use simplify::{run_simplify, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary};
 
 use std::path::{Path, PathBuf};
@@ -11,7 +13,9 @@ use std::time::Instant;
 
 use crate::error::{Error, Result};
 use crate::io::{as_written, read_mesh, write_atomically, write_mesh, MeshFormat};
-use crate::pipeline::{remesh, RemeshParams};
+use crate::pipeline::{
+    remesh, validate_input, Density, RemeshParams, MAX_POINTS, SAMPLES_PER_SIGMA2,
+};
 use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
 
@@ -36,6 +40,10 @@ pub struct RemeshJob {
     /// Euler characteristic, boundary loops) is an error, with nothing written, rather than a
     /// note of the report.
     pub strict: bool,
+    /// The most memory the job may take, in bytes: a job whose estimated peak
+    /// ([`estimate_remesh_bytes`]) is larger is refused before it starts (and an input file too
+    /// large to fit is refused before it is read). `None`: no limit.
+    pub max_memory: Option<u64>,
 }
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
@@ -50,7 +58,9 @@ pub struct RemeshJob {
 /// Whatever reading, the pipeline or writing return, each naming the file concerned; an
 /// [`Error::InvalidParameter`] when the output path is the input path; with `job.strict`, an
 /// [`Error::Internal`] (stage `invariant check`) naming the violations when the output breaks
-/// an invariant or its topology differs from the input's, and then nothing is written.
+/// an invariant or its topology differs from the input's, and then nothing is written;
+/// [`Error::InvalidParameter`] naming `--max-memory` when the job's estimated peak memory is
+/// over `job.max_memory`, before any work.
 pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<QualityReport> {
     // The output's format is known before any work: an unknown extension is a usage error.
     let format = MeshFormat::from_path(&job.output).map_err(|_| Error::InvalidParameter {
@@ -69,11 +79,36 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             ),
         });
     }
+    if let Some(limit) = job.max_memory {
+        memory::check_input_size(&job.input, limit)?;
+    }
     on_stage("read");
     let t = Instant::now();
     let (input, stats) = read_mesh(&job.input)?;
     let read_seconds = t.elapsed().as_secs_f64();
     let params = job.params;
+    if let Some(limit) = job.max_memory {
+        let points = match params.density {
+            Density::Points(n) => n as f64,
+            Density::InputVertices => input.vertex_count() as f64,
+            Density::SigmaP(s) => {
+                // The count sigma_p gives: area / sigma_p² in bbox-100 units.
+                let scale = validate_input(&input)
+                    .map_err(|e| with_path(e, &job.input))?
+                    .scale;
+                SAMPLES_PER_SIGMA2 * input.area() * scale * scale / (s * s)
+            }
+        };
+        // Beyond MAX_POINTS the pipeline refuses the density itself, naming the option.
+        if points <= MAX_POINTS as f64 {
+            memory::check_remesh_budget(
+                input.face_count() as u64,
+                points,
+                job.measure_distance,
+                limit,
+            )?;
+        }
+    }
     let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
     on_stage("check");
     let t = Instant::now();

@@ -9,8 +9,8 @@ use std::time::Duration;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
-    catch_panics, run_points, run_quality, run_remesh, run_simplify, write_report, Density, Error,
-    PointsJob, RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob,
+    catch_panics, parse_bytes, physical_memory, run_points, run_quality, run_remesh, run_simplify,
+    write_report, Density, Error, PointsJob, RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob,
 };
 
 const EXAMPLES: &str = "\
@@ -77,6 +77,12 @@ struct Cli {
     /// characteristic, boundary loops) differs from the input's, instead of reporting it.
     #[arg(long)]
     strict: bool,
+
+    /// The most memory the job may take (e.g. 512M, 8G, 2GiB): a job whose estimated peak is
+    /// larger is refused at once (exit 2), before reading an input file too large for it.
+    /// Default: the machine's physical memory.
+    #[arg(long, value_name = "SIZE", value_parser = parse_bytes)]
+    max_memory: Option<u64>,
 
     /// Print nothing but errors.
     #[arg(short, long)]
@@ -268,6 +274,7 @@ fn config(cli: Cli) -> Result<Config, Error> {
                 params,
                 measure_distance: !cli.no_distance,
                 strict: cli.strict,
+                max_memory: cli.max_memory.or_else(physical_memory),
             };
             Ok(Config::Remesh {
                 job: Box::new(job),
