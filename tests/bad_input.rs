@@ -1053,3 +1053,73 @@ fn concave_polygon_caps_are_triangulated_without_overlap() {
         );
     }
 }
+
+/// Issue 14, item 11: a point file cut short said "the file ends after 0" when 100 of its
+/// points were there (the count before the chunk being read). The message gives the complete
+/// points read and the count the header promised, for binary and ascii PLY.
+#[test]
+fn a_truncated_point_file_gives_the_points_read_and_the_points_promised() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\nelement vertex 200\nproperty float x\nproperty float y\n\
+             property float z\nend_header\n"
+        )
+    };
+    let point = |k: usize| [k as f32, (k * k % 17) as f32, (k % 5) as f32];
+    let mut binary = header("binary_little_endian").into_bytes();
+    let mut ascii = header("ascii");
+    for k in 0..100 {
+        for c in point(k) {
+            binary.extend_from_slice(&c.to_le_bytes());
+        }
+        let [x, y, z] = point(k);
+        ascii += &format!("{x} {y} {z}\n");
+    }
+    // Half a record more in the binary file: still 100 complete points.
+    binary.extend_from_slice(&[0; 6]);
+    for (name, content) in [("binary.ply", binary), ("ascii.ply", ascii.into_bytes())] {
+        let input = write(dir.path(), name, content);
+        let out = dir.path().join(format!("out-{name}"));
+        let o = remesh(&[
+            "simplify",
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--points",
+            "20",
+            "-q",
+        ]);
+        assert_error(
+            &o,
+            3,
+            &[name, "announces 200 points, the file ends after 100"],
+            &out,
+        );
+    }
+}
+
+/// Issue 14, item 11: a model scaled by 1e-310 (subnormal coordinates) was refused with "the
+/// bounding box has zero size". Its box is not empty: the message names the file and the
+/// actual size, for `remesh` and `remesh quality`.
+#[test]
+fn subnormal_coordinates_give_the_actual_bounding_box_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, f) = icosphere(1);
+    let q: Vec<[f64; 3]> = p.iter().map(|v| v.map(|c| c * 1e-310)).collect();
+    let input = write(dir.path(), "subnormal.obj", obj(&q, &tri_faces(&f), false));
+    let out = dir.path().join("out.obj");
+    let o = remesh(&[input.to_str().unwrap(), out.to_str().unwrap(), "-q"]);
+    assert_error(
+        &o,
+        3,
+        &["subnormal.obj", "longest side is 2e-310", "subnormal"],
+        &out,
+    );
+    let o = remesh(&["quality", input.to_str().unwrap()]);
+    assert_error(&o, 3, &["subnormal.obj", "longest side is 2e-310"], &out);
+    // A model of one point has zero size, and says so.
+    let flat: Vec<[f64; 3]> = p.iter().map(|_| [1.0, 2.0, 3.0]).collect();
+    let input = write(dir.path(), "point.obj", obj(&flat, &tri_faces(&f), false));
+    let o = remesh(&[input.to_str().unwrap(), out.to_str().unwrap(), "-q"]);
+    assert_error(&o, 3, &["point.obj"], &out);
+}

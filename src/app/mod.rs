@@ -229,7 +229,7 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
         .bbox()
         .ok_or_else(|| Error::invalid_mesh(path, "the mesh has no vertices"))?;
     let normalization = crate::mesh::Normalization::for_bbox(&bbox)
-        .ok_or_else(|| Error::invalid_mesh(path, "the bounding box has zero size"))?;
+        .ok_or_else(|| Error::invalid_mesh(path, crate::mesh::Normalization::refusal(&bbox)))?;
     let m = normalization.apply_mesh(&mesh);
     let mut report = QualityReport::new(&m);
     report.push_stage("read and measure", t.elapsed().as_secs_f64());
