@@ -559,6 +559,82 @@ fn big_endian_ply_with_int_indices() {
     assert_eq!(m.positions[2], DVec3::new(1.0, 1.0, 0.0));
 }
 
+/// Issue 14, item 11: PLY `tristrips` (the Georgia Tech archive's models: `element tristrips 1`,
+/// `property list int int vertex_indices`, strips separated by -1) was read as "no faces". The
+/// strips give their triangles with the alternating winding (every triangle facing +z here),
+/// the degenerate stitching triangles left out, in ascii and binary files.
+#[test]
+fn ply_triangle_strips_are_read_with_alternating_winding() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two rows of four vertices, x = 0..3: even indices at y = 0, odd ones at y = 1.
+    let positions: Vec<[f32; 3]> = (0..8)
+        .map(|i| [(i / 2) as f32, (i % 2) as f32, 0.0])
+        .collect();
+    // One strip over the first two quads, then -1 and a second strip over the third quad that
+    // starts with two degenerate (stitching) triangles.
+    let strips: [i32; 13] = [1, 0, 3, 2, 5, 4, -1, 4, 4, 5, 4, 7, 6];
+    let header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\ncomment a strip mesh\nelement vertex 8\n\
+             property float x\nproperty float y\nproperty float z\nelement tristrips 1\n\
+             property list int int vertex_indices\nend_header\n"
+        )
+    };
+    let mut ascii = header("ascii");
+    for p in &positions {
+        ascii += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    ascii += &format!("{}", strips.len());
+    for i in strips {
+        ascii += &format!(" {i}");
+    }
+    ascii += "\n";
+    let mut binary = header("binary_little_endian").into_bytes();
+    for c in positions.iter().flatten() {
+        binary.extend_from_slice(&c.to_le_bytes());
+    }
+    binary.extend_from_slice(&(strips.len() as i32).to_le_bytes());
+    for i in strips {
+        binary.extend_from_slice(&i.to_le_bytes());
+    }
+    for (name, bytes) in [("ascii.ply", ascii.into_bytes()), ("binary.ply", binary)] {
+        let path = dir.path().join(name);
+        fs::write(&path, &bytes).unwrap();
+        let (m, s) = read_mesh(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            m.triangles,
+            vec![
+                [1, 0, 3],
+                [3, 0, 2],
+                [3, 2, 5],
+                [5, 2, 4],
+                [5, 4, 7],
+                [7, 4, 6]
+            ],
+            "{name}"
+        );
+        assert_eq!((s.vertices_read, s.faces_read), (8, 6), "{name}");
+        for f in 0..m.face_count() {
+            assert!(
+                m.face_normal(f).distance(DVec3::Z) < 1e-12,
+                "{name} face {f}"
+            );
+        }
+    }
+    // An index that is neither -1 nor a vertex names the strip record.
+    let path = dir.path().join("bad.ply");
+    fs::write(
+        &path,
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+         property float z\nelement tristrips 1\nproperty list int int vertex_indices\n\
+         end_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 -2 2\n",
+    )
+    .unwrap();
+    let e = expect_err(&path);
+    assert!(e.to_string().contains("tristrips record 0"), "{e}");
+    assert!(e.to_string().contains("vertex -2"), "{e}");
+}
+
 /// Standard base64 with padding, as data URIs hold it.
 fn base64(data: &[u8]) -> String {
     use base64::Engine;
