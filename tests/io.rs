@@ -767,6 +767,123 @@ fn gltf_strips_fans_and_scene_less_files() {
     }
 }
 
+/// Issue 14, item 11: glTF files that use Draco without requiring it, and index accessors of
+/// u8 (with or without the `normalized` flag), gave parser jargon. The plain accessors beside a
+/// Draco stream are read; a file whose geometry only Draco holds (required, or no fallback) is
+/// one line naming the compression; u8 indices are read as integers; what glTF does not allow
+/// as indices (signed, floating point) is named plainly.
+#[test]
+fn gltf_draco_fallbacks_and_u8_indices() {
+    let dir = tempfile::tempdir().unwrap();
+    // A tetrahedron: 4 f32 positions and 12 u8 indices (padded to 4 bytes).
+    let positions = [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let faces: [[u8; 3]; 4] = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    let mut bin: Vec<u8> = positions
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    bin.extend(faces.iter().flatten());
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&bin));
+    const DRACO: &str = "KHR_draco_mesh_compression";
+    // `used`/`required`: the extension lists; `fallback`: whether the accessors have data.
+    let doc = |used: bool, required: bool, fallback: bool, index_accessor: serde_json::Value| {
+        let mut primitive = serde_json::json!({ "attributes": { "POSITION": 0 }, "indices": 1 });
+        let mut accessors = serde_json::json!([
+            { "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+              "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] },
+            index_accessor
+        ]);
+        if used {
+            primitive["extensions"] =
+                serde_json::json!({ DRACO: { "bufferView": 1, "attributes": { "POSITION": 0 } } });
+        }
+        if !fallback {
+            for a in accessors.as_array_mut().unwrap() {
+                a.as_object_mut().unwrap().remove("bufferView");
+            }
+        }
+        let mut d = serde_json::json!({
+            "asset": { "version": "2.0" },
+            "scene": 0, "scenes": [ { "nodes": [0] } ], "nodes": [ { "mesh": 0 } ],
+            "meshes": [ { "primitives": [primitive] } ],
+            "accessors": accessors,
+            "bufferViews": [ { "buffer": 0, "byteLength": 48 },
+                             { "buffer": 0, "byteOffset": 48, "byteLength": 12 } ],
+            "buffers": [ { "byteLength": 60, "uri": uri } ]
+        });
+        if used {
+            d["extensionsUsed"] = serde_json::json!([DRACO]);
+        }
+        if required {
+            d["extensionsRequired"] = serde_json::json!([DRACO]);
+        }
+        serde_json::to_vec(&d).unwrap()
+    };
+    let indices = |component_type: u32, normalized: bool| {
+        serde_json::json!({ "bufferView": 1, "componentType": component_type, "count": 12,
+                            "type": "SCALAR", "normalized": normalized })
+    };
+    let write = |name: &str, bytes: Vec<u8>| {
+        let path = dir.path().join(name);
+        fs::write(&path, bytes).unwrap();
+        path
+    };
+    let expected: Vec<[u32; 3]> = faces.iter().map(|f| f.map(u32::from)).collect();
+    // Read: u8 indices, u8 indices flagged `normalized`, Draco used with plain fallbacks.
+    for (name, bytes) in [
+        ("u8.gltf", doc(false, false, true, indices(5121, false))),
+        (
+            "u8-normalized.gltf",
+            doc(false, false, true, indices(5121, true)),
+        ),
+        (
+            "draco-used.gltf",
+            doc(true, false, true, indices(5121, false)),
+        ),
+    ] {
+        let path = write(name, bytes);
+        let (m, s) = read_mesh(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.triangles, expected, "{name}");
+        assert_eq!(m.vertex_count(), 4, "{name}");
+        assert_eq!(s.faces_read, 4, "{name}");
+    }
+    // Refused in one line naming the file and the problem.
+    for (name, bytes, says) in [
+        (
+            "draco-required.gltf",
+            doc(true, true, false, indices(5121, false)),
+            "uses Draco compression (KHR_draco_mesh_compression), which this reader does not decode",
+        ),
+        (
+            "draco-no-fallback.gltf",
+            doc(true, false, false, indices(5121, false)),
+            "uses Draco compression (KHR_draco_mesh_compression), which this reader does not decode",
+        ),
+        (
+            "i8.gltf",
+            doc(false, false, true, indices(5120, false)),
+            "index accessor 1 holds signed 8-bit integers; glTF indices are unsigned",
+        ),
+    ] {
+        let e = expect_err(&write(name, bytes));
+        let line = e.to_string();
+        assert!(line.contains(says), "{name}: {line}");
+        assert_eq!(line.lines().count(), 1, "{line}");
+    }
+    // The `gltf` crate's validation findings, in words: a missing required property.
+    let e = expect_err(&write(
+        "no-count.gltf",
+        br#"{"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#.to_vec(),
+    ));
+    assert!(!e.to_string().contains("Missing data"), "{e}");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Errors
 
