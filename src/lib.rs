@@ -202,5 +202,5 @@ pub use points::{PlyPointWriter, Point, PointReader};
 pub use app::{
     catch_panics, run_points, run_quality, run_remesh, run_simplify, write_report, PointsJob,
     RemeshJob, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary, DISTANCE_SAMPLES,
-    MAX_SURFACE_POINTS,
+    MAX_SURFACE_POINTS, STDOUT,
 };

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::io::{as_written, read_mesh, write_atomically, write_mesh, MeshFormat};
+use crate::io::{as_written, encode_mesh, read_mesh, write_atomically, MeshFormat};
 use crate::pipeline::{remesh, RemeshParams};
 use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
@@ -24,8 +24,13 @@ pub const DISTANCE_SAMPLES: usize = 200_000;
 pub struct RemeshJob {
     /// Input mesh (.obj, .ply, .gltf, .glb).
     pub input: PathBuf,
-    /// Output mesh (.obj, .ply, .glb), format by extension.
+    /// Output mesh (.obj, .ply, .gltf, .glb), format by extension; `-` ([`STDOUT`]) writes it
+    /// to standard output instead, in `format`.
     pub output: PathBuf,
+    /// The output's format: `None` takes it from `output`'s extension, or OBJ for standard
+    /// output. Given with a file, it must agree with the extension; the binary formats (PLY,
+    /// GLB) go to standard output only when asked for here, and never to a terminal.
+    pub format: Option<MeshFormat>,
     /// Pipeline parameters (`Density::InputVertices`: as many as the input has vertices).
     pub params: RemeshParams,
     /// Whether to measure the distance to the input (Hausdorff, RMS).
@@ -38,6 +43,11 @@ pub struct RemeshJob {
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
 ///
+/// The mesh goes to `job.output`, atomically, or with an output of `-` ([`STDOUT`]) to standard
+/// output in `job.format` (OBJ by default); either way its bytes are built in memory and written
+/// only once every check has passed, so an error (or `--strict`) never leaves a part of a mesh
+/// behind.
+///
 /// The output's invariants ([`check_invariants`](crate::check_invariants)) are checked before it
 /// is written, on the mesh as the output format stores it (glTF positions rounded to `f32`
 /// relative to the node's translation; OBJ and PLY are exact); violations go into the report ([`QualityReport::invariant_violations`] and a note).
@@ -46,17 +56,27 @@ pub struct RemeshJob {
 /// Whatever reading, the pipeline or writing return, each naming the file concerned; an
 /// [`Error::InvalidParameter`] when the output path is the input path; with `job.strict`, an
 /// [`Error::Internal`] (stage `invariant check`) naming the violations when the output breaks
-/// an invariant, and then nothing is written.
+/// an invariant, and then nothing is written; [`Error::InvalidParameter`] (usage errors, before
+/// any work) for an output extension no format has, a `job.format` that contradicts it, or a
+/// binary format for standard output when that is a terminal.
 pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<QualityReport> {
     // The output's format is known before any work: an unknown extension is a usage error.
-    let format = MeshFormat::from_path(&job.output).map_err(|_| Error::InvalidParameter {
-        name: "OUTPUT",
-        message: format!(
-            "{}: unsupported output format (expected .obj, .ply, .gltf or .glb)",
-            job.output.display()
-        ),
-    })?;
-    if same_file(&job.input, &job.output) {
+    let to_stdout = is_stdout(&job.output);
+    let format = output_format(&job.output, job.format)?;
+    if to_stdout && matches!(format, MeshFormat::Ply | MeshFormat::Glb) {
+        use std::io::IsTerminal;
+        if std::io::stdout().is_terminal() {
+            return Err(Error::InvalidParameter {
+                name: "--format",
+                message: format!(
+                    "standard output is a terminal, and {} is a binary format; redirect it to a \
+                     file or a pipe",
+                    format.extension().to_ascii_uppercase()
+                ),
+            });
+        }
+    }
+    if !to_stdout && same_file(&job.input, &job.output) {
         return Err(Error::InvalidParameter {
             name: "OUTPUT",
             message: format!(
@@ -107,7 +127,21 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     }
     on_stage("write");
     let t = Instant::now();
-    write_mesh(&job.output, &out.mesh)?;
+    // Every check has passed: standard output gets the complete bytes, or nothing.
+    let bytes = encode_mesh(&job.output, &out.mesh, format)?;
+    if to_stdout {
+        use std::io::Write;
+        let mut stdout = std::io::stdout().lock();
+        stdout
+            .write_all(&bytes)
+            .and_then(|()| stdout.flush())
+            .map_err(|e| Error::Write {
+                path: job.output.clone(),
+                message: format!("cannot write to standard output: {e}"),
+            })?;
+    } else {
+        write_atomically(&job.output, |w| w.write_all(&bytes))?;
+    }
     let write_seconds = t.elapsed().as_secs_f64();
 
     report.push_stage("read", read_seconds);
@@ -253,6 +287,46 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
     Ok(report)
 }
 
+/// The output path that means standard output: `-`.
+pub const STDOUT: &str = "-";
+
+/// Whether `output` is [`STDOUT`].
+fn is_stdout(output: &Path) -> bool {
+    output.as_os_str() == STDOUT
+}
+
+/// The format a [`RemeshJob`] writes: `format` where given (agreeing with a file's extension),
+/// else by the extension, or OBJ for standard output.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `OUTPUT` for an extension no mesh format has, or
+/// `--format` when it contradicts the extension.
+fn output_format(output: &Path, format: Option<MeshFormat>) -> Result<MeshFormat> {
+    if is_stdout(output) {
+        return Ok(format.unwrap_or(MeshFormat::Obj));
+    }
+    let by_extension = MeshFormat::from_path(output).map_err(|_| Error::InvalidParameter {
+        name: "OUTPUT",
+        message: format!(
+            "{}: unsupported output format (expected .obj, .ply, .gltf or .glb, or - for \
+             standard output)",
+            output.display()
+        ),
+    })?;
+    match format {
+        Some(f) if f != by_extension => Err(Error::InvalidParameter {
+            name: "--format",
+            message: format!(
+                "--format {} contradicts the extension of {}; the format of a file is its \
+                 extension's (--format chooses the format of standard output, -)",
+                f.extension(),
+                output.display()
+            ),
+        }),
+        _ => Ok(by_extension),
+    }
+}
+
 /// Fills in the file of an [`Error::InvalidMesh`] that was raised without one.
 fn with_path(e: Error, path: &Path) -> Error {
     match e {
@@ -311,11 +385,20 @@ pub fn run_points(job: &PointsJob) -> Result<()> {
 }
 
 /// Point sets are written as binary PLY only: any other extension of `output` is a usage error
-/// (rather than PLY bytes under another format's name).
+/// (rather than PLY bytes under another format's name), and so is `-` (standard output): point
+/// sets are streamed to a temporary file and renamed into place, so they need a file.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `OUTPUT`.
 pub(crate) fn require_ply_output(output: &Path) -> Result<()> {
+    if is_stdout(output) {
+        return Err(Error::InvalidParameter {
+            name: "OUTPUT",
+            message: "point sets are not written to standard output (-): they are streamed to a \
+                      .ply file through a temporary file beside it; give a .ply path"
+                .to_string(),
+        });
+    }
     match MeshFormat::from_path(output) {
         Ok(MeshFormat::Ply) => Ok(()),
         _ => Err(Error::InvalidParameter {

@@ -250,6 +250,16 @@ fn check_content(path: &Path, format: MeshFormat) -> Result<()> {
 ///   left behind at the target or the temporary path when an error is returned.
 pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
     let format = MeshFormat::from_path(path)?;
+    let bytes = encode_mesh(path, mesh, format)?;
+    write_atomically(path, |w| w.write_all(&bytes))
+}
+
+/// The bytes [`write_mesh`] writes for `mesh` in `format`; `path` is only named in errors.
+///
+/// # Errors
+/// [`Error::Write`] naming `path` when the mesh cannot be written as it is (see
+/// [`write_mesh`]).
+pub(crate) fn encode_mesh(path: &Path, mesh: &TriMesh, format: MeshFormat) -> Result<Vec<u8>> {
     let write_err = |message: String| Error::Write {
         path: path.to_path_buf(),
         message,
@@ -282,7 +292,7 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
         MeshFormat::Glb => gltf::encode_glb(mesh, &normals).map_err(write_err)?,
         MeshFormat::Gltf => gltf::encode_gltf(mesh, &normals).map_err(write_err)?,
     };
-    write_atomically(path, |w| w.write_all(&bytes))
+    Ok(bytes)
 }
 
 /// `mesh` as [`write_mesh`] stores it in `format` and [`read_mesh`] reads it back (vertex and
