@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use crate::error::{Error, Result};
 use crate::io::{as_written, encode_mesh, read_mesh, write_atomically, MeshFormat};
+use crate::mesh::{Normalization, TriMesh};
 use crate::pipeline::{remesh, RemeshParams};
 use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
@@ -88,6 +89,19 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     on_stage("read");
     let t = Instant::now();
     let (input, stats) = read_mesh(&job.input)?;
+    let input_side = input.bbox().map_or(0.0, |b| b.longest_side());
+    let (input, up) = into_normal_range(input);
+    if up != 0 && matches!(format, MeshFormat::Gltf | MeshFormat::Glb) {
+        return Err(Error::InvalidParameter {
+            name: "OUTPUT",
+            message: format!(
+                "{}: glTF stores positions as 32-bit floats, which cannot hold the coordinates \
+                 of {} (subnormal numbers); write .obj or .ply",
+                job.output.display(),
+                job.input.display()
+            ),
+        });
+    }
     let read_seconds = t.elapsed().as_secs_f64();
     let params = job.params;
     let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
@@ -95,9 +109,19 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     let t = Instant::now();
     // The report and `--strict` describe the file: the mesh as the format stores it (OBJ and
     // PLY exactly; glTF in f32 relative to the node's translation), normalized like the input.
+    // A model scaled up by 2^up is written scaled back (rounded to its subnormal numbers), and
+    // checked as written.
+    let scaled_back = (up != 0).then(|| scale_by_power_of_two(&out.mesh, -up));
+    let mesh_out = scaled_back.as_ref().unwrap_or(&out.mesh);
     let written;
     let checked = match format {
-        MeshFormat::Obj | MeshFormat::Ply => &out.mesh_normalized,
+        MeshFormat::Obj | MeshFormat::Ply if up == 0 => &out.mesh_normalized,
+        MeshFormat::Obj | MeshFormat::Ply => {
+            written = out
+                .normalization
+                .apply_mesh(&scale_by_power_of_two(mesh_out, up));
+            &written
+        }
         MeshFormat::Gltf | MeshFormat::Glb => {
             written = out.normalization.apply_mesh(&as_written(&out.mesh, format));
             &written
@@ -128,7 +152,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     on_stage("write");
     let t = Instant::now();
     // Every check has passed: standard output gets the complete bytes, or nothing.
-    let bytes = encode_mesh(&job.output, &out.mesh, format)?;
+    let bytes = encode_mesh(&job.output, mesh_out, format)?;
     if to_stdout {
         use std::io::Write;
         let mut stdout = std::io::stdout().lock();
@@ -209,6 +233,13 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     );
     extra.insert("input_vertices".into(), input.vertex_count().into());
     extra.insert("input_faces".into(), input.face_count().into());
+    if up != 0 {
+        report.notes.push(format!(
+            "the input's coordinates are subnormal numbers (bounding box {:e} across): the model \
+             was scaled by 2^{up} for the work (exactly) and the output scaled back",
+            input_side
+        ));
+    }
     if stats.welded_vertices > 0 {
         report.notes.push(format!(
             "{} input vertices at identical positions were merged",
@@ -258,12 +289,20 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
     let reference = reference
         .map(|r| read_mesh(r).map(|(m, _)| (m, r)))
         .transpose()?;
+    // Subnormal coordinates: both meshes scaled up alike (the report is in bbox-100 units).
+    let (mesh, reference) = match &reference {
+        Some((r, p)) => {
+            let (r, up) = into_normal_range(r.clone());
+            (scale_by_power_of_two(&mesh, up), Some((r, *p)))
+        }
+        None => (into_normal_range(mesh).0, None),
+    };
     let frame = reference.as_ref().map_or(&mesh, |(r, _)| r);
     let bbox = frame
         .bbox()
         .ok_or_else(|| Error::invalid_mesh(path, "the mesh has no vertices"))?;
-    let normalization = crate::mesh::Normalization::for_bbox(&bbox)
-        .ok_or_else(|| Error::invalid_mesh(path, crate::mesh::Normalization::refusal(&bbox)))?;
+    let normalization = Normalization::for_bbox(&bbox)
+        .ok_or_else(|| Error::invalid_mesh(path, Normalization::refusal(&bbox)))?;
     let m = normalization.apply_mesh(&mesh);
     let mut report = QualityReport::new(&m);
     report.push_stage("read and measure", t.elapsed().as_secs_f64());
@@ -324,6 +363,41 @@ fn output_format(output: &Path, format: Option<MeshFormat>) -> Result<MeshFormat
             ),
         }),
         _ => Ok(by_extension),
+    }
+}
+
+/// A model too small for the bbox-100 frame's `f64` scale (a longest side below about
+/// 5.6e-307 model units: subnormal coordinates) scaled up by `2^k` so its longest side is
+/// between 1 and 2, and `k`; every other model as it is, and 0. Scaling by a power of two
+/// changes no digit, so the model is the same one in other units.
+fn into_normal_range(mesh: TriMesh) -> (TriMesh, i32) {
+    let Some(bbox) = mesh.bbox() else {
+        return (mesh, 0);
+    };
+    let side = bbox.longest_side();
+    if !(side.is_finite() && side > 0.0) || Normalization::for_bbox(&bbox).is_some() {
+        return (mesh, 0);
+    }
+    let k = -(side.log2().floor() as i32);
+    (scale_by_power_of_two(&mesh, k), k)
+}
+
+/// `mesh` with every coordinate multiplied by `2^k`, in steps that stay in `f64`'s range (so
+/// each step is exact, and the result is rounded once at most, where it is subnormal).
+fn scale_by_power_of_two(mesh: &TriMesh, k: i32) -> TriMesh {
+    let mut positions = mesh.positions.clone();
+    let mut left = k;
+    while left != 0 {
+        let step = left.clamp(-1000, 1000);
+        let f = 2f64.powi(step);
+        for p in &mut positions {
+            *p *= f;
+        }
+        left -= step;
+    }
+    TriMesh {
+        positions,
+        triangles: mesh.triangles.clone(),
     }
 }
 
