@@ -39,6 +39,7 @@ fn remesh_job(c: &mut Criterion) {
     let job = RemeshJob {
         input: horse(),
         output: dir.path().join("out.obj"),
+        format: None,
         params: RemeshParams {
             density: Density::Points(POINTS),
             ..Default::default()

@@ -203,5 +203,5 @@ pub use points::{PlyPointWriter, Point, PointReader};
 pub use app::{
     catch_panics, estimate_remesh_bytes, parse_bytes, physical_memory, run_points, run_quality,
     run_remesh, run_simplify, write_report, PointsJob, RemeshJob, SimplifyDensity, SimplifyDetail,
-    SimplifyJob, SimplifySummary, DISTANCE_SAMPLES, MAX_SURFACE_POINTS,
+    SimplifyJob, SimplifySummary, DISTANCE_SAMPLES, MAX_SURFACE_POINTS, STDOUT,
 };

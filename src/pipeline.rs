@@ -157,7 +157,8 @@ pub struct RemeshOutput {
 ///
 /// # Errors
 /// [`Error::InvalidMesh`] for no faces, an index out of range, a non-finite coordinate, or a
-/// bounding box of zero size.
+/// bounding box of zero size or one too small or too large to scale to bbox 100 (the message
+/// gives its size).
 pub fn validate_input(mesh: &TriMesh) -> Result<Normalization> {
     if mesh.triangles.is_empty() {
         return Err(Error::invalid_mesh("", "the mesh has no faces"));
@@ -167,7 +168,7 @@ pub fn validate_input(mesh: &TriMesh) -> Result<Normalization> {
         .bbox()
         .ok_or_else(|| Error::invalid_mesh("", "the mesh has no vertices"))?;
     Normalization::for_bbox(&bbox)
-        .ok_or_else(|| Error::invalid_mesh("", "the bounding box has zero size"))
+        .ok_or_else(|| Error::invalid_mesh("", Normalization::refusal(&bbox)))
 }
 
 /// Remeshes `input` (model units): samples its surface with the spectral sampler and

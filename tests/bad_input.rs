@@ -34,11 +34,14 @@
 //! | glTF nodes listed as a child twice or by two parents (issue 14) | input error, at once |
 //! | `remesh points --count` above 10^9 (issue 14) | usage error, nothing written |
 //! | a model at UTM coordinates written as .ply, .glb, .gltf (issue 14) | the file as written is faithful |
+//! | a truncated point file for `simplify` (issue 14) | input error giving the points read and promised |
+//! | subnormal coordinates, a model scaled by 1e-310 (issue 14) | result in the input's units and place, with a note; glTF output a usage error |
 //! | an internal failure (a panic) | internal error, one line (injected in `app::catch_panics`'s unit test; the binary runs every job through it) |
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use glam::DVec3;
 use serde_json::Value;
 
 fn shared(name: &str) -> PathBuf {
@@ -1183,4 +1186,113 @@ fn a_job_over_the_memory_limit_fails_fast_with_one_line() {
     assert!(!out.exists());
     // Within the limit.
     assert_result(&input, &out, &["--points", "400", "--max-memory", "1G"]);
+}
+
+/// Issue 14, item 11: a point file cut short said "the file ends after 0" when 100 of its
+/// points were there (the count before the chunk being read). The message gives the complete
+/// points read and the count the header promised, for binary and ascii PLY.
+#[test]
+fn a_truncated_point_file_gives_the_points_read_and_the_points_promised() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\nelement vertex 200\nproperty float x\nproperty float y\n\
+             property float z\nend_header\n"
+        )
+    };
+    let point = |k: usize| [k as f32, (k * k % 17) as f32, (k % 5) as f32];
+    let mut binary = header("binary_little_endian").into_bytes();
+    let mut ascii = header("ascii");
+    for k in 0..100 {
+        for c in point(k) {
+            binary.extend_from_slice(&c.to_le_bytes());
+        }
+        let [x, y, z] = point(k);
+        ascii += &format!("{x} {y} {z}\n");
+    }
+    // Half a record more in the binary file: still 100 complete points.
+    binary.extend_from_slice(&[0; 6]);
+    for (name, content) in [("binary.ply", binary), ("ascii.ply", ascii.into_bytes())] {
+        let input = write(dir.path(), name, content);
+        let out = dir.path().join(format!("out-{name}"));
+        let o = remesh(&[
+            "simplify",
+            input.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--points",
+            "20",
+            "-q",
+        ]);
+        assert_error(
+            &o,
+            3,
+            &[name, "announces 200 points, the file ends after 100"],
+            &out,
+        );
+    }
+}
+
+/// Issue 14, item 11: a model scaled by 1e-310 (subnormal coordinates) was refused with "the
+/// bounding box has zero size": `100 / side` overflows `f64`. It is now scaled up by a power
+/// of two (exact) for the work and the output scaled back, in the input's units and place, with
+/// a note; `remesh quality` measures it the same way. glTF (`f32` positions) cannot hold it: a
+/// usage error saying so. A model of one point still has zero size, and says so.
+#[test]
+fn subnormal_coordinates_are_remeshed_in_their_own_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, f) = icosphere(3);
+    let (scale, offset) = (1e-310, 3e-310);
+    let q: Vec<[f64; 3]> = p
+        .iter()
+        .map(|v| [v[0] * scale + offset, v[1] * scale, v[2] * scale])
+        .collect();
+    let input = write(dir.path(), "subnormal.obj", obj(&q, &tri_faces(&f), false));
+    let out = dir.path().join("out.obj");
+    let r = assert_result(&input, &out, &["--points", "400"]);
+    assert_closed_genus_0(&r);
+    let notes = r["notes"].as_array().unwrap();
+    assert!(
+        notes.iter().any(|n| n
+            .as_str()
+            .unwrap()
+            .contains("subnormal numbers (bounding box 2e-310")),
+        "{notes:?}"
+    );
+    // Every output vertex lies on the input's sphere (radius 1e-310 around (3e-310, 0, 0)), to
+    // within the chord error of the input's faces and the rounding of subnormal numbers.
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut n = 0;
+    for line in text.lines().filter(|l| l.starts_with("v ")) {
+        let c: Vec<f64> = line[2..]
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        // In units of `scale` (squares of subnormal numbers underflow).
+        let d = DVec3::new((c[0] - offset) / scale, c[1] / scale, c[2] / scale).length();
+        assert!((d - 1.0).abs() < 0.02, "{line}: {d}");
+        n += 1;
+    }
+    assert!((396..=404).contains(&n), "{n}");
+    // The written file measured against the input: clean, close.
+    let q = quality(&out, &input);
+    assert_eq!(
+        q["invariant_violations"].as_array().unwrap().len(),
+        0,
+        "{q}"
+    );
+    assert!(
+        q["distance"]["hausdorff"].as_f64().unwrap() < 2.0,
+        "{}",
+        q["distance"]
+    );
+    // glTF stores f32: refused before any work, nothing written.
+    let glb = dir.path().join("out.glb");
+    let o = remesh(&[input.to_str().unwrap(), glb.to_str().unwrap(), "-q"]);
+    assert_error(&o, 2, &["out.glb", "32-bit floats", "subnormal.obj"], &glb);
+    // A model of one point has zero size, and says so.
+    let point: Vec<[f64; 3]> = p.iter().map(|_| [1.0, 2.0, 3.0]).collect();
+    let input = write(dir.path(), "point.obj", obj(&point, &tri_faces(&f), false));
+    let none = dir.path().join("none.obj");
+    let o = remesh(&[input.to_str().unwrap(), none.to_str().unwrap(), "-q"]);
+    assert_error(&o, 3, &["point.obj"], &none);
 }

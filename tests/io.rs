@@ -559,6 +559,82 @@ fn big_endian_ply_with_int_indices() {
     assert_eq!(m.positions[2], DVec3::new(1.0, 1.0, 0.0));
 }
 
+/// Issue 14, item 11: PLY `tristrips` (the Georgia Tech archive's models: `element tristrips 1`,
+/// `property list int int vertex_indices`, strips separated by -1) was read as "no faces". The
+/// strips give their triangles with the alternating winding (every triangle facing +z here),
+/// the degenerate stitching triangles left out, in ascii and binary files.
+#[test]
+fn ply_triangle_strips_are_read_with_alternating_winding() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two rows of four vertices, x = 0..3: even indices at y = 0, odd ones at y = 1.
+    let positions: Vec<[f32; 3]> = (0..8)
+        .map(|i| [(i / 2) as f32, (i % 2) as f32, 0.0])
+        .collect();
+    // One strip over the first two quads, then -1 and a second strip over the third quad that
+    // starts with two degenerate (stitching) triangles.
+    let strips: [i32; 13] = [1, 0, 3, 2, 5, 4, -1, 4, 4, 5, 4, 7, 6];
+    let header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\ncomment a strip mesh\nelement vertex 8\n\
+             property float x\nproperty float y\nproperty float z\nelement tristrips 1\n\
+             property list int int vertex_indices\nend_header\n"
+        )
+    };
+    let mut ascii = header("ascii");
+    for p in &positions {
+        ascii += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    ascii += &format!("{}", strips.len());
+    for i in strips {
+        ascii += &format!(" {i}");
+    }
+    ascii += "\n";
+    let mut binary = header("binary_little_endian").into_bytes();
+    for c in positions.iter().flatten() {
+        binary.extend_from_slice(&c.to_le_bytes());
+    }
+    binary.extend_from_slice(&(strips.len() as i32).to_le_bytes());
+    for i in strips {
+        binary.extend_from_slice(&i.to_le_bytes());
+    }
+    for (name, bytes) in [("ascii.ply", ascii.into_bytes()), ("binary.ply", binary)] {
+        let path = dir.path().join(name);
+        fs::write(&path, &bytes).unwrap();
+        let (m, s) = read_mesh(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            m.triangles,
+            vec![
+                [1, 0, 3],
+                [3, 0, 2],
+                [3, 2, 5],
+                [5, 2, 4],
+                [5, 4, 7],
+                [7, 4, 6]
+            ],
+            "{name}"
+        );
+        assert_eq!((s.vertices_read, s.faces_read), (8, 6), "{name}");
+        for f in 0..m.face_count() {
+            assert!(
+                m.face_normal(f).distance(DVec3::Z) < 1e-12,
+                "{name} face {f}"
+            );
+        }
+    }
+    // An index that is neither -1 nor a vertex names the strip record.
+    let path = dir.path().join("bad.ply");
+    fs::write(
+        &path,
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+         property float z\nelement tristrips 1\nproperty list int int vertex_indices\n\
+         end_header\n0 0 0\n1 0 0\n0 1 0\n4 0 1 -2 2\n",
+    )
+    .unwrap();
+    let e = expect_err(&path);
+    assert!(e.to_string().contains("tristrips record 0"), "{e}");
+    assert!(e.to_string().contains("vertex -2"), "{e}");
+}
+
 /// Standard base64 with padding, as data URIs hold it.
 fn base64(data: &[u8]) -> String {
     use base64::Engine;
@@ -689,6 +765,123 @@ fn gltf_strips_fans_and_scene_less_files() {
     for f in 0..4 {
         assert!(m.face_normal(f).distance(DVec3::Z) < 1e-12);
     }
+}
+
+/// Issue 14, item 11: glTF files that use Draco without requiring it, and index accessors of
+/// u8 (with or without the `normalized` flag), gave parser jargon. The plain accessors beside a
+/// Draco stream are read; a file whose geometry only Draco holds (required, or no fallback) is
+/// one line naming the compression; u8 indices are read as integers; what glTF does not allow
+/// as indices (signed, floating point) is named plainly.
+#[test]
+fn gltf_draco_fallbacks_and_u8_indices() {
+    let dir = tempfile::tempdir().unwrap();
+    // A tetrahedron: 4 f32 positions and 12 u8 indices (padded to 4 bytes).
+    let positions = [
+        [0.0f32, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let faces: [[u8; 3]; 4] = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    let mut bin: Vec<u8> = positions
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    bin.extend(faces.iter().flatten());
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&bin));
+    const DRACO: &str = "KHR_draco_mesh_compression";
+    // `used`/`required`: the extension lists; `fallback`: whether the accessors have data.
+    let doc = |used: bool, required: bool, fallback: bool, index_accessor: serde_json::Value| {
+        let mut primitive = serde_json::json!({ "attributes": { "POSITION": 0 }, "indices": 1 });
+        let mut accessors = serde_json::json!([
+            { "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+              "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 1.0] },
+            index_accessor
+        ]);
+        if used {
+            primitive["extensions"] =
+                serde_json::json!({ DRACO: { "bufferView": 1, "attributes": { "POSITION": 0 } } });
+        }
+        if !fallback {
+            for a in accessors.as_array_mut().unwrap() {
+                a.as_object_mut().unwrap().remove("bufferView");
+            }
+        }
+        let mut d = serde_json::json!({
+            "asset": { "version": "2.0" },
+            "scene": 0, "scenes": [ { "nodes": [0] } ], "nodes": [ { "mesh": 0 } ],
+            "meshes": [ { "primitives": [primitive] } ],
+            "accessors": accessors,
+            "bufferViews": [ { "buffer": 0, "byteLength": 48 },
+                             { "buffer": 0, "byteOffset": 48, "byteLength": 12 } ],
+            "buffers": [ { "byteLength": 60, "uri": uri } ]
+        });
+        if used {
+            d["extensionsUsed"] = serde_json::json!([DRACO]);
+        }
+        if required {
+            d["extensionsRequired"] = serde_json::json!([DRACO]);
+        }
+        serde_json::to_vec(&d).unwrap()
+    };
+    let indices = |component_type: u32, normalized: bool| {
+        serde_json::json!({ "bufferView": 1, "componentType": component_type, "count": 12,
+                            "type": "SCALAR", "normalized": normalized })
+    };
+    let write = |name: &str, bytes: Vec<u8>| {
+        let path = dir.path().join(name);
+        fs::write(&path, bytes).unwrap();
+        path
+    };
+    let expected: Vec<[u32; 3]> = faces.iter().map(|f| f.map(u32::from)).collect();
+    // Read: u8 indices, u8 indices flagged `normalized`, Draco used with plain fallbacks.
+    for (name, bytes) in [
+        ("u8.gltf", doc(false, false, true, indices(5121, false))),
+        (
+            "u8-normalized.gltf",
+            doc(false, false, true, indices(5121, true)),
+        ),
+        (
+            "draco-used.gltf",
+            doc(true, false, true, indices(5121, false)),
+        ),
+    ] {
+        let path = write(name, bytes);
+        let (m, s) = read_mesh(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.triangles, expected, "{name}");
+        assert_eq!(m.vertex_count(), 4, "{name}");
+        assert_eq!(s.faces_read, 4, "{name}");
+    }
+    // Refused in one line naming the file and the problem.
+    for (name, bytes, says) in [
+        (
+            "draco-required.gltf",
+            doc(true, true, false, indices(5121, false)),
+            "uses Draco compression (KHR_draco_mesh_compression), which this reader does not decode",
+        ),
+        (
+            "draco-no-fallback.gltf",
+            doc(true, false, false, indices(5121, false)),
+            "uses Draco compression (KHR_draco_mesh_compression), which this reader does not decode",
+        ),
+        (
+            "i8.gltf",
+            doc(false, false, true, indices(5120, false)),
+            "index accessor 1 holds signed 8-bit integers; glTF indices are unsigned",
+        ),
+    ] {
+        let e = expect_err(&write(name, bytes));
+        let line = e.to_string();
+        assert!(line.contains(says), "{name}: {line}");
+        assert_eq!(line.lines().count(), 1, "{line}");
+    }
+    // The `gltf` crate's validation findings, in words: a missing required property.
+    let e = expect_err(&write(
+        "no-count.gltf",
+        br#"{"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#.to_vec(),
+    ));
+    assert!(!e.to_string().contains("Missing data"), "{e}");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -7,6 +7,8 @@ use std::process::Command;
 
 use serde_json::Value;
 
+mod common;
+
 fn shared(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/data")
@@ -529,4 +531,112 @@ fn simplify_levels_from_xyz_text_writes_a_level_attribute() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
+}
+
+/// Runs `remesh` with `args`, returning its output (stdout and stderr captured, not a terminal).
+fn remesh_output(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .args(args)
+        .output()
+        .expect("run remesh")
+}
+
+/// Issue 14, item 10: `-` as the output writes the mesh to standard output, OBJ unless
+/// `--format` asks for another format, with the report on standard error so that standard
+/// output holds the mesh only; the bytes are the ones a file gets. `--strict` writes nothing
+/// there when it fails, and point sets (streamed to a file) refuse `-` as a usage error.
+#[test]
+fn a_dash_output_writes_the_mesh_to_standard_output() {
+    use std::ffi::OsStr;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere.obj");
+    let sphere = common::icosphere(3);
+    std::fs::write(&input, sphere_obj(&sphere)).unwrap();
+    let args = ["--points", "300", "--no-distance", "--seed", "3"].map(OsStr::new);
+    for (format, ext) in [(None, "obj"), (Some("ply"), "ply"), (Some("glb"), "glb")] {
+        let file = dir.path().join(format!("file.{ext}"));
+        let o = remesh_output(
+            &[
+                &[input.as_os_str(), file.as_os_str(), OsStr::new("-q")],
+                &args[..],
+            ]
+            .concat(),
+        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let mut dash: Vec<&OsStr> = vec![input.as_os_str(), OsStr::new("-")];
+        dash.extend_from_slice(&args);
+        if let Some(f) = format {
+            dash.extend([OsStr::new("--format"), OsStr::new(f)]);
+        }
+        let o = remesh_output(&dash);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        // The report went to standard error, the mesh alone to standard output.
+        assert!(err.contains("-> standard output"), "{err}");
+        assert!(err.contains("Triangles (Table 1)"), "{err}");
+        assert_eq!(
+            o.stdout,
+            std::fs::read(&file).unwrap(),
+            "--format {format:?}"
+        );
+        // And the crate's reader reads it back as the file's mesh.
+        let piped = dir.path().join(format!("piped.{ext}"));
+        std::fs::write(&piped, &o.stdout).unwrap();
+        let (a, _) = spectral_remesh::read_mesh(&piped).unwrap();
+        let (b, _) = spectral_remesh::read_mesh(&file).unwrap();
+        assert_eq!(a, b);
+        assert!(
+            (295..=305).contains(&a.vertex_count()),
+            "{}",
+            a.vertex_count()
+        );
+    }
+    // --format with a file must agree with its extension.
+    let o = remesh_output(&[
+        input.as_os_str(),
+        dir.path().join("x.obj").as_os_str(),
+        OsStr::new("--format"),
+        OsStr::new("ply"),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--format ply contradicts"));
+    // --strict on a mesh that breaks its invariants: nothing on standard output.
+    let sheets = dir.path().join("sheets.obj");
+    std::fs::write(&sheets, crossing_sheets_obj()).unwrap();
+    let o = remesh_output(
+        &["--points", "2000", "--no-distance", "--strict", "-q"]
+            .map(OsStr::new)
+            .iter()
+            .copied()
+            .chain([sheets.as_os_str(), OsStr::new("-")])
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(o.status.code(), Some(1));
+    assert!(o.stdout.is_empty(), "{} bytes written", o.stdout.len());
+    // Point sets need a file.
+    for sub in ["points", "simplify"] {
+        let mut a = vec![OsStr::new(sub), input.as_os_str(), OsStr::new("-")];
+        a.extend(if sub == "points" {
+            ["--count", "10"].map(OsStr::new)
+        } else {
+            ["--points", "10"].map(OsStr::new)
+        });
+        let o = remesh_output(&a);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{sub}: {err}");
+        assert!(err.contains("standard output"), "{sub}: {err}");
+        assert!(o.stdout.is_empty());
+    }
+}
+
+/// `mesh` as OBJ text.
+fn sphere_obj(mesh: &spectral_remesh::TriMesh) -> String {
+    let mut s = String::new();
+    for p in &mesh.positions {
+        s += &format!("v {} {} {}\n", p.x, p.y, p.z);
+    }
+    for t in &mesh.triangles {
+        s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    s
 }

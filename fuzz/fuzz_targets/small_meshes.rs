@@ -286,6 +286,7 @@ pub fn assert_remesh_is_sound(data: &[u8], dir: &Path) {
         measure_distance: false,
         strict: false,
         max_memory: None,
+        format: None,
     };
     match run_remesh(&job, &|_| {}) {
         Err(Error::Internal { stage, message }) => {

@@ -12,7 +12,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::io::{as_written, read_mesh, write_atomically, write_mesh, MeshFormat};
+use crate::io::{as_written, encode_mesh, read_mesh, write_atomically, MeshFormat};
+use crate::mesh::{Normalization, TriMesh};
 use crate::pipeline::{
     remesh, validate_input, Density, RemeshParams, MAX_POINTS, SAMPLES_PER_SIGMA2,
 };
@@ -28,8 +29,13 @@ pub const DISTANCE_SAMPLES: usize = 200_000;
 pub struct RemeshJob {
     /// Input mesh (.obj, .ply, .gltf, .glb).
     pub input: PathBuf,
-    /// Output mesh (.obj, .ply, .glb), format by extension.
+    /// Output mesh (.obj, .ply, .gltf, .glb), format by extension; `-` ([`STDOUT`]) writes it
+    /// to standard output instead, in `format`.
     pub output: PathBuf,
+    /// The output's format: `None` takes it from `output`'s extension, or OBJ for standard
+    /// output. Given with a file, it must agree with the extension; the binary formats (PLY,
+    /// GLB) go to standard output only when asked for here, and never to a terminal.
+    pub format: Option<MeshFormat>,
     /// Pipeline parameters (`Density::InputVertices`: as many as the input has vertices).
     pub params: RemeshParams,
     /// Whether to measure the distance to the input (Hausdorff, RMS).
@@ -48,6 +54,11 @@ pub struct RemeshJob {
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
 ///
+/// The mesh goes to `job.output`, atomically, or with an output of `-` ([`STDOUT`]) to standard
+/// output in `job.format` (OBJ by default); either way its bytes are built in memory and written
+/// only once every check has passed, so an error (or `--strict`) never leaves a part of a mesh
+/// behind.
+///
 /// The output's invariants ([`check_invariants`](crate::check_invariants)) are checked before it
 /// is written, on the mesh as the output format stores it (glTF positions rounded to `f32`
 /// relative to the node's translation; OBJ and PLY are exact); violations go into the report ([`QualityReport::invariant_violations`] and a note).
@@ -59,18 +70,28 @@ pub struct RemeshJob {
 /// [`Error::InvalidParameter`] when the output path is the input path; with `job.strict`, an
 /// [`Error::Internal`] (stage `invariant check`) naming the violations when the output breaks
 /// an invariant or its topology differs from the input's, and then nothing is written;
-/// [`Error::InvalidParameter`] naming `--max-memory` when the job's estimated peak memory is
-/// over `job.max_memory`, before any work.
+/// [`Error::InvalidParameter`] (usage errors, before any work) for an output extension no
+/// format has, a `job.format` that contradicts it, a binary format for standard output when
+/// that is a terminal, or (naming `--max-memory`) a job whose estimated peak memory is over
+/// `job.max_memory`.
 pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<QualityReport> {
     // The output's format is known before any work: an unknown extension is a usage error.
-    let format = MeshFormat::from_path(&job.output).map_err(|_| Error::InvalidParameter {
-        name: "OUTPUT",
-        message: format!(
-            "{}: unsupported output format (expected .obj, .ply, .gltf or .glb)",
-            job.output.display()
-        ),
-    })?;
-    if same_file(&job.input, &job.output) {
+    let to_stdout = is_stdout(&job.output);
+    let format = output_format(&job.output, job.format)?;
+    if to_stdout && matches!(format, MeshFormat::Ply | MeshFormat::Glb) {
+        use std::io::IsTerminal;
+        if std::io::stdout().is_terminal() {
+            return Err(Error::InvalidParameter {
+                name: "--format",
+                message: format!(
+                    "standard output is a terminal, and {} is a binary format; redirect it to a \
+                     file or a pipe",
+                    format.extension().to_ascii_uppercase()
+                ),
+            });
+        }
+    }
+    if !to_stdout && same_file(&job.input, &job.output) {
         return Err(Error::InvalidParameter {
             name: "OUTPUT",
             message: format!(
@@ -85,6 +106,19 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     on_stage("read");
     let t = Instant::now();
     let (input, stats) = read_mesh(&job.input)?;
+    let input_side = input.bbox().map_or(0.0, |b| b.longest_side());
+    let (input, up) = into_normal_range(input);
+    if up != 0 && matches!(format, MeshFormat::Gltf | MeshFormat::Glb) {
+        return Err(Error::InvalidParameter {
+            name: "OUTPUT",
+            message: format!(
+                "{}: glTF stores positions as 32-bit floats, which cannot hold the coordinates \
+                 of {} (subnormal numbers); write .obj or .ply",
+                job.output.display(),
+                job.input.display()
+            ),
+        });
+    }
     let read_seconds = t.elapsed().as_secs_f64();
     let params = job.params;
     if let Some(limit) = job.max_memory {
@@ -114,9 +148,19 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     let t = Instant::now();
     // The report and `--strict` describe the file: the mesh as the format stores it (OBJ and
     // PLY exactly; glTF in f32 relative to the node's translation), normalized like the input.
+    // A model scaled up by 2^up is written scaled back (rounded to its subnormal numbers), and
+    // checked as written.
+    let scaled_back = (up != 0).then(|| scale_by_power_of_two(&out.mesh, -up));
+    let mesh_out = scaled_back.as_ref().unwrap_or(&out.mesh);
     let written;
     let checked = match format {
-        MeshFormat::Obj | MeshFormat::Ply => &out.mesh_normalized,
+        MeshFormat::Obj | MeshFormat::Ply if up == 0 => &out.mesh_normalized,
+        MeshFormat::Obj | MeshFormat::Ply => {
+            written = out
+                .normalization
+                .apply_mesh(&scale_by_power_of_two(mesh_out, up));
+            &written
+        }
         MeshFormat::Gltf | MeshFormat::Glb => {
             written = out.normalization.apply_mesh(&as_written(&out.mesh, format));
             &written
@@ -164,7 +208,21 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     }
     on_stage("write");
     let t = Instant::now();
-    write_mesh(&job.output, &out.mesh)?;
+    // Every check has passed: standard output gets the complete bytes, or nothing.
+    let bytes = encode_mesh(&job.output, mesh_out, format)?;
+    if to_stdout {
+        use std::io::Write;
+        let mut stdout = std::io::stdout().lock();
+        stdout
+            .write_all(&bytes)
+            .and_then(|()| stdout.flush())
+            .map_err(|e| Error::Write {
+                path: job.output.clone(),
+                message: format!("cannot write to standard output: {e}"),
+            })?;
+    } else {
+        write_atomically(&job.output, |w| w.write_all(&bytes))?;
+    }
     let write_seconds = t.elapsed().as_secs_f64();
 
     report.push_stage("read", read_seconds);
@@ -223,6 +281,13 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     );
     extra.insert("input_vertices".into(), input.vertex_count().into());
     extra.insert("input_faces".into(), input.face_count().into());
+    if up != 0 {
+        report.notes.push(format!(
+            "the input's coordinates are subnormal numbers (bounding box {:e} across): the model \
+             was scaled by 2^{up} for the work (exactly) and the output scaled back",
+            input_side
+        ));
+    }
     if stats.welded_vertices > 0 {
         report.notes.push(format!(
             "{} input vertices at identical positions were merged",
@@ -272,12 +337,20 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
     let reference = reference
         .map(|r| read_mesh(r).map(|(m, _)| (m, r)))
         .transpose()?;
+    // Subnormal coordinates: both meshes scaled up alike (the report is in bbox-100 units).
+    let (mesh, reference) = match &reference {
+        Some((r, p)) => {
+            let (r, up) = into_normal_range(r.clone());
+            (scale_by_power_of_two(&mesh, up), Some((r, *p)))
+        }
+        None => (into_normal_range(mesh).0, None),
+    };
     let frame = reference.as_ref().map_or(&mesh, |(r, _)| r);
     let bbox = frame
         .bbox()
         .ok_or_else(|| Error::invalid_mesh(path, "the mesh has no vertices"))?;
-    let normalization = crate::mesh::Normalization::for_bbox(&bbox)
-        .ok_or_else(|| Error::invalid_mesh(path, "the bounding box has zero size"))?;
+    let normalization = Normalization::for_bbox(&bbox)
+        .ok_or_else(|| Error::invalid_mesh(path, Normalization::refusal(&bbox)))?;
     let m = normalization.apply_mesh(&mesh);
     let mut report = QualityReport::new(&m);
     report.push_stage("read and measure", t.elapsed().as_secs_f64());
@@ -299,6 +372,81 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
         report.push_stage("distance", t.elapsed().as_secs_f64());
     }
     Ok(report)
+}
+
+/// The output path that means standard output: `-`.
+pub const STDOUT: &str = "-";
+
+/// Whether `output` is [`STDOUT`].
+fn is_stdout(output: &Path) -> bool {
+    output.as_os_str() == STDOUT
+}
+
+/// The format a [`RemeshJob`] writes: `format` where given (agreeing with a file's extension),
+/// else by the extension, or OBJ for standard output.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `OUTPUT` for an extension no mesh format has, or
+/// `--format` when it contradicts the extension.
+fn output_format(output: &Path, format: Option<MeshFormat>) -> Result<MeshFormat> {
+    if is_stdout(output) {
+        return Ok(format.unwrap_or(MeshFormat::Obj));
+    }
+    let by_extension = MeshFormat::from_path(output).map_err(|_| Error::InvalidParameter {
+        name: "OUTPUT",
+        message: format!(
+            "{}: unsupported output format (expected .obj, .ply, .gltf or .glb, or - for \
+             standard output)",
+            output.display()
+        ),
+    })?;
+    match format {
+        Some(f) if f != by_extension => Err(Error::InvalidParameter {
+            name: "--format",
+            message: format!(
+                "--format {} contradicts the extension of {}; the format of a file is its \
+                 extension's (--format chooses the format of standard output, -)",
+                f.extension(),
+                output.display()
+            ),
+        }),
+        _ => Ok(by_extension),
+    }
+}
+
+/// A model too small for the bbox-100 frame's `f64` scale (a longest side below about
+/// 5.6e-307 model units: subnormal coordinates) scaled up by `2^k` so its longest side is
+/// between 1 and 2, and `k`; every other model as it is, and 0. Scaling by a power of two
+/// changes no digit, so the model is the same one in other units.
+fn into_normal_range(mesh: TriMesh) -> (TriMesh, i32) {
+    let Some(bbox) = mesh.bbox() else {
+        return (mesh, 0);
+    };
+    let side = bbox.longest_side();
+    if !(side.is_finite() && side > 0.0) || Normalization::for_bbox(&bbox).is_some() {
+        return (mesh, 0);
+    }
+    let k = -(side.log2().floor() as i32);
+    (scale_by_power_of_two(&mesh, k), k)
+}
+
+/// `mesh` with every coordinate multiplied by `2^k`, in steps that stay in `f64`'s range (so
+/// each step is exact, and the result is rounded once at most, where it is subnormal).
+fn scale_by_power_of_two(mesh: &TriMesh, k: i32) -> TriMesh {
+    let mut positions = mesh.positions.clone();
+    let mut left = k;
+    while left != 0 {
+        let step = left.clamp(-1000, 1000);
+        let f = 2f64.powi(step);
+        for p in &mut positions {
+            *p *= f;
+        }
+        left -= step;
+    }
+    TriMesh {
+        positions,
+        triangles: mesh.triangles.clone(),
+    }
 }
 
 /// Fills in the file of an [`Error::InvalidMesh`] that was raised without one.
@@ -359,11 +507,20 @@ pub fn run_points(job: &PointsJob) -> Result<()> {
 }
 
 /// Point sets are written as binary PLY only: any other extension of `output` is a usage error
-/// (rather than PLY bytes under another format's name).
+/// (rather than PLY bytes under another format's name), and so is `-` (standard output): point
+/// sets are streamed to a temporary file and renamed into place, so they need a file.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `OUTPUT`.
 pub(crate) fn require_ply_output(output: &Path) -> Result<()> {
+    if is_stdout(output) {
+        return Err(Error::InvalidParameter {
+            name: "OUTPUT",
+            message: "point sets are not written to standard output (-): they are streamed to a \
+                      .ply file through a temporary file beside it; give a .ply path"
+                .to_string(),
+        });
+    }
     match MeshFormat::from_path(output) {
         Ok(MeshFormat::Ply) => Ok(()),
         _ => Err(Error::InvalidParameter {

@@ -10,7 +10,8 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
     catch_panics, parse_bytes, physical_memory, run_points, run_quality, run_remesh, run_simplify,
-    write_report, Density, Error, PointsJob, RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob,
+    write_report, Density, Error, MeshFormat, PointsJob, RemeshJob, RemeshParams, SimplifyDensity,
+    SimplifyJob, STDOUT,
 };
 
 const EXAMPLES: &str = "\
@@ -18,6 +19,8 @@ Examples:
   remesh data/spot.obj spot-3k.obj --points 3000
   remesh horse.ply horse.glb --points 8600 --report horse.json
   remesh fandisk.obj fandisk.obj.ply --points 6000 --sigma-n 0.75
+  remesh cow.obj - --points 3000 -q | gzip > cow-3k.obj.gz
+  remesh cow.obj - --format glb --points 3000 -q > cow-3k.glb
   remesh quality out.obj --ref in.obj
   remesh points horse.obj horse-14M.ply --count 14000000
   remesh simplify horse-14M.ply horse-300k.ply --points 300000
@@ -37,9 +40,16 @@ struct Cli {
     #[arg(required = true)]
     input: Option<PathBuf>,
 
-    /// Output mesh: .obj, .ply or .glb (format by extension).
+    /// Output mesh: .obj, .ply, .gltf or .glb (format by extension), or - for standard output
+    /// (OBJ unless --format says otherwise; the report then goes to standard error).
     #[arg(required = true)]
     output: Option<PathBuf>,
+
+    /// The format written to standard output (OUTPUT -): obj (the default), ply, gltf or glb.
+    /// The binary ones (ply, glb) only when asked for, and never to a terminal. With a file,
+    /// the format is the extension's, and --format must agree with it.
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    format: Option<OutputFormat>,
 
     /// Number of output vertices (within 1%); sigma_p is searched for and printed. Default: the
     /// input's vertex count.
@@ -115,7 +125,7 @@ enum Command {
         /// The input point set: .ply (ascii or binary) or XYZ/CSV text (.xyz .csv .txt .pts:
         /// `x y z` or `x y z nx ny nz` per line, or named columns), with or without normals.
         input: PathBuf,
-        /// The output point set (.ply).
+        /// The output point set (.ply; not - : point sets need a file).
         output: PathBuf,
         /// About this many output points (sigma_p is searched on a random subset).
         #[arg(long, conflicts_with_all = ["sigma_p", "levels"])]
@@ -151,7 +161,7 @@ enum Command {
     Points {
         /// The mesh to draw from (.obj, .ply, .gltf, .glb).
         mesh: PathBuf,
-        /// The output point set (.ply).
+        /// The output point set (.ply; not - : point sets need a file).
         output: PathBuf,
         /// How many points.
         #[arg(long)]
@@ -160,6 +170,26 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+}
+
+/// The formats `--format` names.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum OutputFormat {
+    Obj,
+    Ply,
+    Gltf,
+    Glb,
+}
+
+impl From<OutputFormat> for MeshFormat {
+    fn from(f: OutputFormat) -> MeshFormat {
+        match f {
+            OutputFormat::Obj => MeshFormat::Obj,
+            OutputFormat::Ply => MeshFormat::Ply,
+            OutputFormat::Gltf => MeshFormat::Gltf,
+            OutputFormat::Glb => MeshFormat::Glb,
+        }
+    }
 }
 
 /// A validated command: what to run and how to print it.
@@ -271,6 +301,7 @@ fn config(cli: Cli) -> Result<Config, Error> {
             let job = RemeshJob {
                 input,
                 output,
+                format: cli.format.map(MeshFormat::from),
                 params,
                 measure_distance: !cli.no_distance,
                 strict: cli.strict,
@@ -294,11 +325,22 @@ fn execute(config: Config) -> Result<(), Error> {
             bar.finish_and_clear();
             let r = result?;
             if !quiet {
-                emit(&format!(
+                // With the mesh on standard output, the report goes to standard error.
+                let to_stdout = job.output.as_os_str() == STDOUT;
+                let text = format!(
                     "{} -> {}\n{r}",
                     job.input.display(),
-                    job.output.display()
-                ));
+                    if to_stdout {
+                        "standard output".into()
+                    } else {
+                        job.output.display().to_string()
+                    }
+                );
+                if to_stdout {
+                    eprint!("{text}");
+                } else {
+                    emit(&text);
+                }
             }
             report.map_or(Ok(()), |p| write_report(&p, &r))
         }

@@ -86,7 +86,8 @@ pub struct ReadStats {
     /// of the POSITION accessor counts over every primitive instance placed in the scene.
     pub vertices_read: usize,
     /// Faces as the file stores them: OBJ `f` statements and PLY `face` elements with at least
-    /// three corners (polygons count once each), or for glTF the triangles its triangle,
+    /// three corners (polygons count once each) plus the triangles of PLY `tristrips` (without
+    /// the degenerate ones that stitch strips), or for glTF the triangles its triangle,
     /// strip and fan primitives describe.
     pub faces_read: usize,
     /// Faces with more than three corners, triangulated into `corners - 2` triangles each: by a
@@ -135,7 +136,9 @@ impl ReadStats {
 ///   not read, so a missing `.mtl` file does not matter. Coordinates are parsed as `f64`.
 /// - PLY: ascii or binary of either byte order; element `vertex` with scalar properties `x`,
 ///   `y`, `z` of any type, element `face` with an integer list property `vertex_indices` (or
-///   `vertex_index`). Other elements and properties are ignored.
+///   `vertex_index`), and/or element `tristrips` with such a list holding triangle strips
+///   separated by -1 (alternating winding; degenerate stitching triangles left out). Other
+///   elements and properties are ignored.
 /// - glTF 2.0: the default scene (else the first scene; with no scene, every mesh
 ///   untransformed), nodes walked recursively with their world transforms applied (winding
 ///   reversed under a negative determinant), meshes instanced once per node using them.
@@ -247,6 +250,16 @@ fn check_content(path: &Path, format: MeshFormat) -> Result<()> {
 ///   left behind at the target or the temporary path when an error is returned.
 pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
     let format = MeshFormat::from_path(path)?;
+    let bytes = encode_mesh(path, mesh, format)?;
+    write_atomically(path, |w| w.write_all(&bytes))
+}
+
+/// The bytes [`write_mesh`] writes for `mesh` in `format`; `path` is only named in errors.
+///
+/// # Errors
+/// [`Error::Write`] naming `path` when the mesh cannot be written as it is (see
+/// [`write_mesh`]).
+pub(crate) fn encode_mesh(path: &Path, mesh: &TriMesh, format: MeshFormat) -> Result<Vec<u8>> {
     let write_err = |message: String| Error::Write {
         path: path.to_path_buf(),
         message,
@@ -279,7 +292,7 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<()> {
         MeshFormat::Glb => gltf::encode_glb(mesh, &normals).map_err(write_err)?,
         MeshFormat::Gltf => gltf::encode_gltf(mesh, &normals).map_err(write_err)?,
     };
-    write_atomically(path, |w| w.write_all(&bytes))
+    Ok(bytes)
 }
 
 /// `mesh` as [`write_mesh`] stores it in `format` and [`read_mesh`] reads it back (vertex and

@@ -326,6 +326,31 @@ impl Normalization {
         })
     }
 
+    /// Why [`Normalization::for_bbox`] gives no normalization for `bbox`, as a message naming
+    /// the box's actual size: zero size (every vertex at one point), a longest side too large
+    /// for `f64`, or one so small (below about 5.6e-307 model units, subnormal coordinates) that
+    /// `100 / side` overflows.
+    pub(crate) fn refusal(bbox: &Aabb) -> String {
+        let side = bbox.longest_side();
+        if side == 0.0 {
+            let c = bbox.min;
+            format!(
+                "the bounding box has zero size (every vertex at ({:e}, {:e}, {:e}))",
+                c.x, c.y, c.z
+            )
+        } else if !side.is_finite() {
+            "the bounding box's longest side is too large for 64-bit floating point (coordinates \
+             span more than 1.8e308 model units)"
+                .to_string()
+        } else {
+            format!(
+                "the bounding box's longest side is {side:e} model units, too small to scale to \
+                 {} (coordinates below about 1e-306 are subnormal numbers); scale the model up",
+                Self::TARGET_SIZE
+            )
+        }
+    }
+
     /// The identity transform.
     pub fn identity() -> Self {
         Normalization {

@@ -392,8 +392,17 @@ impl Buckets {
             w.flush().map_err(io_err)?;
         }
         drop(writers);
-        let normalization = Normalization::for_bbox(&Aabb { min: lo, max: hi })
-            .ok_or_else(|| Error::invalid_mesh(input, "the points' bounding box has no extent"))?;
+        let bbox = Aabb { min: lo, max: hi };
+        let normalization = Normalization::for_bbox(&bbox).ok_or_else(|| {
+            Error::invalid_mesh(
+                input,
+                Normalization::refusal(&bbox).replacen(
+                    "the bounding box",
+                    "the points' bounding box",
+                    1,
+                ),
+            )
+        })?;
         Ok(Buckets {
             dir,
             count,

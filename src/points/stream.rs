@@ -354,13 +354,13 @@ impl PointReader {
             Encoding::BinaryLittle | Encoding::BinaryBig => {
                 let little = self.encoding == Encoding::BinaryLittle;
                 self.buffer.resize(n * self.record_size, 0);
-                self.input.read_exact(&mut self.buffer).map_err(|e| {
-                    if e.kind() == std::io::ErrorKind::UnexpectedEof {
-                        self.truncated()
-                    } else {
-                        Error::io(&self.path, e)
-                    }
-                })?;
+                let filled = fill(&mut self.input, &mut self.buffer)
+                    .map_err(|e| Error::io(&self.path, e))?;
+                if filled < self.buffer.len() {
+                    // The complete records before the end count as read, for the message.
+                    self.read += (filled / self.record_size) as u64;
+                    return Err(self.truncated());
+                }
                 let buffer = std::mem::take(&mut self.buffer);
                 for record in buffer.chunks_exact(self.record_size) {
                     let mut offset = 0;
@@ -439,6 +439,20 @@ impl PointReader {
             ),
         }
     }
+}
+
+/// Reads into `buf` until it is full or the input ends; returns how many bytes were read.
+fn fill(input: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut filled = 0;
+    while filled < buf.len() {
+        match input.read(&mut buf[filled..]) {
+            Ok(0) => break,
+            Ok(k) => filled += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(filled)
 }
 
 /// Whether `path`'s extension names an XYZ/CSV text point set.
@@ -685,6 +699,12 @@ mod tests {
         let mut r = PointReader::open(&path).unwrap();
         let err = r.read_chunk(&mut Vec::new(), 100).unwrap_err().to_string();
         assert!(err.contains("truncated") && err.contains("t.ply"), "{err}");
+        // Issue 14, item 11: the message said "ends after 0" whatever was read; it gives the
+        // complete points before the end (4 of 5 here) and the count the header promised.
+        assert!(
+            err.contains("announces 5 points, the file ends after 4"),
+            "{err}"
+        );
         let short = dir.path().join("short.ply");
         let mut w = PlyPointWriter::create(&short, 5).unwrap();
         w.write(&points(2)).unwrap();

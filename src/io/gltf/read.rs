@@ -168,6 +168,9 @@ const HARMLESS_EXTENSIONS: [&str; 3] = ["KHR_mesh_quantization", "KHR_materials_
 fn validate(document: &::gltf::Document) -> std::result::Result<(), String> {
     let root = document.as_json();
     for ext in &root.extensions_required {
+        if let Some(message) = compression(ext) {
+            return Err(message);
+        }
         let harmless = HARMLESS_EXTENSIONS.iter().any(|h| ext.starts_with(h))
             || matches!(
                 ext.as_str(),
@@ -198,6 +201,26 @@ fn validate(document: &::gltf::Document) -> std::result::Result<(), String> {
             }
         }
     }
+    // Compression that is used but not required leaves plain accessors as a fallback, which
+    // are read; a primitive accessor without data (no buffer view, nothing sparse) in such a
+    // file is one whose data only the compressed stream holds.
+    if let Some(message) = root.extensions_used.iter().find_map(|e| compression(e)) {
+        for mesh in &root.meshes {
+            for primitive in &mesh.primitives {
+                let used = primitive
+                    .attributes
+                    .values()
+                    .chain(primitive.indices.as_ref())
+                    .map(|i| &root.accessors[i.value()]);
+                if used
+                    .into_iter()
+                    .any(|a| a.buffer_view.is_none() && a.sparse.is_none())
+                {
+                    return Err(message);
+                }
+            }
+        }
+    }
     let mut errors: Vec<(String, ValidationError)> = Vec::new();
     root.validate(root, ::gltf::json::Path::new, &mut |path, error| {
         errors.push((path().to_string(), error))
@@ -210,7 +233,14 @@ fn validate(document: &::gltf::Document) -> std::result::Result<(), String> {
     match errors.first() {
         None => Ok(()),
         Some((path, error)) => Err(format!(
-            "invalid glTF: {path}: {error}{}",
+            "invalid glTF: {path} {}{}",
+            match error {
+                ValidationError::IndexOutOfBounds => "names an object the file does not have",
+                ValidationError::Invalid => "has a value glTF 2.0 does not allow",
+                ValidationError::Missing => "is missing",
+                ValidationError::Oversize => "is too large",
+                ValidationError::Unsupported => "names an extension this reader does not support",
+            },
             if errors.len() > 1 {
                 format!(" (and {} more problems)", errors.len() - 1)
             } else {
@@ -218,6 +248,21 @@ fn validate(document: &::gltf::Document) -> std::result::Result<(), String> {
             }
         )),
     }
+}
+
+/// The message for a geometry compression extension (Draco, meshopt), `None` for other
+/// extensions.
+fn compression(extension: &str) -> Option<String> {
+    let kind = match extension {
+        "KHR_draco_mesh_compression" => "Draco",
+        "EXT_meshopt_compression" | "KHR_meshopt_compression" => "meshopt",
+        _ => return None,
+    };
+    Some(format!(
+        "the file uses {kind} compression ({}), which this reader does not decode; export it \
+         without compression",
+        one_line(extension)
+    ))
 }
 
 /// Loads every buffer: the GLB binary chunk, data URIs, or files relative to the glTF file.
@@ -361,22 +406,36 @@ impl Walk<'_, '_> {
                     accessor.dimensions()
                 )));
             }
-            let coords = read_accessor(&accessor, self.buffers).map_err(err)?;
+            let coords =
+                read_accessor(&accessor, self.buffers, Integers::AsFlagged).map_err(err)?;
             let count = accessor.count();
             let indices: Vec<u32> = match primitive.indices() {
                 Some(ia) => {
-                    if ia.dimensions() != Dimensions::Scalar
-                        || ia.normalized()
-                        || !matches!(ia.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
-                    {
+                    // glTF 2.0, 3.7.2.1: SCALAR of unsigned 8-, 16- or 32-bit integers. A
+                    // `normalized` flag (meaningless for indices) is ignored: the integers are
+                    // the indices.
+                    let kind = match ia.data_type() {
+                        DataType::U8 | DataType::U16 | DataType::U32 => None,
+                        DataType::I8 => Some("signed 8-bit integers"),
+                        DataType::I16 => Some("signed 16-bit integers"),
+                        DataType::F32 => Some("floating-point numbers"),
+                    };
+                    if let Some(kind) = kind {
                         return Err(err(format!(
-                            "index accessor {} is {:?} {:?}, expected unsigned integer SCALAR",
-                            ia.index(),
-                            ia.data_type(),
-                            ia.dimensions()
+                            "index accessor {} holds {kind}; glTF indices are unsigned 8-, 16- \
+                             or 32-bit integers",
+                            ia.index()
                         )));
                     }
-                    let values = read_accessor(&ia, self.buffers).map_err(err)?;
+                    if ia.dimensions() != Dimensions::Scalar {
+                        return Err(err(format!(
+                            "index accessor {} has {} components per element; glTF indices \
+                             are single numbers (SCALAR)",
+                            ia.index(),
+                            ia.dimensions().multiplicity()
+                        )));
+                    }
+                    let values = read_accessor(&ia, self.buffers, Integers::Raw).map_err(err)?;
                     let mut out = Vec::with_capacity(values.len());
                     for v in values {
                         // Unsigned 32-bit values read as f64 are exact integers.
@@ -456,12 +515,22 @@ impl Walk<'_, '_> {
     }
 }
 
+/// How [`read_accessor`] reads integer components.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Integers {
+    /// Normalized where the accessor says so (positions).
+    AsFlagged,
+    /// As the integers they are, whatever the accessor's `normalized` flag (indices).
+    Raw,
+}
+
 /// The components of `accessor` as `f64`, `count × components` flat, with bounds checked
 /// against the buffers, byte strides followed, normalized integers mapped to [0, 1] or [-1, 1]
-/// and sparse substitutions applied.
+/// (with [`Integers::AsFlagged`]) and sparse substitutions applied.
 fn read_accessor(
     accessor: &::gltf::Accessor,
     buffers: &[Vec<u8>],
+    integers: Integers,
 ) -> std::result::Result<Vec<f64>, String> {
     let a = accessor.index();
     let ty = accessor.data_type();
@@ -469,7 +538,7 @@ fn read_accessor(
     let dims = accessor.dimensions().multiplicity();
     let elem = csize * dims;
     let count = accessor.count();
-    let normalized = accessor.normalized();
+    let normalized = accessor.normalized() && integers == Integers::AsFlagged;
     let too_big = || format!("accessor {a} is larger than its buffer");
 
     let mut out = match accessor.view() {

@@ -103,10 +103,22 @@ impl PropertyAccess for Element {
     }
 }
 
+/// The element of triangle strips (the Georgia Tech archive's models): one or more records,
+/// each an index list of strips separated by -1.
+const STRIPS: &str = "tristrips";
+
 /// Checks that the header has what we read, before reading the payload: `vertex` with scalar
-/// `x y z`, and `face` (if present) with an integer index list. Returns the name of the face
-/// element's index list, `None` when there is no face element.
-fn check_header(path: &Path, header: &Header) -> Result<Option<&'static str>> {
+/// `x y z`, and `face` and `tristrips` (where present) each with an integer index list. Returns
+/// whether there is a face element and whether there is a strip element.
+fn check_header(path: &Path, header: &Header) -> Result<(bool, bool)> {
+    check_vertices(path, header)?;
+    let faces = check_index_list(path, header, "face")?;
+    let strips = check_index_list(path, header, STRIPS)?;
+    Ok((faces, strips))
+}
+
+/// The `vertex` element has scalar `x y z`.
+fn check_vertices(path: &Path, header: &Header) -> Result<()> {
     let parse_err = |message: String| Error::parse(path, None, message);
     let vertex = header
         .elements
@@ -127,28 +139,64 @@ fn check_header(path: &Path, header: &Header) -> Result<Option<&'static str>> {
             }
         }
     }
-    let Some(face) = header.elements.get("face") else {
-        return Ok(None);
+    Ok(())
+}
+
+/// Whether the header has the element `element` (`face` or `tristrips`); when it has, that
+/// the element has an integer index list `vertex_indices` (or `vertex_index`).
+fn check_index_list(path: &Path, header: &Header, element: &str) -> Result<bool> {
+    let parse_err = |message: String| Error::parse(path, None, message);
+    let Some(face) = header.elements.get(element) else {
+        return Ok(false);
     };
     for name in INDEX_LISTS {
         match face.properties.get(name).map(|p| &p.data_type) {
             Some(PropertyType::List(_, ScalarType::Float | ScalarType::Double)) => {
                 return Err(parse_err(format!(
-                    "face property '{name}' holds floating-point numbers, expected integers"
+                    "{element} property '{name}' holds floating-point numbers, expected integers"
                 )))
             }
-            Some(PropertyType::List(..)) => return Ok(Some(name)),
+            Some(PropertyType::List(..)) => return Ok(true),
             Some(PropertyType::Scalar(_)) => {
                 return Err(parse_err(format!(
-                    "face property '{name}' is a single number, expected a list"
+                    "{element} property '{name}' is a single number, expected a list"
                 )))
             }
             None => {}
         }
     }
-    Err(parse_err(
-        "the 'face' element has no 'vertex_indices' (or 'vertex_index') list".to_string(),
-    ))
+    Err(parse_err(format!(
+        "the '{element}' element has no 'vertex_indices' (or 'vertex_index') list"
+    )))
+}
+
+/// The triangles of triangle strips: `indices` holds strips separated by -1; in each strip,
+/// triangle `k` is `(s[k], s[k+1], s[k+2])` for even `k` and `(s[k+1], s[k], s[k+2])` for odd
+/// `k` (the alternating winding that keeps every triangle's orientation). Triangles with a
+/// repeated corner (the degenerate ones that stitch strips together) are left out; they still
+/// count for the alternation. Appends to `triangles`; returns how many were appended.
+///
+/// # Errors
+/// The first index that is neither -1 nor a vertex (`0 <= i < n`), for the caller's message.
+fn strip_triangles(indices: &[i64], n: i64, triangles: &mut Vec<[u32; 3]>) -> Result<usize, i64> {
+    let before = triangles.len();
+    if let Some(&bad) = indices
+        .iter()
+        .find(|&&i| i != -1 && (i < 0 || i >= n || i > i64::from(u32::MAX)))
+    {
+        return Err(bad);
+    }
+    for strip in indices.split(|&i| i == -1) {
+        for (k, w) in strip.windows(3).enumerate() {
+            // Checked above: 0 <= index <= u32::MAX.
+            let [a, b, c] = [w[0] as u32, w[1] as u32, w[2] as u32];
+            if a == b || b == c || a == c {
+                continue;
+            }
+            triangles.push(if k % 2 == 0 { [a, b, c] } else { [b, a, c] });
+        }
+    }
+    Ok(triangles.len() - before)
 }
 
 /// Parses the PLY file at `path`; polygons are triangulated in their plane
@@ -158,7 +206,7 @@ pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let parser = Parser::<Element>::new();
     let mut reader = Reader::new(BufReader::new(Cursor::new(&data[..])));
     let header = read_header(path, &mut reader)?;
-    let face_list = check_header(path, &header)?;
+    let (has_faces, has_strips) = check_header(path, &header)?;
     let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
         // Line numbers mean something only in ascii files.
         let line = match header.encoding {
@@ -176,7 +224,7 @@ pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
 
     let mut triangles = Vec::with_capacity(faces.len());
     let mut corners: Vec<u32> = Vec::new();
-    if face_list.is_some() {
+    if has_faces {
         for (f, face) in faces.iter().enumerate() {
             let idx = &face.indices;
             if let Some(&bad) = idx
@@ -203,6 +251,20 @@ pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
                 corners.extend(idx.iter().map(|&i| i as u32));
                 triangles.extend(triangulate_polygon(&positions, &corners));
             }
+        }
+    }
+    if has_strips {
+        for (e, record) in payload.get(STRIPS).into_iter().flatten().enumerate() {
+            let made = strip_triangles(&record.indices, n, &mut triangles).map_err(|bad| {
+                Error::invalid_mesh(
+                    path,
+                    format!(
+                        "tristrips record {e} (0-based) names vertex {bad}, but the file has {n} \
+                         vertices (strips are separated by -1)"
+                    ),
+                )
+            })?;
+            stats.faces_read += made;
         }
     }
     Ok(TriMesh::new(positions, triangles))
