@@ -485,9 +485,12 @@ pub fn remesh(
             Target::SigmaP(_) => (true, target_reached, 0.0),
             Target::Points(n) => {
                 let miss = n as f64 - v;
+                // A raised target helps only where the sampler reached its own: a count the
+                // search could not reach is not reached by asking for more.
                 let done = attempt >= 3
                     || miss.abs() <= params.count_tolerance * n as f64
-                    || dropped_samples == 0;
+                    || dropped_samples == 0
+                    || !target_reached;
                 (done, miss.abs() <= 0.01 * n as f64, miss)
             }
         };

@@ -19,14 +19,22 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
-use spectral_remesh::{check_invariants, remesh, Density, Error, RemeshOutput, RemeshParams, TriMesh};
+use spectral_remesh::{
+    check_invariants, remesh, Density, Error, RemeshOutput, RemeshParams, TriMesh,
+};
 
 /// A zigzag strip of 18 faces along x in [0, 100], `width` across: its faces are nearly colinear
 /// when the width is tiny (area about 100 · width, boundary about 200 long).
 fn colinear_strip(width: f64) -> TriMesh {
     let n = 20;
     let positions = (0..n)
-        .map(|i| DVec3::new(i as f64 * 100.0 / (n - 1) as f64, (i % 2) as f64 * width, 0.0))
+        .map(|i| {
+            DVec3::new(
+                i as f64 * 100.0 / (n - 1) as f64,
+                (i % 2) as f64 * width,
+                0.0,
+            )
+        })
         .collect();
     let triangles = (0..n as u32 - 2)
         .map(|i| {
@@ -83,7 +91,11 @@ fn assert_bounded_result(out: &RemeshOutput, target: usize) {
         "the first guess gave {first} samples for a target of {target}: {:?}",
         out.search_history
     );
-    assert!(out.boundary_samples <= 4 * target, "{}", out.boundary_samples);
+    assert!(
+        out.boundary_samples <= 4 * target,
+        "{}",
+        out.boundary_samples
+    );
     assert!(out.samples <= 4 * target, "{}", out.samples);
 }
 
@@ -97,7 +109,10 @@ fn assert_no_area_error(r: Result<RemeshOutput, Error>) {
             assert!(msg.contains("boundary curves"), "{msg}");
         }
         Err(e) => panic!("wrong error: {e}"),
-        Ok(o) => panic!("a mesh of {} faces from a degenerate input", o.mesh.triangles.len()),
+        Ok(o) => panic!(
+            "a mesh of {} faces from a degenerate input",
+            o.mesh.triangles.len()
+        ),
     }
 }
 
@@ -106,7 +121,11 @@ fn nearly_colinear_faces_are_an_input_error_at_once() {
     // Before: the sigma_p guess from the area (1e-11) put about 2e8 samples on the boundary
     // curves (12.6 GB in 120 s).
     let start = Instant::now();
-    assert_no_area_error(remesh(&colinear_strip(1e-13), &RemeshParams::default(), &|_| {}));
+    assert_no_area_error(remesh(
+        &colinear_strip(1e-13),
+        &RemeshParams::default(),
+        &|_| {},
+    ));
     assert_no_area_error(remesh(
         &colinear_strip(1e-13),
         &RemeshParams {
@@ -139,7 +158,11 @@ fn a_sphere_with_a_far_triangle_is_bounded() {
     assert_bounded_result(&out, target);
     // 1e30 away: everything is thinner than rounding in bbox-100 units. Before: an allocation of
     // 2.8e17 bytes aborted the process.
-    assert_no_area_error(remesh(&sphere_and_far_triangle(1e30), &points(target), &|_| {}));
+    assert_no_area_error(remesh(
+        &sphere_and_far_triangle(1e30),
+        &points(target),
+        &|_| {},
+    ));
 }
 
 #[test]
@@ -225,7 +248,30 @@ fn the_degenerate_inputs_end_through_the_binary() {
         assert_eq!(status, Some(code), "{name}: {err}");
         if code != 0 {
             assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
-            assert!(err.contains(name) && err.contains("almost no area"), "{err}");
+            assert!(
+                err.contains(name) && err.contains("almost no area"),
+                "{err}"
+            );
         }
     }
+}
+
+#[test]
+fn a_tiny_sigma_n_ends_after_a_few_evaluations() {
+    // sigma_n 1e-4: every face normal of the icosphere is its own neighbourhood, so the count
+    // has a floor above the target that no sigma_p goes below. Before: 3 × 16 evaluations, each
+    // dearer than the last as sigma_p grew (fandisk: 29 s; now 4 s).
+    let params = RemeshParams {
+        density: Density::Points(500),
+        sigma_n: 1e-4,
+        ..RemeshParams::default()
+    };
+    let out = remesh(&common::icosphere(3), &params, &|_| {}).unwrap();
+    assert!(
+        out.search_history.len() <= 8,
+        "{} evaluations: {:?}",
+        out.search_history.len(),
+        out.search_history
+    );
+    assert!(!out.mesh.triangles.is_empty());
 }
