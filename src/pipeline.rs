@@ -6,9 +6,12 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
 use crate::kernel::Kernel;
 use crate::mesh::{Normalization, TriMesh};
-use crate::sampling::boundary::{boundary_curves, sample_boundary};
+use crate::sampling::boundary::{
+    boundary_curves, boundary_sample_count, curve_length, sample_boundary,
+};
 use crate::sampling::candidates::surface_candidates;
 use crate::sampling::gradient_ascent::{
     gradient_ascent, GradientAscentParams, GradientAscentResult,
@@ -55,6 +58,28 @@ pub const SAMPLES_PER_SIGMA2: f64 = 1.0;
 /// Spacing of the boundary samples in units of sigma_p: the mean edge length the interior
 /// sampling reaches (measured), so boundary triangles match interior ones.
 pub const BOUNDARY_SPACING_PER_SIGMA: f64 = 1.0;
+
+/// The samples a surface of area `area` with boundary curves `boundary_length` long (bbox-100
+/// units) is expected to get at `sigma_p`: `SAMPLES_PER_SIGMA2 · A / sigma_p²` inside and one
+/// per `BOUNDARY_SPACING_PER_SIGMA · sigma_p` along the boundary.
+pub fn expected_samples(area: f64, boundary_length: f64, sigma_p: f64) -> f64 {
+    SAMPLES_PER_SIGMA2 * area / (sigma_p * sigma_p)
+        + boundary_length / (BOUNDARY_SPACING_PER_SIGMA * sigma_p)
+}
+
+/// The first guess of the sigma_p search for `count` samples (bbox-100 units): the larger of
+/// the sigma_p at which the area alone (`sqrt(SAMPLES_PER_SIGMA2 · A / count)`) and the boundary
+/// curves alone (`L / (BOUNDARY_SPACING_PER_SIGMA · count)`) give `count`. Each term of
+/// [`expected_samples`] alone is at most `count` there, so the expected count at the guess is
+/// between `count` and `2 · count`, however long the boundary is for the area (a sliver, a
+/// needle): from the area alone the guess would be far too small there, and the boundary
+/// samples alone many times the target. On a surface whose area term dominates (every closed
+/// one) it is the area-only guess.
+pub fn sigma_p_for_count(area: f64, boundary_length: f64, count: f64) -> f64 {
+    let from_area = (SAMPLES_PER_SIGMA2 * area / count).sqrt();
+    let from_boundary = boundary_length / (BOUNDARY_SPACING_PER_SIGMA * count);
+    from_area.max(from_boundary)
+}
 
 /// The most output points [`remesh`] takes: 20 million (with 10 candidates per sample the
 /// pool holds 2e8 points, about 11 GB).
@@ -215,20 +240,44 @@ pub fn remesh(
     Kernel::new(1.0, params.sigma_n)?;
     on_stage("normalize");
     let normalized = normalization.apply_mesh(input);
-    let surface = MeshSurface::new(&normalized)?;
     let area = normalized.area();
     let curves = boundary_curves(&normalized);
+    let curve_lengths: Vec<f64> = curves
+        .iter()
+        .map(|c| curve_length(&normalized, c))
+        .collect();
+    let boundary_length: f64 = curve_lengths.iter().sum();
+    // A surface thinner everywhere than the zero-area test's tolerance of its own length (a
+    // strip of colinear faces, a needle): every triangle on it would be degenerate, and sampling
+    // its boundary curves at a spacing its area suggests would take without bound.
+    if area <= DEGENERATE_AREA_TOLERANCE * boundary_length * boundary_length {
+        return Err(Error::invalid_mesh(
+            "",
+            format!(
+                "the surface has almost no area ({area:.1e}) but boundary curves \
+                 {boundary_length:.3} long (bbox-100 units): its faces are (nearly) colinear, so \
+                 every triangle on it would be degenerate"
+            ),
+        ));
+    }
+    let surface = MeshSurface::new(&normalized)?;
     timer.lap("normalize");
 
     on_stage("candidates");
+    // Candidates are drawn for the samples expected inside the surface.
     let expected = match density {
         Target::Points(n) => n as f64,
         Target::SigmaP(s) => SAMPLES_PER_SIGMA2 * area / (s * s),
     };
     if let Target::SigmaP(s) = density {
-        // The same bound as --points: the candidate pool and the samples must fit in memory.
+        // The same bound as --points: the candidate pool and the samples, those on the boundary
+        // curves included, must fit in memory.
+        let expected = expected_samples(area, boundary_length, s);
         if !(expected <= MAX_POINTS as f64) {
-            let smallest = (SAMPLES_PER_SIGMA2 * area / MAX_POINTS as f64).sqrt();
+            // The positive root of expected_samples(s) = MAX_POINTS.
+            let (n, a) = (MAX_POINTS as f64, SAMPLES_PER_SIGMA2 * area);
+            let b = boundary_length / BOUNDARY_SPACING_PER_SIGMA;
+            let smallest = (b + (b * b + 4.0 * n * a).sqrt()) / (2.0 * n);
             return Err(Error::InvalidParameter {
                 name: "--sigma-p",
                 message: format!(
@@ -277,21 +326,33 @@ pub fn remesh(
         Target::SigmaP(_) => 0,
     };
     let mut start = match density {
-        Target::Points(n) => (SAMPLES_PER_SIGMA2 * area / n as f64).sqrt(),
+        Target::Points(n) => sigma_p_for_count(area, boundary_length, n as f64),
         Target::SigmaP(s) => s,
     };
     let mut full_history = Vec::new();
     let mut attempt = 0;
     let output = loop {
         on_stage("linear scan");
-        let scan = |sigma_p: f64| -> Result<(usize, ScanWithBoundary)> {
-            let kernel = Kernel::new(sigma_p, params.sigma_n)?;
-            let b = sample_boundary(&normalized, &curves, BOUNDARY_SPACING_PER_SIGMA * sigma_p);
-            let r = linear_scan(&kernel, &pool, &b.samples, &params.linear_scan);
-            Ok((r.samples.len(), (r, b.edges)))
+        // The boundary samples of one evaluation are bounded: a sigma_p whose boundary curves
+        // alone take more than four times the target (or more than the memory bound) is far
+        // from the answer, and its count is reported without sampling (None: skipped). The
+        // count is a lower bound of the scan's, so the search still moves the right way.
+        let boundary_limit = match density {
+            Target::Points(_) => (4.0 * goal as f64).clamp(64.0, MAX_POINTS as f64),
+            Target::SigmaP(_) => MAX_POINTS as f64,
         };
-        let (sigma_p, target_reached, search_history, (scan_result, boundary_edges)) = match density
-        {
+        let scan = |sigma_p: f64| -> Result<(usize, Option<ScanWithBoundary>)> {
+            let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+            let spacing = BOUNDARY_SPACING_PER_SIGMA * sigma_p;
+            let boundary_count = boundary_sample_count(&curves, &curve_lengths, spacing);
+            if !(boundary_count <= boundary_limit) {
+                return Ok((boundary_count.min(usize::MAX as f64) as usize, None));
+            }
+            let b = sample_boundary(&normalized, &curves, spacing);
+            let r = linear_scan(&kernel, &pool, &b.samples, &params.linear_scan);
+            Ok((r.samples.len(), Some((r, b.edges))))
+        };
+        let (sigma_p, target_reached, search_history, value) = match density {
             Target::SigmaP(s) => {
                 let (count, value) = scan(s)?;
                 (s, true, vec![(s, count)], value)
@@ -306,18 +367,7 @@ pub fn remesh(
                     Ok(v) => v,
                     Err(e) => {
                         failure = Some(e);
-                        (
-                            0,
-                            (
-                                LinearScanResult {
-                                    samples: vec![],
-                                    initial: 0,
-                                    rejected_by_nearest: 0,
-                                    measured: 0,
-                                },
-                                vec![],
-                            ),
-                        )
+                        (0, None)
                     }
                 });
                 if let Some(e) = failure {
@@ -325,6 +375,23 @@ pub fn remesh(
                 }
                 (r.sigma_p, r.reached, r.history, r.value)
             }
+        };
+        let Some((scan_result, boundary_edges)) = value else {
+            // Even the best sigma_p tried puts more samples on the boundary curves than the
+            // bound (loops need 3 samples each, however short).
+            let (name, what) = match density {
+                Target::Points(_) => ("--points", format!("{goal} points")),
+                Target::SigmaP(s) => ("--sigma-p", format!("sigma_p {s}")),
+            };
+            return Err(Error::InvalidParameter {
+                name,
+                message: format!(
+                    "{what} cannot be reached on this surface: its {} boundary curves \
+                     ({boundary_length:.3} long, bbox-100 units) alone take more than \
+                     {boundary_limit} samples at every sigma_p tried",
+                    curves.len()
+                ),
+            });
         };
         timer.lap("linear scan");
 
@@ -419,9 +486,12 @@ pub fn remesh(
             Target::SigmaP(_) => (true, target_reached, 0.0),
             Target::Points(n) => {
                 let miss = n as f64 - v;
+                // A raised target helps only where the sampler reached its own: a count the
+                // search could not reach is not reached by asking for more.
                 let done = attempt >= 3
                     || miss.abs() <= params.count_tolerance * n as f64
-                    || dropped_samples == 0;
+                    || dropped_samples == 0
+                    || !target_reached;
                 (done, miss.abs() <= 0.01 * n as f64, miss)
             }
         };

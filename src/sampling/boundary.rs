@@ -120,6 +120,38 @@ pub struct BoundarySamples {
     pub edges: Vec<[u32; 2]>,
 }
 
+/// The arc length of `curve` (bbox-100 units when `mesh` is normalized).
+pub fn curve_length(mesh: &TriMesh, curve: &BoundaryCurve) -> f64 {
+    let nv = curve.vertices.len();
+    let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
+    (0..curve.faces.len())
+        .map(|k| pos(k).distance(pos(k + 1)))
+        .sum()
+}
+
+/// How many samples [`sample_boundary`] places at `spacing` on curves of these `lengths` (the
+/// closed flags from `curves`), without placing them: the whole-number steps of each curve, at
+/// least 3 on a loop, counting each end of an open chain once per chain (an upper bound there,
+/// as chains that meet share their ends). A float, so that a spacing far below the curves'
+/// length gives a large number rather than an overflow.
+pub fn boundary_sample_count(curves: &[BoundaryCurve], lengths: &[f64], spacing: f64) -> f64 {
+    curves
+        .iter()
+        .zip(lengths)
+        .filter(|(_, &total)| total > 0.0)
+        .map(|(curve, &total)| {
+            let steps = (total / spacing)
+                .round()
+                .max(if curve.closed { 3.0 } else { 1.0 });
+            if curve.closed {
+                steps
+            } else {
+                steps + 1.0
+            }
+        })
+        .sum()
+}
+
 /// Places samples along every boundary curve of `mesh` at equal arc-length steps as close to
 /// `spacing` (bbox-100 units) as a whole number of steps allows: a closed loop gets at least 3,
 /// and the ends of open chains are shared between the chains that meet there.

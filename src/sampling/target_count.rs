@@ -7,6 +7,18 @@
 
 use crate::geometry::tolerance::{LOG_BRACKET_TOLERANCE, LOG_COUNT_TOLERANCE};
 
+/// A count that falls slower than `sigma_p^-FLAT_SLOPE` between two evaluations on the same side
+/// of the target, `FLAT_STEP` or more apart in log sigma_p, has stopped answering to sigma_p (on
+/// a surface it falls like sigma_p^-2, like sigma_p^-1 where boundary curves dominate): the
+/// samples are held by something else (a tiny sigma_n makes every direction of the normal its
+/// own neighbourhood), and the search stops there instead of crawling towards a target it
+/// cannot reach, with evaluations that grow dearer as sigma_p grows.
+const FLAT_SLOPE: f64 = 0.5;
+
+/// See [`FLAT_SLOPE`]: the least step in log sigma_p over which a slope is trusted (counts
+/// wobble by a fraction of a percent).
+const FLAT_STEP: f64 = 0.1;
+
 /// Parameters of the search.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TargetCountParams {
@@ -63,6 +75,7 @@ pub fn find_sigma_p<T>(
     let mut lo: Option<(f64, f64)> = None; // (ln sigma, ln count)
     let mut hi: Option<(f64, f64)> = None;
     let mut ln_sigma = sigma_start.ln();
+    let mut previous: Option<(f64, f64)> = None; // (ln sigma, ln count) of the last evaluation
     for _ in 0..params.max_evaluations.max(1) {
         let sigma = ln_sigma.exp();
         let (count, value) = evaluate(sigma);
@@ -77,6 +90,18 @@ pub fn find_sigma_p<T>(
             break;
         }
         let ln_count = (count.max(1) as f64).ln();
+        if let Some((ls, lc)) = previous {
+            let same_side = lo.is_none() || hi.is_none();
+            let step = ln_sigma - ls;
+            if same_side
+                && step.abs() >= FLAT_STEP
+                && (ln_count - lc) / step > -FLAT_SLOPE
+                && ((count as f64) > target) == (lc > ln_target)
+            {
+                break;
+            }
+        }
+        previous = Some((ln_sigma, ln_count));
         if (count as f64) > target {
             if lo.is_none_or(|l| ln_sigma > l.0) {
                 lo = Some((ln_sigma, ln_count));
@@ -132,6 +157,17 @@ mod tests {
             assert_eq!(r.value, r.sigma_p);
             assert!(r.history.len() <= 8, "{} evaluations", r.history.len());
         }
+    }
+
+    #[test]
+    fn stops_when_the_count_no_longer_answers_to_sigma() {
+        // A floor of 6500 above the target (a tiny sigma_n): the count flattens out, and the
+        // search stops after a few evaluations instead of crawling through all 16.
+        let f = |s: f64| ((6500.0 + 20_000.0 / (s * s)).round() as usize, ());
+        let r = find_sigma_p(&TargetCountParams::new(6000), 1.0, f);
+        assert!(!r.reached);
+        assert!(r.history.len() <= 6, "{:?}", r.history);
+        assert_eq!(r.count, r.history.iter().map(|h| h.1).min().unwrap());
     }
 
     #[test]

@@ -83,6 +83,7 @@ fn umbrella(
     neighbors: &[(u32, f64)],
     params: &TangentDelaunayParams,
     chain: &FxHashMap<u32, (Option<u32>, Option<u32>)>,
+    chain_rank: &FxHashMap<u32, usize>,
     out: &mut Vec<[u32; 3]>,
 ) {
     out.clear();
@@ -127,13 +128,21 @@ fn umbrella(
             .copied()
             .chain(std::iter::once((i as u32, center)))
             .collect();
-        for (&a, &(_, next)) in chain.iter() {
-            if let (Some(b), Some(&ha)) = (next, local.get(&a)) {
-                if let Some(&hb) = local.get(&b) {
-                    if cdt.can_add_constraint(ha, hb) {
-                        cdt.add_constraint(ha, hb);
-                    }
-                }
+        // The local boundary edges, in the chain's own order (the order decides which of two
+        // crossing constraints is kept): found from the local points, not by a walk over the
+        // whole chain, which made the triangulation quadratic in the boundary samples.
+        let mut edges: Vec<(usize, FixedVertexHandle, FixedVertexHandle)> = local
+            .iter()
+            .filter_map(|(a, &ha)| {
+                let next = chain.get(a)?.1?;
+                let &hb = local.get(&next)?;
+                Some((chain_rank[a], ha, hb))
+            })
+            .collect();
+        edges.sort_unstable_by_key(|e| e.0);
+        for (_, ha, hb) in edges {
+            if cdt.can_add_constraint(ha, hb) {
+                cdt.add_constraint(ha, hb);
             }
         }
     }
@@ -190,13 +199,15 @@ pub fn vote_triangles(set: &SampleSet, params: &TangentDelaunayParams) -> Vec<Vo
         chain.entry(a).or_insert((None, None)).1 = Some(b);
         chain.entry(b).or_insert((None, None)).0 = Some(a);
     }
+    let chain_rank: FxHashMap<u32, usize> =
+        chain.keys().enumerate().map(|(r, &a)| (a, r)).collect();
     let umbrellas: Vec<Vec<[u32; 3]>> = (0..n)
         .into_par_iter()
         .map_init(
             || (Vec::new(), Vec::new()),
             |(found, tris), i| {
                 tree.nearest_n(set.positions[i], params.neighbors + 1, found);
-                umbrella(i, set, found, params, &chain, tris);
+                umbrella(i, set, found, params, &chain, &chain_rank, tris);
                 tris.clone()
             },
         )
