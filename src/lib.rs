@@ -130,7 +130,9 @@ mod triangulate;
 pub use error::{Error, Result};
 
 // Reading and writing meshes (OBJ, PLY, glTF), atomically.
-pub use io::{read_mesh, write_atomically, write_mesh, AtomicFile, MeshFormat, ReadStats};
+pub use io::{
+    read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, MeshFormat, ReadStats,
+};
 
 // The meshes: the indexed triangle mesh, its normalization to bbox 100, and the editable
 // directed-edge mesh with its local operators.

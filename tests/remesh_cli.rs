@@ -640,3 +640,83 @@ fn sphere_obj(mesh: &spectral_remesh::TriMesh) -> String {
     }
     s
 }
+
+/// Waits (up to 60 s) until `dir` holds an entry whose name `wanted` accepts; its name.
+fn wait_for_entry(dir: &Path, wanted: impl Fn(&str) -> bool) -> String {
+    let start = std::time::Instant::now();
+    while start.elapsed().as_secs() < 60 {
+        if let Some(name) = std::fs::read_dir(dir)
+            .unwrap()
+            .filter_map(|e| e.ok()?.file_name().into_string().ok())
+            .find(|n| wanted(n))
+        {
+            return name;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    panic!("nothing appeared in {}", dir.display());
+}
+
+/// Sends `signal` (`INT`, `TERM`) to the child and waits for it; its exit code.
+fn signal_and_wait(child: &mut std::process::Child, signal: &str) -> Option<i32> {
+    let sent = Command::new("kill")
+        .args([format!("-{signal}"), child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    child.wait().unwrap().code()
+}
+
+/// Issue 14, item 8: an interrupted run left its temporary output (`remesh points`) or its
+/// bucket folder (`remesh simplify`) behind. On SIGINT or SIGTERM both are removed, the target
+/// stays absent, and the exit code is 130.
+#[test]
+fn an_interrupted_run_leaves_no_temporary_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("points.ply");
+    // 10^8 points take far longer than the interrupt.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .args(["points", shared("spot.obj").to_str().unwrap()])
+        .arg(&out)
+        .args(["--count", "100000000"])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let tmp = wait_for_entry(dir.path(), |n| n.ends_with(".tmp"));
+    assert_eq!(signal_and_wait(&mut child, "INT"), Some(130), "{tmp}");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "{tmp} left"
+    );
+
+    // simplify: the buckets go to TMPDIR, here a folder of the test's own.
+    let input = dir.path().join("input.ply");
+    let made = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .args(["points", shared("spot.obj").to_str().unwrap()])
+        .arg(&input)
+        .args(["--count", "3000000"])
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let scratch = dir.path().join("scratch");
+    std::fs::create_dir(&scratch).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .env("TMPDIR", &scratch)
+        .arg("simplify")
+        .arg(&input)
+        .arg(dir.path().join("simplified.ply"))
+        .args(["--points", "20000", "-q"])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let buckets = wait_for_entry(&scratch, |n| n.starts_with("remesh-buckets"));
+    assert_eq!(signal_and_wait(&mut child, "TERM"), Some(130), "{buckets}");
+    assert_eq!(
+        std::fs::read_dir(&scratch).unwrap().count(),
+        0,
+        "{buckets} left"
+    );
+    // The input and the scratch folder: no output, no temporary file.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}

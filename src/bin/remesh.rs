@@ -9,9 +9,9 @@ use std::time::Duration;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
-    catch_panics, parse_bytes, physical_memory, run_points, run_quality, run_remesh, run_simplify,
-    write_report, Density, Error, MeshFormat, PointsJob, RemeshJob, RemeshParams, SimplifyDensity,
-    SimplifyJob, STDOUT,
+    catch_panics, parse_bytes, physical_memory, remove_temporaries, run_points, run_quality,
+    run_remesh, run_simplify, write_report, Density, Error, MeshFormat, PointsJob, RemeshJob,
+    RemeshParams, SimplifyDensity, SimplifyJob, STDOUT,
 };
 
 const EXAMPLES: &str = "\
@@ -406,6 +406,13 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Interrupted (SIGINT, SIGTERM, SIGHUP): the temporary files and bucket folders of the run
+    // are removed and the target stays as it was. Exit 130, as a shell reports an interrupt.
+    let _ = ctrlc::set_handler(|| {
+        remove_temporaries();
+        eprintln!("remesh: interrupted; temporary files removed, nothing written");
+        std::process::exit(130);
+    });
     match catch_panics(|| config(cli).and_then(execute)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -31,6 +31,8 @@ pub struct AtomicFile {
     /// Where the file goes: `path`, or the file a symbolic link at `path` points to.
     target: PathBuf,
     output: BufWriter<NamedTempFile>,
+    /// The temporary file on the list an interrupted run removes.
+    _registered: super::temporaries::Registered,
 }
 
 impl AtomicFile {
@@ -71,6 +73,7 @@ impl AtomicFile {
         Ok(AtomicFile {
             path: given.to_path_buf(),
             target,
+            _registered: super::temporaries::register(file.path()),
             output: BufWriter::with_capacity(BUFFER_BYTES, file),
         })
     }
@@ -96,6 +99,7 @@ impl AtomicFile {
             path,
             target,
             output,
+            _registered,
         } = self;
         let file = output
             .into_inner()

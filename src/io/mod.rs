@@ -16,6 +16,7 @@ mod gltf;
 mod obj;
 pub(crate) mod ply;
 mod polygon;
+pub(crate) mod temporaries;
 
 use std::fs;
 use std::path::Path;
@@ -27,6 +28,7 @@ use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 
 pub use atomic::{write_atomically, AtomicFile};
+pub use temporaries::remove_temporaries;
 
 /// A mesh file format, chosen by the file's extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]

@@ -344,6 +344,8 @@ pub fn simplify_progressive(
 /// The input, bucket-shuffled into temporary files (pass 1 of [`simplify_out_of_core`]).
 struct Buckets {
     dir: tempfile::TempDir,
+    /// The folder on the list an interrupted run removes.
+    _registered: crate::io::temporaries::Registered,
     /// Number of bucket files.
     count: usize,
     /// Points read.
@@ -366,6 +368,8 @@ impl Buckets {
             .prefix("remesh-buckets")
             .tempdir_in(params.temp_dir.clone().unwrap_or_else(std::env::temp_dir))
             .map_err(|e| Error::io(input, e))?;
+        // On the list from the start: an interrupt while bucketing removes it too.
+        let registered = crate::io::temporaries::register(dir.path());
         let io_err = |e: std::io::Error| Error::io(dir.path(), e);
         let mut writers: Vec<BufWriter<File>> = (0..count)
             .map(|b| {
@@ -404,6 +408,7 @@ impl Buckets {
             )
         })?;
         Ok(Buckets {
+            _registered: registered,
             dir,
             count,
             total,

@@ -1,0 +1,82 @@
+//! The temporary files and folders alive in this process (an [`AtomicFile`](super::AtomicFile)'s
+//! file beside its target, `remesh simplify`'s bucket folder), so that an interrupted run can
+//! remove them: the `remesh` binary's SIGINT/SIGTERM/SIGHUP handler calls
+//! [`remove_temporaries`] before it exits. A normal run removes its temporaries itself (on
+//! commit or drop); this list only serves the signal path.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+static LIVE: Mutex<BTreeMap<u64, PathBuf>> = Mutex::new(BTreeMap::new());
+static NEXT: AtomicU64 = AtomicU64::new(0);
+
+/// A temporary path on the list; dropping it takes the path off the list (it does not remove
+/// the file: its owner does).
+#[derive(Debug)]
+pub(crate) struct Registered(u64);
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        if let Ok(mut live) = LIVE.lock() {
+            live.remove(&self.0);
+        }
+    }
+}
+
+/// Puts `path` (a file or a folder) on the list of temporaries until the returned guard drops.
+pub(crate) fn register(path: &Path) -> Registered {
+    let id = NEXT.fetch_add(1, Ordering::Relaxed);
+    if let Ok(mut live) = LIVE.lock() {
+        live.insert(id, path.to_path_buf());
+    }
+    Registered(id)
+}
+
+/// Removes every temporary file and folder on the list (a folder with its content) and
+/// empties the list; returns how many paths were removed. For a signal handler: it never
+/// panics, and paths already gone are skipped.
+pub fn remove_temporaries() -> usize {
+    let paths: Vec<PathBuf> = match LIVE.lock() {
+        Ok(mut live) => std::mem::take(&mut *live).into_values().collect(),
+        Err(poisoned) => std::mem::take(&mut *poisoned.into_inner())
+            .into_values()
+            .collect(),
+    };
+    paths
+        .iter()
+        .filter(|p| {
+            if p.is_dir() {
+                std::fs::remove_dir_all(p).is_ok()
+            } else {
+                std::fs::remove_file(p).is_ok()
+            }
+        })
+        .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registered_paths_are_removed_and_dropped_guards_leave_the_list() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("a.tmp");
+        let folder = dir.path().join("buckets");
+        let kept = dir.path().join("kept.tmp");
+        std::fs::write(&file, b"x").unwrap();
+        std::fs::create_dir(&folder).unwrap();
+        std::fs::write(folder.join("0.bin"), b"y").unwrap();
+        std::fs::write(&kept, b"z").unwrap();
+        let _a = register(&file);
+        let _b = register(&folder);
+        drop(register(&kept));
+        // Other tests of this process may hold temporaries of their own: count only ours.
+        remove_temporaries();
+        assert!(!file.exists());
+        assert!(!folder.exists());
+        assert!(kept.exists());
+    }
+}
