@@ -132,10 +132,10 @@ pub use error::{Error, Result};
 // Reading and writing meshes (OBJ, PLY, glTF), atomically.
 pub use io::{read_mesh, write_atomically, write_mesh, AtomicFile, MeshFormat, ReadStats};
 
-// The meshes: the indexed triangle mesh, its normalization to bbox 100, and the editable
-// directed-edge mesh with its local operators.
+// The meshes: the indexed triangle mesh, its normalization to bbox 100, its consistent
+// orientation, and the editable directed-edge mesh with its local operators.
 pub use mesh::edit::{EditError, EditMesh, EditViolation, SlotPolicy};
-pub use mesh::{Aabb, Normalization, TriMesh};
+pub use mesh::{orient_consistently, Aabb, Normalization, OrientStats, TriMesh};
 
 // The pipeline in one call.
 pub use pipeline::{

@@ -1,4 +1,4 @@
-//! The remeshing pipeline: normalize (bbox 100) → candidates → linear scan (with the sigma_p
+//! The remeshing pipeline: normalize (bbox 100) and orient consistently → candidates → linear scan (with the sigma_p
 //! search for a target count) → gradient ascent + projection → triangulate → clean up → back to
 //! model units.
 
@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
-use crate::mesh::{Normalization, TriMesh};
+use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{boundary_curves, sample_boundary};
 use crate::sampling::candidates::surface_candidates;
 use crate::sampling::gradient_ascent::{
@@ -109,8 +109,11 @@ pub struct RemeshOutput {
     pub mesh: TriMesh,
     /// The same in bbox-100 units.
     pub mesh_normalized: TriMesh,
-    /// The input in bbox-100 units.
+    /// The input in bbox-100 units, oriented consistently (see `orientation`).
     pub input_normalized: TriMesh,
+    /// What orienting the input consistently did ([`orient_consistently`]: faces flipped,
+    /// closed components turned outward, non-orientable components).
+    pub orientation: OrientStats,
     /// Model units ↔ bbox-100 units.
     pub normalization: Normalization,
     /// The sigma_p used (bbox-100 units).
@@ -213,7 +216,10 @@ pub fn remesh(
     // Validate sigma_n early.
     Kernel::new(1.0, params.sigma_n)?;
     on_stage("normalize");
-    let normalized = normalization.apply_mesh(input);
+    let mut normalized = normalization.apply_mesh(input);
+    // Every later stage takes the faces' orientation at face value (normals, tangent planes,
+    // the triangulation's orientation): the input is oriented consistently first.
+    let orientation = orient_consistently(&mut normalized);
     let surface = MeshSurface::new(&normalized)?;
     let area = normalized.area();
     let curves = boundary_curves(&normalized);
@@ -430,6 +436,7 @@ pub fn remesh(
                 mesh: normalization.invert_mesh(&mesh_normalized),
                 mesh_normalized,
                 input_normalized: normalized,
+                orientation,
                 normalization,
                 sigma_p,
                 target: match density {

@@ -7,7 +7,7 @@ pub mod edit;
 mod orient;
 mod trimesh;
 
+pub use orient::{orient_consistently, OrientStats};
 #[cfg(test)]
 pub(crate) use trimesh::test_meshes;
-pub use orient::{orient_consistently, OrientStats};
 pub use trimesh::{Aabb, Normalization, TriMesh};

@@ -7,7 +7,6 @@
 //! coherently" (`vcg::tri::Clean::OrientCoherentlyMesh`); see Botsch, Kobbelt, Pauly, Alliez,
 //! Lévy, *Polygon Mesh Processing*, 2010, Ch. 1 (orientability).
 
-use glam::DVec3;
 use rustc_hash::FxHashMap;
 use serde::Serialize;
 
@@ -18,6 +17,9 @@ use super::TriMesh;
 pub struct OrientStats {
     /// Components: faces connected through manifold edges (edges in exactly two faces).
     pub components: usize,
+    /// Manifold edges whose two faces traversed them the same way in the input (0 for a
+    /// consistently oriented input).
+    pub inconsistent_edges: usize,
     /// Faces whose orientation was reversed.
     pub faces_flipped: usize,
     /// Closed components (no boundary and no non-manifold edge) whose faces mostly (by area)
@@ -69,7 +71,9 @@ pub fn orient_consistently(mesh: &mut TriMesh) -> OrientStats {
         if a == b {
             continue;
         }
-        let e = edges.entry((a.min(b), a.max(b))).or_insert((h as u32, NONE, 0));
+        let e = edges
+            .entry((a.min(b), a.max(b)))
+            .or_insert((h as u32, NONE, 0));
         if e.2 == 1 {
             e.1 = h as u32;
         }
@@ -79,6 +83,7 @@ pub fn orient_consistently(mesh: &mut TriMesh) -> OrientStats {
     let mut twin = vec![NONE; 3 * n];
     // Whether each side lies on a boundary or non-manifold edge (the face's component is open).
     let mut open_side = vec![false; 3 * n];
+    let mut inconsistent_edges = 0;
     for h in 0..3 * n {
         let (a, b) = (tail(h), head(h));
         if a == b {
@@ -87,13 +92,19 @@ pub fn orient_consistently(mesh: &mut TriMesh) -> OrientStats {
         let (h1, h2, count) = edges[&(a.min(b), a.max(b))];
         if count == 2 && h1 / 3 != h2 / 3 {
             twin[h] = if h1 as usize == h { h2 } else { h1 };
+            if h1 as usize == h && tail(h) == tail(h2 as usize) {
+                inconsistent_edges += 1;
+            }
         } else {
             open_side[h] = true;
         }
     }
     drop(edges);
 
-    let mut stats = OrientStats::default();
+    let mut stats = OrientStats {
+        inconsistent_edges,
+        ..OrientStats::default()
+    };
     // flip[f]: whether face f is reversed relative to the input, once visited.
     let mut flip: Vec<Option<bool>> = vec![None; n];
     let mut queue: Vec<u32> = Vec::with_capacity(n);
@@ -189,6 +200,7 @@ mod tests {
     use super::*;
     use crate::check::topology;
     use crate::mesh::test_meshes::{cuboid, grid};
+    use glam::DVec3;
 
     fn consistent(m: &TriMesh) -> bool {
         topology(m).inconsistent_orientation_edges == 0
@@ -261,7 +273,7 @@ mod tests {
             let mut o = m.clone();
             let stats = orient_consistently(&mut o);
             assert_eq!(o, m);
-            assert_eq!(stats.faces_flipped, 0);
+            assert_eq!((stats.faces_flipped, stats.inconsistent_edges), (0, 0));
             assert_eq!(stats.components, 1);
             assert_eq!(stats.non_orientable_components, 0);
         }
@@ -294,6 +306,7 @@ mod tests {
             let stats = orient_consistently(&mut reversed);
             assert_eq!(reversed, m, "the patch is flipped back and nothing else");
             assert_eq!(stats.faces_flipped, count);
+            assert!(stats.inconsistent_edges > 0);
             assert_eq!(stats.components_turned_outward, 0);
         }
     }
@@ -306,7 +319,10 @@ mod tests {
         assert!(inward.signed_volume() < 0.0);
         let stats = orient_consistently(&mut inward);
         assert_eq!(inward, m);
-        assert_eq!(stats.components_turned_outward, 1);
+        assert_eq!(
+            (stats.components_turned_outward, stats.inconsistent_edges),
+            (1, 0)
+        );
         assert_eq!(stats.faces_flipped, m.triangles.len());
         // Inward with a few faces outward: still all outward at the end.
         let mut mixed = m.clone();
@@ -350,7 +366,10 @@ mod tests {
         assert_eq!(stats.non_orientable_faces, m.triangles.len());
         assert!(stats.seam_edges >= 1);
         // Consistent everywhere but across the seam.
-        assert_eq!(topology(&o).inconsistent_orientation_edges, stats.seam_edges);
+        assert_eq!(
+            topology(&o).inconsistent_orientation_edges,
+            stats.seam_edges
+        );
         // The same strip next to a consistent box: only the strip is counted.
         let mut both = o.clone();
         let b = cuboid(DVec3::splat(10.0), DVec3::splat(11.0));
