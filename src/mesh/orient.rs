@@ -7,7 +7,6 @@
 //! coherently" (`vcg::tri::Clean::OrientCoherentlyMesh`); see Botsch, Kobbelt, Pauly, Alliez,
 //! Lévy, *Polygon Mesh Processing*, 2010, Ch. 1 (orientability).
 
-use rustc_hash::FxHashMap;
 use serde::Serialize;
 
 use super::TriMesh;
@@ -52,7 +51,8 @@ const NONE: u32 = u32::MAX;
 /// (`[a, b, c]` → `[a, c, b]`), never reordered otherwise, and face order is kept, so a mesh
 /// that is already consistently oriented (and outward where closed) is left exactly as it is.
 ///
-/// Time: O(F) expected (one hash map of the edges, one walk).
+/// Time: O(V + F) (a counting sort of the edges by their lower vertex, one walk), times the
+/// log of the largest vertex degree (each vertex's edges are sorted).
 ///
 /// Does not fail; indices must be in range (as [`TriMesh::check_indices`] ensures).
 ///
@@ -63,43 +63,55 @@ pub fn orient_consistently(mesh: &mut TriMesh) -> OrientStats {
     // Half-edge h = 3f + k is side k of face f, from corner k to corner k + 1.
     let tail = |h: usize| mesh.triangles[h / 3][h % 3];
     let head = |h: usize| mesh.triangles[h / 3][(h % 3 + 1) % 3];
-    // Each undirected edge's first half-edge and how many it has.
-    let mut edges: FxHashMap<(u32, u32), (u32, u32, u32)> = FxHashMap::default();
-    edges.reserve(3 * n / 2 + 1);
+    // The half-edges of each undirected edge {lo, hi}, bucketed by lo (a counting sort) and
+    // sorted by hi within a bucket (a vertex's few edges).
+    let v = mesh.positions.len();
+    let mut start = vec![0u32; v + 1];
     for h in 0..3 * n {
         let (a, b) = (tail(h), head(h));
-        if a == b {
-            continue;
+        if a != b {
+            start[a.min(b) as usize + 1] += 1;
         }
-        let e = edges
-            .entry((a.min(b), a.max(b)))
-            .or_insert((h as u32, NONE, 0));
-        if e.2 == 1 {
-            e.1 = h as u32;
-        }
-        e.2 += 1;
     }
+    for i in 0..v {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    // (hi, half-edge) per bucket.
+    let mut bucket = vec![(0u32, 0u32); start[v] as usize];
+    for h in 0..3 * n {
+        let (a, b) = (tail(h), head(h));
+        if a != b {
+            let slot = &mut fill[a.min(b) as usize];
+            bucket[*slot as usize] = (a.max(b), h as u32);
+            *slot += 1;
+        }
+    }
+    drop(fill);
     // The twin of each half-edge across a manifold edge (two sides of two different faces).
     let mut twin = vec![NONE; 3 * n];
     // Whether each side lies on a boundary or non-manifold edge (the face's component is open).
     let mut open_side = vec![false; 3 * n];
     let mut inconsistent_edges = 0;
-    for h in 0..3 * n {
-        let (a, b) = (tail(h), head(h));
-        if a == b {
-            continue;
-        }
-        let (h1, h2, count) = edges[&(a.min(b), a.max(b))];
-        if count == 2 && h1 / 3 != h2 / 3 {
-            twin[h] = if h1 as usize == h { h2 } else { h1 };
-            if h1 as usize == h && tail(h) == tail(h2 as usize) {
-                inconsistent_edges += 1;
+    for lo in 0..v {
+        let edges = &mut bucket[start[lo] as usize..start[lo + 1] as usize];
+        edges.sort_unstable();
+        for group in edges.chunk_by(|x, y| x.0 == y.0) {
+            let (h1, h2) = (group[0].1 as usize, group[group.len() - 1].1 as usize);
+            if group.len() == 2 && h1 / 3 != h2 / 3 {
+                twin[h1] = h2 as u32;
+                twin[h2] = h1 as u32;
+                if tail(h1) == tail(h2) {
+                    inconsistent_edges += 1;
+                }
+            } else {
+                for &(_, h) in group.iter() {
+                    open_side[h as usize] = true;
+                }
             }
-        } else {
-            open_side[h] = true;
         }
     }
-    drop(edges);
+    drop(bucket);
 
     let mut stats = OrientStats {
         inconsistent_edges,
