@@ -100,6 +100,9 @@ fn spot_with_a_reversed_region_remeshes_like_clean_spot() {
         );
         assert!(has_note(&r, "not consistently oriented"), "{:?}", r.notes);
         assert_eq!(r.extra["orientation"]["faces_flipped"], count);
+        // The report's input column is the input as read.
+        let input = r.input_topology.as_ref().unwrap();
+        assert!(input.inconsistent_orientation_edges > 0);
         assert!(!has_note(&c, "oriented"), "{:?}", c.notes);
     }
 }

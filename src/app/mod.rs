@@ -117,7 +117,11 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     }
     report.push_stage("check (report)", check_seconds);
     report.push_stage("write", write_seconds);
-    let input_topology = crate::check::topology(&out.input_normalized);
+    // The input column describes the input as read: its faces before they were oriented.
+    let input_topology = crate::check::topology(&crate::mesh::TriMesh::new(
+        out.input_normalized.positions.clone(),
+        input.triangles.clone(),
+    ));
     if input_topology.non_manifold_vertices > 0 || input_topology.non_manifold_edges > 0 {
         report.notes.push(format!(
             "the input has {} non-manifold vertices and {} non-manifold edges; the sampler works on \
