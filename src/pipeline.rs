@@ -216,7 +216,8 @@ pub fn remesh(
     // Validate sigma_n early.
     Kernel::new(1.0, params.sigma_n)?;
     on_stage("normalize");
-    let mut normalized = normalization.apply_mesh(input);
+    let as_read = normalization.apply_mesh(input);
+    let mut normalized = as_read.clone();
     // Every later stage takes the faces' orientation at face value (normals, tangent planes,
     // the triangulation's orientation): the input is oriented consistently first.
     let orientation = orient_consistently(&mut normalized);
@@ -247,7 +248,19 @@ pub fn remesh(
     let pool_size = (params.candidates_per_sample * expected)
         .ceil()
         .clamp(16.0, 2e8) as usize;
-    let mut pool = surface_candidates(&normalized, pool_size, params.seed);
+    // The candidates are drawn on the faces as read, and a reversed face's candidates take its
+    // reversed normal: orienting the input changes the sign of normals, not where points land
+    // (the draw depends on a face's corner order), so it changes the output's orientation and
+    // nothing else of the sampling.
+    let mut pool = surface_candidates(&as_read, pool_size, params.seed);
+    if orientation.faces_flipped > 0 {
+        for c in &mut pool {
+            if normalized.triangles[c.face as usize] != as_read.triangles[c.face as usize] {
+                c.normal = -c.normal;
+            }
+        }
+    }
+    drop(as_read);
     // Where the input passes through itself, the candidates inside its own solid are left out
     // (and samples the gradient ascent moves there are put back): the output follows the outer
     // surface and does not cross itself there.
