@@ -111,9 +111,13 @@ pub struct RemeshOutput {
     pub mesh_normalized: TriMesh,
     /// The input in bbox-100 units, oriented consistently (see `orientation`).
     pub input_normalized: TriMesh,
-    /// What orienting the input consistently did ([`orient_consistently`]: faces flipped,
-    /// closed components turned outward, non-orientable components).
+    /// What orienting the input consistently did ([`orient_consistently`] without turning
+    /// closed parts outward: faces flipped, non-orientable components).
     pub orientation: OrientStats,
+    /// What orienting the output did ([`orient_consistently`] turning closed parts outward:
+    /// the output follows the input's orientation, so this turns the output of an inward-facing
+    /// closed input outward).
+    pub output_orientation: OrientStats,
     /// Model units ↔ bbox-100 units.
     pub normalization: Normalization,
     /// The sigma_p used (bbox-100 units).
@@ -219,8 +223,11 @@ pub fn remesh(
     let as_read = normalization.apply_mesh(input);
     let mut normalized = as_read.clone();
     // Every later stage takes the faces' orientation at face value (normals, tangent planes,
-    // the triangulation's orientation): the input is oriented consistently first.
-    let orientation = orient_consistently(&mut normalized);
+    // the triangulation's orientation): the input is oriented consistently first. Its closed
+    // parts are turned outward on the output instead (below): the sampling does not depend on
+    // which way a consistent input faces, but the projections' rounding does, so an inward
+    // input that is otherwise fine (horse) keeps its output and only the orientation changes.
+    let orientation = orient_consistently(&mut normalized, false);
     let surface = MeshSurface::new(&normalized)?;
     let area = normalized.area();
     let curves = boundary_curves(&normalized);
@@ -430,6 +437,8 @@ pub fn remesh(
             .map(|i| i < boundary_count)
             .collect();
         let untangle_stats = untangle(&mut mesh_normalized, &fixed, sigma_p, &params.untangle);
+        // The output follows the input's orientation: its closed parts are turned outward.
+        let output_orientation = orient_consistently(&mut mesh_normalized, true);
         timer.lap("untangle");
         attempt += 1;
         let v = mesh_normalized.vertex_count() as f64;
@@ -450,6 +459,7 @@ pub fn remesh(
                 mesh_normalized,
                 input_normalized: normalized,
                 orientation,
+                output_orientation,
                 normalization,
                 sigma_p,
                 target: match density {

@@ -207,9 +207,15 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         "orientation".into(),
         serde_json::to_value(out.orientation).unwrap_or_default(),
     );
-    report
-        .notes
-        .extend(orientation_notes(&out.orientation, input.face_count()));
+    extra.insert(
+        "output_orientation".into(),
+        serde_json::to_value(out.output_orientation).unwrap_or_default(),
+    );
+    report.notes.extend(orientation_notes(
+        &out.orientation,
+        &out.output_orientation,
+        input.face_count(),
+    ));
     if out.dropped_samples > 0 {
         report.notes.push(format!(
             "{} samples ended in no triangle and were left out",
@@ -225,17 +231,12 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     Ok(report)
 }
 
-/// The report's notes on orienting the input ([`OrientStats`]): how many faces were reversed
-/// and why (an inconsistently oriented input, an inward-facing closed one), and a
-/// non-orientable input said plainly.
-fn orientation_notes(o: &OrientStats, input_faces: usize) -> Vec<String> {
+/// The report's notes on orienting the input and the output ([`OrientStats`]): how many input
+/// faces were reversed and why, a non-orientable input said plainly, and an inward-facing
+/// closed input whose output was turned outward.
+fn orientation_notes(input: &OrientStats, output: &OrientStats, input_faces: usize) -> Vec<String> {
     let mut notes = Vec::new();
-    let outward = match o.components_turned_outward {
-        0 => String::new(),
-        1 => "one closed part faced inward and was turned outward".to_string(),
-        k => format!("{k} closed parts faced inward and were turned outward"),
-    };
-    if o.non_orientable_components > 0 {
+    if input.non_orientable_components > 0 {
         notes.push(format!(
             "the input is non-orientable ({} part(s), {} faces, like a Möbius strip): the \
              output is an oriented surface, so it cannot have the input's topology there; {} \
@@ -243,28 +244,30 @@ fn orientation_notes(o: &OrientStats, input_faces: usize) -> Vec<String> {
              across a seam of {} edges; the output is cut open there (a Möbius strip comes \
              out as a twisted disc, χ 1 instead of 0, whose two sides of the cut can touch or \
              cross)",
-            o.non_orientable_components, o.non_orientable_faces, o.faces_flipped, o.seam_edges
+            input.non_orientable_components,
+            input.non_orientable_faces,
+            input.faces_flipped,
+            input.seam_edges
         ));
-    } else if o.inconsistent_edges > 0 {
+    } else if input.inconsistent_edges > 0 {
         notes.push(format!(
             "the input was not consistently oriented ({} edges ran the same way in both their \
              faces): {} of its {input_faces} faces were reversed so that every edge between two \
-             faces runs once each way; each open part keeps the orientation of its larger area, \
-             closed parts face outward{}",
-            o.inconsistent_edges,
-            o.faces_flipped,
-            if outward.is_empty() {
-                String::new()
-            } else {
-                format!(" ({outward})")
-            }
+             faces runs once each way (each part keeps the orientation of its larger area)",
+            input.inconsistent_edges, input.faces_flipped,
         ));
-    } else if o.faces_flipped > 0 {
-        notes.push(format!(
-            "the input faced inward (negative signed volume): {} of its {input_faces} faces were \
-             reversed ({outward}), so the output faces outward",
-            o.faces_flipped
-        ));
+    }
+    match output.components_turned_outward {
+        0 => {}
+        1 => notes.push(
+            "the input faced inward (negative signed volume): the output, closed, was turned \
+             outward"
+                .to_string(),
+        ),
+        k => notes.push(format!(
+            "the input faced inward (negative signed volume): {k} closed parts of the output \
+             were turned outward"
+        )),
     }
     notes
 }

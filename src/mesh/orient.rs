@@ -22,7 +22,7 @@ pub struct OrientStats {
     /// Faces whose orientation was reversed.
     pub faces_flipped: usize,
     /// Closed components (no boundary and no non-manifold edge) whose faces mostly (by area)
-    /// faced inward, turned outward as a whole.
+    /// faced inward, turned outward as a whole (with `closed_outward` only).
     pub components_turned_outward: usize,
     /// Components that cannot be oriented consistently (a Möbius strip, a Klein bottle).
     pub non_orientable_components: usize,
@@ -42,14 +42,16 @@ const NONE: u32 = u32::MAX;
 /// A breadth-first walk from each component's first face flips a neighbour that traverses the
 /// shared edge in the same direction as the current face. Of the two consistent orientations
 /// of a component, an open one keeps the one that keeps more of its area as it was (so a small
-/// reversed region is what gets flipped, not the rest), and a closed one (every side of its
-/// faces on a manifold edge) the one of positive signed volume (outward). A component the walk
+/// reversed region is what gets flipped, not the rest), and so does a closed one (every side
+/// of its faces on a manifold edge) unless `closed_outward`, which gives it the orientation of
+/// positive signed volume (outward). A component the walk
 /// reaches with both orientations at some face is non-orientable: it keeps the walk's
 /// orientation (consistent everywhere but across [`OrientStats::seam_edges`]), with the larger
 /// area as it was, and is counted. Sides with a repeated index (`[a, a, b]`) and edges in one
 /// or in three or more faces join nothing; the faces' corners are rotated only by a flip
 /// (`[a, b, c]` → `[a, c, b]`), never reordered otherwise, and face order is kept, so a mesh
-/// that is already consistently oriented (and outward where closed) is left exactly as it is.
+/// that is already consistently oriented (and outward where closed, with `closed_outward`) is
+/// left exactly as it is.
 ///
 /// Time: O(V + F) (a counting sort of the edges by their lower vertex, one walk), times the
 /// log of the largest vertex degree (each vertex's edges are sorted).
@@ -58,7 +60,7 @@ const NONE: u32 = u32::MAX;
 ///
 /// Source: trimesh's `repair.fix_winding` and `fix_inversion`; MeshLab's "Re-Orient all faces
 /// coherently" (`vcg::tri::Clean::OrientCoherentlyMesh`).
-pub fn orient_consistently(mesh: &mut TriMesh) -> OrientStats {
+pub fn orient_consistently(mesh: &mut TriMesh, closed_outward: bool) -> OrientStats {
     let n = mesh.triangles.len();
     // Half-edge h = 3f + k is side k of face f, from corner k to corner k + 1.
     let tail = |h: usize| mesh.triangles[h / 3][h % 3];
@@ -171,7 +173,7 @@ pub fn orient_consistently(mesh: &mut TriMesh) -> OrientStats {
             stats.non_orientable_components += 1;
             stats.non_orientable_faces += faces.len();
             stats.seam_edges += seams;
-        } else if closed {
+        } else if closed && closed_outward {
             // Signed volume of the component as it would be oriented, about one of its corners
             // (closed, so the origin does not matter; this one keeps the products small).
             let origin = mesh.positions[mesh.triangles[seed][0] as usize];
@@ -283,7 +285,7 @@ mod tests {
             uv_sphere(12, 16),
         ] {
             let mut o = m.clone();
-            let stats = orient_consistently(&mut o);
+            let stats = orient_consistently(&mut o, true);
             assert_eq!(o, m);
             assert_eq!((stats.faces_flipped, stats.inconsistent_edges), (0, 0));
             assert_eq!(stats.components, 1);
@@ -297,7 +299,7 @@ mod tests {
         two.triangles
             .extend(b.triangles.iter().map(|t| t.map(|v| v + offset)));
         let mut o = two.clone();
-        let stats = orient_consistently(&mut o);
+        let stats = orient_consistently(&mut o, true);
         assert_eq!((o == two, stats.components), (true, 2));
     }
 
@@ -315,7 +317,7 @@ mod tests {
             }
             assert!(count > 4 && 2 * count < m.triangles.len());
             assert!(!consistent(&reversed));
-            let stats = orient_consistently(&mut reversed);
+            let stats = orient_consistently(&mut reversed, true);
             assert_eq!(reversed, m, "the patch is flipped back and nothing else");
             assert_eq!(stats.faces_flipped, count);
             assert!(stats.inconsistent_edges > 0);
@@ -329,20 +331,26 @@ mod tests {
         let mut inward = m.clone();
         inward.flip_orientation();
         assert!(inward.signed_volume() < 0.0);
-        let stats = orient_consistently(&mut inward);
+        let stats = orient_consistently(&mut inward, true);
         assert_eq!(inward, m);
         assert_eq!(
             (stats.components_turned_outward, stats.inconsistent_edges),
             (1, 0)
         );
         assert_eq!(stats.faces_flipped, m.triangles.len());
+        // Without closed_outward, a consistent inward mesh is left as it is.
+        let mut kept = m.clone();
+        kept.flip_orientation();
+        let before = kept.clone();
+        assert_eq!(orient_consistently(&mut kept, false).faces_flipped, 0);
+        assert_eq!(kept, before);
         // Inward with a few faces outward: still all outward at the end.
         let mut mixed = m.clone();
         mixed.flip_orientation();
         for t in mixed.triangles.iter_mut().take(7) {
             t.swap(1, 2);
         }
-        let stats = orient_consistently(&mut mixed);
+        let stats = orient_consistently(&mut mixed, true);
         assert_eq!(mixed, m);
         assert_eq!(stats.components_turned_outward, 1);
         assert_eq!(stats.faces_flipped, m.triangles.len() - 7);
@@ -351,7 +359,7 @@ mod tests {
         let mut bowl = plane();
         bowl.flip_orientation();
         let before = bowl.clone();
-        assert_eq!(orient_consistently(&mut bowl).faces_flipped, 0);
+        assert_eq!(orient_consistently(&mut bowl, true).faces_flipped, 0);
         assert_eq!(bowl, before);
     }
 
@@ -364,7 +372,7 @@ mod tests {
                 half.triangles[f].swap(1, 2);
             }
         }
-        orient_consistently(&mut half);
+        orient_consistently(&mut half, true);
         assert_eq!(half, m);
     }
 
@@ -372,7 +380,7 @@ mod tests {
     fn a_moebius_strip_is_reported_non_orientable() {
         let m = moebius(24);
         let mut o = m.clone();
-        let stats = orient_consistently(&mut o);
+        let stats = orient_consistently(&mut o, true);
         assert_eq!(stats.components, 1);
         assert_eq!(stats.non_orientable_components, 1);
         assert_eq!(stats.non_orientable_faces, m.triangles.len());
@@ -389,7 +397,7 @@ mod tests {
         both.positions.extend(&b.positions);
         both.triangles
             .extend(b.triangles.iter().map(|t| t.map(|v| v + offset)));
-        let stats = orient_consistently(&mut both);
+        let stats = orient_consistently(&mut both, true);
         assert_eq!((stats.components, stats.non_orientable_components), (2, 1));
     }
 
@@ -407,10 +415,13 @@ mod tests {
             positions,
             vec![[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 2, 3], [0, 2, 1]],
         );
-        let stats = orient_consistently(&mut m);
+        let stats = orient_consistently(&mut m, true);
         assert_eq!(stats.non_orientable_components, 0);
         assert!(stats.components >= 3);
         let mut empty = TriMesh::default();
-        assert_eq!(orient_consistently(&mut empty), OrientStats::default());
+        assert_eq!(
+            orient_consistently(&mut empty, true),
+            OrientStats::default()
+        );
     }
 }
