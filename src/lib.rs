@@ -14,7 +14,8 @@
 //!   │
 //! validate_input, Normalization  → bbox 100 (every length below in bbox-100 units)
 //!   │
-//! orient_consistently            faces oriented consistently, closed parts outward
+//! orient_consistently            faces oriented consistently (and, on the output, closed
+//!                                parts turned outward)
 //!   │
 //! surface_candidates             area-uniform random candidates on the input (MeshSurface)
 //!   + sample_boundary            samples on the boundary curves, kept fixed
