@@ -14,6 +14,9 @@
 //!   │
 //! validate_input, Normalization  → bbox 100 (every length below in bbox-100 units)
 //!   │
+//! orient_consistently            faces oriented consistently (and, on the output, closed
+//!                                parts turned outward)
+//!   │
 //! surface_candidates             area-uniform random candidates on the input (MeshSurface)
 //!   + sample_boundary            samples on the boundary curves, kept fixed
 //!   │
@@ -134,10 +137,10 @@ pub use io::{
     read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, MeshFormat, ReadStats,
 };
 
-// The meshes: the indexed triangle mesh, its normalization to bbox 100, and the editable
-// directed-edge mesh with its local operators.
+// The meshes: the indexed triangle mesh, its normalization to bbox 100, its consistent
+// orientation, and the editable directed-edge mesh with its local operators.
 pub use mesh::edit::{EditError, EditMesh, EditViolation, SlotPolicy};
-pub use mesh::{Aabb, Normalization, TriMesh};
+pub use mesh::{orient_consistently, Aabb, Normalization, OrientStats, TriMesh};
 
 // The pipeline in one call.
 pub use pipeline::{

@@ -1,4 +1,4 @@
-//! The remeshing pipeline: normalize (bbox 100) → candidates → linear scan (with the sigma_p
+//! The remeshing pipeline: normalize (bbox 100) and orient consistently → candidates → linear scan (with the sigma_p
 //! search for a target count) → gradient ascent + projection → triangulate → clean up → back to
 //! model units.
 
@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
 use crate::kernel::Kernel;
-use crate::mesh::{Normalization, TriMesh};
+use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{
     boundary_curves, boundary_sample_count, curve_length, sample_boundary,
 };
@@ -134,8 +134,15 @@ pub struct RemeshOutput {
     pub mesh: TriMesh,
     /// The same in bbox-100 units.
     pub mesh_normalized: TriMesh,
-    /// The input in bbox-100 units.
+    /// The input in bbox-100 units, oriented consistently (see `orientation`).
     pub input_normalized: TriMesh,
+    /// What orienting the input consistently did ([`orient_consistently`] without turning
+    /// closed parts outward: faces flipped, non-orientable components).
+    pub orientation: OrientStats,
+    /// What orienting the output did ([`orient_consistently`] turning closed parts outward:
+    /// the output follows the input's orientation, so this turns the output of an inward-facing
+    /// closed input outward).
+    pub output_orientation: OrientStats,
     /// Model units ↔ bbox-100 units.
     pub normalization: Normalization,
     /// The sigma_p used (bbox-100 units).
@@ -239,7 +246,14 @@ pub fn remesh(
     // Validate sigma_n early.
     Kernel::new(1.0, params.sigma_n)?;
     on_stage("normalize");
-    let normalized = normalization.apply_mesh(input);
+    let as_read = normalization.apply_mesh(input);
+    let mut normalized = as_read.clone();
+    // Every later stage takes the faces' orientation at face value (normals, tangent planes,
+    // the triangulation's orientation): the input is oriented consistently first. Its closed
+    // parts are turned outward on the output instead (below): the sampling does not depend on
+    // which way a consistent input faces, but the projections' rounding does, so an inward
+    // input that is otherwise fine (horse) keeps its output and only the orientation changes.
+    let orientation = orient_consistently(&mut normalized, false);
     let area = normalized.area();
     let curves = boundary_curves(&normalized);
     let curve_lengths: Vec<f64> = curves
@@ -291,7 +305,19 @@ pub fn remesh(
     let pool_size = (params.candidates_per_sample * expected)
         .ceil()
         .clamp(16.0, 2e8) as usize;
-    let mut pool = surface_candidates(&normalized, pool_size, params.seed);
+    // The candidates are drawn on the faces as read, and a reversed face's candidates take its
+    // reversed normal: orienting the input changes the sign of normals, not where points land
+    // (the draw depends on a face's corner order), so it changes the output's orientation and
+    // nothing else of the sampling.
+    let mut pool = surface_candidates(&as_read, pool_size, params.seed);
+    if orientation.faces_flipped > 0 {
+        for c in &mut pool {
+            if normalized.triangles[c.face as usize] != as_read.triangles[c.face as usize] {
+                c.normal = -c.normal;
+            }
+        }
+    }
+    drop(as_read);
     // Where the input passes through itself, the candidates inside its own solid are left out
     // (and samples the gradient ascent moves there are put back): the output follows the outer
     // surface and does not cross itself there.
@@ -479,6 +505,8 @@ pub fn remesh(
             .map(|i| i < boundary_count)
             .collect();
         let untangle_stats = untangle(&mut mesh_normalized, &fixed, sigma_p, &params.untangle);
+        // The output follows the input's orientation: its closed parts are turned outward.
+        let output_orientation = orient_consistently(&mut mesh_normalized, true);
         timer.lap("untangle");
         attempt += 1;
         let v = mesh_normalized.vertex_count() as f64;
@@ -501,6 +529,8 @@ pub fn remesh(
                 mesh: normalization.invert_mesh(&mesh_normalized),
                 mesh_normalized,
                 input_normalized: normalized,
+                orientation,
+                output_orientation,
                 normalization,
                 sigma_p,
                 target: match density {

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use crate::error::{Error, Result};
 use crate::io::{as_written, encode_mesh, read_mesh, write_atomically, MeshFormat};
-use crate::mesh::{Normalization, TriMesh};
+use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::pipeline::{
     remesh, validate_input, Density, RemeshParams, MAX_POINTS, SAMPLES_PER_SIGMA2,
 };
@@ -167,15 +167,21 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         }
     };
     let mut report = QualityReport::new(checked);
-    let input_topology = crate::check::topology(&out.input_normalized);
-    if input_topology.non_manifold_vertices > 0 || input_topology.non_manifold_edges > 0 {
-        report.notes.push(format!(
-            "the input has {} non-manifold vertices and {} non-manifold edges; the sampler works on \
-             the surface as a point set and the output is rebuilt manifold",
-            input_topology.non_manifold_vertices, input_topology.non_manifold_edges
-        ));
+    // The input column describes the input as read: its faces before they were oriented
+    // (orientation changes none of the counts the topology is compared by).
+    report.set_input(&TriMesh::new(
+        out.input_normalized.positions.clone(),
+        input.triangles.clone(),
+    ));
+    if let Some(t) = report.input_topology.clone() {
+        if t.non_manifold_vertices > 0 || t.non_manifold_edges > 0 {
+            report.notes.push(format!(
+                "the input has {} non-manifold vertices and {} non-manifold edges; the sampler \
+                 works on the surface as a point set and the output is rebuilt manifold",
+                t.non_manifold_vertices, t.non_manifold_edges
+            ));
+        }
     }
-    report.set_input(&out.input_normalized);
     let check_seconds = t.elapsed().as_secs_f64();
     let mut refusals = Vec::new();
     if !report.invariant_violations.is_empty() {
@@ -311,6 +317,19 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         ));
     }
     extra.insert("buried_candidates".into(), out.buried_candidates.into());
+    extra.insert(
+        "orientation".into(),
+        serde_json::to_value(out.orientation).unwrap_or_default(),
+    );
+    extra.insert(
+        "output_orientation".into(),
+        serde_json::to_value(out.output_orientation).unwrap_or_default(),
+    );
+    report.notes.extend(orientation_notes(
+        &out.orientation,
+        &out.output_orientation,
+        input.face_count(),
+    ));
     if out.dropped_samples > 0 {
         report.notes.push(format!(
             "{} samples ended in no triangle and were left out",
@@ -324,6 +343,47 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         ));
     }
     Ok(report)
+}
+
+/// The report's notes on orienting the input and the output ([`OrientStats`]): how many input
+/// faces were reversed and why, a non-orientable input said plainly, and an inward-facing
+/// closed input whose output was turned outward.
+fn orientation_notes(input: &OrientStats, output: &OrientStats, input_faces: usize) -> Vec<String> {
+    let mut notes = Vec::new();
+    if input.non_orientable_components > 0 {
+        notes.push(format!(
+            "the input is non-orientable ({} part(s), {} faces, like a Möbius strip): the \
+             output is an oriented surface, so it cannot have the input's topology there; {} \
+             faces were reversed so that the input is consistently oriented everywhere but \
+             across a seam of {} edges; the output is cut open there (a Möbius strip comes \
+             out as a twisted disc, χ 1 instead of 0, whose two sides of the cut can touch or \
+             cross)",
+            input.non_orientable_components,
+            input.non_orientable_faces,
+            input.faces_flipped,
+            input.seam_edges
+        ));
+    } else if input.inconsistent_edges > 0 {
+        notes.push(format!(
+            "the input was not consistently oriented ({} edges ran the same way in both their \
+             faces): {} of its {input_faces} faces were reversed so that every edge between two \
+             faces runs once each way (each part keeps the orientation of its larger area)",
+            input.inconsistent_edges, input.faces_flipped,
+        ));
+    }
+    match output.components_turned_outward {
+        0 => {}
+        1 => notes.push(
+            "the input faced inward (negative signed volume): the output, closed, was turned \
+             outward"
+                .to_string(),
+        ),
+        k => notes.push(format!(
+            "the input faced inward (negative signed volume): {k} closed parts of the output \
+             were turned outward"
+        )),
+    }
+    notes
 }
 
 /// Reports on the mesh in `path`; with `reference`, also the distance to it. Both are scaled by
