@@ -47,6 +47,8 @@ fn remesh(
         },
         measure_distance: true,
         strict: false,
+        format: None,
+        max_memory: None,
     };
     let report = run_remesh(&job, &|_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
     let (out, _) = read_mesh(&output).unwrap();
