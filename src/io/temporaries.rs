@@ -38,12 +38,19 @@ pub(crate) fn register(path: &Path) -> Registered {
 /// empties the list; returns how many paths were removed. For a signal handler: it never
 /// panics, and paths already gone are skipped.
 pub fn remove_temporaries() -> usize {
-    let paths: Vec<PathBuf> = match LIVE.lock() {
-        Ok(mut live) => std::mem::take(&mut *live).into_values().collect(),
-        Err(poisoned) => std::mem::take(&mut *poisoned.into_inner())
-            .into_values()
-            .collect(),
-    };
+    remove_where(|_| true)
+}
+
+/// Removes the temporaries on the list whose path `which` accepts and takes them off it.
+fn remove_where(which: impl Fn(&Path) -> bool) -> usize {
+    let mut live = LIVE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let ids: Vec<u64> = live
+        .iter()
+        .filter(|(_, p)| which(p))
+        .map(|(&id, _)| id)
+        .collect();
+    let paths: Vec<PathBuf> = ids.iter().filter_map(|id| live.remove(id)).collect();
+    drop(live);
     paths
         .iter()
         .filter(|p| {
@@ -73,8 +80,8 @@ mod tests {
         let _a = register(&file);
         let _b = register(&folder);
         drop(register(&kept));
-        // Other tests of this process may hold temporaries of their own: count only ours.
-        remove_temporaries();
+        // Other tests of this process hold temporaries of their own: only this folder's go.
+        assert_eq!(remove_where(|p| p.starts_with(dir.path())), 2);
         assert!(!file.exists());
         assert!(!folder.exists());
         assert!(kept.exists());
