@@ -1296,3 +1296,50 @@ fn subnormal_coordinates_are_remeshed_in_their_own_units() {
     let o = remesh(&[input.to_str().unwrap(), none.to_str().unwrap(), "-q"]);
     assert_error(&o, 3, &["point.obj"], &none);
 }
+
+/// Issue 14, item 1 (its last part): `remesh simplify` kept its bucket files in f32, so a point
+/// set at UTM coordinates (x ≈ 5e5, y ≈ 5e6, where the f32 step is 0.5) came out moved by up
+/// to a quarter unit. The buckets now hold the positions as f64: every output point is an input
+/// point, exactly on the radius-5 sphere the input was drawn on.
+#[test]
+fn simplify_keeps_utm_coordinates() {
+    let dir = tempfile::tempdir().unwrap();
+    let centre = [512_345.678, 5_012_345.678, 123.4];
+    let mut text = String::new();
+    let n = 20_000;
+    for i in 0..n {
+        // A Fibonacci sphere of radius 5.
+        let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+        let r = (1.0 - z * z).sqrt();
+        let a = i as f64 * 2.399_963_229_728_653;
+        let p = [r * a.cos(), r * a.sin(), z].map(|c| c * 5.0);
+        text += &format!(
+            "{} {} {}\n",
+            p[0] + centre[0],
+            p[1] + centre[1],
+            p[2] + centre[2]
+        );
+    }
+    let input = write(dir.path(), "utm.xyz", text);
+    let out = dir.path().join("out.ply");
+    let o = remesh(&[
+        "simplify",
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--points",
+        "1000",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut reader = spectral_remesh::PointReader::open(&out).unwrap();
+    let mut chunk = Vec::new();
+    let mut seen = 0;
+    while reader.read_chunk(&mut chunk, 4096).unwrap() > 0 {
+        for p in &chunk {
+            let d = (p.position - glam::DVec3::from(centre)).length();
+            assert!((d - 5.0).abs() < 1e-6, "a point {} off the sphere", d - 5.0);
+            seen += 1;
+        }
+    }
+    assert!(seen > 500, "{seen} points");
+}

@@ -477,32 +477,31 @@ fn split_fields(line: &str, text: bool) -> impl Iterator<Item = &str> {
         .filter(|f| !f.is_empty())
 }
 
-/// Bytes of one point in the binary layout this module writes (`x y z nx ny nz` as float32 LE).
-pub(crate) const RECORD_BYTES: usize = 24;
+/// Bytes of one point in the binary record layout of `remesh simplify`'s bucket files:
+/// `x y z` as float64 LE (so coordinates far from the origin, such as UTM, keep their precision)
+/// and `nx ny nz` as float32 LE.
+pub(crate) const RECORD_BYTES: usize = 36;
 
 /// The point of one record in that layout (`b` holds at least [`RECORD_BYTES`] bytes).
 pub(crate) fn decode_record(b: &[u8]) -> Point {
+    let d = |k: usize| f64::from_le_bytes(b[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]));
     let f = |k: usize| {
         f64::from(f32::from_le_bytes(
-            b[4 * k..4 * k + 4].try_into().unwrap_or([0; 4]),
+            b[24 + 4 * k..28 + 4 * k].try_into().unwrap_or([0; 4]),
         ))
     };
     Point {
-        position: DVec3::new(f(0), f(1), f(2)),
-        normal: DVec3::new(f(3), f(4), f(5)),
+        position: DVec3::new(d(0), d(1), d(2)),
+        normal: DVec3::new(f(0), f(1), f(2)),
     }
 }
 
 /// Appends `p` in that layout.
 pub(crate) fn encode_record(p: &Point, out: &mut Vec<u8>) {
-    for v in [
-        p.position.x,
-        p.position.y,
-        p.position.z,
-        p.normal.x,
-        p.normal.y,
-        p.normal.z,
-    ] {
+    for v in [p.position.x, p.position.y, p.position.z] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in [p.normal.x, p.normal.y, p.normal.z] {
         out.extend_from_slice(&(v as f32).to_le_bytes());
     }
 }
