@@ -8,9 +8,7 @@
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
 
-use spectral_remesh::{
-    run_remesh, Density, Error, RemeshJob, RemeshParams, Violation,
-};
+use spectral_remesh::{run_remesh, Density, Error, RemeshJob, RemeshParams, Violation};
 
 /// Bytes read in order (0x5a once they run out).
 struct Bytes<'a>(&'a [u8], usize);
@@ -213,8 +211,9 @@ pub fn small_mesh(data: &[u8]) -> (String, usize, u64) {
                 let t = &f[face];
                 let (a, c) = (t[0], t[1]);
                 let s = 10f64.powf(-1.0 - 12.0 * b.unit());
-                for k in 0..3 {
-                    p[a][k] = p[c][k] + s * (p[a][k] - p[c][k]);
+                let towards = p[c];
+                for (v, t) in p[a].iter_mut().zip(towards) {
+                    *v = t + s * (*v - t);
                 }
             }
             3 => {
