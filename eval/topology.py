@@ -18,7 +18,10 @@ and at 30000. Generated shapes (written as OBJ into a temporary folder, checked 
   plate-0.1      plate 100 x 100 x 0.1 (closed box)
   plate-1        plate 100 x 100 x 1
   cylinder       closed cylinder, radius 0.1, length 100 (16 sides)
-  two-boxes      two 10 x 10 x 10 boxes 2.5 apart (two components)
+  two-boxes      two 10 x 10 x 10 boxes 2.5 apart (two components; the gap is 11% of the
+                 bounding box, wider than the sample spacing at 2000 points)
+  two-boxes-100  two 100 x 100 x 100 boxes 2.5 apart (the gap is 1.2% of the bounding box,
+                 below the sample spacing: the case where boxes fuse)
   two-sheets     two open 10 x 10 squares 0.05 apart, facing away from each other
                  (two components, one boundary loop each)
   cone           cone of apex angle 2.9 degrees (half-angle 1.45), height 100, base closed
@@ -157,11 +160,12 @@ def plate(thickness):
     return m
 
 
-def two_boxes():
+def two_boxes(side):
+    """Two side x side x side boxes 2.5 apart along x."""
     m = MeshBuilder()
-    n = segments(10, 10 / 20)
-    m.box([0, 0, 0], [10, 10, 10], [n, n, n])
-    m.box([12.5, 0, 0], [10, 10, 10], [n, n, n])
+    n = segments(side, side / 20)
+    m.box([0, 0, 0], [side, side, side], [n, n, n])
+    m.box([side + 2.5, 0, 0], [side, side, side], [n, n, n])
     return m
 
 
@@ -264,7 +268,8 @@ SHAPES = {
     "plate-0.1": (lambda: plate(0.1), (1, 2, 0), "plate 100 x 100 x 0.1"),
     "plate-1": (lambda: plate(1.0), (1, 2, 0), "plate 100 x 100 x 1"),
     "cylinder": (cylinder, (1, 2, 0), "closed cylinder r 0.1, length 100"),
-    "two-boxes": (two_boxes, (2, 4, 0), "two 10-cubes 2.5 apart"),
+    "two-boxes": (lambda: two_boxes(10), (2, 4, 0), "two 10-cubes 2.5 apart"),
+    "two-boxes-100": (lambda: two_boxes(100), (2, 4, 0), "two 100-cubes 2.5 apart (gap 1.2% of the bbox)"),
     "two-sheets": (two_sheets, (2, 2, 2), "two open 10 x 10 sheets 0.05 apart"),
     "cone": (cone, (1, 2, 0), "cone, apex angle 2.9°, height 100, base closed"),
 }
@@ -468,7 +473,7 @@ def table(rows, distance):
     for row in rows:
         n = len(row["seeds"])
         fail = ", ".join(str(s) for s in row["failing_seeds"]) or "none"
-        errors = "; ".join(f"s{s}: {e}" for s, e in sorted(row["errors"].items()))
+        errors = "; ".join(f"s{s}: {e}" for s, e in sorted(row["errors"].items())).replace("|", "\\|")
         if "theta_min_worst" not in row:
             cells = [row["model"], str(row["count"])] + ["–"] * (len(head) - 3) + [f"{fail} ({errors})"]
             lines.append("| " + " | ".join(cells) + " |")
