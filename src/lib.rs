@@ -151,6 +151,10 @@ pub use timing::Stage;
 
 // The input surface: closest points, projection, and the test for its self-buried parts.
 pub use surface::winding::BuriedTest;
+// The local feature size of the input (shrinking medial balls), for a graded kernel width.
+pub use surface::local_feature_size::{
+    local_feature_size, LfsParams, LocalFeatureSize, MAX_LFS_SAMPLES,
+};
 pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceSample};
 
 // Sampling stages: candidates and boundary samples, the linear scan (and the sigma_p search for
