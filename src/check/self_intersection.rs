@@ -34,42 +34,17 @@ pub fn self_intersections(mesh: &TriMesh) -> SelfIntersections {
 mod tests {
     use super::*;
     use crate::geometry::triangle_intersection::triangles_intersect;
-    use glam::DVec3;
-
-    fn v(x: f64, y: f64, z: f64) -> DVec3 {
-        DVec3::new(x, y, z)
-    }
 
     #[test]
     fn a_sphere_has_none_and_a_pushed_vertex_makes_some() {
         // A closed UV sphere: no self-intersection.
-        let (nu, nv) = (24, 12);
-        let mut positions = vec![v(0., 0., 1.), v(0., 0., -1.)];
-        for j in 1..nv {
-            let th = std::f64::consts::PI * j as f64 / nv as f64;
-            for i in 0..nu {
-                let ph = std::f64::consts::TAU * i as f64 / nu as f64;
-                positions.push(v(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()));
-            }
-        }
-        let idx = |j: usize, i: usize| (2 + (j - 1) * nu + i % nu) as u32;
-        let mut triangles = Vec::new();
-        for i in 0..nu {
-            triangles.push([0, idx(1, i), idx(1, i + 1)]);
-            triangles.push([1, idx(nv - 1, i + 1), idx(nv - 1, i)]);
-        }
-        for j in 1..nv - 1 {
-            for i in 0..nu {
-                triangles.push([idx(j, i), idx(j + 1, i), idx(j + 1, i + 1)]);
-                triangles.push([idx(j, i), idx(j + 1, i + 1), idx(j, i + 1)]);
-            }
-        }
-        let mut m = TriMesh::new(positions, triangles);
+        let mut m = crate::mesh::test_meshes::uv_sphere(1.0, 12, 24);
         let r = self_intersections(&m);
         assert_eq!((r.pairs, r.first), (0, None), "{r:?}");
         assert!(r.candidates > 0);
         // Push one vertex through the opposite side: its fan crosses faces there.
-        let k = idx(6, 0) as usize;
+        // Ring 6 (the equator), longitude 0: vertex 2 + 5 · 24.
+        let k = 2 + 5 * 24;
         m.positions[k] = -1.5 * m.positions[k];
         let r = self_intersections(&m);
         assert!(r.pairs > 0, "{r:?}");

@@ -227,29 +227,7 @@ mod tests {
 
     /// A UV sphere of radius 1: `rings` latitude bands, `segments` longitudes, outward.
     fn uv_sphere(rings: usize, segments: usize) -> TriMesh {
-        let mut positions = vec![DVec3::Z, -DVec3::Z];
-        for r in 1..rings {
-            let theta = std::f64::consts::PI * r as f64 / rings as f64;
-            for s in 0..segments {
-                let phi = std::f64::consts::TAU * s as f64 / segments as f64;
-                positions.push(DVec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                ));
-            }
-        }
-        let v = |r: usize, s: usize| (2 + (r - 1) * segments + s % segments) as u32;
-        let mut triangles = Vec::new();
-        for s in 0..segments {
-            triangles.push([0, v(1, s), v(1, s + 1)]);
-            triangles.push([1, v(rings - 1, s + 1), v(rings - 1, s)]);
-            for r in 1..rings - 1 {
-                triangles.push([v(r, s), v(r + 1, s), v(r + 1, s + 1)]);
-                triangles.push([v(r, s), v(r + 1, s + 1), v(r, s + 1)]);
-            }
-        }
-        TriMesh::new(positions, triangles)
+        crate::mesh::test_meshes::uv_sphere(1.0, rings, segments)
     }
 
     /// A Möbius strip: `n` quads around a circle of radius 3, width 1, half a turn of twist;

@@ -408,6 +408,33 @@ pub(crate) mod test_meshes {
             .collect()
     }
 
+    /// A UV sphere of radius `r` at the origin, outward: the poles (vertices 0 and 1), then
+    /// `rings − 1` latitude circles of `segments` vertices; the two polar caps' faces first,
+    /// then the bands ring by ring.
+    pub fn uv_sphere(r: f64, rings: usize, segments: usize) -> TriMesh {
+        let mut positions = vec![DVec3::new(0.0, 0.0, r), DVec3::new(0.0, 0.0, -r)];
+        for k in 1..rings {
+            let t = std::f64::consts::PI * k as f64 / rings as f64;
+            for i in 0..segments {
+                let a = std::f64::consts::TAU * i as f64 / segments as f64;
+                positions.push(r * DVec3::new(t.sin() * a.cos(), t.sin() * a.sin(), t.cos()));
+            }
+        }
+        let id = |k: usize, i: usize| (2 + (k - 1) * segments + i % segments) as u32;
+        let mut triangles = Vec::new();
+        for i in 0..segments {
+            triangles.push([0, id(1, i), id(1, i + 1)]);
+            triangles.push([1, id(rings - 1, i + 1), id(rings - 1, i)]);
+        }
+        for k in 1..rings - 1 {
+            for i in 0..segments {
+                triangles.push([id(k, i), id(k + 1, i), id(k + 1, i + 1)]);
+                triangles.push([id(k, i), id(k + 1, i + 1), id(k, i + 1)]);
+            }
+        }
+        TriMesh::new(positions, triangles)
+    }
+
     /// The flip tests' fixture: the 8 corners (z = 0) of a convex quad 0-3-1-2 whose long
     /// diagonal is 0-1 and of a ring 6-5-7-4 around it, and the faces: the quad split along 0-1
     /// (the first two), then the ring's eight, which give 0 and 1 six faces each.

@@ -348,27 +348,7 @@ mod tests {
 
     /// A UV sphere of radius `r` at the origin: `rings` latitude bands, `segments` around.
     fn sphere(r: f64, rings: usize, segments: usize) -> TriMesh {
-        let mut positions = vec![DVec3::new(0.0, 0.0, r), DVec3::new(0.0, 0.0, -r)];
-        for k in 1..rings {
-            let t = std::f64::consts::PI * k as f64 / rings as f64;
-            for i in 0..segments {
-                let a = TAU * i as f64 / segments as f64;
-                positions.push(r * DVec3::new(t.sin() * a.cos(), t.sin() * a.sin(), t.cos()));
-            }
-        }
-        let id = |k: usize, i: usize| (2 + (k - 1) * segments + i % segments) as u32;
-        let mut triangles = Vec::new();
-        for i in 0..segments {
-            triangles.push([0, id(1, i), id(1, i + 1)]);
-            triangles.push([1, id(rings - 1, i + 1), id(rings - 1, i)]);
-        }
-        for k in 1..rings - 1 {
-            for i in 0..segments {
-                triangles.push([id(k, i), id(k + 1, i), id(k + 1, i + 1)]);
-                triangles.push([id(k, i), id(k + 1, i + 1), id(k, i + 1)]);
-            }
-        }
-        TriMesh::new(positions, triangles)
+        crate::mesh::test_meshes::uv_sphere(r, rings, segments)
     }
 
     /// A closed cylinder of radius `r` along z from −len/2 to len/2: `bands` along, `segments`
