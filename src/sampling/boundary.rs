@@ -140,9 +140,7 @@ pub fn boundary_sample_count(curves: &[BoundaryCurve], lengths: &[f64], spacing:
         .zip(lengths)
         .filter(|(_, &total)| total > 0.0)
         .map(|(curve, &total)| {
-            let steps = (total / spacing)
-                .round()
-                .max(if curve.closed { 3.0 } else { 1.0 });
+            let steps = curve_steps(total, spacing, curve.closed);
             if curve.closed {
                 steps
             } else {
@@ -150,6 +148,15 @@ pub fn boundary_sample_count(curves: &[BoundaryCurve], lengths: &[f64], spacing:
             }
         })
         .sum()
+}
+
+/// The whole number of equal steps closest to `spacing` along a curve of length `total`: at
+/// least 3 on a closed loop, at least 1 on an open chain. A float, so that a spacing far below
+/// the length gives a large number rather than an overflow.
+fn curve_steps(total: f64, spacing: f64, closed: bool) -> f64 {
+    (total / spacing)
+        .round()
+        .max(if closed { 3.0 } else { 1.0 })
 }
 
 /// Places samples along every boundary curve of `mesh` at equal arc-length steps as close to
@@ -167,8 +174,7 @@ pub fn sample_boundary(mesh: &TriMesh, curves: &[BoundaryCurve], spacing: f64) -
         if !(total > 0.0) {
             continue;
         }
-        let min_steps = if curve.closed { 3 } else { 1 };
-        let steps = ((total / spacing).round() as usize).max(min_steps);
+        let steps = curve_steps(total, spacing, curve.closed) as usize;
         let mut ids = Vec::with_capacity(steps + 1);
         let count = if curve.closed { steps } else { steps + 1 };
         let (mut edge, mut edge_start) = (0usize, 0.0f64);
