@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::io::{as_written, encode_mesh, read_mesh, write_atomically, MeshFormat};
 use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::pipeline::{
-    remesh, validate_input, Density, RemeshParams, MAX_POINTS, SAMPLES_PER_SIGMA2,
+    expected_samples, remesh, validate_input, Density, RemeshParams, MAX_POINTS,
 };
 use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
@@ -126,11 +126,12 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             Density::Points(n) => n as f64,
             Density::InputVertices => input.vertex_count() as f64,
             Density::SigmaP(s) => {
-                // The count sigma_p gives: area / sigma_p² in bbox-100 units.
+                // The count sigma_p gives on the area, in bbox-100 units (the interior term of
+                // the pipeline's expected count; the boundary samples are not counted here).
                 let scale = validate_input(&input)
                     .map_err(|e| with_path(e, &job.input))?
                     .scale;
-                SAMPLES_PER_SIGMA2 * input.area() * scale * scale / (s * s)
+                expected_samples(input.area() * scale * scale, 0.0, s)
             }
         };
         // Beyond MAX_POINTS the pipeline refuses the density itself, naming the option.
