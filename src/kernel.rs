@@ -3,6 +3,18 @@
 //!
 //! sigma_p and sigma_n are in bbox-100 units (Sec. 7: models are scaled so that the longest side
 //! of their bounding box is 100). sigma_n = infinity gives the isotropic (positions-only) kernel.
+//!
+//! A graded kernel (issue 15: sample density following the local feature size) gives each point
+//! its own spatial width sigma_p(x) = w(x) · sigma_p with w in (0, 1]. Two points then meet with
+//! the Gibbs kernel (M. N. Gibbs, *Bayesian Gaussian processes for regression and
+//! classification*, PhD thesis, Cambridge 1997, eq. 3.24; C. E. Rasmussen, C. K. I. Williams,
+//! *Gaussian Processes for Machine Learning*, MIT Press 2006, eq. 4.32):
+//!
+//! k(x, y) = (w_x w_y / s²)^{3/2} exp(-|p_x - p_y|² / (s² sigma_p²) - |n_x - n_y|² / sigma_n²),
+//! s² = (w_x² + w_y²) / 2,
+//!
+//! positive definite for any width field (so the measure stays in [0, 1]), k(x, x) = 1, and the
+//! kernel above when w_x = w_y = 1.
 
 use glam::DVec3;
 
@@ -11,26 +23,51 @@ use crate::error::{Error, Result};
 /// The neighbourhood radius in kernel space (Sec. 6.3): k(x, y) = exp(-6.25) ≈ 0.0019 beyond it.
 pub const SUPPORT_RADIUS: f64 = 2.5;
 
-/// A point mapped to kernel space: `[p/sigma_p, n/sigma_n]` (dimensionless).
+/// A point mapped to kernel space: `coords = [p/sigma_p, n/sigma_n]` (dimensionless) and its
+/// relative spatial width `width` = sigma_p(x) / sigma_p in (0, 1] (1 for the global kernel).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct KernelPoint(pub [f64; 6]);
+pub struct KernelPoint {
+    /// `[p/sigma_p, n/sigma_n]`; the normal part is zero for the isotropic kernel.
+    pub coords: [f64; 6],
+    /// sigma_p(x) / sigma_p, in (0, 1]: 1 everywhere gives the paper's kernel.
+    pub width: f64,
+}
 
 impl KernelPoint {
-    /// Squared Euclidean distance in kernel space.
+    /// Squared Euclidean distance of the coordinates in kernel space (widths ignored).
     #[inline]
     pub fn dist2(&self, other: &KernelPoint) -> f64 {
         let mut d = 0.0;
         for k in 0..6 {
-            let t = self.0[k] - other.0[k];
+            let t = self.coords[k] - other.coords[k];
             d += t * t;
         }
         d
     }
 
+    /// The exponent of the kernel between the two points: |Δp|² / s² + |Δn|² (see the module
+    /// docs; [`KernelPoint::dist2`] when both widths are 1). Points beyond
+    /// [`SUPPORT_RADIUS`]² of each other in this measure contribute less than exp(-6.25).
+    #[inline]
+    pub fn pair_dist2(&self, other: &KernelPoint) -> f64 {
+        if self.width == 1.0 && other.width == 1.0 {
+            return self.dist2(other);
+        }
+        let s2 = 0.5 * (self.width * self.width + other.width * other.width);
+        let (mut dp, mut dn) = (0.0, 0.0);
+        for k in 0..3 {
+            let t = self.coords[k] - other.coords[k];
+            dp += t * t;
+            let t = self.coords[k + 3] - other.coords[k + 3];
+            dn += t * t;
+        }
+        dp / s2 + dn
+    }
+
     /// The position part, `p / sigma_p`.
     #[inline]
     pub fn position(&self) -> DVec3 {
-        DVec3::new(self.0[0], self.0[1], self.0[2])
+        DVec3::new(self.coords[0], self.coords[1], self.coords[2])
     }
 }
 
@@ -80,22 +117,39 @@ impl Kernel {
         self.sigma_n.is_infinite()
     }
 
-    /// Maps a surface point (position in bbox-100 units, unit normal) to kernel space.
+    /// Maps a surface point (position in bbox-100 units, unit normal) to kernel space, with the
+    /// global width (`width` 1).
     #[inline]
     pub fn embed(&self, p: DVec3, n: DVec3) -> KernelPoint {
+        self.embed_graded(p, n, 1.0)
+    }
+
+    /// Maps a surface point to kernel space with its own spatial width `width` · sigma_p
+    /// (`width` in (0, 1]; see the module docs).
+    #[inline]
+    pub fn embed_graded(&self, p: DVec3, n: DVec3, width: f64) -> KernelPoint {
         let q = p / self.sigma_p;
         let m = if self.is_isotropic() {
             DVec3::ZERO
         } else {
             n / self.sigma_n
         };
-        KernelPoint([q.x, q.y, q.z, m.x, m.y, m.z])
+        KernelPoint {
+            coords: [q.x, q.y, q.z, m.x, m.y, m.z],
+            width,
+        }
     }
 
-    /// k(x, y) = exp(-|x - y|^2).
+    /// k(x, y): exp(-|x - y|^2) for two points of width 1, the Gibbs kernel of the module docs
+    /// otherwise.
     #[inline]
     pub fn eval(&self, x: &KernelPoint, y: &KernelPoint) -> f64 {
-        (-x.dist2(y)).exp()
+        if x.width == 1.0 && y.width == 1.0 {
+            return (-x.dist2(y)).exp();
+        }
+        let s2 = 0.5 * (x.width * x.width + y.width * y.width);
+        let r = x.width * y.width / s2;
+        r * r.sqrt() * (-x.pair_dist2(y)).exp()
     }
 
     /// The radius in position space (bbox-100 units) that holds every point within
