@@ -161,8 +161,13 @@ pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceSample};
 // a count), the gradient ascent.
 pub use sampling::boundary::{boundary_curves, sample_boundary, BoundaryCurve, BoundarySamples};
 pub use sampling::candidates::surface_candidates;
-pub use sampling::gradient_ascent::{gradient_ascent, GradientAscentParams, GradientAscentResult};
-pub use sampling::linear_scan::{linear_scan, LinearScanParams, LinearScanResult, LinearScanner};
+pub use sampling::gradient_ascent::{
+    gradient_ascent, gradient_ascent_graded, GradientAscentParams, GradientAscentResult, WidthField,
+};
+pub use sampling::grading::{GradedRegion, Grading, GradingParams, GradingStats};
+pub use sampling::linear_scan::{
+    linear_scan, linear_scan_graded, LinearScanParams, LinearScanResult, LinearScanner,
+};
 pub use sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
 
 // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
@@ -177,8 +182,8 @@ pub use triangulate::{
 // The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).
 pub use kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 pub use measure::{
-    measure_and_gradient, projection_coefficients, spectral_measure, IncrementalInverse, Measure,
-    MeasureWorkspace, Push, DEFAULT_EPSILON,
+    measure_and_gradient, measure_and_gradient_graded, projection_coefficients, spectral_measure,
+    IncrementalInverse, Measure, MeasureWorkspace, Push, DEFAULT_EPSILON,
 };
 
 // A kd-tree over fixed points (neighbourhoods of the measure).

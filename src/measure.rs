@@ -222,7 +222,7 @@ pub fn measure_and_gradient(
     measure_and_gradient_graded(kernel, x, [0.0; 3], neighbors, ws)
 }
 
-/// [`measure_and_gradient`] for a graded kernel (see [`crate::kernel`]): x's width w follows a
+/// [`measure_and_gradient`] for a graded kernel (see [`Kernel`](crate::Kernel)): x's width w follows a
 /// width field whose gradient at x, in kernel units (d w / d(p / sigma_p)), is
 /// `width_gradient`; the gradient returned is that of s(x) with x's width moving with it. The
 /// neighbours keep their widths.

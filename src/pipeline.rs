@@ -14,9 +14,12 @@ use crate::sampling::boundary::{
 };
 use crate::sampling::candidates::surface_candidates;
 use crate::sampling::gradient_ascent::{
-    gradient_ascent, GradientAscentParams, GradientAscentResult,
+    gradient_ascent_graded, GradientAscentParams, GradientAscentResult, WidthField,
 };
-use crate::sampling::linear_scan::{linear_scan, LinearScanParams, LinearScanResult};
+use crate::sampling::grading::{Grading, GradingParams, GradingStats};
+use crate::sampling::linear_scan::{
+    linear_scan, linear_scan_graded, LinearScanParams, LinearScanResult,
+};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::surface::winding::BuriedTest;
 use crate::surface::MeshSurface;
@@ -81,6 +84,10 @@ pub fn sigma_p_for_count(area: f64, boundary_length: f64, count: f64) -> f64 {
     from_area.max(from_boundary)
 }
 
+/// The most points the local feature size is estimated at for the grading (their spacing is
+/// about the expected samples' otherwise).
+const MAX_GRADING_POINTS: f64 = 200_000.0;
+
 /// The most output points [`remesh`] takes: 20 million (with 10 candidates per sample the
 /// pool holds 2e8 points, about 11 GB).
 pub const MAX_POINTS: usize = 20_000_000;
@@ -104,6 +111,9 @@ pub struct RemeshParams {
     pub optimize: Option<OptimizeParams>,
     /// The separation of crossing faces, last.
     pub untangle: UntangleParams,
+    /// Sample density graded by the local feature size (issue 15; `None`: one sigma_p
+    /// everywhere, as in the paper).
+    pub grading: Option<GradingParams>,
     /// Relative tolerance of the count search (default 0.005).
     pub count_tolerance: f64,
     /// Seed of every random choice.
@@ -121,6 +131,7 @@ impl Default for RemeshParams {
             triangulate: TriangulateParams::default(),
             optimize: Some(OptimizeParams::default()),
             untangle: UntangleParams::default(),
+            grading: Some(GradingParams::default()),
             count_tolerance: 0.005,
             seed: 1,
         }
@@ -181,6 +192,8 @@ pub struct RemeshOutput {
     /// Samples the gradient ascent moved onto the buried part of a face, put back where the
     /// scan put them.
     pub buried_samples: usize,
+    /// What the grading by the local feature size did (`None` when it was off).
+    pub grading: Option<GradingStats>,
     /// Timed stages in order.
     pub stages: Vec<Stage>,
 }
@@ -343,6 +356,26 @@ pub fn remesh(
         .collect();
     timer.lap("candidates");
 
+    // The local feature size, for the grading of the kernel width: estimated up to a few times
+    // the largest width the search is expected to try (a part thicker than that is not graded).
+    let first_sigma_p = match density {
+        Target::Points(n) => sigma_p_for_count(area, boundary_length, n as f64),
+        Target::SigmaP(s) => s,
+    };
+    let grading = match params.grading {
+        Some(g) => {
+            on_stage("local feature size");
+            let cap = 2.0 * first_sigma_p / g.lfs_factor;
+            // Estimate points every first_sigma_p (about one per expected sample), at most
+            // MAX_GRADING_POINTS of them.
+            let spacing = first_sigma_p.max((area / MAX_GRADING_POINTS).sqrt());
+            let grading = Grading::new(&normalized, g, cap, spacing)?;
+            timer.lap("local feature size");
+            Some(grading)
+        }
+        None => None,
+    };
+
     // The sampler's count is searched for; the triangulation may set a few samples aside (at
     // parts thinner than the sampling), so when the output's vertex count misses the target by
     // more than the search tolerance, the search runs again for a target raised by the
@@ -357,6 +390,8 @@ pub fn remesh(
     };
     let mut full_history = Vec::new();
     let mut attempt = 0;
+    // The sigma_p the grading's widths are taken for (see the search).
+    let mut sigma_ref = start;
     let output = loop {
         on_stage("linear scan");
         // The boundary samples of one evaluation are bounded: a sigma_p whose boundary curves
@@ -367,7 +402,9 @@ pub fn remesh(
             Target::Points(_) => (4.0 * goal as f64).clamp(64.0, MAX_POINTS as f64),
             Target::SigmaP(_) => MAX_POINTS as f64,
         };
-        let scan = |sigma_p: f64| -> Result<(usize, Option<ScanWithBoundary>)> {
+        // With grading, the widths are those for sigma_ref (held fixed through a search, so the
+        // count falls like sigma_p^-2 as without grading; see the search below).
+        let scan = |sigma_p: f64, sigma_ref: f64| -> Result<(usize, Option<ScanWithBoundary>)> {
             let kernel = Kernel::new(sigma_p, params.sigma_n)?;
             let spacing = BOUNDARY_SPACING_PER_SIGMA * sigma_p;
             let boundary_count = boundary_sample_count(&curves, &curve_lengths, spacing);
@@ -375,31 +412,60 @@ pub fn remesh(
                 return Ok((boundary_count.min(usize::MAX as f64) as usize, None));
             }
             let b = sample_boundary(&normalized, &curves, spacing);
-            let r = linear_scan(&kernel, &pool, &b.samples, &params.linear_scan);
+            let r = match &grading {
+                Some(g) => linear_scan_graded(
+                    &kernel,
+                    &pool,
+                    &b.samples,
+                    Some(&|p| g.width(p, sigma_ref)),
+                    &params.linear_scan,
+                ),
+                None => linear_scan(&kernel, &pool, &b.samples, &params.linear_scan),
+            };
             Ok((r.samples.len(), Some((r, b.edges))))
         };
         let (sigma_p, target_reached, search_history, value) = match density {
             Target::SigmaP(s) => {
-                let (count, value) = scan(s)?;
+                let (count, value) = scan(s, s)?;
                 (s, true, vec![(s, count)], value)
             }
             Target::Points(_) => {
+                // The widths depend on sigma_p; a search over sigma_p with them moving could
+                // find the count flat (a part graded at every sigma_p tried). So each search
+                // holds the widths of sigma_ref, and when it ends far from sigma_ref, the
+                // widths are taken again at its answer and the search repeats from there (at
+                // most 3 rounds; only when the grading changes some width).
                 let search = TargetCountParams {
                     tolerance: params.count_tolerance,
                     ..TargetCountParams::new(goal)
                 };
-                let mut failure = None;
-                let r = find_sigma_p(&search, start, |s| match scan(s) {
-                    Ok(v) => v,
-                    Err(e) => {
-                        failure = Some(e);
-                        (0, None)
+                let mut history = Vec::new();
+                let mut round_start = start;
+                let mut round = 0;
+                loop {
+                    let mut failure = None;
+                    let r = find_sigma_p(&search, round_start, |s| match scan(s, sigma_ref) {
+                        Ok(v) => v,
+                        Err(e) => {
+                            failure = Some(e);
+                            (0, None)
+                        }
+                    });
+                    if let Some(e) = failure {
+                        return Err(e);
                     }
-                });
-                if let Some(e) = failure {
-                    return Err(e);
+                    history.extend(r.history.iter().copied());
+                    round += 1;
+                    let moved = (r.sigma_p / sigma_ref).ln().abs() > 0.1;
+                    let widths_change = grading
+                        .as_ref()
+                        .is_some_and(|g| g.grades_below(sigma_ref.max(r.sigma_p)));
+                    if round >= 3 || !moved || !widths_change {
+                        break (r.sigma_p, r.reached, history, r.value);
+                    }
+                    sigma_ref = r.sigma_p;
+                    round_start = r.sigma_p;
                 }
-                (r.sigma_p, r.reached, r.history, r.value)
             }
         };
         let Some((scan_result, boundary_edges)) = value else {
@@ -430,11 +496,15 @@ pub fn remesh(
             measured,
         } = scan_result;
         let before_ascent = buried_test.as_ref().map(|_| samples.clone());
-        let ga = gradient_ascent(
+        let width_field = grading
+            .as_ref()
+            .map(|g| move |p: DVec3| g.width(p, sigma_ref));
+        let ga = gradient_ascent_graded(
             &kernel,
             &surface,
             &mut samples,
             boundary_count,
+            width_field.as_ref().map(|f| f as WidthField),
             &params.gradient_ascent,
             params.seed,
         );
@@ -525,6 +595,9 @@ pub fn remesh(
         };
         if done {
             full_history.extend(search_history.iter().copied());
+            let grading_record = grading
+                .as_ref()
+                .map(|g| g.stats(&mesh_normalized.positions, sigma_ref, &normalization, area));
             break RemeshOutput {
                 mesh: normalization.invert_mesh(&mesh_normalized),
                 mesh_normalized,
@@ -552,6 +625,7 @@ pub fn remesh(
                 dropped_samples,
                 buried_candidates,
                 buried_samples,
+                grading: grading_record,
                 stages: timer.take_stages(),
             };
         }

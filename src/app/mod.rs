@@ -318,6 +318,25 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         ));
     }
     extra.insert("buried_candidates".into(), out.buried_candidates.into());
+    if let Some(g) = &out.grading {
+        extra.insert(
+            "grading".into(),
+            serde_json::json!({
+                "graded_samples": g.graded_samples,
+                "unresolved_samples": g.unresolved_samples,
+                "min_width": g.min_width,
+                "regions": g.regions.iter().map(|r| serde_json::json!({
+                    "min": [r.min.x, r.min.y, r.min.z],
+                    "max": [r.max.x, r.max.y, r.max.z],
+                    "samples": r.samples,
+                    "unresolved": r.unresolved,
+                })).collect::<Vec<_>>(),
+            }),
+        );
+        report
+            .notes
+            .extend(grading_notes(g, out.mesh.vertex_count()));
+    }
     extra.insert(
         "orientation".into(),
         serde_json::to_value(out.orientation).unwrap_or_default(),
@@ -643,6 +662,63 @@ pub fn catch_panics<T>(job: impl FnOnce() -> Result<T>) -> Result<T> {
             message: format!("{} (a bug: please report it)", what.replace('\n', " ")),
         })
     })
+}
+
+/// The report's notes on the grading by the local feature size: how many samples it moved to a
+/// finer spacing and where, and the parts too thin for the count.
+fn grading_notes(g: &crate::sampling::grading::GradingStats, vertices: usize) -> Vec<String> {
+    let bbox = |r: &crate::sampling::grading::GradedRegion| {
+        format!(
+            "[{:.4}, {:.4}, {:.4}]-[{:.4}, {:.4}, {:.4}]",
+            r.min.x, r.min.y, r.min.z, r.max.x, r.max.y, r.max.z
+        )
+    };
+    let mut notes = Vec::new();
+    if g.graded_samples > 0 {
+        let shown: Vec<String> = g
+            .regions
+            .iter()
+            .take(3)
+            .map(|r| format!("{} in {}", r.samples, bbox(r)))
+            .collect();
+        notes.push(format!(
+            "local feature size: {} of {vertices} samples are spaced finer than sigma_p (down to \
+             {:.2} sigma_p) at thin parts, in {} regions (largest: {})",
+            g.graded_samples,
+            g.min_width,
+            g.regions.len(),
+            shown.join("; ")
+        ));
+    }
+    if g.unresolved_samples > 0 {
+        let shown: Vec<String> = g
+            .regions
+            .iter()
+            .filter(|r| r.unresolved > 0)
+            .take(3)
+            .map(|r| format!("{} in {}", r.unresolved, bbox(r)))
+            .collect();
+        let resolve = g.resolving_count.map_or(String::new(), |n| {
+            format!("; about --points {} would resolve them", round_up_2(n))
+        });
+        notes.push(format!(
+            "{} samples lie on parts thinner than this count can resolve (held at the finest \
+             spacing the grading allows, so the output there may split, fuse or lose a tip): \
+             {}{resolve}",
+            g.unresolved_samples,
+            shown.join("; ")
+        ));
+    }
+    notes
+}
+
+/// `n` rounded up to two significant digits (a count for a note).
+fn round_up_2(n: f64) -> u64 {
+    if !(n.is_finite() && n > 0.0) {
+        return 0;
+    }
+    let scale = 10f64.powi((n.log10().floor() as i32 - 1).max(0));
+    ((n / scale).ceil() * scale) as u64
 }
 
 #[cfg(test)]

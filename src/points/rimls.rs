@@ -23,7 +23,7 @@
 //! ```
 //!
 //! The kernel is the one of the spectral sampling paper (Öztireli, Alexa, Gross 2010, Sec. 3,
-//! [`crate::kernel`]): k(x, y) = exp(-|x - y|²) with x = [p/σ_p, n/σ_n], so the spatial weight is
+//! [`Kernel`](crate::Kernel)): k(x, y) = exp(-|x - y|²) with x = [p/σ_p, n/σ_n], so the spatial weight is
 //! φ = exp(-|x - p_i|²/σ_p²) and the normal term exp(-|∇f - n_i|²/σ_n²) uses the same σ_n
 //! (σ_n = ∞ turns it off: positions only). φ is cut off at `support_radius_sigma_p · σ_p` and
 //! shifted down by its value there, so that f stays continuous when a point enters or leaves the

@@ -4,10 +4,13 @@
 use rayon::prelude::*;
 
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
+#[cfg(doc)]
+use crate::measure::measure_and_gradient_graded;
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
 use crate::spatial::StaticTree;
 use crate::surface::Projection;
 use crate::surface::SurfaceSample;
+use glam::DVec3;
 
 /// Parameters of the gradient ascent.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,6 +85,33 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
     params: &GradientAscentParams,
     seed: u64,
 ) -> GradientAscentResult {
+    gradient_ascent_graded(kernel, surface, samples, fixed, None, params, seed)
+}
+
+/// A field of relative kernel widths w(p) in (0, 1] over positions (bbox-100 units): a graded
+/// kernel's sigma_p(p) = w(p) · sigma_p (see [`Kernel`](crate::Kernel)).
+pub type WidthField<'a> = &'a (dyn Fn(DVec3) -> f64 + Sync);
+
+/// [`gradient_ascent`] with a graded kernel: each sample's width is `width(position)`, taken
+/// again after each of its moves. The field is treated as locally constant (the pipeline's is
+/// piecewise constant, so its gradient is zero almost everywhere): the step is that of
+/// [`measure_and_gradient_graded`] with ∇w = 0, scaled by w² (the gradient of s grows as 1/w
+/// where the kernel is w times narrower, and a step should be w times shorter), and the
+/// largest move is `max_move_sigma_p` · w · sigma_p. With `width` `None` (or 1 everywhere) this
+/// is [`gradient_ascent`] exactly.
+pub fn gradient_ascent_graded<S: Projection + ?Sized>(
+    kernel: &Kernel,
+    surface: &S,
+    samples: &mut [SurfaceSample],
+    fixed: usize,
+    width: Option<WidthField>,
+    params: &GradientAscentParams,
+    seed: u64,
+) -> GradientAscentResult {
+    let embed = |s: &SurfaceSample| match width {
+        Some(w) => kernel.embed_graded(s.position, s.normal, w(s.position)),
+        None => kernel.embed(s.position, s.normal),
+    };
     let n = samples.len();
     let fixed = fixed.min(n);
     let sigma_p = kernel.sigma_p();
@@ -111,10 +141,7 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let mut order: Vec<usize> = (fixed..n).collect();
-        let mut embedded: Vec<KernelPoint> = samples
-            .iter()
-            .map(|s| kernel.embed(s.position, s.normal))
-            .collect();
+        let mut embedded: Vec<KernelPoint> = samples.iter().map(embed).collect();
         let (mut ws, mut near, mut sorted) = (MeasureWorkspace::new(), Vec::new(), Vec::new());
         for _ in 0..params.iterations {
             order.shuffle(&mut rng);
@@ -133,7 +160,7 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
                     &mut sorted,
                 );
                 samples[i] = moved;
-                embedded[i] = kernel.embed(moved.position, moved.normal);
+                embedded[i] = embed(&moved);
                 total_move += dist;
                 total_s += s;
                 min_s = f64::min(min_s, s);
@@ -146,10 +173,7 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
         return result;
     }
     for _ in 0..params.iterations {
-        let embedded: Vec<KernelPoint> = samples
-            .iter()
-            .map(|s| kernel.embed(s.position, s.normal))
-            .collect();
+        let embedded: Vec<KernelPoint> = samples.par_iter().map(embed).collect();
         let moves: Vec<(SurfaceSample, f64, f64)> = (fixed..n)
             .into_par_iter()
             .map_init(
@@ -217,7 +241,7 @@ fn move_one<S: Projection + ?Sized>(
     near.clear();
     for &j in list {
         let y = embedded[j as usize];
-        let d2 = x.dist2(&y);
+        let d2 = x.pair_dist2(&y);
         if d2 <= r_kernel_2 {
             near.push((d2, y));
         }
@@ -226,10 +250,15 @@ fn move_one<S: Projection + ?Sized>(
     sorted.clear();
     sorted.extend(near.iter().map(|p| p.1));
     let (s, g) = measure_and_gradient(kernel, &x, sorted, ws);
-    // Kernel units to position units: Δp = sigma_p · step · ∇_x s.
-    let mut delta = glam::DVec3::new(g[0], g[1], g[2]) * (params.step * sigma_p);
+    // Kernel units to position units: Δp = sigma_p · step · w² · ∇_x s (w = 1: eq. 11).
+    let w = x.width;
+    let mut delta = if w == 1.0 {
+        glam::DVec3::new(g[0], g[1], g[2]) * (params.step * sigma_p)
+    } else {
+        glam::DVec3::new(g[0], g[1], g[2]) * (params.step * sigma_p * w * w)
+    };
     let len = delta.length();
-    let max_move = params.max_move_sigma_p * sigma_p;
+    let max_move = params.max_move_sigma_p * sigma_p * w;
     if len > max_move {
         delta *= max_move / len;
     }
@@ -237,7 +266,7 @@ fn move_one<S: Projection + ?Sized>(
     let mut moved = project(delta);
     for _ in 0..params.backtracking {
         // Keep the move only if it does not lower s (with the neighbours held where they are).
-        let y = kernel.embed(moved.position, moved.normal);
+        let y = kernel.embed_graded(moved.position, moved.normal, w);
         let m = crate::measure::spectral_measure(kernel, &y, sorted.iter().copied(), -1.0, ws);
         if m.s >= s {
             break;

@@ -126,6 +126,9 @@ pub struct LinearScanner {
     tree: DynamicTree,
     embedded: Vec<KernelPoint>,
     buffers: Buffers,
+    /// Whether a point of width below 1 (a graded kernel) has been seen: neighbours are then
+    /// ordered by the kernel's exponent, not by position.
+    graded: bool,
     /// Candidates rejected by their nearest output sample alone.
     pub rejected_by_nearest: usize,
     /// Candidates rejected by the measure over their few nearest output samples.
@@ -143,6 +146,7 @@ impl LinearScanner {
             tree: DynamicTree::new(),
             embedded: Vec::new(),
             buffers: Buffers::default(),
+            graded: false,
             rejected_by_nearest: 0,
             rejected_by_few: 0,
             measured: 0,
@@ -161,7 +165,13 @@ impl LinearScanner {
 
     /// Puts a point into O without testing it (an initial sample).
     pub fn insert(&mut self, position: DVec3, normal: DVec3) {
-        let x = self.kernel.embed(position, normal);
+        self.insert_graded(position, normal, 1.0);
+    }
+
+    /// [`LinearScanner::insert`] with the point's relative kernel width (see [`Kernel`](crate::Kernel)).
+    pub fn insert_graded(&mut self, position: DVec3, normal: DVec3, width: f64) {
+        let x = self.kernel.embed_graded(position, normal, width);
+        self.graded |= width != 1.0;
         self.add(position, x);
     }
 
@@ -169,8 +179,14 @@ impl LinearScanner {
     /// its neighbours in O (or it has none). Quick tests first (see `quick_reject`): the nearest
     /// output sample alone (s <= 1 - k(x, x_1)^2), then the few nearest.
     pub fn offer(&mut self, position: DVec3, normal: DVec3) -> bool {
+        self.offer_graded(position, normal, 1.0)
+    }
+
+    /// [`LinearScanner::offer`] with the point's relative kernel width (see [`Kernel`](crate::Kernel)).
+    pub fn offer_graded(&mut self, position: DVec3, normal: DVec3, width: f64) -> bool {
+        self.graded |= width != 1.0;
         let kernel = &self.kernel;
-        let x = kernel.embed(position, normal);
+        let x = kernel.embed_graded(position, normal, width);
         let quick = quick_reject(
             kernel,
             &self.params,
@@ -214,6 +230,21 @@ impl LinearScanner {
     /// alone is tried first on the next). Chunks grow as acceptances become rare: the next chunk
     /// is sized so that it is expected to add about 2% to O (between 8k and 1M candidates).
     pub fn offer_batch(&mut self, batch: &[(DVec3, DVec3)], accepted: &mut Vec<usize>) {
+        self.offer_batch_graded(batch, None, accepted);
+    }
+
+    /// [`LinearScanner::offer_batch`] with each point's relative kernel width (`widths[k]` for
+    /// `batch[k]`, in (0, 1]; `None`: all 1). The decisions are those of
+    /// [`LinearScanner::offer_graded`] one by one: s(x) still only falls as O grows, and every
+    /// pair's support lies within the global support radius (widths are at most 1).
+    pub fn offer_batch_graded(
+        &mut self,
+        batch: &[(DVec3, DVec3)],
+        widths: Option<&[f64]>,
+        accepted: &mut Vec<usize>,
+    ) {
+        let width = |k: usize| widths.map_or(1.0, |w| w[k]);
+        self.graded |= widths.is_some_and(|w| w.iter().any(|&w| w != 1.0));
         const MIN_CHUNK: usize = 8192;
         const MAX_CHUNK: usize = 1 << 20;
         let mut verdicts: Vec<Verdict> = Vec::new();
@@ -222,7 +253,8 @@ impl LinearScanner {
         let r_pos = self.params.support_radius * self.kernel.sigma_p();
         while start < batch.len() {
             let chunk = &batch[start..(start + chunk_len).min(batch.len())];
-            self.parallel_tests(chunk, &mut order, &mut verdicts);
+            let chunk_widths = widths.map(|w| &w[start..start + chunk.len()]);
+            self.parallel_tests(chunk, chunk_widths, &mut order, &mut verdicts);
             let size_at_start = self.embedded.len();
             for (k, (&(p, n), verdict)) in chunk.iter().zip(&verdicts).enumerate() {
                 let take = match *verdict {
@@ -243,10 +275,10 @@ impl LinearScanner {
                             found.iter().all(|&(j, _)| (j as usize) < size_at_start)
                         };
                         if unchanged {
-                            self.insert(p, n);
+                            self.insert_graded(p, n, width(start + k));
                             true
                         } else {
-                            self.offer(p, n)
+                            self.offer_graded(p, n, width(start + k))
                         }
                     }
                 };
@@ -267,11 +299,17 @@ impl LinearScanner {
     fn parallel_tests(
         &self,
         chunk: &[(DVec3, DVec3)],
+        widths: Option<&[f64]>,
         order: &mut Vec<(u64, u32)>,
         verdicts: &mut Vec<Verdict>,
     ) {
-        let (kernel, params, tree, embedded) =
-            (&self.kernel, &self.params, &self.tree, &self.embedded);
+        let (kernel, params, tree, embedded, graded) = (
+            &self.kernel,
+            &self.params,
+            &self.tree,
+            &self.embedded,
+            self.graded,
+        );
         let (lo, hi) = chunk.iter().fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(lo, hi), c| (lo.min(c.0), hi.max(c.0)),
@@ -288,10 +326,10 @@ impl LinearScanner {
             .par_iter()
             .map_init(Buffers::default, |b, &(_, k)| {
                 let (p, n) = chunk[k as usize];
-                let x = kernel.embed(p, n);
+                let x = kernel.embed_graded(p, n, widths.map_or(1.0, |w| w[k as usize]));
                 match quick_reject(kernel, params, tree, embedded, p, &x, b) {
                     Some(why) => Verdict::Quick(why),
-                    None => match full_measure(kernel, params, tree, embedded, p, &x, b) {
+                    None => match full_measure(kernel, params, tree, embedded, graded, p, &x, b) {
                         Some(accept) => Verdict::Measured(accept),
                         None => Verdict::Alone,
                     },
@@ -320,6 +358,7 @@ impl LinearScanner {
             &self.params,
             &self.tree,
             &self.embedded,
+            self.graded,
             position,
             x,
             &mut self.buffers,
@@ -341,7 +380,8 @@ enum Verdict {
 }
 
 /// The samples of `b.found` (indices into `embedded`) within the support radius of `x` in kernel
-/// space, with their squared kernel-space distances, into `b.neighbors` (in `b.found`'s order).
+/// space (the pair's exponent, [`KernelPoint::pair_dist2`]), with that exponent, into
+/// `b.neighbors` (in `b.found`'s order).
 fn gather_neighbors(
     params: &LinearScanParams,
     embedded: &[KernelPoint],
@@ -352,7 +392,7 @@ fn gather_neighbors(
     b.neighbors.clear();
     for &(j, _) in &b.found {
         let y = embedded[j as usize];
-        let d2 = x.dist2(&y);
+        let d2 = x.pair_dist2(&y);
         if d2 <= r_kernel_2 {
             b.neighbors.push((d2, y));
         }
@@ -360,12 +400,15 @@ fn gather_neighbors(
 }
 
 /// The measure of `x` over its whole neighbourhood in O (`tree`, `embedded`) within the support
-/// radius, nearest first: `Some(s > epsilon)`, or `None` when it has no neighbour.
+/// radius, nearest first (by the kernel's exponent when `graded`): `Some(s > epsilon)`, or `None`
+/// when it has no neighbour.
+#[allow(clippy::too_many_arguments)]
 fn full_measure(
     kernel: &Kernel,
     params: &LinearScanParams,
     tree: &DynamicTree,
     embedded: &[KernelPoint],
+    graded: bool,
     position: DVec3,
     x: &KernelPoint,
     b: &mut Buffers,
@@ -376,7 +419,7 @@ fn full_measure(
     if b.neighbors.is_empty() {
         return None;
     }
-    if !kernel.is_isotropic() {
+    if !kernel.is_isotropic() || graded {
         // Nearest first in kernel space (positions alone order them otherwise).
         b.neighbors.sort_by(|a, c| a.0.total_cmp(&c.0));
     }
@@ -407,15 +450,29 @@ pub fn linear_scan(
     initial: &[SurfaceSample],
     params: &LinearScanParams,
 ) -> LinearScanResult {
+    linear_scan_graded(kernel, candidates, initial, None, params)
+}
+
+/// [`linear_scan`] with a graded kernel: each point's relative width (see [`Kernel`](crate::Kernel)) is
+/// `width(position)` (`None`: 1 everywhere, the same as [`linear_scan`]).
+pub fn linear_scan_graded(
+    kernel: &Kernel,
+    candidates: &[SurfaceSample],
+    initial: &[SurfaceSample],
+    width: Option<&(dyn Fn(DVec3) -> f64 + Sync)>,
+    params: &LinearScanParams,
+) -> LinearScanResult {
     let mut samples: Vec<SurfaceSample> = Vec::with_capacity(initial.len() + candidates.len() / 8);
     let mut scanner = LinearScanner::new(kernel, params);
     for s in initial {
-        scanner.insert(s.position, s.normal);
+        scanner.insert_graded(s.position, s.normal, width.map_or(1.0, |w| w(s.position)));
         samples.push(*s);
     }
     let batch: Vec<(DVec3, DVec3)> = candidates.iter().map(|c| (c.position, c.normal)).collect();
+    let widths: Option<Vec<f64>> =
+        width.map(|w| candidates.par_iter().map(|c| w(c.position)).collect());
     let mut accepted = Vec::new();
-    scanner.offer_batch(&batch, &mut accepted);
+    scanner.offer_batch_graded(&batch, widths.as_deref(), &mut accepted);
     samples.extend(accepted.iter().map(|&i| candidates[i]));
     LinearScanResult {
         samples,

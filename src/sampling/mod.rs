@@ -5,6 +5,7 @@
 pub mod boundary;
 pub mod candidates;
 pub mod gradient_ascent;
+pub mod grading;
 pub mod linear_scan;
 pub mod surface_sampler;
 pub mod target_count;

@@ -38,6 +38,16 @@ pub struct LfsParams {
     /// facet's (a facet tilted by α lowers the estimate by about 2α / θ, θ the separation
     /// angle), while across an edge sharper than this the faces keep their own. Default 30.
     pub crease_angle_deg: f64,
+    /// The separation angle (degrees, seen from a medial ball's centre, between the point and
+    /// the contact that set the radius) from which the ball counts toward
+    /// [`LocalFeatureSize::thickness`]. Default 120: a plate, a tube, two facing sheets and the
+    /// tip of a wedge sharper than 60° give 120° to 180°; a concave crease of dihedral angle
+    /// φ gives 180° − φ, a bump on one sheet less.
+    pub thin_separation_deg: f64,
+    /// Estimate at the mesh's vertices too (default true); when false, only at the
+    /// area-uniform points (`vertex_count` is then 0): enough for a field on a dense mesh, at a
+    /// cost set by the spacing rather than by the input.
+    pub at_vertices: bool,
 }
 
 impl Default for LfsParams {
@@ -49,6 +59,8 @@ impl Default for LfsParams {
             max_iterations: 64,
             seed: 1,
             crease_angle_deg: 30.0,
+            thin_separation_deg: 150.0,
+            at_vertices: true,
         }
     }
 }
@@ -64,7 +76,14 @@ pub struct LocalFeatureSize {
     pub positions: Vec<DVec3>,
     /// The estimate at each of `positions`: the smaller radius of the two medial balls.
     pub lfs: Vec<f64>,
-    /// Number of mesh vertices (the first entries of `positions` and `lfs`).
+    /// The thickness at each of `positions`: the smaller radius of the medial balls whose
+    /// contacts are at least [`LfsParams::thin_separation_deg`] apart seen from the centre
+    /// (the ball reaches across to another sheet: the solid's thickness or the gap to a nearby
+    /// sheet, a tube's radius, a tip), the cap otherwise (a ball set by a concave crease, a
+    /// bump or the curvature of one sheet). Bounds `lfs` from above.
+    pub thickness: Vec<f64>,
+    /// Number of mesh vertices (the first entries of `positions` and `lfs`; 0 without
+    /// [`LfsParams::at_vertices`]).
     pub vertex_count: usize,
     /// The spacing of the area-uniform points actually used (larger than asked when
     /// [`MAX_LFS_SAMPLES`] capped the count).
@@ -89,10 +108,15 @@ impl LocalFeatureSize {
     /// this is off by at most |x − q| (about [`LocalFeatureSize::spacing`] / 2 on the surface)
     /// beyond the estimate's own error. `f64::INFINITY` when there are no points.
     pub fn at(&self, x: DVec3) -> f64 {
+        self.nearest(x).map_or(f64::INFINITY, |j| self.lfs[j])
+    }
+
+    /// The index (into `positions`) of the estimate point nearest `x`; `None` when there are
+    /// none.
+    pub fn nearest(&self, x: DVec3) -> Option<usize> {
         let mut near = Vec::with_capacity(1);
         self.tree.nearest_n(x, 1, &mut near);
-        near.first()
-            .map_or(f64::INFINITY, |&(j, _)| self.lfs[j as usize])
+        near.first().map(|&(j, _)| j as usize)
     }
 
     /// The 1-Lipschitz lower envelope of the estimate, clamped at `max_radius` (bbox-100 units):
@@ -101,16 +125,22 @@ impl LocalFeatureSize {
     /// max_radius)` of `p`, so only that neighbourhood is searched. The grading of a kernel
     /// width by the local feature size needs this (Lipschitz) form. Same order as `lfs`.
     pub fn smoothed(&self, max_radius: f64) -> Vec<f64> {
+        self.lipschitz_envelope(&self.lfs, max_radius)
+    }
+
+    /// [`LocalFeatureSize::smoothed`] of any values at the estimate points (`values[i]` at
+    /// `positions[i]`, for example [`LocalFeatureSize::thickness`]).
+    pub fn lipschitz_envelope(&self, values: &[f64], max_radius: f64) -> Vec<f64> {
         (0..self.positions.len())
             .into_par_iter()
             .map_init(Vec::new, |near, i| {
-                let m = self.lfs[i].min(max_radius);
+                let m = values[i].min(max_radius);
                 if !(m > 0.0) {
                     return m.max(0.0);
                 }
                 self.tree.within_unsorted(self.positions[i], m * m, near);
                 near.iter()
-                    .map(|&(j, d2)| self.lfs[j as usize] + d2.sqrt())
+                    .map(|&(j, d2)| values[j as usize] + d2.sqrt())
                     .fold(m, f64::min)
             })
             .collect()
@@ -182,9 +212,12 @@ pub fn local_feature_size(mesh: &TriMesh, params: &LfsParams) -> Result<LocalFea
         count = MAX_LFS_SAMPLES as f64;
     }
     let samples = surface_candidates(mesh, count as usize, params.seed);
-    let vertex_count = mesh.vertex_count();
-    let mut positions = mesh.positions.clone();
-    let mut normals = mesh.vertex_normals();
+    let (mut positions, mut normals) = if params.at_vertices {
+        (mesh.positions.clone(), mesh.vertex_normals())
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let vertex_count = positions.len();
     positions.extend(samples.iter().map(|s| s.position));
     let corner_normals = mesh.corner_normals(params.crease_angle_deg);
     normals.extend(samples.iter().map(|s| {
@@ -206,16 +239,22 @@ pub fn local_feature_size(mesh: &TriMesh, params: &LfsParams) -> Result<LocalFea
         chord_per_radius: 2.0 * (0.5 * params.min_separation_deg.to_radians()).sin(),
         max_iterations: params.max_iterations,
     };
-    let per_point: Vec<(f64, usize)> = positions
+    let thin_angle = params.thin_separation_deg.to_radians();
+    let per_point: Vec<(f64, usize, f64)> = positions
         .par_iter()
         .zip(normals.par_iter())
         .map(|(&p, &n)| {
             if !(n.length_squared() > 0.5) || !p.is_finite() {
-                return (max_radius, 0);
+                return (max_radius, 0, max_radius);
             }
-            let (inner, a) = ball.shrink(p, n, -1.0, &tree);
-            let (outer, b) = ball.shrink(p, n, 1.0, &tree);
-            (inner.min(outer), usize::from(!a) + usize::from(!b))
+            let (inner, a, inner_angle) = ball.shrink(p, n, -1.0, &tree);
+            let (outer, b, outer_angle) = ball.shrink(p, n, 1.0, &tree);
+            let thin = |r: f64, angle: f64| if angle >= thin_angle { r } else { max_radius };
+            (
+                inner.min(outer),
+                usize::from(!a) + usize::from(!b),
+                thin(inner, inner_angle).min(thin(outer, outer_angle)),
+            )
         })
         .collect();
     let without_normal = normals
@@ -224,11 +263,13 @@ pub fn local_feature_size(mesh: &TriMesh, params: &LfsParams) -> Result<LocalFea
         .filter(|(n, p)| !(n.length_squared() > 0.5) || !p.is_finite())
         .count();
     let not_converged = per_point.iter().map(|x| x.1).sum();
+    let thickness = per_point.iter().map(|x| x.2).collect();
     let lfs = per_point.into_iter().map(|x| x.0).collect();
     Ok(LocalFeatureSize {
         tree,
         positions,
         lfs,
+        thickness,
         vertex_count,
         spacing,
         max_radius,
@@ -270,18 +311,29 @@ impl Ball<'_> {
     /// below the largest surface-empty ball (nested tangent balls); the second pass, against the
     /// mesh itself, starts from its radius instead of the cap, which spares the BVH most far
     /// queries.
-    fn shrink(&self, p: DVec3, n: DVec3, side: f64, points: &StaticTree) -> (f64, bool) {
+    ///
+    /// Also returns the separation angle (radians) at the ball's centre between p and the
+    /// surface point that set the final radius (0 when the ball never shrank from the cap).
+    fn shrink(&self, p: DVec3, n: DVec3, side: f64, points: &StaticTree) -> (f64, bool, f64) {
         let mut near = Vec::with_capacity(2);
-        let (upper, _) = self.shrink_with(p, n, side, self.max_radius, |c, r| {
+        let (upper, _, q1) = self.shrink_with(p, n, side, self.max_radius, |c, r| {
             points.nearest_n(c, 1, &mut near);
             let &(j, d2) = near.first()?;
             (d2 < r * r * (1.0 - 1e-9) * (1.0 - 1e-9)).then(|| self.positions[j as usize])
         });
-        self.shrink_with(p, n, side, upper, |c, r| {
+        let (r, converged, q2) = self.shrink_with(p, n, side, upper, |c, r| {
             self.surface
                 .closest_point_within(c, r * (1.0 - 1e-9))
                 .map(|q| q.position)
-        })
+        });
+        let angle = match q2.or(q1) {
+            Some(q) => {
+                let c = p + side * r * n;
+                (p - c).angle_between(q - c)
+            }
+            None => 0.0,
+        };
+        (r, converged, if angle.is_finite() { angle } else { 0.0 })
     }
 
     /// The shrinking loop from radius `start`; `inside(c, r)` gives a point of the surface
@@ -293,28 +345,30 @@ impl Ball<'_> {
         side: f64,
         start: f64,
         mut inside: impl FnMut(DVec3, f64) -> Option<DVec3>,
-    ) -> (f64, bool) {
+    ) -> (f64, bool, Option<DVec3>) {
         let mut r = start;
+        let mut last = None;
         for _ in 0..self.max_iterations {
             let c = p + side * r * n;
             let Some(q) = inside(c, r) else {
-                return (r, true);
+                return (r, true, last);
             };
             let d = q - p;
             let denominator = 2.0 * side * d.dot(n);
             if !(denominator > 0.0) {
-                return (r, true);
+                return (r, true, last);
             }
             let r_new = d.length_squared() / denominator;
             if !(r_new < r * (1.0 - 1e-9)) {
-                return (r, true);
+                return (r, true, last);
             }
             if d.length() < self.chord_per_radius * r_new {
-                return (r, true);
+                return (r, true, last);
             }
             r = r_new;
+            last = Some(q);
         }
-        (r, false)
+        (r, false, last)
     }
 }
 

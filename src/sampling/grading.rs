@@ -1,0 +1,278 @@
+//! Sample density graded by the local feature size (issue 15): a kernel width
+//! sigma_p(x) = min(sigma_p, c · lfs(x)), so that a part thinner than the sampling (a tube, a
+//! plate, two sheets close together, a tip) gets enough samples around it to be triangulated as
+//! itself.
+//!
+//! The local feature size comes from [`crate::surface::local_feature_size`] (shrinking balls),
+//! smoothed to its 1-Lipschitz envelope, so sigma_p(x) is c-Lipschitz and the spacing changes
+//! gradually. The width is bounded below by `min_width` · sigma_p: where c · lfs is smaller
+//! still, the part cannot be resolved at the asked count, and [`Grading::unresolved`] says how
+//! many samples would resolve it.
+
+use glam::DVec3;
+
+use crate::error::Result;
+use crate::mesh::{Normalization, TriMesh};
+use crate::pipeline::SAMPLES_PER_SIGMA2;
+use crate::surface::local_feature_size::{local_feature_size, LfsParams, LocalFeatureSize};
+
+/// Parameters of the grading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GradingParams {
+    /// c in sigma_p(x) = min(sigma_p, c · lfs(x)) (default 0.75: a tube of radius r is graded
+    /// once it would get fewer than 2π / (1.2 c) ≈ 7 samples around it at the sampler's mean
+    /// edge of 1.2 sigma_p, and then keeps about 7).
+    pub lfs_factor: f64,
+    /// The smallest width relative to sigma_p (default 0.25: at most 16 times the density).
+    pub min_width: f64,
+}
+
+impl Default for GradingParams {
+    fn default() -> Self {
+        GradingParams {
+            lfs_factor: 0.75,
+            min_width: 0.25,
+        }
+    }
+}
+
+/// What the grading of the kernel width by the local feature size did ([`GradingParams`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GradingStats {
+    /// Output samples whose width is below 1 (a finer spacing than sigma_p).
+    pub graded_samples: usize,
+    /// The smallest width of an output sample (relative to sigma_p).
+    pub min_width: f64,
+    /// Output samples held at the smallest width although the local feature size asks for a
+    /// finer one: parts too thin for the asked count.
+    pub unresolved_samples: usize,
+    /// When some samples are unresolved: about how many samples would resolve every thin part
+    /// ([`Grading::resolving_count`]).
+    pub resolving_count: Option<f64>,
+    /// Where the graded samples are: the bounding boxes (model units) of the groups of graded
+    /// samples within 2 sigma_p of each other, largest first, with their sample counts and
+    /// whether they hold unresolved samples.
+    pub regions: Vec<GradedRegion>,
+}
+
+/// A group of graded samples ([`GradingStats::regions`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GradedRegion {
+    /// Bounding box corners, model units.
+    pub min: DVec3,
+    /// Bounding box corners, model units.
+    pub max: DVec3,
+    /// Samples in the group.
+    pub samples: usize,
+    /// Of those, samples held at the smallest width (unresolved).
+    pub unresolved: usize,
+}
+
+/// A local feature size field ready to grade the kernel width.
+pub struct Grading {
+    lfs: LocalFeatureSize,
+    /// The smoothed thickness at the estimate points (the field the width follows).
+    thickness: Vec<f64>,
+    params: GradingParams,
+    /// Estimates at or above this radius (bbox-100 units) mean "no feature nearer": width 1.
+    cap: f64,
+    /// The smallest of `thickness`.
+    min_thickness: f64,
+}
+
+impl Grading {
+    /// Estimates the local feature size of `mesh` (bbox-100 units) up to `cap` (a part thicker
+    /// than `cap` is not graded: pass a few times the largest sigma_p / c the sampling may use),
+    /// with estimate points every `spacing`.
+    ///
+    /// # Errors
+    /// Those of [`local_feature_size`] (an unusable mesh, a bad spacing).
+    pub fn new(mesh: &TriMesh, params: GradingParams, cap: f64, spacing: f64) -> Result<Self> {
+        let lfs = local_feature_size(
+            mesh,
+            &LfsParams {
+                spacing,
+                max_radius: cap,
+                at_vertices: false,
+                ..LfsParams::default()
+            },
+        )?;
+        let thickness = lfs.lipschitz_envelope(&median_filtered(&lfs, MEDIAN_NEIGHBORS), cap);
+        let min_thickness = thickness.iter().copied().fold(f64::INFINITY, f64::min);
+        Ok(Grading {
+            lfs,
+            min_thickness,
+            thickness,
+            params,
+            cap,
+        })
+    }
+
+    /// The thickness at `x` (bbox-100 units; [`LocalFeatureSize::thickness`], smoothed to its
+    /// 1-Lipschitz envelope): the local feature size where a medial ball reaches across to
+    /// another sheet; `f64::INFINITY` at or beyond the cap.
+    pub fn lfs(&self, x: DVec3) -> f64 {
+        let l = self
+            .lfs
+            .nearest(x)
+            .map_or(f64::INFINITY, |j| self.thickness[j]);
+        if l >= self.cap {
+            f64::INFINITY
+        } else {
+            l
+        }
+    }
+
+    /// The relative kernel width at `x` for the global `sigma_p`: `min(1, c · lfs(x) / sigma_p)`,
+    /// at least `min_width`.
+    pub fn width(&self, x: DVec3, sigma_p: f64) -> f64 {
+        let l = self.lfs(x);
+        if !l.is_finite() {
+            return 1.0;
+        }
+        (self.params.lfs_factor * l / sigma_p).clamp(self.params.min_width, 1.0)
+    }
+
+    /// Whether some width is below 1 at a global `sigma_p` of `sigma_p` or less (some
+    /// thickness t has c · t < sigma_p).
+    pub fn grades_below(&self, sigma_p: f64) -> bool {
+        self.params.lfs_factor * self.min_thickness < sigma_p
+    }
+
+    /// Whether the width at `x` is held at `min_width` although c · lfs(x) asks for less: a part
+    /// too thin for the sampling at `sigma_p`.
+    pub fn is_unresolved(&self, x: DVec3, sigma_p: f64) -> bool {
+        let l = self.lfs(x);
+        l.is_finite() && self.params.lfs_factor * l < self.params.min_width * sigma_p
+    }
+
+    /// The count of samples at which every part of a surface of area `area` (bbox-100 units)
+    /// is resolved: the global sigma_p* at which the thinnest part's width c · t_min / sigma_p*
+    /// is `min_width`, and the expected samples there with sigma_p(x) = min(sigma_p*, c · t(x)),
+    /// `SAMPLES_PER_SIGMA2` per sigma², summed over the estimate points (area-uniform, each
+    /// standing for `area / points`). `None` without a graded part.
+    pub fn resolving_count(&self, area: f64) -> Option<f64> {
+        let c = self.params.lfs_factor;
+        if !(self.min_thickness.is_finite() && self.min_thickness > 0.0) {
+            return None;
+        }
+        let sigma_star = c * self.min_thickness / self.params.min_width;
+        let points = self.thickness.len().max(1) as f64;
+        let per_point = area / points;
+        Some(
+            self.thickness
+                .iter()
+                .map(|&t| {
+                    let s = (c * t).min(sigma_star);
+                    SAMPLES_PER_SIGMA2 * per_point / (s * s)
+                })
+                .sum(),
+        )
+    }
+
+    /// The grading's record over the output's vertices `positions` (bbox-100 units in, model
+    /// units out) for the widths of `sigma_p`, on a surface of area `area`.
+    pub fn stats(
+        &self,
+        positions: &[DVec3],
+        sigma_p: f64,
+        normalization: &Normalization,
+        area: f64,
+    ) -> GradingStats {
+        let grading = self;
+        let graded: Vec<(DVec3, bool)> = positions
+            .iter()
+            .filter(|&&p| grading.width(p, sigma_p) < 1.0)
+            .map(|&p| (p, grading.is_unresolved(p, sigma_p)))
+            .collect();
+        let min_width = positions
+            .iter()
+            .map(|&p| grading.width(p, sigma_p))
+            .fold(1.0, f64::min);
+        // Groups: connected components of the graph "within 2 sigma_p" (union-find over a kd-tree).
+        let points: Vec<DVec3> = graded.iter().map(|g| g.0).collect();
+        let tree = crate::spatial::StaticTree::new(&points);
+        let mut parent: Vec<usize> = (0..points.len()).collect();
+        fn find(parent: &mut [usize], mut i: usize) -> usize {
+            while parent[i] != i {
+                parent[i] = parent[parent[i]];
+                i = parent[i];
+            }
+            i
+        }
+        let r = 2.0 * sigma_p;
+        let mut found = Vec::new();
+        for (i, &p) in points.iter().enumerate() {
+            tree.within(p, r * r, &mut found);
+            for &(j, _) in &found {
+                let (a, b) = (find(&mut parent, i), find(&mut parent, j as usize));
+                if a != b {
+                    parent[a.max(b)] = a.min(b);
+                }
+            }
+        }
+        let mut regions: Vec<GradedRegion> = Vec::new();
+        let mut index = std::collections::HashMap::new();
+        for (i, &(p, unresolved)) in graded.iter().enumerate() {
+            let root = find(&mut parent, i);
+            let k = *index.entry(root).or_insert_with(|| {
+                regions.push(GradedRegion {
+                    min: DVec3::splat(f64::INFINITY),
+                    max: DVec3::splat(f64::NEG_INFINITY),
+                    samples: 0,
+                    unresolved: 0,
+                });
+                regions.len() - 1
+            });
+            let q = normalization.invert(p);
+            let g = &mut regions[k];
+            g.min = g.min.min(q);
+            g.max = g.max.max(q);
+            g.samples += 1;
+            g.unresolved += usize::from(unresolved);
+        }
+        regions.sort_by_key(|r| std::cmp::Reverse(r.samples));
+        let unresolved_samples = graded.iter().filter(|g| g.1).count();
+        GradingStats {
+            graded_samples: graded.len(),
+            min_width,
+            unresolved_samples,
+            resolving_count: if unresolved_samples > 0 {
+                grading.resolving_count(area)
+            } else {
+                None
+            },
+            regions,
+        }
+    }
+}
+
+/// Estimate points whose median thickness [`median_filtered`] takes (the point and its nearest
+/// 15).
+const MEDIAN_NEIGHBORS: usize = 16;
+
+/// The thickness at each estimate point replaced by the median over it and its nearest
+/// `k - 1`: a thin part is thin at all of its points and keeps its value, while the isolated
+/// near-zero values where an input passes through itself (two sheets crossing: a medial ball
+/// of radius 0) or folds in a scanning artifact are dropped; their Lipschitz envelope would
+/// otherwise grade everything around them.
+fn median_filtered(lfs: &LocalFeatureSize, k: usize) -> Vec<f64> {
+    use rayon::prelude::*;
+    let tree = crate::spatial::StaticTree::new(&lfs.positions);
+    lfs.positions
+        .par_iter()
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |(near, values): &mut (Vec<(u32, f64)>, Vec<f64>), &p| {
+                tree.nearest_n(p, k, near);
+                values.clear();
+                values.extend(near.iter().map(|&(j, _)| lfs.thickness[j as usize]));
+                values.sort_by(f64::total_cmp);
+                values
+                    .get(values.len() / 2)
+                    .copied()
+                    .unwrap_or(f64::INFINITY)
+            },
+        )
+        .collect()
+}
