@@ -39,7 +39,7 @@ pub struct LfsParams {
     /// angle), while across an edge sharper than this the faces keep their own. Default 30.
     pub crease_angle_deg: f64,
     /// The separation angle (degrees, seen from a medial ball's centre, between the point and
-    /// the contact that set the radius) from which the ball counts toward
+    /// a contact on another sheet) from which the ball counts toward
     /// [`LocalFeatureSize::thickness`]. Default 120: a plate, a tube, two facing sheets and the
     /// tip of a wedge sharper than 60° give 120° to 180°; a concave crease of dihedral angle
     /// φ gives 180° − φ, a bump on one sheet less.
@@ -76,10 +76,10 @@ pub struct LocalFeatureSize {
     pub positions: Vec<DVec3>,
     /// The estimate at each of `positions`: the smaller radius of the two medial balls.
     pub lfs: Vec<f64>,
-    /// The thickness at each of `positions`: the smaller radius of the medial balls whose
-    /// contacts are at least [`LfsParams::thin_separation_deg`] apart seen from the centre
-    /// (the ball reaches across to another sheet: the solid's thickness or the gap to a nearby
-    /// sheet, a tube's radius, a tip), the cap otherwise (a ball set by a concave crease, a
+    /// The thickness at each of `positions`: the smaller radius of the medial balls that reach
+    /// across to another sheet (the surface passes within r (1 + cos θ) of the ball's point
+    /// opposite the tangent point, θ = [`LfsParams::thin_separation_deg`]: the solid's
+    /// thickness or the gap to a nearby sheet, a tube's radius, a tip), the cap otherwise (a ball set by a concave crease, a
     /// bump or the curvature of one sheet). Bounds `lfs` from above.
     pub thickness: Vec<f64>,
     /// Number of mesh vertices (the first entries of `positions` and `lfs`; 0 without
@@ -238,8 +238,8 @@ pub fn local_feature_size(mesh: &TriMesh, params: &LfsParams) -> Result<LocalFea
         max_radius,
         chord_per_radius: 2.0 * (0.5 * params.min_separation_deg.to_radians()).sin(),
         max_iterations: params.max_iterations,
+        cos_thin: params.thin_separation_deg.to_radians().cos(),
     };
-    let thin_angle = params.thin_separation_deg.to_radians();
     let per_point: Vec<(f64, usize, f64)> = positions
         .par_iter()
         .zip(normals.par_iter())
@@ -247,13 +247,13 @@ pub fn local_feature_size(mesh: &TriMesh, params: &LfsParams) -> Result<LocalFea
             if !(n.length_squared() > 0.5) || !p.is_finite() {
                 return (max_radius, 0, max_radius);
             }
-            let (inner, a, inner_angle) = ball.shrink(p, n, -1.0, &tree);
-            let (outer, b, outer_angle) = ball.shrink(p, n, 1.0, &tree);
-            let thin = |r: f64, angle: f64| if angle >= thin_angle { r } else { max_radius };
+            let (inner, a, inner_thin) = ball.shrink(p, n, -1.0, &tree);
+            let (outer, b, outer_thin) = ball.shrink(p, n, 1.0, &tree);
+            let thin = |r: f64, thin: bool| if thin { r } else { max_radius };
             (
                 inner.min(outer),
                 usize::from(!a) + usize::from(!b),
-                thin(inner, inner_angle).min(thin(outer, outer_angle)),
+                thin(inner, inner_thin).min(thin(outer, outer_thin)),
             )
         })
         .collect();
@@ -293,6 +293,13 @@ fn barycentric([a, b, c]: [DVec3; 3], p: DVec3) -> [f64; 3] {
     [1.0 - v - w, v, w]
 }
 
+/// How far from a medial ball's centre, in ball radii, the other sheet may be for the ball to
+/// count toward the thickness (see `Ball::shrink`): a faceted tube stops the ball short of its
+/// inscribed radius (the adjacent facet of a 16-gon, seen along an interpolated normal, stops
+/// it at 0.57 of the radius on the generated 2.9° cone), and its far side is then up to about
+/// 2.5 ball radii from the centre.
+const ACROSS_REACH: f64 = 3.0;
+
 /// The shrinking ball's fixed inputs.
 struct Ball<'a> {
     surface: &'a MeshSurface,
@@ -301,6 +308,8 @@ struct Ball<'a> {
     /// Chord |p − q| per radius below which q is too close to p (2 sin(θ/2)).
     chord_per_radius: f64,
     max_iterations: usize,
+    /// cos of [`LfsParams::thin_separation_deg`]: see [`Ball::shrink`].
+    cos_thin: f64,
 }
 
 impl Ball<'_> {
@@ -312,9 +321,15 @@ impl Ball<'_> {
     /// mesh itself, starts from its radius instead of the cap, which spares the BVH most far
     /// queries.
     ///
-    /// Also returns the separation angle (radians) at the ball's centre between p and the
-    /// surface point that set the final radius (0 when the ball never shrank from the cap).
-    fn shrink(&self, p: DVec3, n: DVec3, side: f64, points: &StaticTree) -> (f64, bool, f64) {
+    /// Also returns whether the ball reaches across to another sheet: whether the surface point
+    /// q nearest to the point of the ball diametrically opposite p lies within
+    /// [`ACROSS_REACH`] · r of the centre c and at a separation angle of at least θ (the
+    /// angle p c q; θ = [`LfsParams::thin_separation_deg`]) from p. A plate, a tube or two
+    /// facing sheets give about 180° (whichever of a tube's ring of contacts set the radius,
+    /// and although a faceted tube stops the ball short of its inscribed radius); a concave
+    /// crease of dihedral angle φ gives 180° − φ / 2 or less (135° at a right angle); a bump
+    /// on one sheet, whose ball is small, finds the other sheet far beyond the reach.
+    fn shrink(&self, p: DVec3, n: DVec3, side: f64, points: &StaticTree) -> (f64, bool, bool) {
         let mut near = Vec::with_capacity(2);
         let (upper, _, q1) = self.shrink_with(p, n, side, self.max_radius, |c, r| {
             points.nearest_n(c, 1, &mut near);
@@ -326,14 +341,17 @@ impl Ball<'_> {
                 .closest_point_within(c, r * (1.0 - 1e-9))
                 .map(|q| q.position)
         });
-        let angle = match q2.or(q1) {
-            Some(q) => {
-                let c = p + side * r * n;
-                (p - c).angle_between(q - c)
-            }
-            None => 0.0,
-        };
-        (r, converged, if angle.is_finite() { angle } else { 0.0 })
+        let c = p + side * r * n;
+        let thin = (q1.is_some() || q2.is_some())
+            && self
+                .surface
+                .closest_point_within(c + side * r * n, (ACROSS_REACH + 1.0) * r)
+                .is_some_and(|q| {
+                    let (u, v) = (p - c, q.position - c);
+                    v.length() <= ACROSS_REACH * r
+                        && u.dot(v) <= self.cos_thin * u.length() * v.length()
+                });
+        (r, converged, thin)
     }
 
     /// The shrinking loop from radius `start`; `inside(c, r)` gives a point of the surface
