@@ -527,4 +527,38 @@ mod tests {
             assert_eq!(one.len(), batch.len());
         }
     }
+
+    #[test]
+    fn a_graded_batch_makes_the_decisions_of_one_by_one_offers() {
+        // Widths from 0.3 to 1 varying over the sphere: a band of finer spacing.
+        let width = |p: DVec3| (0.3 + 0.7 * (p.z / 20.0).abs()).min(1.0);
+        for (sigma_n, seed) in [(f64::INFINITY, 3), (0.75, 4)] {
+            let kernel = Kernel::new(1.0, sigma_n).unwrap();
+            let params = LinearScanParams::default();
+            let points = sphere_points(40_000, seed);
+            let widths: Vec<f64> = points.iter().map(|p| width(p.0)).collect();
+            let mut one = LinearScanner::new(&kernel, &params);
+            let mut batch = LinearScanner::new(&kernel, &params);
+            let by_one: Vec<usize> = (0..points.len())
+                .filter(|&i| one.offer_graded(points[i].0, points[i].1, widths[i]))
+                .collect();
+            let mut by_batch = Vec::new();
+            batch.offer_batch_graded(&points, Some(&widths), &mut by_batch);
+            assert_eq!(by_one, by_batch, "sigma_n {sigma_n}");
+            // The band near z = 0 is sampled finer than the caps: more samples per area.
+            let near = |lo: f64, hi: f64| {
+                by_one
+                    .iter()
+                    .filter(|&&i| (lo..hi).contains(&points[i].0.z.abs()))
+                    .count()
+            };
+            // Equal areas on a sphere: |z| in [0, 4) and [16, 20).
+            assert!(
+                near(0.0, 4.0) > 3 * near(16.0, 20.0),
+                "{} vs {}",
+                near(0.0, 4.0),
+                near(16.0, 20.0)
+            );
+        }
+    }
 }
