@@ -365,7 +365,7 @@ pub fn remesh(
     let grading = match params.grading {
         Some(g) => {
             on_stage("local feature size");
-            let cap = 2.0 * first_sigma_p / g.lfs_factor;
+            let cap = 1.5 * first_sigma_p / g.lfs_factor;
             // Estimate points every first_sigma_p (about one per expected sample), at most
             // MAX_GRADING_POINTS of them.
             let spacing = first_sigma_p.max((area / MAX_GRADING_POINTS).sqrt());

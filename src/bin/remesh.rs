@@ -10,8 +10,8 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
     catch_panics, parse_bytes, physical_memory, remove_temporaries, run_points, run_quality,
-    run_remesh, run_simplify, write_report, Density, Error, MeshFormat, PointsJob, RemeshJob,
-    RemeshParams, SimplifyDensity, SimplifyJob, STDOUT,
+    run_remesh, run_simplify, write_report, Density, Error, GradingParams, MeshFormat, PointsJob,
+    RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob, STDOUT,
 };
 
 const EXAMPLES: &str = "\
@@ -65,6 +65,12 @@ struct Cli {
     /// normals vary; 0.5 to 1 is typical). Default: infinity (isotropic).
     #[arg(long)]
     sigma_n: Option<f64>,
+
+    /// Thin parts: the kernel width follows the local thickness, sigma_p(x) = min(sigma_p,
+    /// C · thickness(x)), so tubes, plates, close sheets and tips get enough samples around
+    /// them. 0 turns it off (one sigma_p everywhere, as in the paper).
+    #[arg(long, default_value_t = 0.75, value_name = "C")]
+    lfs_factor: f64,
 
     /// Gradient-ascent sweeps (Sec. 6.2).
     #[arg(long, default_value_t = 10)]
@@ -295,6 +301,16 @@ fn config(cli: Cli) -> Result<Config, Error> {
                 ..Default::default()
             };
             params.gradient_ascent.iterations = cli.iterations;
+            if !(cli.lfs_factor.is_finite() && cli.lfs_factor >= 0.0) {
+                return Err(Error::InvalidParameter {
+                    name: "--lfs-factor",
+                    message: format!("must be a number >= 0, got {}", cli.lfs_factor),
+                });
+            }
+            params.grading = (cli.lfs_factor > 0.0).then(|| GradingParams {
+                lfs_factor: cli.lfs_factor,
+                ..GradingParams::default()
+            });
             if let Some(s) = cli.sigma_n {
                 params.sigma_n = s;
             }
