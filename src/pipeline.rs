@@ -27,6 +27,7 @@ use crate::surface::SurfaceSample;
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
+use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, FaceSource, SampleSet, TriangulateParams};
 
@@ -87,6 +88,10 @@ pub fn sigma_p_for_count(area: f64, boundary_length: f64, count: f64) -> f64 {
 /// The most points the local feature size is estimated at for the grading (their spacing is
 /// about the expected samples' otherwise).
 const MAX_GRADING_POINTS: f64 = 200_000.0;
+
+/// The most vertices of a shell [`remove_stray_shells`] removes: a few samples closing on
+/// themselves at a tip (4 make a tetrahedron), not a part of the surface.
+const STRAY_SHELL_VERTICES: usize = 8;
 
 /// The most output points [`remesh`] takes: 20 million (with 10 candidates per sample the
 /// pool holds 2e8 points, about 11 GB).
@@ -194,6 +199,8 @@ pub struct RemeshOutput {
     pub buried_samples: usize,
     /// What the grading by the local feature size did (`None` when it was off).
     pub grading: Option<GradingStats>,
+    /// Tiny closed shells at unresolved tips removed (bbox-100 units).
+    pub stray_shells: StrayShells,
     /// Timed stages in order.
     pub stages: Vec<Stage>,
 }
@@ -289,6 +296,7 @@ pub fn remesh(
     }
     let surface = MeshSurface::new(&normalized)?;
     timer.lap("normalize");
+    let input_components = crate::check::topology(&normalized).components;
 
     on_stage("candidates");
     // Candidates are drawn for the samples expected inside the surface.
@@ -575,6 +583,28 @@ pub fn remesh(
             .map(|i| i < boundary_count)
             .collect();
         let untangle_stats = untangle(&mut mesh_normalized, &fixed, sigma_p, &params.untangle);
+        // Tiny shells split off at tips too thin for the count (four samples closing into a
+        // tetrahedron) go when the output has more parts than the input.
+        let stray = match &grading {
+            Some(g) => remove_stray_shells(
+                &mut mesh_normalized,
+                &mut face_sources,
+                input_components,
+                STRAY_SHELL_VERTICES,
+                |shell| {
+                    let (lo, hi) = shell.iter().fold(
+                        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+                        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+                    );
+                    lo.distance(hi) <= 4.0 * sigma_p
+                        || shell.iter().all(|&p| g.width(p, sigma_ref) < 1.0)
+                },
+            ),
+            None => StrayShells::default(),
+        };
+        if stray.shells > 0 {
+            mesh_normalized.remove_unreferenced_vertices();
+        }
         // The output follows the input's orientation: its closed parts are turned outward.
         let output_orientation = orient_consistently(&mut mesh_normalized, true);
         timer.lap("untangle");
@@ -626,6 +656,7 @@ pub fn remesh(
                 buried_candidates,
                 buried_samples,
                 grading: grading_record,
+                stray_shells: stray,
                 stages: timer.take_stages(),
             };
         }

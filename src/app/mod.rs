@@ -336,6 +336,23 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         report
             .notes
             .extend(grading_notes(g, out.mesh.vertex_count()));
+        let st = &out.stray_shells;
+        if st.shells > 0 {
+            let (lo, hi) = (
+                out.normalization.invert(st.min),
+                out.normalization.invert(st.max),
+            );
+            report.notes.push(format!(
+                "{} tiny closed pieces ({} vertices) that split off at a tip too thin for this \
+                 count were left out, so the tip comes out blunted there: [{:.4}, {:.4}, {:.4}]-\
+                 [{:.4}, {:.4}, {:.4}]",
+                st.shells, st.vertices, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+            ));
+        }
+        extra.insert(
+            "stray_shells".into(),
+            serde_json::json!({"shells": st.shells, "vertices": st.vertices}),
+        );
     }
     extra.insert(
         "orientation".into(),

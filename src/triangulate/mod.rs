@@ -5,6 +5,7 @@ pub mod cleanup;
 mod flip;
 pub mod optimize;
 pub mod refine;
+pub mod stray_shells;
 pub mod tangent_delaunay;
 pub mod untangle;
 

@@ -1,0 +1,185 @@
+//! Stray shells at unresolved tips: a tip thinner than the sampling can resolve (a cone's apex,
+//! a horse's tail tip at the grading's finest width) can leave a handful of samples that close
+//! into a tiny shell of their own (four samples, a tetrahedron) apart from the surface. When
+//! the output has more components than the input, such shells are removed, smallest first,
+//! down to the input's count: the tip comes out blunted (the report says where) instead of as
+//! an extra component.
+
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+
+use crate::mesh::TriMesh;
+use crate::triangulate::FaceSource;
+
+/// What [`remove_stray_shells`] removed.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StrayShells {
+    /// Shells removed.
+    pub shells: usize,
+    /// Their vertices.
+    pub vertices: usize,
+    /// Bounding box of the removed vertices (bbox-100 units; meaningless when none).
+    pub min: DVec3,
+    /// Bounding box of the removed vertices (bbox-100 units).
+    pub max: DVec3,
+}
+
+/// Removes closed components (no boundary edge) of `mesh` with at most `max_vertices`
+/// vertices that `stray(positions of its vertices)` calls stray (the pipeline: smaller than
+/// the sample spacing, or every vertex at a thin part),
+/// smallest first, while `mesh` has more components than `keep`. `face_sources` (one per face)
+/// is filtered along. The removed vertices stay in `positions` unreferenced.
+pub fn remove_stray_shells(
+    mesh: &mut TriMesh,
+    face_sources: &mut Vec<FaceSource>,
+    keep: usize,
+    max_vertices: usize,
+    stray: impl Fn(&[DVec3]) -> bool,
+) -> StrayShells {
+    let mut record = StrayShells {
+        min: DVec3::splat(f64::INFINITY),
+        max: DVec3::splat(f64::NEG_INFINITY),
+        ..StrayShells::default()
+    };
+    let n = mesh.positions.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            parent[i as usize] = parent[parent[i as usize] as usize];
+            i = parent[i as usize];
+        }
+        i
+    }
+    for t in &mesh.triangles {
+        for k in 1..3 {
+            let (a, b) = (find(&mut parent, t[0]), find(&mut parent, t[k]));
+            if a != b {
+                parent[a.max(b) as usize] = a.min(b);
+            }
+        }
+    }
+    // Per component: its faces, vertices and whether it is closed.
+    let mut faces_of: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        faces_of.entry(find(&mut parent, t[0])).or_default().push(f);
+    }
+    if faces_of.len() <= keep {
+        return record;
+    }
+    let mut small: Vec<(usize, u32, Vec<u32>)> = Vec::new();
+    for (&root, faces) in &faces_of {
+        let mut vertices: Vec<u32> = faces
+            .iter()
+            .flat_map(|&f| mesh.triangles[f])
+            .collect::<Vec<_>>();
+        vertices.sort_unstable();
+        vertices.dedup();
+        if vertices.len() > max_vertices {
+            continue;
+        }
+        let mut edges: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+        for &f in faces {
+            let t = mesh.triangles[f];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let closed = edges.values().all(|&c| c == 2);
+        let points: Vec<DVec3> = vertices
+            .iter()
+            .map(|&v| mesh.positions[v as usize])
+            .collect();
+        if closed && stray(&points) {
+            small.push((vertices.len(), root, vertices));
+        }
+    }
+    small.sort_by_key(|s| (s.0, s.1));
+    let excess = faces_of.len() - keep;
+    let mut removed_roots = Vec::new();
+    for (_, root, vertices) in small.into_iter().take(excess) {
+        record.shells += 1;
+        record.vertices += vertices.len();
+        for v in vertices {
+            let p = mesh.positions[v as usize];
+            record.min = record.min.min(p);
+            record.max = record.max.max(p);
+        }
+        removed_roots.push(root);
+    }
+    if removed_roots.is_empty() {
+        return record;
+    }
+    let mut keep_face = vec![true; mesh.triangles.len()];
+    for root in removed_roots {
+        for &f in &faces_of[&root] {
+            keep_face[f] = false;
+        }
+    }
+    let mut k = 0;
+    mesh.triangles.retain(|_| {
+        k += 1;
+        keep_face[k - 1]
+    });
+    let mut k = 0;
+    face_sources.retain(|_| {
+        k += 1;
+        keep_face[k - 1]
+    });
+    record
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes::cuboid;
+
+    fn two_parts() -> (TriMesh, Vec<FaceSource>) {
+        // A big box and a tiny closed tetrahedron beside it.
+        let mut m = cuboid(DVec3::ZERO, DVec3::splat(10.0));
+        let o = m.positions.len() as u32;
+        m.positions.extend([
+            DVec3::new(11.0, 0.0, 0.0),
+            DVec3::new(11.1, 0.0, 0.0),
+            DVec3::new(11.0, 0.1, 0.0),
+            DVec3::new(11.0, 0.0, 0.1),
+        ]);
+        m.triangles.extend([
+            [o, o + 2, o + 1],
+            [o, o + 1, o + 3],
+            [o + 1, o + 2, o + 3],
+            [o, o + 3, o + 2],
+        ]);
+        let sources = vec![FaceSource::Refined; m.triangles.len()];
+        (m, sources)
+    }
+
+    #[test]
+    fn a_tiny_shell_at_a_thin_tip_goes_when_the_input_has_fewer_parts() {
+        let (mut m, mut sources) = two_parts();
+        let r = remove_stray_shells(&mut m, &mut sources, 1, 8, |s| s.iter().all(|p| p.x > 10.5));
+        assert_eq!((r.shells, r.vertices), (1, 4));
+        assert_eq!(m.triangles.len(), 12);
+        assert_eq!(sources.len(), 12);
+        assert!(r.min.x >= 11.0 && r.max.x <= 11.1 + 1e-12);
+    }
+
+    #[test]
+    fn shells_stay_when_the_input_has_as_many_parts_or_they_are_not_thin() {
+        let (mut m, mut sources) = two_parts();
+        assert_eq!(
+            remove_stray_shells(&mut m, &mut sources, 2, 8, |_| true).shells,
+            0
+        );
+        assert_eq!(
+            remove_stray_shells(&mut m, &mut sources, 1, 8, |_| false).shells,
+            0
+        );
+        // The box itself is small enough (8 vertices) but not thin.
+        assert_eq!(
+            remove_stray_shells(&mut m, &mut sources, 1, 3, |_| true).shells,
+            0
+        );
+        assert_eq!(m.triangles.len(), 16);
+    }
+}
