@@ -15,10 +15,12 @@ use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::mesh_projection::MeshSurface;
 
+mod angles;
 mod collapse;
 mod cover;
 mod relax;
 
+use angles::mend_small_angles;
 use collapse::collapse_short;
 use cover::cover;
 use relax::{flip_poor, relax_poor};
@@ -50,6 +52,11 @@ pub struct OptimizeParams {
     /// Largest distance a collapse may put between the removed vertex's position and the mesh, in
     /// units of sigma_p (default 0.25).
     pub collapse_offset_sigma_p: f64,
+    /// The last pass mends the faces whose smallest angle is still below this, degrees
+    /// (default 30; 0 turns the pass off).
+    pub final_theta_deg: f64,
+    /// Rounds of the last pass at most (default 4).
+    pub final_rounds: usize,
 }
 
 impl Default for OptimizeParams {
@@ -64,6 +71,8 @@ impl Default for OptimizeParams {
             cover_rounds: 3,
             short_edge_ratio: 0.5,
             collapse_offset_sigma_p: 0.25,
+            final_theta_deg: 30.0,
+            final_rounds: 4,
         }
     }
 }
@@ -90,6 +99,10 @@ pub(super) struct Limits {
     pub(super) short_edge_ratio: f64,
     /// [`OptimizeParams::collapse_offset_sigma_p`] · sigma_p, bbox-100 units.
     pub(super) collapse_offset: f64,
+    /// [`OptimizeParams::final_theta_deg`], degrees.
+    pub(super) final_theta_deg: f64,
+    /// [`OptimizeParams::final_rounds`].
+    pub(super) final_rounds: usize,
 }
 
 impl Limits {
@@ -104,6 +117,8 @@ impl Limits {
             cover_rounds: params.cover_rounds,
             short_edge_ratio: params.short_edge_ratio,
             collapse_offset: params.collapse_offset_sigma_p * sigma_p,
+            final_theta_deg: params.final_theta_deg,
+            final_rounds: params.final_rounds,
         }
     }
 }
@@ -119,6 +134,8 @@ pub struct OptimizeStats {
     pub flips: usize,
     /// Vertex moves.
     pub moves: usize,
+    /// Operations of the last pass on the faces with a small angle (flips, collapses, moves).
+    pub small_angle_mends: usize,
 }
 
 /// The mesh being optimized: each face labelled with the index of the input face it still is
@@ -235,6 +252,7 @@ pub fn optimize(
             break;
         }
     }
+    stats.small_angle_mends = mend_small_angles(&mut m, surface, &fixed, params);
     let (positions, faces, origin) = m.into_parts();
     *mesh = TriMesh::new(positions, faces);
     (stats, origin)
