@@ -388,3 +388,119 @@ impl CrossingGuard {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::self_intersection::intersecting_pairs;
+    use crate::mesh::test_meshes::grid;
+
+    /// The smallest angle of the live faces, degrees.
+    fn theta_min(m: &Mesh) -> f64 {
+        worst_angle(m, m.live_faces().0)
+    }
+
+    /// A flat `n × n` grid of unit squares as the mesh to mend (every face labelled with its
+    /// index) and as the surface.
+    fn flat(n: usize) -> (TriMesh, MeshSurface) {
+        let g = grid(n, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let surface = MeshSurface::new(&g).unwrap();
+        (g, surface)
+    }
+
+    fn limits() -> Limits {
+        Limits::new(&OptimizeParams::default(), 1.0)
+    }
+
+    #[test]
+    fn a_vertex_of_three_faces_near_an_edge_is_collapsed_away() {
+        // (Horse at 2000, seed 4: a vertex of three faces with a 137° angle, 17.6° beside it.)
+        // One grid triangle split at a point near the middle of its long edge.
+        let (g, surface) = flat(6);
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        let f = g.triangles.iter().position(|&t| t == [14, 15, 22]).unwrap() as u32;
+        let [a, _, c] = m.corners([14, 15, 22]);
+        let v = m.add_vertex(a.lerp(c, 0.5) + DVec3::new(0.12, -0.12, 0.0));
+        m.split_face(f, v, None).unwrap();
+        let before = theta_min(&m);
+        assert!(before < 20.0, "{before}");
+        let fixed = vec![false; m.vertex_count()];
+        let made = mend_small_angles(&mut m, &surface, &fixed, &limits());
+        assert!(made >= 1);
+        assert_eq!(m.degree(v), 0, "the vertex is gone");
+        assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn a_sliver_on_a_short_fixed_boundary_edge_is_mended_and_the_boundary_stays() {
+        // (Bunny's small hole: two boundary samples 0.4 spacings apart, the interior vertex
+        // across them a whole spacing away.) A boundary vertex of the grid moved along the
+        // boundary towards its neighbour; the boundary is fixed.
+        let (mut g, surface) = flat(6);
+        g.positions[3] = DVec3::new(2.6, 0.0, 0.0);
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        let fixed: Vec<bool> = (0..m.vertex_count() as u32)
+            .map(|v| m.is_boundary_vertex(v))
+            .collect();
+        let before = theta_min(&m);
+        assert!(before < 25.0, "{before}");
+        let boundary: Vec<DVec3> = (0..m.vertex_count())
+            .filter(|&v| fixed[v])
+            .map(|v| m.position(v as u32))
+            .collect();
+        mend_small_angles(&mut m, &surface, &fixed, &limits());
+        assert!(theta_min(&m) >= 25.0, "{before} -> {}", theta_min(&m));
+        let after: Vec<DVec3> = (0..m.vertex_count())
+            .filter(|&v| fixed[v])
+            .map(|v| m.position(v as u32))
+            .collect();
+        assert_eq!(boundary, after);
+        assert!(m.positions().iter().all(|p| p.z == 0.0));
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn a_mesh_without_small_angles_is_left_alone() {
+        let (g, surface) = flat(4);
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        let fixed = vec![false; m.vertex_count()];
+        assert_eq!(mend_small_angles(&mut m, &surface, &fixed, &limits()), 0);
+        assert_eq!(m.to_trimesh(), g);
+    }
+
+    #[test]
+    fn the_crossing_guard_sees_faces_near_and_faces_changed() {
+        // Two parallel grids 0.2 apart.
+        let a = grid(4, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let b = grid(4, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
+        let mut both = a.clone();
+        let off = both.positions.len() as u32;
+        both.positions.extend(b.positions.iter().copied());
+        both.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        assert!(intersecting_pairs(&both.positions, &both.triangles).is_empty());
+        let mut m: Mesh = EditMesh::from_trimesh(&both, Some, SlotPolicy::Reuse);
+        let mut guard = CrossingGuard::new(&m);
+        // The faces around an upper vertex, were it pushed through the lower grid.
+        let v = off + 2 * 5 + 2;
+        let slots = m.faces_around(v).to_vec();
+        let faces: Vec<[u32; 3]> = slots.iter().map(|&f| face(&m, f)).collect();
+        assert!(!guard.crosses(&m, &faces, &slots));
+        let p = m.position(v);
+        m.relocate_vertex(v, p - DVec3::new(0.0, 0.0, 0.5)).unwrap();
+        assert!(guard.crosses(&m, &faces, &slots));
+        // Once those faces are recorded as moved, a lower face moved up through them is seen
+        // crossing them through the list of changed faces.
+        guard.changed(&slots);
+        m.relocate_vertex(v, p).unwrap();
+        let u = 2 * 5 + 2;
+        let lower = m.faces_around(u).to_vec();
+        let lower_faces: Vec<[u32; 3]> = lower.iter().map(|&f| face(&m, f)).collect();
+        m.relocate_vertex(u, m.position(u) + DVec3::new(0.0, 0.0, 0.5))
+            .unwrap();
+        guard.changed(&lower);
+        assert!(guard.crosses(&m, &lower_faces, &lower));
+        assert!(!guard.crosses(&m, &lower_faces, &[lower.clone(), slots.clone()].concat()));
+    }
+}
