@@ -1,6 +1,6 @@
-//! The optimization's last pass: the faces whose smallest angle is still below a bound are
-//! mended one by one with the best of a few local operations, each guarded against leaving the
-//! input surface and against crossing another face.
+//! The optimization's last pass: the faces whose smallest angle is still below a bound, and
+//! the faces that cross another, are mended one by one with the best of a few local operations,
+//! each guarded against leaving the input surface and against making a crossing.
 
 use glam::DVec3;
 use parry3d_f64::bounding_volume::Aabb;
@@ -9,6 +9,7 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 
 use super::*;
+use crate::geometry::self_intersection::intersecting_pairs;
 use crate::geometry::triangle_intersection::triangles_intersect;
 use crate::triangulate::flip::max_min_candidate;
 
@@ -23,15 +24,20 @@ enum Op {
     Move(u32, DVec3),
 }
 
-/// Mends the faces of `m` whose smallest angle is below `params.final_theta_deg`, worst first,
-/// in up to `params.final_rounds` rounds. For each such face the candidates are: the max-min
-/// flip of each of its edges, the collapse of each of its edges (the end that is neither fixed
-/// nor on the boundary merges into the other, at the other's position or at the surface point
-/// nearest the edge's midpoint), and the move of each corner that is neither fixed nor on the
-/// boundary (towards the centroid of its neighbours or the apex of the equilateral triangle on a
-/// small-angled face's far edge, projected onto the surface). The candidate that leaves the
-/// largest smallest angle among the faces it makes is taken, when that angle is larger than the
-/// smallest angle among the faces it replaces and it passes every guard:
+/// Mends the faces of `m` whose smallest angle is below `params.final_theta_deg` (worst first),
+/// then the faces that cross another face (the exact pairs of [`intersecting_pairs`]), in up to
+/// `params.final_rounds` rounds. For each such face the candidates are: the max-min flip of each
+/// of its edges, the collapse of each of its edges (an end that may move merges into the other,
+/// at the other's position or, when both may move, at the surface point nearest the edge's
+/// midpoint), and the move of each corner that may move (towards the centroid of its neighbours
+/// or the apex of the equilateral triangle on a small-angled face's far edge, all, half or a
+/// quarter of the way, projected onto the surface). Vertices on the boundary never move; fixed
+/// vertices (boundary samples, covering vertices) move only to undo a crossing.
+///
+/// Of the candidates that pass every guard, the one whose new faces have the largest smallest
+/// angle is taken: for a face with a small angle, when that angle is larger than the smallest
+/// angle of the faces it replaces; for a crossing face, when it is not below the smaller of that
+/// and the bound. The guards:
 /// - no new face turns by more than `max_normal_turn_deg` from the face it replaces (a flip:
 ///   from the two old faces' mean normal);
 /// - the mesh stays on the surface, within the offset a collapse of the optimization may make
@@ -40,28 +46,40 @@ enum Op {
 ///   midpoints), a collapse leaves both old positions within it of the new faces, and a move
 ///   leaves the old position within it of them;
 /// - no new face shares a point with a face it has no vertex in common with (the exact test of
-///   [`triangles_intersect`], against the faces near it), so the pass makes no crossing.
+///   [`triangles_intersect`], against the faces near it), so the pass makes no crossing and a
+///   crossing face is replaced only by faces that cross nothing.
 ///
 /// Returns the number of operations made. Deterministic.
-pub(super) fn mend_small_angles(
+pub(super) fn mend_faces(
     m: &mut Mesh,
     surface: &MeshSurface,
     fixed: &[bool],
     params: &Limits,
 ) -> usize {
     let bound = params.final_theta_deg;
-    let small = |m: &Mesh| -> Vec<(f64, u32)> {
+    // The faces to mend: those with a small angle, smallest first, then those that cross
+    // another face.
+    let targets = |m: &Mesh| -> Vec<u32> {
         let (live, slots) = m.live_faces();
-        let mut out: Vec<(f64, u32)> = live
+        let mut small: Vec<(f64, u32)> = live
             .iter()
-            .zip(slots)
-            .map(|(&t, f)| (min_angle(m, t), f))
+            .zip(&slots)
+            .map(|(&t, &f)| (min_angle(m, t), f))
             .filter(|&(a, _)| a < bound)
             .collect();
-        out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        small.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut out: Vec<u32> = small.into_iter().map(|x| x.1).collect();
+        let mut crossing: Vec<u32> = intersecting_pairs(m.positions(), &live)
+            .into_iter()
+            .flatten()
+            .map(|i| slots[i as usize])
+            .collect();
+        crossing.sort_unstable();
+        crossing.dedup();
+        out.extend(crossing);
         out
     };
-    let mut faces = small(m);
+    let mut faces = targets(m);
     if faces.is_empty() {
         return 0;
     }
@@ -70,36 +88,47 @@ pub(super) fn mend_small_angles(
     let mut done = 0;
     for _ in 0..params.final_rounds {
         let mut made = 0;
-        for &(_, f) in &faces {
+        for &f in &faces {
             let Some(t) = m.face(f) else {
                 continue;
             };
-            if min_angle(m, t) >= bound {
+            // A face that crosses another is mended by any operation that replaces or moves it
+            // without a crossing or a new angle below the bound; there, a covering vertex may
+            // go too. A face with a small angle is mended by one that raises that angle.
+            let crossing = guard.crosses(m, &[t], &[f]);
+            if !crossing && min_angle(m, t) >= bound {
                 continue;
             }
+            let stays = |m: &Mesh, v: u32| (is_fixed(v) && !crossing) || m.is_boundary_vertex(v);
             let mut best: Option<(f64, Op)> = None;
-            let mut offer = |value: Option<f64>, op: Op| {
-                if let Some(v) = value {
-                    if best.is_none_or(|b| v > b.0) {
-                        best = Some((v, op));
-                    }
+            let mut offer = |value: Option<(f64, f64)>, op: Op| {
+                let Some((old, new)) = value else {
+                    return;
+                };
+                let good = if crossing {
+                    new >= old.min(bound)
+                } else {
+                    new > old + IMPROVEMENT_TOLERANCE
+                };
+                if good && best.is_none_or(|b| new > b.0) {
+                    best = Some((new, op));
                 }
             };
             for k in 0..3 {
                 let (x, y) = (t[k], t[(k + 1) % 3]);
                 offer(try_flip(m, surface, &guard, x, y, params), Op::Flip(x, y));
                 for (removed, kept) in [(x, y), (y, x)] {
-                    if is_fixed(removed) || m.is_boundary_vertex(removed) {
+                    if stays(m, removed) {
                         continue;
                     }
                     let (pk, pr) = (m.position(kept), m.position(removed));
-                    let mut targets = vec![pk];
-                    if !is_fixed(kept) && !m.is_boundary_vertex(kept) {
+                    let mut aims = vec![pk];
+                    if !stays(m, kept) {
                         if let Some(sp) = surface.closest_point(0.5 * (pk + pr)) {
-                            targets.push(sp.position);
+                            aims.push(sp.position);
                         }
                     }
-                    for q in targets {
+                    for q in aims {
                         offer(
                             try_collapse(m, &guard, removed, kept, q, params),
                             Op::Collapse(removed, kept, q),
@@ -108,7 +137,7 @@ pub(super) fn mend_small_angles(
                 }
             }
             for &v in &t {
-                if is_fixed(v) || m.is_boundary_vertex(v) {
+                if stays(m, v) {
                     continue;
                 }
                 for q in move_targets(m, surface, v, bound) {
@@ -134,7 +163,7 @@ pub(super) fn mend_small_angles(
         if made == 0 {
             break;
         }
-        faces = small(m);
+        faces = targets(m);
         if faces.is_empty() {
             break;
         }
@@ -162,7 +191,7 @@ fn distance_to(m: &Mesh, faces: &[[u32; 3]], p: DVec3) -> f64 {
 }
 
 /// The smallest angle of the two faces the max-min flip of `x`–`y` makes, when it passes the
-/// guards of [`mend_small_angles`].
+/// guards of [`mend_faces`].
 fn try_flip(
     m: &Mesh,
     surface: &MeshSurface,
@@ -170,7 +199,7 @@ fn try_flip(
     x: u32,
     y: u32,
     params: &Limits,
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     let flip = max_min_candidate(m, x, y)?;
     let [t1, t2] = flip.old;
     let [new1, new2] = flip.new;
@@ -201,11 +230,11 @@ fn try_flip(
     if guard.crosses(m, &flip.new, &flip.slots) {
         return None;
     }
-    (new > old + IMPROVEMENT_TOLERANCE).then_some(new)
+    Some((old, new))
 }
 
 /// The smallest angle of the faces the collapse of `removed` into `kept` at `q` makes, when it
-/// passes the guards of [`mend_small_angles`].
+/// passes the guards of [`mend_faces`].
 fn try_collapse(
     m: &mut Mesh,
     guard: &CrossingGuard,
@@ -213,7 +242,7 @@ fn try_collapse(
     kept: u32,
     q: DVec3,
     params: &Limits,
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     let (f1, f2, c, d) = m.edge_faces(removed, kept).ok()?;
     let (ra, rb) = (m.ring(removed), m.ring(kept));
     let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
@@ -258,13 +287,10 @@ fn try_collapse(
     let new = worst_angle(m, new_faces.iter().copied());
     let mut replaced = involved.clone();
     replaced.extend([f1, f2]);
-    let ok = !turned
-        && near
-        && new > old + IMPROVEMENT_TOLERANCE
-        && !guard.crosses(m, &new_faces, &replaced);
+    let ok = !turned && near && !guard.crosses(m, &new_faces, &replaced);
     // The old position was finite: restoring it cannot fail.
     let _ = m.relocate_vertex(kept, pb);
-    ok.then_some(new)
+    ok.then_some((old, new))
 }
 
 /// Where a move of `v` is tried: towards the centroid of its neighbours and towards the apex of
@@ -304,8 +330,14 @@ fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, bound: f64) -> Vec<DVec
 }
 
 /// The smallest angle of the faces around `v` once it is at `q`, when the move passes the
-/// guards of [`mend_small_angles`].
-fn try_move(m: &mut Mesh, guard: &CrossingGuard, v: u32, q: DVec3, params: &Limits) -> Option<f64> {
+/// guards of [`mend_faces`].
+fn try_move(
+    m: &mut Mesh,
+    guard: &CrossingGuard,
+    v: u32,
+    q: DVec3,
+    params: &Limits,
+) -> Option<(f64, f64)> {
     let slots = m.faces_around(v).to_vec();
     let faces: Vec<[u32; 3]> = slots.iter().map(|&f| face(m, f)).collect();
     let old = worst_angle(m, faces.iter().copied());
@@ -319,11 +351,10 @@ fn try_move(m: &mut Mesh, guard: &CrossingGuard, v: u32, q: DVec3, params: &Limi
         .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
     let new = worst_angle(m, faces.iter().copied());
     let ok = !turned
-        && new > old + IMPROVEMENT_TOLERANCE
         && distance_to(m, &faces, p) <= params.collapse_offset
         && !guard.crosses(m, &faces, &slots);
     let _ = m.relocate_vertex(v, p);
-    ok.then_some(new)
+    ok.then_some((old, new))
 }
 
 /// Finds the faces a new face would cross: a BVH over the faces as they were when the pass
@@ -392,7 +423,6 @@ impl CrossingGuard {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::self_intersection::intersecting_pairs;
     use crate::mesh::test_meshes::grid;
 
     /// The smallest angle of the live faces, degrees.
@@ -425,7 +455,7 @@ mod tests {
         let before = theta_min(&m);
         assert!(before < 20.0, "{before}");
         let fixed = vec![false; m.vertex_count()];
-        let made = mend_small_angles(&mut m, &surface, &fixed, &limits());
+        let made = mend_faces(&mut m, &surface, &fixed, &limits());
         assert!(made >= 1);
         assert_eq!(m.degree(v), 0, "the vertex is gone");
         assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
@@ -449,7 +479,7 @@ mod tests {
             .filter(|&v| fixed[v])
             .map(|v| m.position(v as u32))
             .collect();
-        mend_small_angles(&mut m, &surface, &fixed, &limits());
+        mend_faces(&mut m, &surface, &fixed, &limits());
         assert!(theta_min(&m) >= 25.0, "{before} -> {}", theta_min(&m));
         let after: Vec<DVec3> = (0..m.vertex_count())
             .filter(|&v| fixed[v])
@@ -465,7 +495,7 @@ mod tests {
         let (g, surface) = flat(4);
         let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
         let fixed = vec![false; m.vertex_count()];
-        assert_eq!(mend_small_angles(&mut m, &surface, &fixed, &limits()), 0);
+        assert_eq!(mend_faces(&mut m, &surface, &fixed, &limits()), 0);
         assert_eq!(m.to_trimesh(), g);
     }
 
