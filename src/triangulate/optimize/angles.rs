@@ -499,6 +499,53 @@ mod tests {
         assert_eq!(m.to_trimesh(), g);
     }
 
+    /// Two parallel 6 × 6 grids 0.2 apart: (the input surface, the mesh with vertex `poke` of
+    /// the upper grid pushed to z = -0.3, through the lower grid).
+    fn poked_sheets() -> (MeshSurface, TriMesh, usize) {
+        let a = grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let b = grid(6, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
+        let mut both = a.clone();
+        let off = both.positions.len() as u32;
+        both.positions.extend(b.positions.iter().copied());
+        both.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        let surface = MeshSurface::new(&both).unwrap();
+        let poke = off as usize + 3 * 7 + 3;
+        both.positions[poke].z = -0.3;
+        (surface, both, poke)
+    }
+
+    #[test]
+    fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
+        let (surface, mesh, poke) = poked_sheets();
+        assert!(!intersecting_pairs(&mesh.positions, &mesh.triangles).is_empty());
+        let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+        let fixed = vec![false; m.vertex_count()];
+        // sigma_p 4: the pass may move the mesh by up to 1 off the surface, more than the poke.
+        let wide = Limits::new(&OptimizeParams::default(), 4.0);
+        let made = mend_faces(&mut m, &surface, &fixed, &wide);
+        assert!(made >= 1);
+        let out = m.to_trimesh();
+        let pairs = intersecting_pairs(&out.positions, &out.triangles);
+        assert!(pairs.is_empty(), "{pairs:?}");
+        assert!(
+            m.position(poke as u32).z > 0.0,
+            "{}",
+            m.position(poke as u32)
+        );
+        assert!(theta_min(&m) >= 30.0, "{}", theta_min(&m));
+        assert_eq!(m.sanity_check(), Ok(()));
+        // Without moves that far (sigma_p 1: 0.25), nothing is made that would cross.
+        let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+        mend_faces(&mut m, &surface, &fixed, &limits());
+        let out = m.to_trimesh();
+        assert!(
+            intersecting_pairs(&out.positions, &out.triangles).len()
+                <= intersecting_pairs(&mesh.positions, &mesh.triangles).len()
+        );
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
     #[test]
     fn the_crossing_guard_sees_faces_near_and_faces_changed() {
         // Two parallel grids 0.2 apart.
