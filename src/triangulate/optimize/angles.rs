@@ -412,7 +412,6 @@ impl CrossingGuard {
             };
             self.bvh
                 .intersect_aabb(&aabb)
-                .map(|g| g as u32)
                 .filter(|&g| !self.stale.get(g as usize).copied().unwrap_or(true))
                 .any(hits)
                 || self.changed.iter().any(|&g| hits(g))
