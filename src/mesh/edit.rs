@@ -299,11 +299,13 @@ impl<L: Copy> EditMesh<L> {
         r
     }
 
-    /// Whether `v` is on a boundary edge (an edge with a face on one side only).
+    /// Whether `v` is on a boundary edge (an edge with a face on one side only). Only the two
+    /// edges of each face around `v` that end at `v` count: a vertex whose faces touch the
+    /// boundary elsewhere is not on it.
     pub fn is_boundary_vertex(&self, v: u32) -> bool {
         self.around[v as usize].iter().any(|&f| {
-            let t = self.faces[f as usize];
-            (0..3).any(|k| !self.edge.contains_key(&(t[(k + 1) % 3], t[k])))
+            let [_, a, b] = starting_at(self.faces[f as usize], v);
+            !self.edge.contains_key(&(a, v)) || !self.edge.contains_key(&(v, b))
         })
     }
 

@@ -102,6 +102,29 @@ fn meshes_built_in_code_are_sane() {
     assert_eq!(f.degree(0), 6);
 }
 
+/// Regression (issue 15, bunny's small hole): a vertex next to the boundary, whose faces have
+/// boundary edges it is not on, is not a boundary vertex; it counted as one, so the optimizer
+/// never moved it and a sliver on the hole stayed.
+#[test]
+fn a_vertex_beside_the_boundary_is_not_on_it() {
+    let g = EditMesh::from_trimesh(
+        &grid(4, |i, j| DVec3::new(i as f64, j as f64, 0.0)),
+        |_| (),
+        SlotPolicy::Reuse,
+    );
+    // (1, 1) is in the face [0, 1, 6], whose edge 0-1 is on the boundary.
+    assert!(g
+        .faces_around(6)
+        .iter()
+        .any(|&f| g.face(f) == Some([0, 1, 6])));
+    assert!(!g.is_boundary_vertex(6));
+    let on: Vec<u32> = (0..25).filter(|&v| g.is_boundary_vertex(v)).collect();
+    let expected: Vec<u32> = (0..25u32)
+        .filter(|v| v % 5 == 0 || v % 5 == 4 || v / 5 == 0 || v / 5 == 4)
+        .collect();
+    assert_eq!(on, expected);
+}
+
 #[test]
 fn flip_turns_an_edge_of_the_octahedron() {
     let mut m = octahedron(SlotPolicy::Reuse);

@@ -15,10 +15,12 @@ use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::mesh_projection::MeshSurface;
 
+mod angles;
 mod collapse;
 mod cover;
 mod relax;
 
+use angles::mend_faces;
 use collapse::collapse_short;
 use cover::cover;
 use relax::{flip_poor, relax_poor};
@@ -50,6 +52,11 @@ pub struct OptimizeParams {
     /// Largest distance a collapse may put between the removed vertex's position and the mesh, in
     /// units of sigma_p (default 0.25).
     pub collapse_offset_sigma_p: f64,
+    /// The last pass mends the faces whose smallest angle is still below this, degrees
+    /// (default 30), and the faces that cross another.
+    pub final_theta_deg: f64,
+    /// Rounds of the last pass at most (default 4).
+    pub final_rounds: usize,
 }
 
 impl Default for OptimizeParams {
@@ -64,6 +71,8 @@ impl Default for OptimizeParams {
             cover_rounds: 3,
             short_edge_ratio: 0.5,
             collapse_offset_sigma_p: 0.25,
+            final_theta_deg: 30.0,
+            final_rounds: 4,
         }
     }
 }
@@ -90,6 +99,10 @@ pub(super) struct Limits {
     pub(super) short_edge_ratio: f64,
     /// [`OptimizeParams::collapse_offset_sigma_p`] · sigma_p, bbox-100 units.
     pub(super) collapse_offset: f64,
+    /// [`OptimizeParams::final_theta_deg`], degrees.
+    pub(super) final_theta_deg: f64,
+    /// [`OptimizeParams::final_rounds`].
+    pub(super) final_rounds: usize,
 }
 
 impl Limits {
@@ -104,6 +117,8 @@ impl Limits {
             cover_rounds: params.cover_rounds,
             short_edge_ratio: params.short_edge_ratio,
             collapse_offset: params.collapse_offset_sigma_p * sigma_p,
+            final_theta_deg: params.final_theta_deg,
+            final_rounds: params.final_rounds,
         }
     }
 }
@@ -119,6 +134,9 @@ pub struct OptimizeStats {
     pub flips: usize,
     /// Vertex moves.
     pub moves: usize,
+    /// Operations of the last pass on the faces with a small angle or a crossing (flips,
+    /// collapses, moves).
+    pub mends: usize,
 }
 
 /// The mesh being optimized: each face labelled with the index of the input face it still is
@@ -192,6 +210,14 @@ pub(super) fn distance_to_faces(m: &Mesh, faces: &[u32], p: DVec3) -> f64 {
 ///   of them much (Laplacian smoothing with projection, as in Botsch & Kobbelt 2004, Sec. 3,
 ///   restricted to the poor triangles).
 ///
+/// Then a last pass (`angles.rs`) takes the faces whose smallest angle is still below
+/// `final_theta_deg` and the faces that cross another (the sweeps' guards refuse what would leave
+/// the surface, so a sliver on a tip or beside a short fixed edge, or a fold at a crease, can
+/// stay): each gets the best of a flip, a collapse or a move of its own, accepted only when it
+/// raises the smallest angle there (a crossing face: removes the crossing without a new angle
+/// below the bound), keeps the mesh within `collapse_offset_sigma_p` · sigma_p of the surface
+/// and makes no crossing (exact test against the faces near it).
+///
 /// Everything else stays as the sampler and the tangent-plane Delaunay left it. On horse at 8600
 /// about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
 /// spacing).
@@ -235,6 +261,7 @@ pub fn optimize(
             break;
         }
     }
+    stats.mends = mend_faces(&mut m, surface, &fixed, params);
     let (positions, faces, origin) = m.into_parts();
     *mesh = TriMesh::new(positions, faces);
     (stats, origin)

@@ -1,0 +1,582 @@
+//! The optimization's last pass: the faces whose smallest angle is still below a bound, and
+//! the faces that cross another, are mended one by one with the best of a few local operations,
+//! each guarded against leaving the input surface and against making a crossing.
+
+use glam::DVec3;
+use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use parry3d_f64::query::PointQuery;
+use parry3d_f64::shape::Triangle;
+
+use super::*;
+use crate::geometry::self_intersection::intersecting_pairs;
+use crate::geometry::triangle_intersection::triangles_intersect;
+use crate::triangulate::flip::max_min_candidate;
+
+/// One local operation on the mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Op {
+    /// Flip the edge `x`–`y`.
+    Flip(u32, u32),
+    /// Collapse `removed` into `kept`, which moves to the position.
+    Collapse(u32, u32, DVec3),
+    /// Move the vertex to the position.
+    Move(u32, DVec3),
+}
+
+/// Mends the faces of `m` whose smallest angle is below `params.final_theta_deg` (worst first),
+/// then the faces that cross another face (the exact pairs of [`intersecting_pairs`]), in up to
+/// `params.final_rounds` rounds. For each such face the candidates are: the max-min flip of each
+/// of its edges, the collapse of each of its edges (an end that may move merges into the other,
+/// at the other's position or, when both may move, at the surface point nearest the edge's
+/// midpoint), and the move of each corner that may move (towards the centroid of its neighbours
+/// or the apex of the equilateral triangle on a small-angled face's far edge, all, half or a
+/// quarter of the way, projected onto the surface). Vertices on the boundary never move; fixed
+/// vertices (boundary samples, covering vertices) move only to undo a crossing.
+///
+/// Of the candidates that pass every guard, the one whose new faces have the largest smallest
+/// angle is taken: for a face with a small angle, when that angle is larger than the smallest
+/// angle of the faces it replaces; for a crossing face, when it is not below the smaller of that
+/// and the bound. The guards:
+/// - no new face turns by more than `max_normal_turn_deg` from the face it replaces (a flip:
+///   from the two old faces' mean normal);
+/// - the mesh stays on the surface, within the offset a collapse of the optimization may make
+///   (`collapse_offset`): a flip leaves the two faces no farther from the surface than that or
+///   than the two old faces were (measured at the surface points nearest the two diagonals'
+///   midpoints), a collapse leaves both old positions within it of the new faces, and a move
+///   leaves the old position within it of them;
+/// - no new face shares a point with a face it has no vertex in common with (the exact test of
+///   [`triangles_intersect`], against the faces near it), so the pass makes no crossing and a
+///   crossing face is replaced only by faces that cross nothing.
+///
+/// Returns the number of operations made. Deterministic.
+pub(super) fn mend_faces(
+    m: &mut Mesh,
+    surface: &MeshSurface,
+    fixed: &[bool],
+    params: &Limits,
+) -> usize {
+    let bound = params.final_theta_deg;
+    // The faces to mend: those with a small angle, smallest first, then those that cross
+    // another face.
+    let targets = |m: &Mesh| -> Vec<u32> {
+        let (live, slots) = m.live_faces();
+        let mut small: Vec<(f64, u32)> = live
+            .iter()
+            .zip(&slots)
+            .map(|(&t, &f)| (min_angle(m, t), f))
+            .filter(|&(a, _)| a < bound)
+            .collect();
+        small.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut out: Vec<u32> = small.into_iter().map(|x| x.1).collect();
+        let mut crossing: Vec<u32> = intersecting_pairs(m.positions(), &live)
+            .into_iter()
+            .flatten()
+            .map(|i| slots[i as usize])
+            .collect();
+        crossing.sort_unstable();
+        crossing.dedup();
+        out.extend(crossing);
+        out
+    };
+    let mut faces = targets(m);
+    if faces.is_empty() {
+        return 0;
+    }
+    let mut guard = CrossingGuard::new(m);
+    let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
+    let mut done = 0;
+    for _ in 0..params.final_rounds {
+        let mut made = 0;
+        for &f in &faces {
+            let Some(t) = m.face(f) else {
+                continue;
+            };
+            // A face that crosses another is mended by any operation that replaces or moves it
+            // without a crossing or a new angle below the bound; there, a covering vertex may
+            // go too. A face with a small angle is mended by one that raises that angle.
+            let crossing = guard.crosses(m, &[t], &[f]);
+            if !crossing && min_angle(m, t) >= bound {
+                continue;
+            }
+            let stays = |m: &Mesh, v: u32| (is_fixed(v) && !crossing) || m.is_boundary_vertex(v);
+            let mut best: Option<(f64, Op)> = None;
+            let mut offer = |value: Option<(f64, f64)>, op: Op| {
+                let Some((old, new)) = value else {
+                    return;
+                };
+                let good = if crossing {
+                    new >= old.min(bound)
+                } else {
+                    new > old + IMPROVEMENT_TOLERANCE
+                };
+                if good && best.is_none_or(|b| new > b.0) {
+                    best = Some((new, op));
+                }
+            };
+            for k in 0..3 {
+                let (x, y) = (t[k], t[(k + 1) % 3]);
+                offer(try_flip(m, surface, &guard, x, y, params), Op::Flip(x, y));
+                for (removed, kept) in [(x, y), (y, x)] {
+                    if stays(m, removed) {
+                        continue;
+                    }
+                    let (pk, pr) = (m.position(kept), m.position(removed));
+                    let mut aims = vec![pk];
+                    if !stays(m, kept) {
+                        if let Some(sp) = surface.closest_point(0.5 * (pk + pr)) {
+                            aims.push(sp.position);
+                        }
+                    }
+                    for q in aims {
+                        offer(
+                            try_collapse(m, &guard, removed, kept, q, params),
+                            Op::Collapse(removed, kept, q),
+                        );
+                    }
+                }
+            }
+            for &v in &t {
+                if stays(m, v) {
+                    continue;
+                }
+                for q in move_targets(m, surface, v, bound) {
+                    offer(try_move(m, &guard, v, q, params), Op::Move(v, q));
+                }
+            }
+            let Some((_, op)) = best else {
+                continue;
+            };
+            let applied = match op {
+                Op::Flip(x, y) => m.flip_edge(x, y, None).map(|s| s.to_vec()),
+                Op::Collapse(removed, kept, q) => m
+                    .collapse_edge(removed, kept, q, None)
+                    .map(|_| m.faces_around(kept).to_vec()),
+                Op::Move(v, q) => m.relocate_vertex(v, q).map(|_| m.faces_around(v).to_vec()),
+            };
+            if let Ok(slots) = applied {
+                guard.changed(&slots);
+                made += 1;
+            }
+        }
+        done += made;
+        if made == 0 {
+            break;
+        }
+        faces = targets(m);
+        if faces.is_empty() {
+            break;
+        }
+    }
+    done
+}
+
+/// The smallest angle of the faces `t`, degrees (infinity for none).
+fn worst_angle(m: &Mesh, faces: impl IntoIterator<Item = [u32; 3]>) -> f64 {
+    faces
+        .into_iter()
+        .map(|t| min_angle(m, t))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The distance from `p` to the nearest of the faces `faces`.
+fn distance_to(m: &Mesh, faces: &[[u32; 3]], p: DVec3) -> f64 {
+    faces
+        .iter()
+        .map(|&t| {
+            let [a, b, c] = m.corners(t);
+            Triangle::new(a, b, c).distance_to_local_point(p, true)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The smallest angle of the two faces the max-min flip of `x`–`y` makes, when it passes the
+/// guards of [`mend_faces`].
+fn try_flip(
+    m: &Mesh,
+    surface: &MeshSurface,
+    guard: &CrossingGuard,
+    x: u32,
+    y: u32,
+    params: &Limits,
+) -> Option<(f64, f64)> {
+    let flip = max_min_candidate(m, x, y)?;
+    let [t1, t2] = flip.old;
+    let [new1, new2] = flip.new;
+    let (c, d) = (t1[2], t2[2]);
+    let mean_old = normal(m, t1) + normal(m, t2);
+    let (m1, m2) = (normal(m, new1), normal(m, new2));
+    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
+    let mean = mean_old.normalize_or_zero();
+    if m1.dot(mean) < cos_turn || m2.dot(mean) < cos_turn || m1.dot(m2) < 0.0 {
+        return None;
+    }
+    // How far each pair of faces is from the surface: at the surface points nearest the two
+    // diagonals' midpoints.
+    let (px, py, pc, pd) = (m.position(x), m.position(y), m.position(c), m.position(d));
+    let old_mid = surface.closest_point(0.5 * (px + py))?;
+    let new_mid = surface.closest_point(0.5 * (pc + pd))?;
+    let old_off = old_mid
+        .distance
+        .max(distance_to(m, &flip.old, new_mid.position));
+    let new_off = new_mid
+        .distance
+        .max(distance_to(m, &flip.new, old_mid.position));
+    let old = worst_angle(m, flip.old);
+    let new = worst_angle(m, flip.new);
+    if new_off > params.collapse_offset.max(old_off) {
+        return None;
+    }
+    if guard.crosses(m, &flip.new, &flip.slots) {
+        return None;
+    }
+    Some((old, new))
+}
+
+/// The smallest angle of the faces the collapse of `removed` into `kept` at `q` makes, when it
+/// passes the guards of [`mend_faces`].
+fn try_collapse(
+    m: &mut Mesh,
+    guard: &CrossingGuard,
+    removed: u32,
+    kept: u32,
+    q: DVec3,
+    params: &Limits,
+) -> Option<(f64, f64)> {
+    let (f1, f2, c, d) = m.edge_faces(removed, kept).ok()?;
+    let (ra, rb) = (m.ring(removed), m.ring(kept));
+    let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
+    if c == d
+        || common.len() != 2
+        || !common.contains(&c)
+        || !common.contains(&d)
+        || m.degree(c) <= 3
+        || m.degree(d) <= 3
+    {
+        return None;
+    }
+    let mut involved: Vec<u32> = m
+        .faces_around(removed)
+        .iter()
+        .chain(m.faces_around(kept))
+        .copied()
+        .filter(|&g| g != f1 && g != f2)
+        .collect();
+    involved.sort_unstable();
+    involved.dedup();
+    let old_faces: Vec<[u32; 3]> = involved
+        .iter()
+        .chain([&f1, &f2])
+        .map(|&g| face(m, g))
+        .collect();
+    let old = worst_angle(m, old_faces.iter().copied());
+    let old_normals: Vec<DVec3> = involved.iter().map(|&g| normal(m, face(m, g))).collect();
+    let (pa, pb) = (m.position(removed), m.position(kept));
+    let new_faces: Vec<[u32; 3]> = involved
+        .iter()
+        .map(|&g| face(m, g).map(|u| if u == removed { kept } else { u }))
+        .collect();
+    m.relocate_vertex(kept, q).ok()?;
+    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
+    let turned = new_faces
+        .iter()
+        .zip(&old_normals)
+        .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
+    let near = distance_to(m, &new_faces, pa) <= params.collapse_offset
+        && distance_to(m, &new_faces, pb) <= params.collapse_offset;
+    let new = worst_angle(m, new_faces.iter().copied());
+    let mut replaced = involved.clone();
+    replaced.extend([f1, f2]);
+    let ok = !turned && near && !guard.crosses(m, &new_faces, &replaced);
+    // The old position was finite: restoring it cannot fail.
+    let _ = m.relocate_vertex(kept, pb);
+    ok.then_some((old, new))
+}
+
+/// Where a move of `v` is tried: towards the centroid of its neighbours and towards the apex of
+/// the equilateral triangle on the far edge of each of its faces with an angle below `bound`
+/// (all the way, half and a quarter of the way), projected onto the surface.
+fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, bound: f64) -> Vec<DVec3> {
+    let old = m.position(v);
+    let ring = m.ring(v);
+    if ring.is_empty() {
+        return Vec::new();
+    }
+    let centroid = ring
+        .iter()
+        .map(|&u| m.position(u))
+        .fold(DVec3::ZERO, |a, b| a + b)
+        / ring.len() as f64;
+    let mut aims = vec![centroid];
+    for &f in m.faces_around(v) {
+        let t = starting_at(face(m, f), v);
+        if min_angle(m, t) >= bound {
+            continue;
+        }
+        let (pb, pc) = (m.position(t[1]), m.position(t[2]));
+        let mid = 0.5 * (pb + pc);
+        let e = pc - pb;
+        let height = old - mid;
+        let across = (height - e * (height.dot(e) / e.length_squared().max(f64::MIN_POSITIVE)))
+            .normalize_or_zero();
+        if across != DVec3::ZERO {
+            aims.push(mid + across * (0.75f64.sqrt() * e.length()));
+        }
+    }
+    aims.iter()
+        .flat_map(|&a| [1.0, 0.5, 0.25].map(|s| old.lerp(a, s)))
+        .filter_map(|p| surface.closest_point(p).map(|sp| sp.position))
+        .collect()
+}
+
+/// The smallest angle of the faces around `v` once it is at `q`, when the move passes the
+/// guards of [`mend_faces`].
+fn try_move(
+    m: &mut Mesh,
+    guard: &CrossingGuard,
+    v: u32,
+    q: DVec3,
+    params: &Limits,
+) -> Option<(f64, f64)> {
+    let slots = m.faces_around(v).to_vec();
+    let faces: Vec<[u32; 3]> = slots.iter().map(|&f| face(m, f)).collect();
+    let old = worst_angle(m, faces.iter().copied());
+    let old_normals: Vec<DVec3> = faces.iter().map(|&t| normal(m, t)).collect();
+    let p = m.position(v);
+    m.relocate_vertex(v, q).ok()?;
+    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
+    let turned = faces
+        .iter()
+        .zip(&old_normals)
+        .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
+    let new = worst_angle(m, faces.iter().copied());
+    let ok = !turned
+        && distance_to(m, &faces, p) <= params.collapse_offset
+        && !guard.crosses(m, &faces, &slots);
+    let _ = m.relocate_vertex(v, p);
+    ok.then_some((old, new))
+}
+
+/// Finds the faces a new face would cross: a BVH over the faces as they were when the pass
+/// began, and the list of the faces made or moved since (tested one by one).
+struct CrossingGuard {
+    bvh: Bvh,
+    /// Whether the face in a slot was made or moved since the BVH was built.
+    stale: Vec<bool>,
+    /// Those slots.
+    changed: Vec<u32>,
+}
+
+impl CrossingGuard {
+    fn new(m: &Mesh) -> Self {
+        let (live, slots) = m.live_faces();
+        let boxes = live.iter().zip(&slots).map(|(&t, &f)| {
+            let [a, b, c] = m.corners(t);
+            (f as usize, Aabb::new(a.min(b).min(c), a.max(b).max(c)))
+        });
+        CrossingGuard {
+            bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
+            stale: vec![false; m.slots()],
+            changed: Vec::new(),
+        }
+    }
+
+    /// Records that the faces in `slots` were made or moved.
+    fn changed(&mut self, slots: &[u32]) {
+        for &f in slots {
+            let i = f as usize;
+            if i >= self.stale.len() {
+                self.stale.resize(i + 1, false);
+            }
+            if !self.stale[i] {
+                self.stale[i] = true;
+                self.changed.push(f);
+            }
+        }
+    }
+
+    /// Whether one of `faces` (at the mesh's current positions) shares a point with a live face
+    /// of `m` that is not in `replaced` and has no vertex in common with it.
+    fn crosses(&self, m: &Mesh, faces: &[[u32; 3]], replaced: &[u32]) -> bool {
+        faces.iter().any(|&t| {
+            let p = m.corners(t);
+            let aabb = Aabb::new(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+            let hits = |g: u32| {
+                if replaced.contains(&g) {
+                    return false;
+                }
+                let Some(u) = m.face(g) else {
+                    return false;
+                };
+                !t.iter().any(|v| u.contains(v)) && triangles_intersect(p, m.corners(u))
+            };
+            self.bvh
+                .intersect_aabb(&aabb)
+                .filter(|&g| !self.stale.get(g as usize).copied().unwrap_or(true))
+                .any(hits)
+                || self.changed.iter().any(|&g| hits(g))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes::grid;
+
+    /// The smallest angle of the live faces, degrees.
+    fn theta_min(m: &Mesh) -> f64 {
+        worst_angle(m, m.live_faces().0)
+    }
+
+    /// A flat `n × n` grid of unit squares as the mesh to mend (every face labelled with its
+    /// index) and as the surface.
+    fn flat(n: usize) -> (TriMesh, MeshSurface) {
+        let g = grid(n, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let surface = MeshSurface::new(&g).unwrap();
+        (g, surface)
+    }
+
+    fn limits() -> Limits {
+        Limits::new(&OptimizeParams::default(), 1.0)
+    }
+
+    #[test]
+    fn a_vertex_of_three_faces_near_an_edge_is_collapsed_away() {
+        // (Horse at 2000, seed 4: a vertex of three faces with a 137° angle, 17.6° beside it.)
+        // One grid triangle split at a point near the middle of its long edge.
+        let (g, surface) = flat(6);
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        let f = g.triangles.iter().position(|&t| t == [14, 15, 22]).unwrap() as u32;
+        let [a, _, c] = m.corners([14, 15, 22]);
+        let v = m.add_vertex(a.lerp(c, 0.5) + DVec3::new(0.12, -0.12, 0.0));
+        m.split_face(f, v, None).unwrap();
+        let before = theta_min(&m);
+        assert!(before < 20.0, "{before}");
+        let fixed = vec![false; m.vertex_count()];
+        let made = mend_faces(&mut m, &surface, &fixed, &limits());
+        assert!(made >= 1);
+        assert_eq!(m.degree(v), 0, "the vertex is gone");
+        assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn a_sliver_on_a_short_fixed_boundary_edge_is_mended_and_the_boundary_stays() {
+        // (Bunny's small hole: two boundary samples 0.4 spacings apart, the interior vertex
+        // across them a whole spacing away.) A boundary vertex of the grid moved along the
+        // boundary towards its neighbour; the boundary is fixed.
+        let (mut g, surface) = flat(6);
+        g.positions[3] = DVec3::new(2.6, 0.0, 0.0);
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        let fixed: Vec<bool> = (0..m.vertex_count() as u32)
+            .map(|v| m.is_boundary_vertex(v))
+            .collect();
+        let before = theta_min(&m);
+        assert!(before < 25.0, "{before}");
+        let boundary: Vec<DVec3> = (0..m.vertex_count())
+            .filter(|&v| fixed[v])
+            .map(|v| m.position(v as u32))
+            .collect();
+        mend_faces(&mut m, &surface, &fixed, &limits());
+        assert!(theta_min(&m) >= 25.0, "{before} -> {}", theta_min(&m));
+        let after: Vec<DVec3> = (0..m.vertex_count())
+            .filter(|&v| fixed[v])
+            .map(|v| m.position(v as u32))
+            .collect();
+        assert_eq!(boundary, after);
+        assert!(m.positions().iter().all(|p| p.z == 0.0));
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn a_mesh_without_small_angles_is_left_alone() {
+        let (g, surface) = flat(4);
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        let fixed = vec![false; m.vertex_count()];
+        assert_eq!(mend_faces(&mut m, &surface, &fixed, &limits()), 0);
+        assert_eq!(m.to_trimesh(), g);
+    }
+
+    /// Two parallel 6 × 6 grids 0.2 apart: (the input surface, the mesh with vertex `poke` of
+    /// the upper grid pushed to z = -0.3, through the lower grid).
+    fn poked_sheets() -> (MeshSurface, TriMesh, usize) {
+        let a = grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let b = grid(6, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
+        let mut both = a.clone();
+        let off = both.positions.len() as u32;
+        both.positions.extend(b.positions.iter().copied());
+        both.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        let surface = MeshSurface::new(&both).unwrap();
+        let poke = off as usize + 3 * 7 + 3;
+        both.positions[poke].z = -0.3;
+        (surface, both, poke)
+    }
+
+    #[test]
+    fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
+        let (surface, mesh, poke) = poked_sheets();
+        assert!(!intersecting_pairs(&mesh.positions, &mesh.triangles).is_empty());
+        let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+        let fixed = vec![false; m.vertex_count()];
+        // sigma_p 4: the pass may move the mesh by up to 1 off the surface, more than the poke.
+        let wide = Limits::new(&OptimizeParams::default(), 4.0);
+        let made = mend_faces(&mut m, &surface, &fixed, &wide);
+        assert!(made >= 1);
+        let out = m.to_trimesh();
+        let pairs = intersecting_pairs(&out.positions, &out.triangles);
+        assert!(pairs.is_empty(), "{pairs:?}");
+        assert!(
+            m.position(poke as u32).z > 0.0,
+            "{}",
+            m.position(poke as u32)
+        );
+        assert!(theta_min(&m) >= 30.0, "{}", theta_min(&m));
+        assert_eq!(m.sanity_check(), Ok(()));
+        // Without moves that far (sigma_p 1: 0.25), nothing is made that would cross.
+        let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+        mend_faces(&mut m, &surface, &fixed, &limits());
+        let out = m.to_trimesh();
+        assert!(
+            intersecting_pairs(&out.positions, &out.triangles).len()
+                <= intersecting_pairs(&mesh.positions, &mesh.triangles).len()
+        );
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn the_crossing_guard_sees_faces_near_and_faces_changed() {
+        // Two parallel grids 0.2 apart.
+        let a = grid(4, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let b = grid(4, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
+        let mut both = a.clone();
+        let off = both.positions.len() as u32;
+        both.positions.extend(b.positions.iter().copied());
+        both.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        assert!(intersecting_pairs(&both.positions, &both.triangles).is_empty());
+        let mut m: Mesh = EditMesh::from_trimesh(&both, Some, SlotPolicy::Reuse);
+        let mut guard = CrossingGuard::new(&m);
+        // The faces around an upper vertex, were it pushed through the lower grid.
+        let v = off + 2 * 5 + 2;
+        let slots = m.faces_around(v).to_vec();
+        let faces: Vec<[u32; 3]> = slots.iter().map(|&f| face(&m, f)).collect();
+        assert!(!guard.crosses(&m, &faces, &slots));
+        let p = m.position(v);
+        m.relocate_vertex(v, p - DVec3::new(0.0, 0.0, 0.5)).unwrap();
+        assert!(guard.crosses(&m, &faces, &slots));
+        // Once those faces are recorded as moved, a lower face moved up through them is seen
+        // crossing them through the list of changed faces.
+        guard.changed(&slots);
+        m.relocate_vertex(v, p).unwrap();
+        let u = 2 * 5 + 2;
+        let lower = m.faces_around(u).to_vec();
+        let lower_faces: Vec<[u32; 3]> = lower.iter().map(|&f| face(&m, f)).collect();
+        m.relocate_vertex(u, m.position(u) + DVec3::new(0.0, 0.0, 0.5))
+            .unwrap();
+        guard.changed(&lower);
+        assert!(guard.crosses(&m, &lower_faces, &lower));
+        assert!(!guard.crosses(&m, &lower_faces, &[lower.clone(), slots.clone()].concat()));
+    }
+}
