@@ -10,7 +10,7 @@ use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
 use crate::kernel::Kernel;
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{
-    boundary_curves, boundary_sample_count, curve_length, sample_boundary,
+    boundary_curves, boundary_sample_count, curve_length, sample_boundary, sample_boundary_graded,
 };
 use crate::sampling::candidates::surface_candidates;
 use crate::sampling::gradient_ascent::{
@@ -377,7 +377,7 @@ pub fn remesh(
             // Estimate points every first_sigma_p (about one per expected sample), at most
             // MAX_GRADING_POINTS of them.
             let spacing = first_sigma_p.max((area / MAX_GRADING_POINTS).sqrt());
-            let grading = Grading::new(&normalized, g, cap, spacing)?;
+            let grading = Grading::new(&normalized, &curves, g, cap, spacing)?;
             timer.lap("local feature size");
             Some(grading)
         }
@@ -419,7 +419,15 @@ pub fn remesh(
             if !(boundary_count <= boundary_limit) {
                 return Ok((boundary_count.min(usize::MAX as f64) as usize, None));
             }
-            let b = sample_boundary(&normalized, &curves, spacing);
+            let b = match &grading {
+                Some(g) => sample_boundary_graded(
+                    &normalized,
+                    &curves,
+                    spacing,
+                    Some(&|p| g.width(p, sigma_ref)),
+                ),
+                None => sample_boundary(&normalized, &curves, spacing),
+            };
             let r = match &grading {
                 Some(g) => linear_scan_graded(
                     &kernel,

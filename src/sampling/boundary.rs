@@ -6,6 +6,7 @@
 //! stay fixed during gradient ascent, and consecutive ones become the output mesh's boundary
 //! edges, so every hole of the input stays a hole of the output and no other hole appears.
 
+use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 use crate::mesh::TriMesh;
@@ -157,6 +158,85 @@ fn curve_steps(total: f64, spacing: f64, closed: bool) -> f64 {
     (total / spacing)
         .round()
         .max(if closed { 3.0 } else { 1.0 })
+}
+
+/// [`sample_boundary`] with a spacing that follows a relative width field: the samples are at
+/// equal steps of ∫ ds / (`width(x)` · `spacing`) along each curve (the width taken at the
+/// curve's vertices, linear in between), their number that integral rounded (at least 3 on a
+/// loop, 1 step on a chain). With `width` `None` this is [`sample_boundary`].
+pub fn sample_boundary_graded(
+    mesh: &TriMesh,
+    curves: &[BoundaryCurve],
+    spacing: f64,
+    width: Option<&(dyn Fn(DVec3) -> f64 + Sync)>,
+) -> BoundarySamples {
+    let Some(width) = width else {
+        return sample_boundary(mesh, curves, spacing);
+    };
+    let mut out = BoundarySamples::default();
+    let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();
+    for curve in curves {
+        let nv = curve.vertices.len();
+        let ne = curve.faces.len();
+        let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
+        let w: Vec<f64> = (0..nv).map(|k| width(pos(k)).max(1e-6)).collect();
+        // Steps per edge: ∫ ds / (w spacing), trapezoid rule in 1/w.
+        let steps_of: Vec<f64> = (0..ne)
+            .map(|k| {
+                let l = pos(k).distance(pos(k + 1));
+                0.5 * l * (1.0 / w[k % nv] + 1.0 / w[(k + 1) % nv]) / spacing
+            })
+            .collect();
+        let total: f64 = steps_of.iter().sum();
+        if !(total > 0.0) {
+            continue;
+        }
+        let steps = curve_steps(total, 1.0, curve.closed) as usize;
+        let count = if curve.closed { steps } else { steps + 1 };
+        let mut ids = Vec::with_capacity(count);
+        let (mut edge, mut edge_start) = (0usize, 0.0f64);
+        for s in 0..count {
+            let t = total * s as f64 / steps as f64;
+            while edge + 1 < ne && edge_start + steps_of[edge] < t {
+                edge_start += steps_of[edge];
+                edge += 1;
+            }
+            let endpoint = if !curve.closed && s == 0 {
+                Some(curve.vertices[0])
+            } else if !curve.closed && s == steps {
+                Some(curve.vertices[nv - 1])
+            } else {
+                None
+            };
+            if let Some(&id) = endpoint.and_then(|v| at_vertex.get(&v)) {
+                ids.push(id);
+                continue;
+            }
+            let u = if steps_of[edge] > 0.0 {
+                ((t - edge_start) / steps_of[edge]).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let face = curve.faces[edge];
+            let id = out.samples.len() as u32;
+            out.samples.push(SurfaceSample {
+                position: pos(edge).lerp(pos(edge + 1), u),
+                normal: mesh.face_normal(face as usize),
+                face,
+            });
+            if let Some(v) = endpoint {
+                at_vertex.insert(v, id);
+            }
+            ids.push(id);
+        }
+        for k in 0..ids.len() - 1 {
+            out.edges.push([ids[k], ids[k + 1]]);
+        }
+        if curve.closed {
+            out.edges.push([ids[ids.len() - 1], ids[0]]);
+        }
+    }
+    out
 }
 
 /// Places samples along every boundary curve of `mesh` at equal arc-length steps as close to

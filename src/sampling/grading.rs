@@ -14,6 +14,8 @@ use glam::DVec3;
 use crate::error::Result;
 use crate::mesh::{Normalization, TriMesh};
 use crate::pipeline::SAMPLES_PER_SIGMA2;
+use crate::sampling::boundary::BoundaryCurve;
+use crate::spatial::StaticTree;
 use crate::surface::local_feature_size::{local_feature_size, LfsParams, LocalFeatureSize};
 
 /// Parameters of the grading.
@@ -76,9 +78,15 @@ pub struct Grading {
     params: GradingParams,
     /// Estimates at or above this radius (bbox-100 units) mean "no feature nearer": width 1.
     cap: f64,
-    /// The smallest of `thickness`.
+    /// The smallest of `thickness` and of the boundary gaps.
     min_thickness: f64,
+    /// One kd-tree per boundary loop over its vertices (at most [`MAX_GAP_LOOPS`] loops), for
+    /// the gap between loops ([`Grading::boundary_gap`]).
+    loops: Vec<StaticTree>,
 }
+
+/// The most boundary loops whose gaps the grading follows (each point queries every loop).
+pub const MAX_GAP_LOOPS: usize = 64;
 
 impl Grading {
     /// Estimates the local feature size of `mesh` (bbox-100 units) up to `cap` (a part thicker
@@ -87,7 +95,17 @@ impl Grading {
     ///
     /// # Errors
     /// Those of [`local_feature_size`] (an unusable mesh, a bad spacing).
-    pub fn new(mesh: &TriMesh, params: GradingParams, cap: f64, spacing: f64) -> Result<Self> {
+    ///
+    /// With `curves` (the input's boundary curves), the thickness also follows the gap between
+    /// two boundary loops (a strip of surface between two holes is thin too; see
+    /// [`Grading::boundary_gap`]), for inputs with at most [`MAX_GAP_LOOPS`] loops.
+    pub fn new(
+        mesh: &TriMesh,
+        curves: &[BoundaryCurve],
+        params: GradingParams,
+        cap: f64,
+        spacing: f64,
+    ) -> Result<Self> {
         let lfs = local_feature_size(
             mesh,
             &LfsParams {
@@ -98,29 +116,83 @@ impl Grading {
             },
         )?;
         let thickness = lfs.lipschitz_envelope(&median_filtered(&lfs, MEDIAN_NEIGHBORS), cap);
-        let min_thickness = thickness.iter().copied().fold(f64::INFINITY, f64::min);
-        Ok(Grading {
+        let loops: Vec<StaticTree> = if curves.len() >= 2 && curves.len() <= MAX_GAP_LOOPS {
+            curves
+                .iter()
+                .map(|c| {
+                    let points: Vec<DVec3> = c
+                        .vertices
+                        .iter()
+                        .map(|&v| mesh.positions[v as usize])
+                        .collect();
+                    StaticTree::new(&points)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let mut grading = Grading {
             lfs,
-            min_thickness,
+            min_thickness: f64::INFINITY,
             thickness,
             params,
             cap,
-        })
+            loops,
+        };
+        let boundary_min = curves
+            .iter()
+            .flat_map(|c| c.vertices.iter())
+            .map(|&v| grading.boundary_gap(mesh.positions[v as usize]))
+            .fold(f64::INFINITY, f64::min);
+        grading.min_thickness = grading
+            .thickness
+            .iter()
+            .copied()
+            .fold(boundary_min, f64::min);
+        Ok(grading)
     }
 
     /// The thickness at `x` (bbox-100 units; [`LocalFeatureSize::thickness`], smoothed to its
     /// 1-Lipschitz envelope): the local feature size where a medial ball reaches across to
     /// another sheet; `f64::INFINITY` at or beyond the cap.
+    ///
+    /// The smaller of that and [`Grading::boundary_gap`].
     pub fn lfs(&self, x: DVec3) -> f64 {
         let l = self
             .lfs
             .nearest(x)
-            .map_or(f64::INFINITY, |j| self.thickness[j]);
+            .map_or(f64::INFINITY, |j| self.thickness[j])
+            .min(self.boundary_gap(x));
         if l >= self.cap {
             f64::INFINITY
         } else {
             l
         }
+    }
+
+    /// Half the width of the strip of surface between two boundary loops at `x` (bbox-100
+    /// units): (d1 + d2) / 2, d1 and d2 the distances from `x` to its nearest and second-nearest
+    /// boundary loops (1-Lipschitz; half the gap between the loops on a boundary point);
+    /// `f64::INFINITY` with fewer than two loops followed.
+    pub fn boundary_gap(&self, x: DVec3) -> f64 {
+        if self.loops.len() < 2 {
+            return f64::INFINITY;
+        }
+        let mut near = Vec::with_capacity(1);
+        let (mut d1, mut d2) = (f64::INFINITY, f64::INFINITY);
+        for tree in &self.loops {
+            tree.nearest_n(x, 1, &mut near);
+            if let Some(&(_, d)) = near.first() {
+                let d = d.sqrt();
+                if d < d1 {
+                    d2 = d1;
+                    d1 = d;
+                } else if d < d2 {
+                    d2 = d;
+                }
+            }
+        }
+        0.5 * (d1 + d2)
     }
 
     /// The relative kernel width at `x` for the global `sigma_p`: `min(1, c · lfs(x) / sigma_p)`,
