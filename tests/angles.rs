@@ -4,26 +4,14 @@
 //! apart and the interior vertex across them a whole spacing away, never moved because a vertex
 //! whose faces touch the boundary counted as on it.
 
-use std::path::{Path, PathBuf};
+mod common;
 
 use spectral_remesh::geometry::intersecting_pairs;
 use spectral_remesh::{read_mesh, remesh, triangle_quality, Density, RemeshParams};
 
-fn shared(name: &str) -> PathBuf {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(name);
-    assert!(
-        p.is_file(),
-        "{} is missing: this test needs the shared models",
-        p.display()
-    );
-    p
-}
-
 #[test]
 fn bunny_at_its_harness_count_has_no_angle_below_25_and_no_crossing_at_seeds_1_to_5() {
-    let (input, _) = read_mesh(&shared("stanford-bunny.obj")).unwrap();
+    let (input, _) = read_mesh(&common::shared("stanford-bunny.obj")).unwrap();
     for seed in 1..=5 {
         let params = RemeshParams {
             density: Density::Points(9635),

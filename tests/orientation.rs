@@ -7,23 +7,11 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use spectral_remesh::{
     read_mesh, run_remesh, write_mesh, Density, QualityReport, RemeshJob, RemeshParams, TriMesh,
 };
-
-fn shared(name: &str) -> PathBuf {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(name);
-    assert!(
-        p.is_file(),
-        "{} is missing: these regression tests need the shared models",
-        p.display()
-    );
-    p
-}
 
 /// Writes `mesh` as `dir/name`, remeshes it to `points` vertices with `seed`, and returns the
 /// report (with distances) and the output as written.
@@ -84,7 +72,7 @@ const HAUSDORFF_FACTOR: f64 = 2.0;
 #[test]
 fn spot_with_a_reversed_region_remeshes_like_clean_spot() {
     let dir = tempfile::tempdir().unwrap();
-    let (clean, _) = read_mesh(&shared("spot.obj")).unwrap();
+    let (clean, _) = read_mesh(&common::shared("spot.obj")).unwrap();
     let mut reversed = clean.clone();
     let centre = clean.positions[0];
     let count = reverse_within(&mut reversed, centre, 0.4);

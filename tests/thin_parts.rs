@@ -194,23 +194,11 @@ fn grading_changes_nothing_on_a_surface_without_thin_parts() {
     assert_eq!(on.mesh.triangles, off.mesh.triangles);
 }
 
-fn shared(name: &str) -> std::path::PathBuf {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(name);
-    assert!(
-        p.exists(),
-        "{} is missing: the shared test models must be beside the checkout",
-        p.display()
-    );
-    p
-}
-
 #[test]
 fn the_bunnys_five_holes_stay_five_at_2000_and_1000_points() {
     // Two of its holes lie a strip narrower than the spacing apart: without the boundary gap
     // in the grading they merged into one at 1000 points at every seed and at 2000 at 4 of 5.
-    let (bunny, _) = spectral_remesh::read_mesh(&shared("stanford-bunny.obj")).unwrap();
+    let (bunny, _) = spectral_remesh::read_mesh(&common::shared("stanford-bunny.obj")).unwrap();
     for (points, seeds) in [(2000, 1..=5), (1000, 1..=2)] {
         for seed in seeds {
             let out = run(&bunny, points, seed, Some(GradingParams::default()));

@@ -173,88 +173,40 @@ pub fn sample_boundary_graded(
     let Some(width) = width else {
         return sample_boundary(mesh, curves, spacing);
     };
-    let mut out = BoundarySamples::default();
-    let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();
-    for curve in curves {
-        let nv = curve.vertices.len();
-        let ne = curve.faces.len();
-        let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
-        let w: Vec<f64> = (0..nv).map(|k| width(pos(k)).max(1e-6)).collect();
-        // Steps per edge: ∫ ds / (w spacing), trapezoid rule in 1/w.
-        let steps_of: Vec<f64> = (0..ne)
-            .map(|k| {
-                let l = pos(k).distance(pos(k + 1));
-                0.5 * l * (1.0 / w[k % nv] + 1.0 / w[(k + 1) % nv]) / spacing
-            })
-            .collect();
-        let total: f64 = steps_of.iter().sum();
-        if !(total > 0.0) {
-            continue;
-        }
-        let steps = curve_steps(total, 1.0, curve.closed) as usize;
-        let count = if curve.closed { steps } else { steps + 1 };
-        let mut ids = Vec::with_capacity(count);
-        let (mut edge, mut edge_start) = (0usize, 0.0f64);
-        for s in 0..count {
-            let t = total * s as f64 / steps as f64;
-            while edge + 1 < ne && edge_start + steps_of[edge] < t {
-                edge_start += steps_of[edge];
-                edge += 1;
-            }
-            let endpoint = if !curve.closed && s == 0 {
-                Some(curve.vertices[0])
-            } else if !curve.closed && s == steps {
-                Some(curve.vertices[nv - 1])
-            } else {
-                None
-            };
-            if let Some(&id) = endpoint.and_then(|v| at_vertex.get(&v)) {
-                ids.push(id);
-                continue;
-            }
-            let u = if steps_of[edge] > 0.0 {
-                ((t - edge_start) / steps_of[edge]).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let face = curve.faces[edge];
-            let id = out.samples.len() as u32;
-            out.samples.push(SurfaceSample {
-                position: pos(edge).lerp(pos(edge + 1), u),
-                normal: mesh.face_normal(face as usize),
-                face,
-            });
-            if let Some(v) = endpoint {
-                at_vertex.insert(v, id);
-            }
-            ids.push(id);
-        }
-        for k in 0..ids.len() - 1 {
-            out.edges.push([ids[k], ids[k + 1]]);
-        }
-        if curve.closed {
-            out.edges.push([ids[ids.len() - 1], ids[0]]);
-        }
-    }
-    out
+    // Per edge, its steps: the trapezoid rule in 1/w, in units of one step.
+    sample_curves(mesh, curves, 1.0, |a, b| {
+        0.5 * a.distance(b) * (1.0 / width(a).max(1e-6) + 1.0 / width(b).max(1e-6)) / spacing
+    })
 }
 
 /// Places samples along every boundary curve of `mesh` at equal arc-length steps as close to
 /// `spacing` (bbox-100 units) as a whole number of steps allows: a closed loop gets at least 3,
 /// and the ends of open chains are shared between the chains that meet there.
 pub fn sample_boundary(mesh: &TriMesh, curves: &[BoundaryCurve], spacing: f64) -> BoundarySamples {
+    sample_curves(mesh, curves, spacing, |a, b| a.distance(b))
+}
+
+/// The samples of every curve at equal steps of a measure along it: `measure(a, b)` of each
+/// edge from a to b, the step count the whole number of `unit`s closest to the curve's total
+/// ([`curve_steps`]), positions linear in the measure within an edge.
+fn sample_curves(
+    mesh: &TriMesh,
+    curves: &[BoundaryCurve],
+    unit: f64,
+    measure: impl Fn(DVec3, DVec3) -> f64,
+) -> BoundarySamples {
     let mut out = BoundarySamples::default();
     let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();
     for curve in curves {
         let nv = curve.vertices.len();
         let ne = curve.faces.len();
         let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
-        let lengths: Vec<f64> = (0..ne).map(|k| pos(k).distance(pos(k + 1))).collect();
+        let lengths: Vec<f64> = (0..ne).map(|k| measure(pos(k), pos(k + 1))).collect();
         let total: f64 = lengths.iter().sum();
         if !(total > 0.0) {
             continue;
         }
-        let steps = curve_steps(total, spacing, curve.closed) as usize;
+        let steps = curve_steps(total, unit, curve.closed) as usize;
         let mut ids = Vec::with_capacity(steps + 1);
         let count = if curve.closed { steps } else { steps + 1 };
         let (mut edge, mut edge_start) = (0usize, 0.0f64);

@@ -1,8 +1,24 @@
 //! Meshes built in code, shared by the integration tests.
 #![allow(dead_code)]
 
+use std::path::{Path, PathBuf};
+
 use glam::DVec3;
 use spectral_remesh::TriMesh;
+
+/// The path of a shared test model (`../shared/data/NAME` beside the checkout); a missing one
+/// fails the test that needs it, with its path.
+pub fn shared(name: &str) -> PathBuf {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(name);
+    assert!(
+        p.is_file(),
+        "{} is missing: this test needs the shared models beside the checkout",
+        p.display()
+    );
+    p
+}
 
 /// Flips every face whose normal points towards the origin (for convex meshes around it).
 pub fn orient_outward(mut m: TriMesh) -> TriMesh {
