@@ -328,7 +328,11 @@ impl Ball<'_> {
     /// facing sheets give about 180° (whichever of a tube's ring of contacts set the radius,
     /// and although a faceted tube stops the ball short of its inscribed radius); a concave
     /// crease of dihedral angle φ gives 180° − φ / 2 or less (135° at a right angle); a bump
-    /// on one sheet, whose ball is small, finds the other sheet far beyond the reach.
+    /// on one sheet, whose ball is small, finds the other sheet far beyond the reach. The
+    /// other sheet must also face nearly opposite to p (normals at least θ apart): a plate, a
+    /// tube, a sharp cone or two facing sheets are nearly parallel across, while near the
+    /// corner of a polyhedron (a tetrahedron's faces are 109.5° apart) the ball's antipode can
+    /// land on a third face at a wide angle: a corner is a feature, not a thin part.
     fn shrink(&self, p: DVec3, n: DVec3, side: f64, points: &StaticTree) -> (f64, bool, bool) {
         let mut near = Vec::with_capacity(2);
         let (upper, _, q1) = self.shrink_with(p, n, side, self.max_radius, |c, r| {
@@ -350,6 +354,7 @@ impl Ball<'_> {
                     let (u, v) = (p - c, q.position - c);
                     v.length() <= ACROSS_REACH * r
                         && u.dot(v) <= self.cos_thin * u.length() * v.length()
+                        && self.surface.face_normal(q.face).dot(n) <= self.cos_thin
                 });
         (r, converged, thin)
     }
