@@ -626,7 +626,7 @@ pub fn remesh(
                 // search could not reach is not reached by asking for more.
                 let done = attempt >= 3
                     || miss.abs() <= params.count_tolerance * n as f64
-                    || dropped_samples == 0
+                    || (dropped_samples == 0 && miss.abs() <= 0.01 * n as f64)
                     || !target_reached;
                 (done, miss.abs() <= 0.01 * n as f64, miss)
             }

@@ -255,15 +255,7 @@ fn try_collapse(
     {
         return None;
     }
-    let mut involved: Vec<u32> = m
-        .faces_around(removed)
-        .iter()
-        .chain(m.faces_around(kept))
-        .copied()
-        .filter(|&g| g != f1 && g != f2)
-        .collect();
-    involved.sort_unstable();
-    involved.dedup();
+    let involved = faces_around_edge(m, removed, kept, f1, f2);
     let old_faces: Vec<[u32; 3]> = involved
         .iter()
         .chain([&f1, &f2])
@@ -313,15 +305,7 @@ fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, bound: f64) -> Vec<DVec
         if min_angle(m, t) >= bound {
             continue;
         }
-        let (pb, pc) = (m.position(t[1]), m.position(t[2]));
-        let mid = 0.5 * (pb + pc);
-        let e = pc - pb;
-        let height = old - mid;
-        let across = (height - e * (height.dot(e) / e.length_squared().max(f64::MIN_POSITIVE)))
-            .normalize_or_zero();
-        if across != DVec3::ZERO {
-            aims.push(mid + across * (0.75f64.sqrt() * e.length()));
-        }
+        aims.extend(equilateral_apex(old, m.position(t[1]), m.position(t[2])));
     }
     aims.iter()
         .flat_map(|&a| [1.0, 0.5, 0.25].map(|s| old.lerp(a, s)))

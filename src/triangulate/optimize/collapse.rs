@@ -75,15 +75,7 @@ pub(super) fn collapse_short(
             }
         }
         // The faces that change: all around a and b but f1 and f2.
-        let mut involved: Vec<u32> = m
-            .faces_around(a)
-            .iter()
-            .chain(m.faces_around(b))
-            .copied()
-            .filter(|&g| g != f1 && g != f2)
-            .collect();
-        involved.sort_unstable();
-        involved.dedup();
+        let involved = faces_around_edge(m, a, b, f1, f2);
         let before = involved
             .iter()
             .chain([&f1, &f2])

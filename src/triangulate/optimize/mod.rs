@@ -174,6 +174,33 @@ pub(super) fn face(m: &Mesh, f: u32) -> [u32; 3] {
         .unwrap_or_else(|| unreachable!("face {f} is live"))
 }
 
+/// The faces that an edit of edge a–b changes besides its own two faces `f1` and `f2`: every
+/// face around a or b, once each, in index order.
+pub(super) fn faces_around_edge(m: &Mesh, a: u32, b: u32, f1: u32, f2: u32) -> Vec<u32> {
+    let mut involved: Vec<u32> = m
+        .faces_around(a)
+        .iter()
+        .chain(m.faces_around(b))
+        .copied()
+        .filter(|&g| g != f1 && g != f2)
+        .collect();
+    involved.sort_unstable();
+    involved.dedup();
+    involved
+}
+
+/// The apex of the equilateral triangle on edge pb–pc on the side of `old` (in the plane of
+/// the three): where a vertex at `old` would make the face opposite it equilateral; `None` when
+/// `old` lies on the edge's line.
+pub(super) fn equilateral_apex(old: DVec3, pb: DVec3, pc: DVec3) -> Option<DVec3> {
+    let mid = 0.5 * (pb + pc);
+    let e = pc - pb;
+    let height = old - mid;
+    let across = (height - e * (height.dot(e) / e.length_squared().max(f64::MIN_POSITIVE)))
+        .normalize_or_zero();
+    (across != DVec3::ZERO).then(|| mid + across * (0.75f64.sqrt() * e.length()))
+}
+
 pub(super) fn distance_to_faces(m: &Mesh, faces: &[u32], p: DVec3) -> f64 {
     faces
         .iter()

@@ -102,15 +102,7 @@ pub(super) fn relax_poor(
             if !is_poor(m, t, params) {
                 continue;
             }
-            let (pb, pc) = (m.position(t[1]), m.position(t[2]));
-            let mid = 0.5 * (pb + pc);
-            let e = pc - pb;
-            let height = old - mid;
-            let across = (height - e * (height.dot(e) / e.length_squared().max(f64::MIN_POSITIVE)))
-                .normalize_or_zero();
-            if across != DVec3::ZERO {
-                targets.push(mid + across * (0.75f64.sqrt() * e.length()));
-            }
+            targets.extend(equilateral_apex(old, m.position(t[1]), m.position(t[2])));
         }
         let mut best = (worst_q(m), old);
         for (target, t) in targets
