@@ -343,9 +343,9 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
                 out.normalization.invert(st.max),
             );
             report.notes.push(format!(
-                "{} tiny closed pieces ({} vertices) that split off at a tip too thin for this \
-                 count were left out, so the tip comes out blunted there: [{:.4}, {:.4}, {:.4}]-\
-                 [{:.4}, {:.4}, {:.4}]",
+                "{} tiny closed pieces ({} vertices) that split off where the surface is too \
+                 thin for this count were left out (a tip comes out blunted, a part thinner \
+                 still may come out broken): [{:.4}, {:.4}, {:.4}]-[{:.4}, {:.4}, {:.4}]",
                 st.shells, st.vertices, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
             ));
         }
