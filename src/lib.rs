@@ -164,7 +164,7 @@ pub use sampling::candidates::surface_candidates;
 pub use sampling::gradient_ascent::{
     gradient_ascent, gradient_ascent_graded, GradientAscentParams, GradientAscentResult, WidthField,
 };
-pub use sampling::grading::{GradedRegion, Grading, GradingParams, GradingStats};
+pub use sampling::grading::{GradedRegion, Grading, GradingParams, GradingStats, MAX_GAP_LOOPS};
 pub use sampling::linear_scan::{
     linear_scan, linear_scan_graded, LinearScanParams, LinearScanResult, LinearScanner,
 };
