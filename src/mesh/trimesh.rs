@@ -503,6 +503,20 @@ pub(crate) mod test_meshes {
         TriMesh::new(positions, triangles)
     }
 
+    /// Two parallel `n × n` unit grids 0.2 apart, the upper one shifted by (0.3, 0.4) so that no
+    /// vertex lies above another; returns the mesh and the index of the upper grid's first
+    /// vertex.
+    pub fn stacked_grids(n: usize) -> (TriMesh, u32) {
+        let a = grid(n, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let b = grid(n, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
+        let mut m = a;
+        let off = m.positions.len() as u32;
+        m.positions.extend(b.positions.iter().copied());
+        m.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        (m, off)
+    }
+
     /// An `n × n` grid of squares, each cut by a diagonal; vertex `(i, j)` (0 ..= n each) is at
     /// `position(i, j)`.
     pub fn grid(n: usize, position: impl Fn(usize, usize) -> DVec3) -> TriMesh {

@@ -218,13 +218,7 @@ mod tests {
     fn a_dent_through_a_nearby_sheet_is_pulled_back_and_a_clean_mesh_is_left_alone() {
         // Two parallel 6 x 6 grids 0.2 apart; one vertex of the upper one pokes through the
         // lower one.
-        let a = grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0));
-        let b = grid(6, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
-        let mut m = a.clone();
-        let off = m.positions.len() as u32;
-        m.positions.extend(b.positions.iter().copied());
-        m.triangles
-            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        let (mut m, off) = crate::mesh::test_meshes::stacked_grids(6);
         let poke = off as usize + 3 * 7 + 3;
         m.positions[poke].z = -0.3;
         assert!(!intersecting_pairs(&m.positions, &m.triangles).is_empty());
@@ -248,6 +242,7 @@ mod tests {
         assert_eq!(s.pairs_after, 0, "{s:?}");
         assert_eq!(m2.positions[poke].z, -0.3);
         // A mesh without crossings is unchanged.
+        let a = grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0));
         let mut clean = a.clone();
         let none = vec![false; clean.positions.len()];
         let s = untangle(&mut clean, &none, 1.0, &UntangleParams::default());

@@ -244,15 +244,7 @@ fn try_collapse(
     params: &Limits,
 ) -> Option<(f64, f64)> {
     let (f1, f2, c, d) = m.edge_faces(removed, kept).ok()?;
-    let (ra, rb) = (m.ring(removed), m.ring(kept));
-    let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
-    if c == d
-        || common.len() != 2
-        || !common.contains(&c)
-        || !common.contains(&d)
-        || m.degree(c) <= 3
-        || m.degree(d) <= 3
-    {
+    if !collapse_keeps_links(m, removed, kept, c, d) {
         return None;
     }
     let involved = faces_around_edge(m, removed, kept, f1, f2);
@@ -532,13 +524,7 @@ mod tests {
     #[test]
     fn the_crossing_guard_sees_faces_near_and_faces_changed() {
         // Two parallel grids 0.2 apart.
-        let a = grid(4, |i, j| DVec3::new(i as f64, j as f64, 0.0));
-        let b = grid(4, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
-        let mut both = a.clone();
-        let off = both.positions.len() as u32;
-        both.positions.extend(b.positions.iter().copied());
-        both.triangles
-            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        let (both, off) = crate::mesh::test_meshes::stacked_grids(4);
         assert!(intersecting_pairs(&both.positions, &both.triangles).is_empty());
         let mut m: Mesh = EditMesh::from_trimesh(&both, Some, SlotPolicy::Reuse);
         let mut guard = CrossingGuard::new(&m);

@@ -47,15 +47,7 @@ pub(super) fn collapse_short(
         if pa.distance(pb) >= short {
             continue;
         }
-        let (ra, rb) = (m.ring(a), m.ring(b));
-        let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
-        if c == d
-            || common.len() != 2
-            || !common.contains(&c)
-            || !common.contains(&d)
-            || m.degree(c) <= 3
-            || m.degree(d) <= 3
-        {
+        if !collapse_keeps_links(m, a, b, c, d) {
             continue;
         }
         let keep_a = is_fixed(a) || m.is_boundary_vertex(a);

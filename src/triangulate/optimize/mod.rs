@@ -174,6 +174,20 @@ pub(super) fn face(m: &Mesh, f: u32) -> [u32; 3] {
         .unwrap_or_else(|| unreachable!("face {f} is live"))
 }
 
+/// Whether collapsing edge a–b (its opposite vertices `c` and `d`) keeps the mesh's links: a and
+/// b share exactly the two neighbours c and d (the link condition), and c and d keep at least
+/// three faces each.
+pub(super) fn collapse_keeps_links(m: &Mesh, a: u32, b: u32, c: u32, d: u32) -> bool {
+    let (ra, rb) = (m.ring(a), m.ring(b));
+    let common: Vec<u32> = ra.iter().copied().filter(|u| rb.contains(u)).collect();
+    c != d
+        && common.len() == 2
+        && common.contains(&c)
+        && common.contains(&d)
+        && m.degree(c) > 3
+        && m.degree(d) > 3
+}
+
 /// The faces that an edit of edge a–b changes besides its own two faces `f1` and `f2`: every
 /// face around a or b, once each, in index order.
 pub(super) fn faces_around_edge(m: &Mesh, a: u32, b: u32, f1: u32, f2: u32) -> Vec<u32> {
