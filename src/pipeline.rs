@@ -116,8 +116,10 @@ pub struct RemeshParams {
     pub optimize: Option<OptimizeParams>,
     /// The separation of crossing faces, last.
     pub untangle: UntangleParams,
-    /// Sample density graded by the local feature size (issue 15; `None`: one sigma_p
-    /// everywhere, as in the paper).
+    /// Sample density graded by the local feature size (issue 15; `None`, the default: one
+    /// sigma_p everywhere, as in the paper). Not yet the default: on horse at 8600 it raises the
+    /// Hausdorff distance (median of seeds 1-5 from 0.449 to 0.508, at the ears) although it
+    /// keeps the topology of thin parts at low counts.
     pub grading: Option<GradingParams>,
     /// Relative tolerance of the count search (default 0.005).
     pub count_tolerance: f64,
@@ -136,7 +138,7 @@ impl Default for RemeshParams {
             triangulate: TriangulateParams::default(),
             optimize: Some(OptimizeParams::default()),
             untangle: UntangleParams::default(),
-            grading: Some(GradingParams::default()),
+            grading: None,
             count_tolerance: 0.005,
             seed: 1,
         }
