@@ -53,7 +53,18 @@ impl KernelPoint {
         if self.width == 1.0 && other.width == 1.0 {
             return self.dist2(other);
         }
-        let s2 = 0.5 * (self.width * self.width + other.width * other.width);
+        self.graded_dist2(other, self.pair_s2(other))
+    }
+
+    /// s² = (w_x² + w_y²) / 2 of the pair (see the module docs).
+    #[inline]
+    fn pair_s2(&self, other: &KernelPoint) -> f64 {
+        0.5 * (self.width * self.width + other.width * other.width)
+    }
+
+    /// |Δp|² / s2 + |Δn|².
+    #[inline]
+    fn graded_dist2(&self, other: &KernelPoint, s2: f64) -> f64 {
         let (mut dp, mut dn) = (0.0, 0.0);
         for k in 0..3 {
             let t = self.coords[k] - other.coords[k];
@@ -147,9 +158,9 @@ impl Kernel {
         if x.width == 1.0 && y.width == 1.0 {
             return (-x.dist2(y)).exp();
         }
-        let s2 = 0.5 * (x.width * x.width + y.width * y.width);
+        let s2 = x.pair_s2(y);
         let r = x.width * y.width / s2;
-        r * r.sqrt() * (-x.pair_dist2(y)).exp()
+        r * r.sqrt() * (-x.graded_dist2(y, s2)).exp()
     }
 
     /// The radius in position space (bbox-100 units) that holds every point within

@@ -162,13 +162,14 @@ pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceSample};
 pub use sampling::boundary::{boundary_curves, sample_boundary, BoundaryCurve, BoundarySamples};
 pub use sampling::candidates::surface_candidates;
 pub use sampling::gradient_ascent::{
-    gradient_ascent, gradient_ascent_graded, GradientAscentParams, GradientAscentResult, WidthField,
+    gradient_ascent, gradient_ascent_graded, GradientAscentParams, GradientAscentResult,
 };
 pub use sampling::grading::{GradedRegion, Grading, GradingParams, GradingStats, MAX_GAP_LOOPS};
 pub use sampling::linear_scan::{
     linear_scan, linear_scan_graded, LinearScanParams, LinearScanResult, LinearScanner,
 };
 pub use sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
+pub use sampling::WidthField;
 
 // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
 // optimization against the input, the separation of crossing faces.

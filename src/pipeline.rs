@@ -14,13 +14,14 @@ use crate::sampling::boundary::{
 };
 use crate::sampling::candidates::surface_candidates;
 use crate::sampling::gradient_ascent::{
-    gradient_ascent_graded, GradientAscentParams, GradientAscentResult, WidthField,
+    gradient_ascent_graded, GradientAscentParams, GradientAscentResult,
 };
 use crate::sampling::grading::{Grading, GradingParams, GradingStats};
 use crate::sampling::linear_scan::{
     linear_scan, linear_scan_graded, LinearScanParams, LinearScanResult,
 };
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
+use crate::sampling::WidthField;
 use crate::surface::winding::BuriedTest;
 use crate::surface::MeshSurface;
 use crate::surface::SurfaceSample;
@@ -298,7 +299,6 @@ pub fn remesh(
     }
     let surface = MeshSurface::new(&normalized)?;
     timer.lap("normalize");
-    let input_components = crate::check::topology(&normalized).components;
 
     on_stage("candidates");
     // Candidates are drawn for the samples expected inside the surface.
@@ -368,6 +368,7 @@ pub fn remesh(
 
     // The local feature size, for the grading of the kernel width: estimated up to a few times
     // the largest width the search is expected to try (a part thicker than that is not graded).
+    // The search's first sigma_p (the given one for --sigma-p).
     let first_sigma_p = match density {
         Target::Points(n) => sigma_p_for_count(area, boundary_length, n as f64),
         Target::SigmaP(s) => s,
@@ -385,6 +386,11 @@ pub fn remesh(
         }
         None => None,
     };
+    // The input's component count, which the stray-shell pass (grading only) brings the output
+    // back to.
+    let input_components = grading
+        .as_ref()
+        .map_or(0, |_| crate::check::topology(&normalized).components);
 
     // The sampler's count is searched for; the triangulation may set a few samples aside (at
     // parts thinner than the sampling), so when the output's vertex count misses the target by
@@ -394,10 +400,7 @@ pub fn remesh(
         Target::Points(n) => n,
         Target::SigmaP(_) => 0,
     };
-    let mut start = match density {
-        Target::Points(n) => sigma_p_for_count(area, boundary_length, n as f64),
-        Target::SigmaP(s) => s,
-    };
+    let mut start = first_sigma_p;
     let mut full_history = Vec::new();
     let mut attempt = 0;
     // The sigma_p the grading's widths are taken for (see the search).
@@ -414,7 +417,16 @@ pub fn remesh(
         };
         // With grading, the widths are those for sigma_ref (held fixed through a search, so the
         // count falls like sigma_p^-2 as without grading; see the search below).
-        let scan = |sigma_p: f64, sigma_ref: f64| -> Result<(usize, Option<ScanWithBoundary>)> {
+        // The candidates' widths for one sigma_ref, taken once for a round's evaluations.
+        let pool_widths = |g: &Grading, sigma_ref: f64| -> Vec<f64> {
+            pool.par_iter()
+                .map(|c| g.width(c.position, sigma_ref))
+                .collect()
+        };
+        let scan = |sigma_p: f64,
+                    sigma_ref: f64,
+                    pool_widths: Option<&[f64]>|
+         -> Result<(usize, Option<ScanWithBoundary>)> {
             let kernel = Kernel::new(sigma_p, params.sigma_n)?;
             let spacing = BOUNDARY_SPACING_PER_SIGMA * sigma_p;
             let boundary_count = boundary_sample_count(&curves, &curve_lengths, spacing);
@@ -434,6 +446,7 @@ pub fn remesh(
                 Some(g) => linear_scan_graded(
                     &kernel,
                     &pool,
+                    pool_widths,
                     &b.samples,
                     Some(&|p| g.width(p, sigma_ref)),
                     &params.linear_scan,
@@ -444,7 +457,8 @@ pub fn remesh(
         };
         let (sigma_p, target_reached, search_history, value) = match density {
             Target::SigmaP(s) => {
-                let (count, value) = scan(s, s)?;
+                let widths = grading.as_ref().map(|g| pool_widths(g, s));
+                let (count, value) = scan(s, s, widths.as_deref())?;
                 (s, true, vec![(s, count)], value)
             }
             Target::Points(_) => {
@@ -461,12 +475,15 @@ pub fn remesh(
                 let mut round_start = start;
                 let mut round = 0;
                 loop {
+                    let widths = grading.as_ref().map(|g| pool_widths(g, sigma_ref));
                     let mut failure = None;
-                    let r = find_sigma_p(&search, round_start, |s| match scan(s, sigma_ref) {
-                        Ok(v) => v,
-                        Err(e) => {
-                            failure = Some(e);
-                            (0, None)
+                    let r = find_sigma_p(&search, round_start, |s| {
+                        match scan(s, sigma_ref, widths.as_deref()) {
+                            Ok(v) => v,
+                            Err(e) => {
+                                failure = Some(e);
+                                (0, None)
+                            }
                         }
                     });
                     if let Some(e) = failure {

@@ -10,6 +10,7 @@ use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 use crate::mesh::TriMesh;
+use crate::sampling::WidthField;
 use crate::surface::SurfaceSample;
 
 /// One boundary curve of a mesh: input vertex indices in order, the surface on the left (the
@@ -168,7 +169,7 @@ pub fn sample_boundary_graded(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
     spacing: f64,
-    width: Option<&(dyn Fn(DVec3) -> f64 + Sync)>,
+    width: Option<WidthField>,
 ) -> BoundarySamples {
     let Some(width) = width else {
         return sample_boundary(mesh, curves, spacing);

@@ -7,10 +7,10 @@ use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 #[cfg(doc)]
 use crate::measure::measure_and_gradient_graded;
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
+use crate::sampling::WidthField;
 use crate::spatial::StaticTree;
 use crate::surface::Projection;
 use crate::surface::SurfaceSample;
-use glam::DVec3;
 
 /// Parameters of the gradient ascent.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,10 +87,6 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
 ) -> GradientAscentResult {
     gradient_ascent_graded(kernel, surface, samples, fixed, None, params, seed)
 }
-
-/// A field of relative kernel widths w(p) in (0, 1] over positions (bbox-100 units): a graded
-/// kernel's sigma_p(p) = w(p) · sigma_p (see [`Kernel`](crate::Kernel)).
-pub type WidthField<'a> = &'a (dyn Fn(DVec3) -> f64 + Sync);
 
 /// [`gradient_ascent`] with a graded kernel: each sample's width is `width(position)`, taken
 /// again after each of its moves. The field is treated as locally constant (the pipeline's is
@@ -252,11 +248,7 @@ fn move_one<S: Projection + ?Sized>(
     let (s, g) = measure_and_gradient(kernel, &x, sorted, ws);
     // Kernel units to position units: Δp = sigma_p · step · w² · ∇_x s (w = 1: eq. 11).
     let w = x.width;
-    let mut delta = if w == 1.0 {
-        glam::DVec3::new(g[0], g[1], g[2]) * (params.step * sigma_p)
-    } else {
-        glam::DVec3::new(g[0], g[1], g[2]) * (params.step * sigma_p * w * w)
-    };
+    let mut delta = glam::DVec3::new(g[0], g[1], g[2]) * (params.step * sigma_p * w * w);
     let len = delta.length();
     let max_move = params.max_move_sigma_p * sigma_p * w;
     if len > max_move {

@@ -3,6 +3,7 @@
 use crate::geometry::morton::morton_code;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{spectral_measure, MeasureWorkspace, DEFAULT_EPSILON};
+use crate::sampling::WidthField;
 use crate::spatial::DynamicTree;
 use crate::surface::SurfaceSample;
 use glam::DVec3;
@@ -450,16 +451,19 @@ pub fn linear_scan(
     initial: &[SurfaceSample],
     params: &LinearScanParams,
 ) -> LinearScanResult {
-    linear_scan_graded(kernel, candidates, initial, None, params)
+    linear_scan_graded(kernel, candidates, None, initial, None, params)
 }
 
-/// [`linear_scan`] with a graded kernel: each point's relative width (see [`Kernel`](crate::Kernel)) is
-/// `width(position)` (`None`: 1 everywhere, the same as [`linear_scan`]).
+/// [`linear_scan`] with a graded kernel: each point's relative width (see
+/// [`Kernel`](crate::Kernel)), `candidate_widths[k]` for `candidates[k]` and `width(position)`
+/// for the initial samples (`None`: 1 everywhere, the same as [`linear_scan`]). The candidates'
+/// widths are taken by the caller, once for the evaluations that share them.
 pub fn linear_scan_graded(
     kernel: &Kernel,
     candidates: &[SurfaceSample],
+    candidate_widths: Option<&[f64]>,
     initial: &[SurfaceSample],
-    width: Option<&(dyn Fn(DVec3) -> f64 + Sync)>,
+    width: Option<WidthField>,
     params: &LinearScanParams,
 ) -> LinearScanResult {
     let mut samples: Vec<SurfaceSample> = Vec::with_capacity(initial.len() + candidates.len() / 8);
@@ -469,10 +473,8 @@ pub fn linear_scan_graded(
         samples.push(*s);
     }
     let batch: Vec<(DVec3, DVec3)> = candidates.iter().map(|c| (c.position, c.normal)).collect();
-    let widths: Option<Vec<f64>> =
-        width.map(|w| candidates.par_iter().map(|c| w(c.position)).collect());
     let mut accepted = Vec::new();
-    scanner.offer_batch_graded(&batch, widths.as_deref(), &mut accepted);
+    scanner.offer_batch_graded(&batch, candidate_widths, &mut accepted);
     samples.extend(accepted.iter().map(|&i| candidates[i]));
     LinearScanResult {
         samples,

@@ -9,3 +9,7 @@ pub mod grading;
 pub mod linear_scan;
 pub mod surface_sampler;
 pub mod target_count;
+
+/// A field of relative kernel widths w(p) in (0, 1] over positions (bbox-100 units): a graded
+/// kernel's sigma_p(p) = w(p) · sigma_p (see [`Kernel`](crate::Kernel)).
+pub type WidthField<'a> = &'a (dyn Fn(glam::DVec3) -> f64 + Sync);

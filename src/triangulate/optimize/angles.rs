@@ -5,8 +5,6 @@
 use glam::DVec3;
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
-use parry3d_f64::query::PointQuery;
-use parry3d_f64::shape::Triangle;
 
 use super::*;
 use crate::geometry::self_intersection::intersecting_pairs;
@@ -179,17 +177,6 @@ fn worst_angle(m: &Mesh, faces: impl IntoIterator<Item = [u32; 3]>) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// The distance from `p` to the nearest of the faces `faces`.
-fn distance_to(m: &Mesh, faces: &[[u32; 3]], p: DVec3) -> f64 {
-    faces
-        .iter()
-        .map(|&t| {
-            let [a, b, c] = m.corners(t);
-            Triangle::new(a, b, c).distance_to_local_point(p, true)
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
 /// The smallest angle of the two faces the max-min flip of `x`–`y` makes, when it passes the
 /// guards of [`mend_faces`].
 fn try_flip(
@@ -218,10 +205,10 @@ fn try_flip(
     let new_mid = surface.closest_point(0.5 * (pc + pd))?;
     let old_off = old_mid
         .distance
-        .max(distance_to(m, &flip.old, new_mid.position));
+        .max(distance_to(m, flip.old, new_mid.position));
     let new_off = new_mid
         .distance
-        .max(distance_to(m, &flip.new, old_mid.position));
+        .max(distance_to(m, flip.new, old_mid.position));
     let old = worst_angle(m, flip.old);
     let new = worst_angle(m, flip.new);
     if new_off > params.collapse_offset.max(old_off) {
@@ -262,12 +249,9 @@ fn try_collapse(
         .collect();
     m.relocate_vertex(kept, q).ok()?;
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
-    let turned = new_faces
-        .iter()
-        .zip(&old_normals)
-        .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
-    let near = distance_to(m, &new_faces, pa) <= params.collapse_offset
-        && distance_to(m, &new_faces, pb) <= params.collapse_offset;
+    let turned = turned(m, &new_faces, &old_normals, cos_turn);
+    let near = distance_to(m, new_faces.iter().copied(), pa) <= params.collapse_offset
+        && distance_to(m, new_faces.iter().copied(), pb) <= params.collapse_offset;
     let new = worst_angle(m, new_faces.iter().copied());
     let mut replaced = involved.clone();
     replaced.extend([f1, f2]);
@@ -321,13 +305,10 @@ fn try_move(
     let p = m.position(v);
     m.relocate_vertex(v, q).ok()?;
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
-    let turned = faces
-        .iter()
-        .zip(&old_normals)
-        .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
+    let turned = turned(m, &faces, &old_normals, cos_turn);
     let new = worst_angle(m, faces.iter().copied());
     let ok = !turned
-        && distance_to(m, &faces, p) <= params.collapse_offset
+        && distance_to(m, faces.iter().copied(), p) <= params.collapse_offset
         && !guard.crosses(m, &faces, &slots);
     let _ = m.relocate_vertex(v, p);
     ok.then_some((old, new))

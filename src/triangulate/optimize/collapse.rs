@@ -2,8 +2,6 @@
 //! the input surface.
 
 use glam::DVec3;
-use parry3d_f64::query::PointQuery;
-use parry3d_f64::shape::Triangle;
 
 use super::*;
 
@@ -84,23 +82,12 @@ pub(super) fn collapse_short(
                 .iter()
                 .map(|&g| face(m, g).map(|u| if u == removed { kept } else { u }))
                 .collect();
-            let turned = new_faces
-                .iter()
-                .zip(&old_normals)
-                .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn);
+            let turned = turned(m, &new_faces, &old_normals, cos_turn);
             let worst = new_faces
                 .iter()
                 .map(|&t| score(m, t))
                 .fold(f64::INFINITY, f64::min);
-            let dist = |p: DVec3| {
-                new_faces
-                    .iter()
-                    .map(|&t| {
-                        let [x, y, z] = m.corners(t);
-                        Triangle::new(x, y, z).distance_to_local_point(p, true)
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            };
+            let dist = |p: DVec3| distance_to(m, new_faces.iter().copied(), p);
             let near = dist(pa) <= params.collapse_offset && dist(pb) <= params.collapse_offset;
             // The old position was finite: restoring it cannot fail.
             let _ = m.relocate_vertex(kept, saved);

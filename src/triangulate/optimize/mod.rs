@@ -216,13 +216,27 @@ pub(super) fn equilateral_apex(old: DVec3, pb: DVec3, pc: DVec3) -> Option<DVec3
 }
 
 pub(super) fn distance_to_faces(m: &Mesh, faces: &[u32], p: DVec3) -> f64 {
+    distance_to(m, faces.iter().map(|&f| face(m, f)), p)
+}
+
+/// The distance from `p` to the nearest of the triangles `faces` (vertex indices).
+pub(super) fn distance_to(m: &Mesh, faces: impl IntoIterator<Item = [u32; 3]>, p: DVec3) -> f64 {
     faces
-        .iter()
-        .map(|&f| {
-            let [a, b, c] = m.corners(face(m, f));
+        .into_iter()
+        .map(|t| {
+            let [a, b, c] = m.corners(t);
             Triangle::new(a, b, c).distance_to_local_point(p, true)
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// Whether some face `faces[i]` has turned from its old normal `old_normals[i]` by more than the
+/// angle whose cosine is `cos_turn`.
+pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_turn: f64) -> bool {
+    faces
+        .iter()
+        .zip(old_normals)
+        .any(|(&t, &n0)| normal(m, t).dot(n0) < cos_turn)
 }
 
 /// Optimizes `mesh` (bbox-100 units, edge-manifold and consistently oriented) against `surface`
