@@ -114,6 +114,7 @@
 
 mod app;
 mod check;
+mod disjoint_sets;
 mod error;
 pub mod geometry;
 mod io;

@@ -4,6 +4,7 @@
 //! Source: standard combinatorial topology of simplicial surfaces; see e.g. Botsch, Kobbelt,
 //! Pauly, Alliez, Lévy, *Polygon Mesh Processing*, 2010, Ch. 1.
 
+use crate::disjoint_sets::Dsu;
 use serde::Serialize;
 
 use crate::geometry::triangle::is_degenerate_face;
@@ -106,64 +107,6 @@ impl Topology {
 /// sides), sequential and deterministic.
 pub fn topology(mesh: &TriMesh) -> Topology {
     analyze(mesh).topology
-}
-
-/// Disjoint sets over `0..n` with, for each element, a parity relative to its root (used for
-/// orientability; plain connectivity ignores the parity).
-struct Dsu {
-    parent: Vec<u32>,
-    parity: Vec<bool>,
-    size: Vec<u32>,
-}
-
-impl Dsu {
-    fn new(n: usize) -> Self {
-        Dsu {
-            parent: (0..n as u32).collect(),
-            parity: vec![false; n],
-            size: vec![1; n],
-        }
-    }
-
-    /// The root of `x` and the parity of `x` relative to it, compressing the path.
-    fn find(&mut self, x: usize) -> (usize, bool) {
-        let mut root = x;
-        let mut acc = false;
-        while self.parent[root] as usize != root {
-            acc ^= self.parity[root];
-            root = self.parent[root] as usize;
-        }
-        let mut y = x;
-        let mut py = acc;
-        while self.parent[y] as usize != y {
-            let next = self.parent[y] as usize;
-            let old = self.parity[y];
-            self.parent[y] = root as u32;
-            self.parity[y] = py;
-            py ^= old;
-            y = next;
-        }
-        (root, acc)
-    }
-
-    /// Joins `a` and `b` with relative parity `rel`; returns `false` when they were already
-    /// joined with the other parity.
-    fn union(&mut self, a: usize, b: usize, rel: bool) -> bool {
-        let (ra, pa) = self.find(a);
-        let (rb, pb) = self.find(b);
-        if ra == rb {
-            return (pa ^ pb) == rel;
-        }
-        let (big, small) = if self.size[ra] >= self.size[rb] {
-            (ra, rb)
-        } else {
-            (rb, ra)
-        };
-        self.parent[small] = big as u32;
-        self.parity[small] = pa ^ pb ^ rel;
-        self.size[big] += self.size[small];
-        true
-    }
 }
 
 /// Everything [`topology`] and [`check_invariants`](super::check_invariants) need, with the first offender of each kind.
@@ -410,26 +353,5 @@ pub(super) fn analyze(mesh: &TriMesh) -> Analysis {
         first_non_manifold_vertex,
         first_unreferenced,
         first_inconsistent,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn parity_dsu_detects_odd_cycles() {
-        let mut d = Dsu::new(4);
-        assert!(d.union(0, 1, true));
-        assert!(d.union(1, 2, true));
-        // 0 and 2 have even relative parity.
-        assert!(d.union(0, 2, false));
-        assert!(!d.union(0, 2, true));
-        assert_eq!(d.find(0).0, d.find(2).0);
-        assert_ne!(d.find(3).0, d.find(0).0);
-        let (r, p0) = d.find(0);
-        let (_, p1) = d.find(1);
-        assert!(p0 ^ p1);
-        assert!(!d.find(r).1);
     }
 }

@@ -213,7 +213,7 @@ pub fn orient_consistently(mesh: &mut TriMesh, closed_outward: bool) -> OrientSt
 mod tests {
     use super::*;
     use crate::check::topology;
-    use crate::mesh::test_meshes::{cuboid, grid};
+    use crate::mesh::test_meshes::{cuboid, grid, uv_sphere};
     use glam::DVec3;
 
     fn consistent(m: &TriMesh) -> bool {
@@ -223,11 +223,6 @@ mod tests {
     /// A 20 × 20 grid in the plane z = 0, faces up.
     fn plane() -> TriMesh {
         grid(20, |i, j| DVec3::new(i as f64, j as f64, 0.0))
-    }
-
-    /// A UV sphere of radius 1: `rings` latitude bands, `segments` longitudes, outward.
-    fn uv_sphere(rings: usize, segments: usize) -> TriMesh {
-        crate::mesh::test_meshes::uv_sphere(1.0, rings, segments)
     }
 
     /// A Möbius strip: `n` quads around a circle of radius 3, width 1, half a turn of twist;
@@ -260,7 +255,7 @@ mod tests {
         for m in [
             plane(),
             cuboid(DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0)),
-            uv_sphere(12, 16),
+            uv_sphere(1.0, 12, 16),
         ] {
             let mut o = m.clone();
             let stats = orient_consistently(&mut o, true);
@@ -283,7 +278,7 @@ mod tests {
 
     #[test]
     fn a_reversed_patch_is_flipped_back() {
-        for (m, radius) in [(plane(), 5.0), (uv_sphere(12, 16), 0.8)] {
+        for (m, radius) in [(plane(), 5.0), (uv_sphere(1.0, 12, 16), 0.8)] {
             let centre = m.positions[m.triangles[m.triangles.len() / 3][0] as usize];
             let mut reversed = m.clone();
             let mut count = 0;
@@ -305,7 +300,7 @@ mod tests {
 
     #[test]
     fn an_inward_closed_mesh_is_turned_outward() {
-        let m = uv_sphere(10, 12);
+        let m = uv_sphere(1.0, 10, 12);
         let mut inward = m.clone();
         inward.flip_orientation();
         assert!(inward.signed_volume() < 0.0);
@@ -343,7 +338,7 @@ mod tests {
 
     #[test]
     fn a_half_reversed_sphere_comes_out_consistent_and_outward() {
-        let m = uv_sphere(16, 20);
+        let m = uv_sphere(1.0, 16, 20);
         let mut half = m.clone();
         for f in 0..half.triangles.len() {
             if half.corners(f).iter().map(|p| p.x).sum::<f64>() > 0.0 {

@@ -6,11 +6,12 @@
 //! The local feature size comes from [`crate::surface::local_feature_size`] (shrinking balls),
 //! smoothed to its 1-Lipschitz envelope, so sigma_p(x) is c-Lipschitz and the spacing changes
 //! gradually. The width is bounded below by `min_width` · sigma_p: where c · lfs is smaller
-//! still, the part cannot be resolved at the asked count, and [`Grading::unresolved`] says how
-//! many samples would resolve it.
+//! still, the part cannot be resolved at the asked count, and [`Grading::resolving_count`] says
+//! how many samples would resolve it.
 
 use glam::DVec3;
 
+use crate::disjoint_sets::Dsu;
 use crate::error::Result;
 use crate::mesh::{Normalization, TriMesh};
 use crate::pipeline::SAMPLES_PER_SIGMA2;
@@ -263,30 +264,20 @@ impl Grading {
             .fold(1.0, f64::min);
         // Groups: connected components of the graph "within 2 sigma_p" (union-find over a kd-tree).
         let points: Vec<DVec3> = graded.iter().map(|g| g.0).collect();
-        let tree = crate::spatial::StaticTree::new(&points);
-        let mut parent: Vec<usize> = (0..points.len()).collect();
-        fn find(parent: &mut [usize], mut i: usize) -> usize {
-            while parent[i] != i {
-                parent[i] = parent[parent[i]];
-                i = parent[i];
-            }
-            i
-        }
+        let tree = StaticTree::new(&points);
+        let mut sets = Dsu::new(points.len());
         let r = 2.0 * sigma_p;
         let mut found = Vec::new();
         for (i, &p) in points.iter().enumerate() {
             tree.within(p, r * r, &mut found);
             for &(j, _) in &found {
-                let (a, b) = (find(&mut parent, i), find(&mut parent, j as usize));
-                if a != b {
-                    parent[a.max(b)] = a.min(b);
-                }
+                sets.union(i, j as usize, false);
             }
         }
         let mut regions: Vec<GradedRegion> = Vec::new();
         let mut index = std::collections::HashMap::new();
         for (i, &(p, unresolved)) in graded.iter().enumerate() {
-            let root = find(&mut parent, i);
+            let root = sets.find(i).0;
             let k = *index.entry(root).or_insert_with(|| {
                 regions.push(GradedRegion {
                     min: DVec3::splat(f64::INFINITY),

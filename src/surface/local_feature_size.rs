@@ -77,10 +77,9 @@ pub struct LocalFeatureSize {
     /// The estimate at each of `positions`: the smaller radius of the two medial balls.
     pub lfs: Vec<f64>,
     /// The thickness at each of `positions`: the smaller radius of the medial balls that reach
-    /// across to another sheet (the surface passes within r (1 + cos θ) of the ball's point
-    /// opposite the tangent point, θ = [`LfsParams::thin_separation_deg`]: the solid's
-    /// thickness or the gap to a nearby sheet, a tube's radius, a tip), the cap otherwise (a ball set by a concave crease, a
-    /// bump or the curvature of one sheet). Bounds `lfs` from above.
+    /// across to another sheet (see `Ball::shrink`: the solid's thickness or the gap to a
+    /// nearby sheet, a tube's radius, a tip), the cap otherwise (a ball set by a concave crease,
+    /// a bump, a polyhedron's corner or the curvature of one sheet). Bounds `lfs` from above.
     pub thickness: Vec<f64>,
     /// Number of mesh vertices (the first entries of `positions` and `lfs`; 0 without
     /// [`LfsParams::at_vertices`]).
@@ -398,7 +397,7 @@ impl Ball<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::{cuboid, grid};
+    use crate::mesh::test_meshes::{cuboid, grid, uv_sphere};
     use std::f64::consts::TAU;
 
     /// A closed surface of revolution-like grid: `nu × nv` quads of `position(u, v)` with
@@ -421,11 +420,6 @@ mod tests {
             }
         }
         TriMesh::new(positions, triangles)
-    }
-
-    /// A UV sphere of radius `r` at the origin: `rings` latitude bands, `segments` around.
-    fn sphere(r: f64, rings: usize, segments: usize) -> TriMesh {
-        crate::mesh::test_meshes::uv_sphere(r, rings, segments)
     }
 
     /// A closed cylinder of radius `r` along z from −len/2 to len/2: `bands` along, `segments`
@@ -481,7 +475,7 @@ mod tests {
 
     #[test]
     fn sphere_lfs_is_its_radius() {
-        let l = local_feature_size(&sphere(50.0, 64, 128), &LfsParams::default()).unwrap();
+        let l = local_feature_size(&uv_sphere(50.0, 64, 128), &LfsParams::default()).unwrap();
         assert_close("sphere r 50", range(&l, |_| true), 50.0, 0.03);
         assert_eq!(l.not_converged, 0);
         assert!((l.at(DVec3::new(0.0, 50.0, 0.0)) - 50.0).abs() < 1.5);

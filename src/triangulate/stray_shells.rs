@@ -8,6 +8,7 @@
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
+use crate::disjoint_sets::Dsu;
 use crate::mesh::TriMesh;
 use crate::triangulate::FaceSource;
 
@@ -41,32 +42,24 @@ pub fn remove_stray_shells(
         max: DVec3::splat(f64::NEG_INFINITY),
         ..StrayShells::default()
     };
-    let n = mesh.positions.len();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            parent[i as usize] = parent[parent[i as usize] as usize];
-            i = parent[i as usize];
-        }
-        i
-    }
+    let mut sets = Dsu::new(mesh.positions.len());
     for t in &mesh.triangles {
         for k in 1..3 {
-            let (a, b) = (find(&mut parent, t[0]), find(&mut parent, t[k]));
-            if a != b {
-                parent[a.max(b) as usize] = a.min(b);
-            }
+            sets.union(t[0] as usize, t[k] as usize, false);
         }
     }
     // Per component: its faces, vertices and whether it is closed.
-    let mut faces_of: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
+    let mut faces_of: FxHashMap<usize, Vec<usize>> = FxHashMap::default();
     for (f, t) in mesh.triangles.iter().enumerate() {
-        faces_of.entry(find(&mut parent, t[0])).or_default().push(f);
+        faces_of
+            .entry(sets.find(t[0] as usize).0)
+            .or_default()
+            .push(f);
     }
     if faces_of.len() <= keep {
         return record;
     }
-    let mut small: Vec<(usize, u32, Vec<u32>)> = Vec::new();
+    let mut small: Vec<(usize, u32, usize, Vec<u32>)> = Vec::new();
     for (&root, faces) in &faces_of {
         let mut vertices: Vec<u32> = faces
             .iter()
@@ -91,13 +84,14 @@ pub fn remove_stray_shells(
             .map(|&v| mesh.positions[v as usize])
             .collect();
         if closed && stray(&points) {
-            small.push((vertices.len(), root, vertices));
+            // Ties broken by the smallest vertex index (deterministic, whatever the roots).
+            small.push((vertices.len(), vertices[0], root, vertices));
         }
     }
     small.sort_by_key(|s| (s.0, s.1));
     let excess = faces_of.len() - keep;
     let mut removed_roots = Vec::new();
-    for (_, root, vertices) in small.into_iter().take(excess) {
+    for (_, _, root, vertices) in small.into_iter().take(excess) {
         record.shells += 1;
         record.vertices += vertices.len();
         for v in vertices {
