@@ -177,8 +177,9 @@ pub use sampling::WidthField;
 pub use triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
 pub use triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 pub use triangulate::{
-    assemble, triangulate, vote_triangles, AssemblyParams, AssemblyStats, FaceSource, RefineParams,
-    SampleSet, TangentDelaunayParams, TriangulateParams, VotedTriangle,
+    assemble, triangulate, triangulate_restricted, vote_triangles, AssemblyParams, AssemblyStats,
+    FaceSource, RefineParams, RestrictedDelaunayParams, RestrictedDelaunayStats, SampleSet,
+    TangentDelaunayParams, TriangulateParams, TriangulationMethod, VotedTriangle,
 };
 
 // The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).

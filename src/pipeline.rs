@@ -30,7 +30,10 @@ use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
-use crate::triangulate::{triangulate, AssemblyStats, FaceSource, SampleSet, TriangulateParams};
+use crate::triangulate::{
+    triangulate, triangulate_restricted, AssemblyStats, FaceSource, SampleSet, TriangulateParams,
+    TriangulationMethod,
+};
 
 /// How dense the output is: a vertex count, or sigma_p directly.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -578,7 +581,15 @@ pub fn remesh(
             normals: &normals,
             boundary_edges: &boundary_edges,
         };
-        let (faces, face_sources, assembly) = triangulate(&set, &params.triangulate);
+        let (faces, face_sources, assembly) = match params.triangulate.method {
+            TriangulationMethod::Umbrellas => triangulate(&set, &params.triangulate),
+            TriangulationMethod::RestrictedDelaunay(rd) => {
+                let spacing = (area / samples.len().max(1) as f64).sqrt();
+                let (f, s, a, _) =
+                    triangulate_restricted(&set, &surface, spacing, &params.triangulate, &rd);
+                (f, s, a)
+            }
+        };
         let mut mesh_normalized = TriMesh::new(positions, faces);
         timer.lap("triangulate");
         on_stage("optimize");

@@ -11,7 +11,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
     catch_panics, parse_bytes, physical_memory, remove_temporaries, run_points, run_quality,
     run_remesh, run_simplify, write_report, Density, Error, GradingParams, MeshFormat, PointsJob,
-    RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob, STDOUT,
+    RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob, TriangulationMethod, STDOUT,
 };
 
 const EXAMPLES: &str = "\
@@ -72,6 +72,12 @@ struct Cli {
     /// everywhere, as in the paper).
     #[arg(long, default_value_t = 0.0, value_name = "C")]
     lfs_factor: f64,
+
+    /// How the samples are connected: `umbrellas` (tangent-plane Delaunay umbrellas merged by
+    /// votes) or `restricted` (the restricted Delaunay triangulation on the input mesh: the dual
+    /// of the samples' Voronoi cells grown over the input).
+    #[arg(long, default_value = "umbrellas", value_name = "METHOD")]
+    triangulation: String,
 
     /// Gradient-ascent sweeps (Sec. 6.2).
     #[arg(long, default_value_t = 10)]
@@ -308,6 +314,16 @@ fn config(cli: Cli) -> Result<Config, Error> {
                     message: format!("must be a number >= 0, got {}", cli.lfs_factor),
                 });
             }
+            params.triangulate.method = match cli.triangulation.as_str() {
+                "umbrellas" => TriangulationMethod::Umbrellas,
+                "restricted" => TriangulationMethod::RestrictedDelaunay(Default::default()),
+                other => {
+                    return Err(Error::InvalidParameter {
+                        name: "--triangulation",
+                        message: format!("must be umbrellas or restricted, got {other}"),
+                    })
+                }
+            };
             params.grading = (cli.lfs_factor > 0.0).then(|| GradingParams {
                 lfs_factor: cli.lfs_factor,
                 ..GradingParams::default()

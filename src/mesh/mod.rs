@@ -3,6 +3,7 @@
 //! operators that the triangulation stage works on ([`edit::EditMesh`]); the consistent
 //! orientation of an input ([`orient_consistently`]).
 
+pub mod bisect;
 pub mod edit;
 mod orient;
 mod trimesh;

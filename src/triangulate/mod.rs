@@ -5,18 +5,21 @@ pub mod cleanup;
 mod flip;
 pub mod optimize;
 pub mod refine;
+pub mod restricted_delaunay;
 pub mod stray_shells;
 pub mod tangent_delaunay;
 pub mod untangle;
 
 pub use cleanup::{assemble, AssemblyParams, AssemblyStats, FaceSource};
 pub use refine::RefineParams;
+pub use restricted_delaunay::{RestrictedDelaunayParams, RestrictedDelaunayStats};
 pub use tangent_delaunay::{vote_triangles, SampleSet, TangentDelaunayParams, VotedTriangle};
 
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 use crate::geometry::triangle::is_degenerate_triangle;
+use crate::surface::MeshSurface;
 
 /// Parameters of [`triangulate`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -25,6 +28,18 @@ pub struct TriangulateParams {
     pub local: TangentDelaunayParams,
     /// The assembly and clean-up step.
     pub assembly: AssemblyParams,
+    /// Where the candidate triangles come from.
+    pub method: TriangulationMethod,
+}
+
+/// Where [`TriangulateParams`]' candidate triangles come from.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum TriangulationMethod {
+    /// Tangent-plane Delaunay umbrellas of the samples (the default; [`triangulate`]).
+    #[default]
+    Umbrellas,
+    /// The restricted Delaunay triangulation on the input mesh ([`triangulate_restricted`]).
+    RestrictedDelaunay(RestrictedDelaunayParams),
 }
 
 /// Triangulates samples on a surface: every sample's tangent-plane Delaunay umbrella, merged by
@@ -37,8 +52,48 @@ pub fn triangulate(
     set: &SampleSet,
     params: &TriangulateParams,
 ) -> (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats) {
-    // Coincident samples would give faces of zero area (found by the triangulate fuzz target):
-    // triangulate the distinct positions and map the faces back.
+    on_distinct(set, |s| triangulate_distinct(s, params))
+}
+
+/// Triangulates samples on `surface` (their restricted Delaunay triangulation: the dual of
+/// their Voronoi cells grown over the input mesh, see [`restricted_delaunay`]), then assembles
+/// and cleans it up as [`triangulate`] does. `spacing`: the mean sample spacing (units of the
+/// positions). Returns also what the restricted Delaunay step did.
+pub fn triangulate_restricted(
+    set: &SampleSet,
+    surface: &MeshSurface,
+    spacing: f64,
+    params: &TriangulateParams,
+    rd: &RestrictedDelaunayParams,
+) -> (
+    Vec<[u32; 3]>,
+    Vec<FaceSource>,
+    AssemblyStats,
+    RestrictedDelaunayStats,
+) {
+    let mut rd_stats = RestrictedDelaunayStats::default();
+    let (faces, sources, stats) = on_distinct(set, |s| {
+        let (mut voted, st) =
+            restricted_delaunay::restricted_delaunay(surface, s.positions, spacing, rd);
+        rd_stats = st;
+        voted.retain(|t| !is_degenerate_triangle(t.corners.map(|v| s.positions[v as usize])));
+        assemble(
+            s.positions,
+            s.normals,
+            &voted,
+            s.boundary_edges,
+            &params.assembly,
+        )
+    });
+    (faces, sources, stats, rd_stats)
+}
+
+type Triangulated = (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats);
+
+/// Runs `run` on the samples at distinct positions and maps its faces back: coincident samples
+/// would give faces of zero area (found by the triangulate fuzz target), so they count as one
+/// (the first of them); the others are in no face.
+fn on_distinct(set: &SampleSet, mut run: impl FnMut(&SampleSet) -> Triangulated) -> Triangulated {
     let mut first_at: FxHashMap<[u64; 3], u32> = FxHashMap::default();
     let mut distinct: Vec<u32> = Vec::new();
     let mut to_distinct: Vec<u32> = Vec::with_capacity(set.positions.len());
@@ -50,32 +105,30 @@ pub fn triangulate(
         });
         to_distinct.push(k);
     }
-    let (faces, sources, stats) = if distinct.len() == set.positions.len() {
-        triangulate_distinct(set, params)
-    } else {
-        let positions: Vec<DVec3> = distinct
-            .iter()
-            .map(|&i| set.positions[i as usize])
-            .collect();
-        let normals: Vec<DVec3> = distinct.iter().map(|&i| set.normals[i as usize]).collect();
-        let boundary_edges: Vec<[u32; 2]> = set
-            .boundary_edges
-            .iter()
-            .map(|e| e.map(|v| to_distinct[v as usize]))
-            .filter(|e| e[0] != e[1])
-            .collect();
-        let reduced = SampleSet {
-            positions: &positions,
-            normals: &normals,
-            boundary_edges: &boundary_edges,
-        };
-        let (faces, sources, stats) = triangulate_distinct(&reduced, params);
-        let faces = faces
-            .into_iter()
-            .map(|f| f.map(|v| distinct[v as usize]))
-            .collect();
-        (faces, sources, stats)
+    if distinct.len() == set.positions.len() {
+        return run(set);
+    }
+    let positions: Vec<DVec3> = distinct
+        .iter()
+        .map(|&i| set.positions[i as usize])
+        .collect();
+    let normals: Vec<DVec3> = distinct.iter().map(|&i| set.normals[i as usize]).collect();
+    let boundary_edges: Vec<[u32; 2]> = set
+        .boundary_edges
+        .iter()
+        .map(|e| e.map(|v| to_distinct[v as usize]))
+        .filter(|e| e[0] != e[1])
+        .collect();
+    let reduced = SampleSet {
+        positions: &positions,
+        normals: &normals,
+        boundary_edges: &boundary_edges,
     };
+    let (faces, sources, stats) = run(&reduced);
+    let faces = faces
+        .into_iter()
+        .map(|f| f.map(|v| distinct[v as usize]))
+        .collect();
     (faces, sources, stats)
 }
 
