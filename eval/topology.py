@@ -329,7 +329,7 @@ def longest_edge(m):
 # Runs
 
 
-def run_one(job, work, distance, timeout):
+def run_one(job, work, distance, timeout, extra=()):
     """One remesh run; returns a flat record of what issue 15 checks (or the error line)."""
     label, path, count, seed = job
     stem = f"{label.replace('.', '_')}-{count}-s{seed}"
@@ -338,6 +338,7 @@ def run_one(job, work, distance, timeout):
     cmd = [REMESH, str(path), str(out), "--points", str(count), "--seed", str(seed), "-q", "--report", str(report)]
     if not distance:
         cmd.insert(-2, "--no-distance")
+    cmd[3:3] = list(extra)
     rec = {"model": label, "count": count, "seed": seed, "command": " ".join(["remesh"] + cmd[1:])}
     start = time.monotonic()
     try:
@@ -568,6 +569,8 @@ def parse_args():
     p.add_argument("--distance", action="store_true", help="also measure the Hausdorff distance (slower)")
     p.add_argument("--jobs", type=int, default=1, choices=[1, 2], help="runs at a time (default 1)")
     p.add_argument("--timeout", type=float, default=3600, help="seconds one run may take")
+    p.add_argument("--remesh-args", default="",
+                   help="more options for every run, e.g. '--triangulation restricted'")
     p.add_argument("--quick", action="store_true",
                    help="a fast look: 2000 only, seeds 1-2, spot, cow, fandisk and the shapes;"
                         " writes topology-quick.md/json")
@@ -643,7 +646,7 @@ def main():
         done = [0]
 
         def go(job):
-            rec = run_one(job, work, args.distance, args.timeout)
+            rec = run_one(job, work, args.distance, args.timeout, args.remesh_args.split())
             done[0] += 1
             if "error" in rec:
                 what = "ERROR " + rec["error"]

@@ -114,7 +114,9 @@ pub struct RemeshParams {
     pub linear_scan: LinearScanParams,
     /// The gradient ascent.
     pub gradient_ascent: GradientAscentParams,
-    /// The triangulation.
+    /// The triangulation: where its candidate triangles come from.
+    pub triangulation: TriangulationMethod,
+    /// The triangulation's local step (umbrellas only) and assembly.
     pub triangulate: TriangulateParams,
     /// The local optimization against the input surface after triangulation (`None`: skipped).
     pub optimize: Option<OptimizeParams>,
@@ -139,6 +141,7 @@ impl Default for RemeshParams {
             candidates_per_sample: 10.0,
             linear_scan: LinearScanParams::default(),
             gradient_ascent: GradientAscentParams::default(),
+            triangulation: TriangulationMethod::default(),
             triangulate: TriangulateParams::default(),
             optimize: Some(OptimizeParams::default()),
             untangle: UntangleParams::default(),
@@ -195,6 +198,9 @@ pub struct RemeshOutput {
     pub untangle: UntangleStats,
     /// How each face of `mesh` came in.
     pub face_sources: Vec<crate::triangulate::FaceSource>,
+    /// What the restricted Delaunay triangulation did; `None` when the umbrellas made the
+    /// triangles (asked for, or the input's refinement would have been too large).
+    pub restricted_delaunay: Option<crate::triangulate::RestrictedDelaunayStats>,
     /// Samples that ended in no triangle and were dropped.
     pub dropped_samples: usize,
     /// Candidates left out as buried inside the input's own solid (a self-intersecting input;
@@ -581,13 +587,22 @@ pub fn remesh(
             normals: &normals,
             boundary_edges: &boundary_edges,
         };
-        let (faces, face_sources, assembly) = match params.triangulate.method {
-            TriangulationMethod::Umbrellas => triangulate(&set, &params.triangulate),
+        // The restricted Delaunay triangulation, or the umbrellas where it is not asked for or
+        // its refinement of the input would be too large.
+        let restricted = match params.triangulation {
+            TriangulationMethod::Umbrellas => None,
             TriangulationMethod::RestrictedDelaunay(rd) => {
-                let spacing = (area / samples.len().max(1) as f64).sqrt();
-                let (f, s, a, _) =
-                    triangulate_restricted(&set, &surface, spacing, &params.triangulate, &rd);
-                (f, s, a)
+                // The sample spacing is about sigma_p (SAMPLES_PER_SIGMA2 samples per
+                // sigma_p^2 of area; on boundary curves one per sigma_p or closer).
+                let spacing = sigma_p / SAMPLES_PER_SIGMA2.sqrt();
+                triangulate_restricted(&set, &surface, spacing, &params.triangulate, &rd)
+            }
+        };
+        let (faces, face_sources, assembly, restricted_delaunay) = match restricted {
+            Some((f, s, a, rd)) => (f, s, a, Some(rd)),
+            None => {
+                let (f, s, a) = triangulate(&set, &params.triangulate);
+                (f, s, a, None)
             }
         };
         let mut mesh_normalized = TriMesh::new(positions, faces);
@@ -687,6 +702,7 @@ pub fn remesh(
                 measured,
                 gradient_ascent: ga,
                 assembly,
+                restricted_delaunay,
                 optimize: optimize_stats,
                 untangle: untangle_stats,
                 face_sources,

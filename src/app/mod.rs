@@ -19,6 +19,7 @@ use crate::pipeline::{
 };
 use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
+use crate::triangulate::TriangulationMethod;
 
 /// Samples per side for the Hausdorff and RMS distances of the report (Metro-style, on top of
 /// every vertex).
@@ -278,6 +279,17 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         "assembly".into(),
         serde_json::to_value(&out.assembly).unwrap_or_default(),
     );
+    extra.insert(
+        "restricted_delaunay".into(),
+        serde_json::to_value(&out.restricted_delaunay).unwrap_or_default(),
+    );
+    if out.restricted_delaunay.is_none() && params.triangulation != TriangulationMethod::Umbrellas {
+        report.notes.push(
+            "the samples were connected by tangent-plane umbrellas: the restricted Delaunay \
+             triangulation would have refined this input too far (slivers)"
+                .into(),
+        );
+    }
     extra.insert(
         "optimize".into(),
         serde_json::to_value(out.optimize).unwrap_or_default(),

@@ -73,10 +73,11 @@ struct Cli {
     #[arg(long, default_value_t = 0.0, value_name = "C")]
     lfs_factor: f64,
 
-    /// How the samples are connected: `umbrellas` (tangent-plane Delaunay umbrellas merged by
-    /// votes) or `restricted` (the restricted Delaunay triangulation on the input mesh: the dual
-    /// of the samples' Voronoi cells grown over the input).
-    #[arg(long, default_value = "umbrellas", value_name = "METHOD")]
+    /// How the samples are connected: `restricted`, the default (the restricted Delaunay
+    /// triangulation on the input mesh: the dual of the samples' Voronoi cells grown over the
+    /// input, which keeps thin parts whole), or `umbrellas` (tangent-plane Delaunay umbrellas
+    /// merged by votes, as before).
+    #[arg(long, default_value = "restricted", value_name = "METHOD")]
     triangulation: String,
 
     /// Gradient-ascent sweeps (Sec. 6.2).
@@ -314,7 +315,7 @@ fn config(cli: Cli) -> Result<Config, Error> {
                     message: format!("must be a number >= 0, got {}", cli.lfs_factor),
                 });
             }
-            params.triangulate.method = match cli.triangulation.as_str() {
+            params.triangulation = match cli.triangulation.as_str() {
                 "umbrellas" => TriangulationMethod::Umbrellas,
                 "restricted" => TriangulationMethod::RestrictedDelaunay(Default::default()),
                 other => {

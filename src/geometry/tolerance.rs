@@ -48,3 +48,13 @@ pub const LOG_BRACKET_TOLERANCE: f64 = 1e-9;
 
 /// Two log counts closer than this make no secant (`sampling::target_count`). Dimensionless.
 pub const LOG_COUNT_TOLERANCE: f64 = 1e-12;
+
+/// A point within this fraction of the sample spacing of an input face lies in it: the vertices
+/// the restricted Delaunay triangulation adds to the input (edge midpoints) lie on their faces up
+/// to rounding, far closer than a sheet across a thin part.
+pub const ON_SURFACE_RELATIVE: f64 = 1e-9;
+
+/// Two squared lengths within this relative difference count as equal where a choice between
+/// them must not depend on rounding (the longest edge of a face in `mesh::bisect`: a mesh read
+/// from float32 coordinates and the same mesh from text refine alike). Dimensionless.
+pub const LENGTH_TIE: f64 = 1e-6;

@@ -10,6 +10,7 @@ use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
 
 use super::TriMesh;
+use crate::geometry::tolerance::LENGTH_TIE;
 
 /// A refined mesh: positions, faces, and for each face the face of the source mesh it lies in.
 #[derive(Debug, Clone, PartialEq)]
@@ -23,54 +24,123 @@ pub struct Refined {
     pub parent: Vec<u32>,
 }
 
-/// The most splits [`bisect_to_length`] makes: a guard against a length far below the mesh's
-/// size (each split adds one vertex).
-pub const MAX_SPLITS: usize = 20_000_000;
-
 fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
+/// Undirected edge -> the faces on it: two inline (`NONE` when empty), more (a non-manifold
+/// edge) in `more`.
+#[derive(Default)]
+struct EdgeFaces {
+    two: FxHashMap<(u32, u32), [u32; 2]>,
+    more: FxHashMap<(u32, u32), Vec<u32>>,
+}
+
+const NONE: u32 = u32::MAX;
+
+impl EdgeFaces {
+    fn with_capacity(n: usize) -> Self {
+        EdgeFaces {
+            two: FxHashMap::with_capacity_and_hasher(n, Default::default()),
+            more: FxHashMap::default(),
+        }
+    }
+
+    fn push(&mut self, e: (u32, u32), f: u32) {
+        let slot = self.two.entry(e).or_insert([NONE; 2]);
+        if slot[0] == NONE {
+            slot[0] = f;
+        } else if slot[1] == NONE {
+            slot[1] = f;
+        } else {
+            self.more.entry(e).or_default().push(f);
+        }
+    }
+
+    /// Removes the edge; returns its faces.
+    fn take(&mut self, e: (u32, u32), out: &mut Vec<u32>) {
+        out.clear();
+        if let Some(slot) = self.two.remove(&e) {
+            out.extend(slot.into_iter().filter(|&f| f != NONE));
+            if let Some(m) = self.more.remove(&e) {
+                out.extend(m);
+            }
+        }
+    }
+
+    /// Face `g` on edge `e` becomes face `h`.
+    fn replace(&mut self, e: (u32, u32), g: u32, h: u32) {
+        if let Some(slot) = self.two.get_mut(&e) {
+            if let Some(s) = slot.iter_mut().find(|s| **s == g) {
+                *s = h;
+                return;
+            }
+        }
+        if let Some(m) = self.more.get_mut(&e) {
+            if let Some(s) = m.iter_mut().find(|s| **s == g) {
+                *s = h;
+            }
+        }
+    }
+}
+
 /// Splits edges of `mesh` at their midpoints, each face's longest first, until every edge is
-/// at most `max_length` long (units of the mesh) or [`MAX_SPLITS`] splits were made.
-/// Deterministic: the same input gives the same output.
-pub fn bisect_to_length(mesh: &TriMesh, max_length: f64) -> Refined {
+/// at most `max_length` long (units of the mesh). `None` when that takes more than `max_splits`
+/// splits (each adds one vertex; slivers, whose bisection makes ever thinner slivers, can take
+/// far more than their area suggests). Deterministic: the same input gives the same output.
+pub fn bisect_to_length(mesh: &TriMesh, max_length: f64, max_splits: usize) -> Option<Refined> {
     let mut positions = mesh.positions.clone();
     let mut triangles = mesh.triangles.clone();
     let mut parent: Vec<u32> = (0..triangles.len() as u32).collect();
-    let mut edge_faces: FxHashMap<(u32, u32), Vec<u32>> = FxHashMap::default();
+    let limit2 = max_length * max_length;
+    // About how many faces the refinement makes (a face of the refined mesh has about half the
+    // area of a right triangle with legs max_length / 2 or more).
+    let expected = triangles.len() + (mesh.area() / (0.2 * limit2)).min(max_splits as f64) as usize;
+    positions.reserve(expected / 2);
+    triangles.reserve(expected);
+    parent.reserve(expected);
+    let mut edge_faces = EdgeFaces::with_capacity(3 * expected / 2);
     for (f, t) in triangles.iter().enumerate() {
         for k in 0..3 {
-            edge_faces
-                .entry(key(t[k], t[(k + 1) % 3]))
-                .or_default()
-                .push(f as u32);
+            edge_faces.push(key(t[k], t[(k + 1) % 3]), f as u32);
         }
     }
-    let limit2 = max_length * max_length;
+    // The longest edge; edges equal in length up to LENGTH_TIE (the same mesh read from float32
+    // and from text) are told apart by their vertex indices, so both refine alike.
     let longest = |positions: &[DVec3], t: [u32; 3]| -> (usize, f64) {
-        (0..3)
-            .map(|k| {
-                let d =
-                    positions[t[k] as usize].distance_squared(positions[t[(k + 1) % 3] as usize]);
-                (k, d)
-            })
-            .fold((0, -1.0), |best, x| if x.1 > best.1 { x } else { best })
+        let d = |k: usize| {
+            positions[t[k] as usize].distance_squared(positions[t[(k + 1) % 3] as usize])
+        };
+        let (mut best, mut best_d) = (0, d(0));
+        for k in 1..3 {
+            let dk = d(k);
+            let tie = (dk - best_d).abs() <= LENGTH_TIE * dk.max(best_d);
+            if (!tie && dk > best_d)
+                || (tie && key(t[k], t[(k + 1) % 3]) < key(t[best], t[(best + 1) % 3]))
+            {
+                (best, best_d) = (k, dk);
+            }
+        }
+        (best, best_d)
     };
     let mut queue: VecDeque<u32> = (0..triangles.len() as u32).collect();
     let mut splits = 0;
+    let mut faces = Vec::new();
     while let Some(f) = queue.pop_front() {
         let t = triangles[f as usize];
         let (k, d2) = longest(&positions, t);
-        if d2 <= limit2 || !d2.is_finite() || splits >= MAX_SPLITS {
+        if d2 <= limit2 || !d2.is_finite() {
             continue;
+        }
+        if splits >= max_splits {
+            return None;
         }
         let (a, b) = (t[k], t[(k + 1) % 3]);
         let m = positions.len() as u32;
         positions.push(0.5 * (positions[a as usize] + positions[b as usize]));
         splits += 1;
-        let faces = edge_faces.remove(&key(a, b)).unwrap_or_default();
-        for g in faces {
+        edge_faces.take(key(a, b), &mut faces);
+        for &g in &faces {
             let tg = triangles[g as usize];
             let Some(j) = (0..3).find(|&j| key(tg[j], tg[(j + 1) % 3]) == key(a, b)) else {
                 continue;
@@ -80,25 +150,20 @@ pub fn bisect_to_length(mesh: &TriMesh, max_length: f64) -> Refined {
             triangles[g as usize] = [x, m, c];
             triangles.push([m, y, c]);
             parent.push(parent[g as usize]);
-            edge_faces.entry(key(x, m)).or_default().push(g);
-            edge_faces.entry(key(m, y)).or_default().push(h);
-            let mc = edge_faces.entry(key(m, c)).or_default();
-            mc.push(g);
-            mc.push(h);
-            if let Some(yc) = edge_faces.get_mut(&key(y, c)) {
-                if let Some(s) = yc.iter_mut().find(|s| **s == g) {
-                    *s = h;
-                }
-            }
+            edge_faces.push(key(x, m), g);
+            edge_faces.push(key(m, y), h);
+            edge_faces.push(key(m, c), g);
+            edge_faces.push(key(m, c), h);
+            edge_faces.replace(key(y, c), g, h);
             queue.push_back(g);
             queue.push_back(h);
         }
     }
-    Refined {
+    Some(Refined {
         positions,
         triangles,
         parent,
-    }
+    })
 }
 
 #[cfg(test)]
@@ -117,7 +182,7 @@ mod tests {
     #[test]
     fn refines_below_the_length_and_keeps_the_surface() {
         let mesh = test_meshes::uv_sphere(10.0, 6, 8);
-        let r = bisect_to_length(&mesh, 1.0);
+        let r = bisect_to_length(&mesh, 1.0, usize::MAX).unwrap();
         assert!(max_edge(&r) <= 1.0 + 1e-12);
         let before = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
         let after = TriMesh::new(r.positions.clone(), r.triangles.clone());
@@ -139,9 +204,15 @@ mod tests {
     }
 
     #[test]
+    fn the_split_budget_is_kept() {
+        let mesh = test_meshes::uv_sphere(10.0, 6, 8);
+        assert!(bisect_to_length(&mesh, 1.0, 100).is_none());
+    }
+
+    #[test]
     fn a_mesh_already_fine_is_unchanged() {
         let mesh = test_meshes::uv_sphere(1.0, 6, 8);
-        let r = bisect_to_length(&mesh, 10.0);
+        let r = bisect_to_length(&mesh, 10.0, 0).unwrap();
         assert_eq!(r.positions, mesh.positions);
         assert_eq!(r.triangles, mesh.triangles);
     }

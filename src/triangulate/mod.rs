@@ -28,18 +28,22 @@ pub struct TriangulateParams {
     pub local: TangentDelaunayParams,
     /// The assembly and clean-up step.
     pub assembly: AssemblyParams,
-    /// Where the candidate triangles come from.
-    pub method: TriangulationMethod,
 }
 
-/// Where [`TriangulateParams`]' candidate triangles come from.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// Where the candidate triangles of the remesh's triangulation come from.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TriangulationMethod {
-    /// Tangent-plane Delaunay umbrellas of the samples (the default; [`triangulate`]).
-    #[default]
+    /// Tangent-plane Delaunay umbrellas of the samples ([`triangulate`]).
     Umbrellas,
-    /// The restricted Delaunay triangulation on the input mesh ([`triangulate_restricted`]).
+    /// The restricted Delaunay triangulation on the input mesh ([`triangulate_restricted`]; the
+    /// default: it keeps thin parts whole where the umbrellas of their two sides see each other).
     RestrictedDelaunay(RestrictedDelaunayParams),
+}
+
+impl Default for TriangulationMethod {
+    fn default() -> Self {
+        TriangulationMethod::RestrictedDelaunay(RestrictedDelaunayParams::default())
+    }
 }
 
 /// Triangulates samples on a surface: every sample's tangent-plane Delaunay umbrella, merged by
@@ -56,26 +60,25 @@ pub fn triangulate(
 }
 
 /// Triangulates samples on `surface` (their restricted Delaunay triangulation: the dual of
-/// their Voronoi cells grown over the input mesh, see [`restricted_delaunay`]), then assembles
-/// and cleans it up as [`triangulate`] does. `spacing`: the mean sample spacing (units of the
-/// positions). Returns also what the restricted Delaunay step did.
+/// their Voronoi cells grown over the input mesh, see `restricted_delaunay`), then assembles
+/// and cleans it up as [`triangulate`] does. `spacing`: the sample spacing (units of the
+/// positions). Returns also what the restricted Delaunay step did; `None` when its refinement of
+/// the input would be too large (see [`RestrictedDelaunayParams::max_added_per_sample`]).
 pub fn triangulate_restricted(
     set: &SampleSet,
     surface: &MeshSurface,
     spacing: f64,
     params: &TriangulateParams,
     rd: &RestrictedDelaunayParams,
-) -> (
-    Vec<[u32; 3]>,
-    Vec<FaceSource>,
-    AssemblyStats,
-    RestrictedDelaunayStats,
-) {
-    let mut rd_stats = RestrictedDelaunayStats::default();
+) -> Option<Restricted> {
+    let mut rd_stats = None;
     let (faces, sources, stats) = on_distinct(set, |s| {
-        let (mut voted, st) =
-            restricted_delaunay::restricted_delaunay(surface, s.positions, spacing, rd);
-        rd_stats = st;
+        let Some((mut voted, st)) =
+            restricted_delaunay::restricted_delaunay(surface, s.positions, spacing, rd)
+        else {
+            return (Vec::new(), Vec::new(), AssemblyStats::default());
+        };
+        rd_stats = Some(st);
         voted.retain(|t| !is_degenerate_triangle(t.corners.map(|v| s.positions[v as usize])));
         assemble(
             s.positions,
@@ -85,9 +88,18 @@ pub fn triangulate_restricted(
             &params.assembly,
         )
     });
-    (faces, sources, stats, rd_stats)
+    rd_stats.map(|st| (faces, sources, stats, st))
 }
 
+/// [`Triangulated`] and what the restricted Delaunay step did.
+pub type Restricted = (
+    Vec<[u32; 3]>,
+    Vec<FaceSource>,
+    AssemblyStats,
+    RestrictedDelaunayStats,
+);
+
+/// Faces, how each came in, and what the assembly did.
 type Triangulated = (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats);
 
 /// Runs `run` on the samples at distinct positions and maps its faces back: coincident samples
