@@ -120,6 +120,18 @@ fn tube(r: f64, len: f64, segments: usize, step: f64) -> TriMesh {
     TriMesh::new(positions, triangles)
 }
 
+/// `mesh` is closed (no boundary edge), manifold, with `components` pieces and Euler
+/// characteristic `chi`.
+fn assert_closed_manifold(mesh: &TriMesh, components: usize, chi: i64, at: &str) {
+    let t = topology(mesh);
+    assert_eq!(
+        (t.components, t.euler_characteristic, t.boundary_edges),
+        (components, chi, 0),
+        "{at}"
+    );
+    assert_eq!(t.non_manifold_edges + t.non_manifold_vertices, 0, "{at}");
+}
+
 fn run(mesh: &TriMesh, points: usize, seed: u64, grading: Option<GradingParams>) -> RemeshOutput {
     let params = RemeshParams {
         density: Density::Points(points),
@@ -143,17 +155,7 @@ fn two_boxes_close_together_stay_two_closed_boxes_at_every_seed() {
     );
     for seed in 1..=5 {
         let out = run(&boxes, 2000, seed, Some(GradingParams::default()));
-        let t = topology(&out.mesh);
-        assert_eq!(
-            (t.components, t.euler_characteristic, t.boundary_edges),
-            (2, 4, 0),
-            "seed {seed}"
-        );
-        assert_eq!(
-            t.non_manifold_edges + t.non_manifold_vertices,
-            0,
-            "seed {seed}"
-        );
+        assert_closed_manifold(&out.mesh, 2, 4, &format!("seed {seed}"));
         assert_eq!(self_intersections(&out.mesh).pairs, 0, "seed {seed}");
         let v = out.mesh.vertex_count() as f64;
         assert!((v - 2000.0).abs() <= 20.0, "seed {seed}: {v} vertices");
@@ -271,16 +273,6 @@ fn a_plate_far_thinner_than_the_spacing_stays_one_closed_piece() {
     let plate = grid_box_counts(DVec3::ZERO, DVec3::new(100.0, 100.0, 0.1), [100, 100, 1]);
     for seed in 1..=5 {
         let out = run(&plate, 2000, seed, None);
-        let t = topology(&out.mesh);
-        assert_eq!(
-            (t.components, t.euler_characteristic, t.boundary_edges),
-            (1, 2, 0),
-            "seed {seed}"
-        );
-        assert_eq!(
-            t.non_manifold_edges + t.non_manifold_vertices,
-            0,
-            "seed {seed}"
-        );
+        assert_closed_manifold(&out.mesh, 1, 2, &format!("seed {seed}"));
     }
 }

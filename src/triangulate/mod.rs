@@ -73,20 +73,13 @@ pub fn triangulate_restricted(
 ) -> Option<Restricted> {
     let mut rd_stats = None;
     let (faces, sources, stats) = on_distinct(set, |s| {
-        let Some((mut voted, st)) =
+        let Some((voted, st)) =
             restricted_delaunay::restricted_delaunay(surface, s.positions, spacing, rd)
         else {
             return (Vec::new(), Vec::new(), AssemblyStats::default());
         };
         rd_stats = Some(st);
-        voted.retain(|t| !is_degenerate_triangle(t.corners.map(|v| s.positions[v as usize])));
-        assemble(
-            s.positions,
-            s.normals,
-            &voted,
-            s.boundary_edges,
-            &params.assembly,
-        )
+        assemble_candidates(s, voted, params)
     });
     rd_stats.map(|st| (faces, sources, stats, st))
 }
@@ -149,12 +142,21 @@ fn triangulate_distinct(
     set: &SampleSet,
     params: &TriangulateParams,
 ) -> (Vec<[u32; 3]>, Vec<FaceSource>, AssemblyStats) {
-    let mut voted = vote_triangles(set, &params.local);
-    voted.retain(|t| !is_degenerate_triangle(t.corners.map(|v| set.positions[v as usize])));
+    assemble_candidates(set, vote_triangles(set, &params.local), params)
+}
+
+/// Assembles candidate triangles of samples at distinct positions, those of zero area (three
+/// samples on a line) left out.
+fn assemble_candidates(
+    set: &SampleSet,
+    mut candidates: Vec<VotedTriangle>,
+    params: &TriangulateParams,
+) -> Triangulated {
+    candidates.retain(|t| !is_degenerate_triangle(t.corners.map(|v| set.positions[v as usize])));
     assemble(
         set.positions,
         set.normals,
-        &voted,
+        &candidates,
         set.boundary_edges,
         &params.assembly,
     )

@@ -147,26 +147,21 @@ pub fn restricted_delaunay(
         })
         .collect();
     seen.sort_unstable();
-    let mut tally: Vec<(usize, [u32; 3])> = Vec::new();
-    let mut i = 0;
-    while i < seen.len() {
-        let t = seen[i].0;
-        let (mut forward, mut backward) = (0usize, 0usize);
-        while i < seen.len() && seen[i].0 == t {
-            if seen[i].1 {
-                forward += 1;
+    // Per triple, the orientation most of its faces give (the ascending one on a tie).
+    let mut tally: Vec<(usize, [u32; 3])> = seen
+        .chunk_by(|a, b| a.0 == b.0)
+        .map(|group| {
+            let t = group[0].0;
+            let forward = group.iter().filter(|x| x.1).count();
+            let backward = group.len() - forward;
+            let corners = if forward >= backward {
+                t
             } else {
-                backward += 1;
-            }
-            i += 1;
-        }
-        let corners = if forward >= backward {
-            t
-        } else {
-            [t[0], t[2], t[1]]
-        };
-        tally.push((forward.max(backward), corners));
-    }
+                [t[0], t[2], t[1]]
+            };
+            (forward.max(backward), corners)
+        })
+        .collect();
     tally.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
     let mut owned = vec![false; positions.len()];
     for &l in &label {
