@@ -145,8 +145,8 @@ pub use mesh::{orient_consistently, Aabb, Normalization, OrientStats, TriMesh};
 
 // The pipeline in one call.
 pub use pipeline::{
-    remesh, validate_input, Density, RemeshOutput, RemeshParams, BOUNDARY_SPACING_PER_SIGMA,
-    MAX_POINTS, SAMPLES_PER_SIGMA2,
+    remesh, validate_input, Density, FeatureStats, RemeshOutput, RemeshParams,
+    BOUNDARY_SPACING_PER_SIGMA, MAX_POINTS, SAMPLES_PER_SIGMA2,
 };
 pub use timing::Stage;
 
@@ -155,6 +155,11 @@ pub use surface::winding::BuriedTest;
 // The local feature size of the input (shrinking medial balls), for a graded kernel width.
 pub use surface::local_feature_size::{
     local_feature_size, LfsParams, LocalFeatureSize, MAX_LFS_SAMPLES,
+};
+// Sharp features of the input: crease edges, curves and corners.
+pub use surface::features::{
+    detect_features, FeatureCurve, FeatureParams, Features, CAD_FEATURE_ANGLE_DEG,
+    DEFAULT_FEATURE_ANGLE_DEG,
 };
 pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceSample};
 

@@ -10,9 +10,10 @@ use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
 use crate::kernel::Kernel;
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{
-    boundary_curves, boundary_sample_count, curve_length, sample_boundary, sample_boundary_graded,
+    boundary_curves, boundary_sample_count, curve_length, sample_curves_and_features, BoundaryCurve,
 };
 use crate::sampling::candidates::surface_candidates;
+use crate::sampling::features::feature_pieces;
 use crate::sampling::gradient_ascent::{
     gradient_ascent_graded, GradientAscentParams, GradientAscentResult,
 };
@@ -22,6 +23,7 @@ use crate::sampling::linear_scan::{
 };
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::sampling::WidthField;
+use crate::surface::features::{detect_features, FeatureParams, DEFAULT_FEATURE_ANGLE_DEG};
 use crate::surface::winding::BuriedTest;
 use crate::surface::MeshSurface;
 use crate::surface::SurfaceSample;
@@ -47,8 +49,9 @@ pub enum Density {
     InputVertices,
 }
 
-/// A linear scan's result and the boundary edges between its first samples.
-type ScanWithBoundary = (LinearScanResult, Vec<[u32; 2]>);
+/// A linear scan's result with the edges between its fixed curve samples: boundary edges, then
+/// feature edges.
+type ScanWithBoundary = (LinearScanResult, Vec<[u32; 2]>, Vec<[u32; 2]>);
 
 /// [`Density`] resolved for one input: a vertex count or sigma_p.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -127,6 +130,12 @@ pub struct RemeshParams {
     /// Hausdorff distance (median of seeds 1-5 from 0.449 to 0.508, at the ears) although it
     /// keeps the topology of thin parts at low counts.
     pub grading: Option<GradingParams>,
+    /// The feature angle (degrees) of the sharp-feature detection ([`detect_features`], at the
+    /// sample spacing of the first sigma_p): the creases found are sampled evenly along with the
+    /// boundary ([`feature_pieces`]), kept fixed, and their consecutive samples reported as
+    /// output edges. Default [`DEFAULT_FEATURE_ANGLE_DEG`] (180: off);
+    /// [`CAD_FEATURE_ANGLE_DEG`](crate::CAD_FEATURE_ANGLE_DEG) for CAD parts.
+    pub feature_angle_deg: f64,
     /// Relative tolerance of the count search (default 0.005).
     pub count_tolerance: f64,
     /// Seed of every random choice.
@@ -146,10 +155,52 @@ impl Default for RemeshParams {
             optimize: Some(OptimizeParams::default()),
             untangle: UntangleParams::default(),
             grading: None,
+            feature_angle_deg: DEFAULT_FEATURE_ANGLE_DEG,
             count_tolerance: 0.005,
             seed: 1,
         }
     }
+}
+
+/// How many of `edges` (vertex pairs, either direction) are edges of a face of `mesh`.
+fn edges_present(mesh: &TriMesh, edges: &[[u32; 2]]) -> usize {
+    let mut have: rustc_hash::FxHashSet<(u32, u32)> = rustc_hash::FxHashSet::default();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            have.insert((a.min(b), a.max(b)));
+        }
+    }
+    edges
+        .iter()
+        .filter(|e| have.contains(&(e[0].min(e[1]), e[0].max(e[1]))))
+        .count()
+}
+
+/// The sharp features [`remesh`] found on its input ([`detect_features`]). Lengths in bbox-100
+/// units.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FeatureStats {
+    /// The feature angle, degrees.
+    pub angle_deg: f64,
+    /// The scale the creases were tested at (the sample spacing of the first sigma_p).
+    pub scale: f64,
+    /// Feature edges of the input.
+    pub edges: usize,
+    /// Curves they chain into.
+    pub curves: usize,
+    /// Of those, closed ones (without a corner).
+    pub closed_curves: usize,
+    /// Corners (ends of the open curves).
+    pub corners: usize,
+    /// Total length of the feature edges.
+    pub length: f64,
+    /// Edges between consecutive samples along the sampled feature curves.
+    pub sampled_edges: usize,
+    /// Of those, edges of the triangulation.
+    pub triangulated_edges: usize,
+    /// Of those, edges of the output (after the optimization).
+    pub kept_edges: usize,
 }
 
 /// The output of [`remesh`].
@@ -211,6 +262,8 @@ pub struct RemeshOutput {
     pub buried_samples: usize,
     /// What the grading by the local feature size did (`None` when it was off).
     pub grading: Option<GradingStats>,
+    /// The sharp features detected on the input (see [`RemeshParams::feature_angle_deg`]).
+    pub features: FeatureStats,
     /// Tiny closed shells at unresolved tips removed (bbox-100 units).
     pub stray_shells: StrayShells,
     /// Timed stages in order.
@@ -382,6 +435,29 @@ pub fn remesh(
         Target::Points(n) => sigma_p_for_count(area, boundary_length, n as f64),
         Target::SigmaP(s) => s,
     };
+    // Sharp features: creases that stay sharp at the sample spacing.
+    on_stage("features");
+    let feature_scale = first_sigma_p / SAMPLES_PER_SIGMA2.sqrt();
+    let features = detect_features(
+        &surface,
+        &FeatureParams {
+            angle_deg: params.feature_angle_deg,
+            scale: feature_scale,
+        },
+    );
+    let feature_stats = FeatureStats {
+        angle_deg: params.feature_angle_deg,
+        scale: feature_scale,
+        edges: features.edges.len(),
+        curves: features.curves.len(),
+        closed_curves: features.curves.iter().filter(|c| c.closed).count(),
+        corners: features.corners.len(),
+        length: features.length(&normalized.positions),
+        sampled_edges: 0,
+        triangulated_edges: 0,
+        kept_edges: 0,
+    };
+    timer.lap("features");
     let grading = match params.grading {
         Some(g) => {
             on_stage("local feature size");
@@ -438,19 +514,36 @@ pub fn remesh(
          -> Result<(usize, Option<ScanWithBoundary>)> {
             let kernel = Kernel::new(sigma_p, params.sigma_n)?;
             let spacing = BOUNDARY_SPACING_PER_SIGMA * sigma_p;
-            let boundary_count = boundary_sample_count(&curves, &curve_lengths, spacing);
+            // The boundary curves, cut where creases end on them, and the creases long enough
+            // to take samples at this spacing.
+            let (boundary_pieces, feature_curves) =
+                feature_pieces(&normalized, &curves, &features, spacing);
+            let piece_lengths = |pieces: &[BoundaryCurve]| -> Vec<f64> {
+                pieces
+                    .iter()
+                    .map(|c| curve_length(&normalized, c))
+                    .collect()
+            };
+            let boundary_count =
+                boundary_sample_count(&boundary_pieces, &piece_lengths(&boundary_pieces), spacing)
+                    + boundary_sample_count(
+                        &feature_curves,
+                        &piece_lengths(&feature_curves),
+                        spacing,
+                    );
             if !(boundary_count <= boundary_limit) {
                 return Ok((boundary_count.min(usize::MAX as f64) as usize, None));
             }
-            let b = match &grading {
-                Some(g) => sample_boundary_graded(
-                    &normalized,
-                    &curves,
-                    spacing,
-                    Some(&|p| g.width(p, sigma_ref)),
-                ),
-                None => sample_boundary(&normalized, &curves, spacing),
-            };
+            let width = grading
+                .as_ref()
+                .map(|g| move |p: DVec3| g.width(p, sigma_ref));
+            let b = sample_curves_and_features(
+                &normalized,
+                &boundary_pieces,
+                &feature_curves,
+                spacing,
+                width.as_ref().map(|f| f as WidthField),
+            );
             let r = match &grading {
                 Some(g) => linear_scan_graded(
                     &kernel,
@@ -462,7 +555,7 @@ pub fn remesh(
                 ),
                 None => linear_scan(&kernel, &pool, &b.samples, &params.linear_scan),
             };
-            Ok((r.samples.len(), Some((r, b.edges))))
+            Ok((r.samples.len(), Some((r, b.edges, b.feature_edges))))
         };
         let (sigma_p, target_reached, search_history, value) = match density {
             Target::SigmaP(s) => {
@@ -512,7 +605,7 @@ pub fn remesh(
                 }
             }
         };
-        let Some((scan_result, boundary_edges)) = value else {
+        let Some((scan_result, boundary_edges, feature_edges)) = value else {
             // Even the best sigma_p tried puts more samples on the boundary curves than the
             // bound (loops need 3 samples each, however short).
             let (name, what) = match density {
@@ -606,6 +699,7 @@ pub fn remesh(
             }
         };
         let mut mesh_normalized = TriMesh::new(positions, faces);
+        let feature_edges_triangulated = edges_present(&mesh_normalized, &feature_edges);
         timer.lap("triangulate");
         on_stage("optimize");
         let mut face_sources = face_sources;
@@ -628,6 +722,8 @@ pub fn remesh(
             }
             None => OptimizeStats::default(),
         };
+        // Connectivity is final here (untangle only moves vertices).
+        let feature_edges_kept = edges_present(&mesh_normalized, &feature_edges);
         let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
         timer.lap("optimize");
         // Faces that still cross (where the input's sheets lie closer than the output's chords
@@ -710,6 +806,12 @@ pub fn remesh(
                 buried_candidates,
                 buried_samples,
                 grading: grading_record,
+                features: FeatureStats {
+                    sampled_edges: feature_edges.len(),
+                    triangulated_edges: feature_edges_triangulated,
+                    kept_edges: feature_edges_kept,
+                    ..feature_stats.clone()
+                },
                 stray_shells: stray,
                 stages: timer.take_stages(),
             };

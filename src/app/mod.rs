@@ -298,6 +298,10 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         "untangle".into(),
         serde_json::to_value(out.untangle).unwrap_or_default(),
     );
+    extra.insert(
+        "features".into(),
+        serde_json::to_value(&out.features).unwrap_or_default(),
+    );
     extra.insert("input_vertices".into(), input.vertex_count().into());
     extra.insert("input_faces".into(), input.face_count().into());
     if up != 0 {

@@ -73,6 +73,14 @@ struct Cli {
     #[arg(long, default_value_t = 0.0, value_name = "C")]
     lfs_factor: f64,
 
+    /// Sharp features: an input edge is a crease when the surface either side of it turns by
+    /// at least DEG degrees, between its two faces and still at the sample spacing (so a scan's
+    /// folds are not creases); creases are sampled evenly like the boundary and kept as output
+    /// edges. 60 is the measured choice for CAD parts. 180, the default, turns it off (on
+    /// organic models the creases found cost about 8° of θmin)
+    #[arg(long, default_value_t = spectral_remesh::DEFAULT_FEATURE_ANGLE_DEG, value_name = "DEG")]
+    feature_angle: f64,
+
     /// How the samples are connected: `restricted`, the default (the restricted Delaunay
     /// triangulation on the input mesh: the dual of the samples' Voronoi cells grown over the
     /// input, which keeps thin parts whole), or `umbrellas` (tangent-plane Delaunay umbrellas
@@ -315,6 +323,16 @@ fn config(cli: Cli) -> Result<Config, Error> {
                     message: format!("must be a number >= 0, got {}", cli.lfs_factor),
                 });
             }
+            if !(cli.feature_angle >= 0.0 && cli.feature_angle <= 180.0) {
+                return Err(Error::InvalidParameter {
+                    name: "--feature-angle",
+                    message: format!(
+                        "must be an angle from 0 to 180 degrees, got {}",
+                        cli.feature_angle
+                    ),
+                });
+            }
+            params.feature_angle_deg = cli.feature_angle;
             params.triangulation = match cli.triangulation.as_str() {
                 "umbrellas" => TriangulationMethod::Umbrellas,
                 "restricted" => TriangulationMethod::RestrictedDelaunay(Default::default()),

@@ -120,6 +120,10 @@ pub struct BoundarySamples {
     /// Consecutive samples along a curve, `[from, to]` indices into `samples`, directed with the
     /// surface on the left.
     pub edges: Vec<[u32; 2]>,
+    /// Consecutive samples along a sharp-feature curve ([`sample_curves_and_features`]),
+    /// `[from, to]` indices into `samples`: edges the output should have, with a face either
+    /// side.
+    pub feature_edges: Vec<[u32; 2]>,
 }
 
 /// The arc length of `curve` (bbox-100 units when `mesh` is normalized).
@@ -161,21 +165,25 @@ fn curve_steps(total: f64, spacing: f64, closed: bool) -> f64 {
         .max(if closed { 3.0 } else { 1.0 })
 }
 
-/// [`sample_boundary`] with a spacing that follows a relative width field: the samples are at
-/// equal steps of ∫ ds / (`width(x)` · `spacing`) along each curve (the width taken at the
-/// curve's vertices, linear in between), their number that integral rounded (at least 3 on a
-/// loop, 1 step on a chain). With `width` `None` this is [`sample_boundary`].
-pub fn sample_boundary_graded(
+/// [`sample_boundary`] on the boundary curves and on sharp-feature curves together (the pieces
+/// of [`feature_pieces`](crate::sampling::features::feature_pieces), given as curves with a face
+/// per edge): one sample shared where curves meet, the feature curves' consecutive samples in
+/// `feature_edges` rather than `edges`. With a `width` field the spacing follows it: the samples
+/// are at equal steps of ∫ ds / (`width(x)` · `spacing`) along each curve (the width taken at
+/// the curve's vertices, linear in between), their number that integral rounded (at least 3 on
+/// a loop, 1 step on a chain).
+pub fn sample_curves_and_features(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
+    features: &[BoundaryCurve],
     spacing: f64,
     width: Option<WidthField>,
 ) -> BoundarySamples {
     let Some(width) = width else {
-        return sample_boundary(mesh, curves, spacing);
+        return sample_curves(mesh, curves, features, spacing, |a, b| a.distance(b));
     };
     // Per edge, its steps: the trapezoid rule in 1/w, in units of one step.
-    sample_curves(mesh, curves, 1.0, |a, b| {
+    sample_curves(mesh, curves, features, 1.0, |a, b| {
         0.5 * a.distance(b) * (1.0 / width(a).max(1e-6) + 1.0 / width(b).max(1e-6)) / spacing
     })
 }
@@ -184,42 +192,81 @@ pub fn sample_boundary_graded(
 /// `spacing` (bbox-100 units) as a whole number of steps allows: a closed loop gets at least 3,
 /// and the ends of open chains are shared between the chains that meet there.
 pub fn sample_boundary(mesh: &TriMesh, curves: &[BoundaryCurve], spacing: f64) -> BoundarySamples {
-    sample_curves(mesh, curves, spacing, |a, b| a.distance(b))
+    sample_curves(mesh, curves, &[], spacing, |a, b| a.distance(b))
 }
 
-/// The samples of every curve at equal steps of a measure along it: `measure(a, b)` of each
-/// edge from a to b, the step count the whole number of `unit`s closest to the curve's total
-/// ([`curve_steps`]), positions linear in the measure within an edge.
+/// The points of one curve at equal steps of a measure along it: `measure(a, b)` of each edge
+/// from a to b, the step count the whole number of `unit`s closest to the curve's total
+/// ([`curve_steps`]), positions linear in the measure within an edge. Each point with the
+/// index of the edge it lies on; an open curve's first and last points are its end vertices.
+/// Empty for a curve of measure 0.
+pub(crate) fn curve_points(
+    mesh: &TriMesh,
+    curve: &BoundaryCurve,
+    unit: f64,
+    measure: impl Fn(DVec3, DVec3) -> f64,
+) -> Vec<(DVec3, usize)> {
+    let nv = curve.vertices.len();
+    let ne = curve.faces.len();
+    let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
+    let lengths: Vec<f64> = (0..ne).map(|k| measure(pos(k), pos(k + 1))).collect();
+    let total: f64 = lengths.iter().sum();
+    if !(total > 0.0) {
+        return Vec::new();
+    }
+    let steps = curve_steps(total, unit, curve.closed) as usize;
+    let count = if curve.closed { steps } else { steps + 1 };
+    let mut out = Vec::with_capacity(count);
+    let (mut edge, mut edge_start) = (0usize, 0.0f64);
+    for s in 0..count {
+        let t = total * s as f64 / steps as f64;
+        while edge + 1 < ne && edge_start + lengths[edge] < t {
+            edge_start += lengths[edge];
+            edge += 1;
+        }
+        let u = if lengths[edge] > 0.0 {
+            ((t - edge_start) / lengths[edge]).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let p = if !curve.closed && s == steps {
+            pos(nv - 1)
+        } else if s == 0 {
+            pos(0)
+        } else {
+            pos(edge).lerp(pos(edge + 1), u)
+        };
+        out.push((p, edge));
+    }
+    out
+}
+
+/// The samples of every curve ([`curve_points`]), one shared sample where open curves meet.
 fn sample_curves(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
+    features: &[BoundaryCurve],
     unit: f64,
     measure: impl Fn(DVec3, DVec3) -> f64,
 ) -> BoundarySamples {
     let mut out = BoundarySamples::default();
     let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();
-    for curve in curves {
+    let all = curves
+        .iter()
+        .map(|c| (c, false))
+        .chain(features.iter().map(|c| (c, true)));
+    for (curve, feature) in all {
         let nv = curve.vertices.len();
-        let ne = curve.faces.len();
-        let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
-        let lengths: Vec<f64> = (0..ne).map(|k| measure(pos(k), pos(k + 1))).collect();
-        let total: f64 = lengths.iter().sum();
-        if !(total > 0.0) {
+        let points = curve_points(mesh, curve, unit, &measure);
+        if points.is_empty() {
             continue;
         }
-        let steps = curve_steps(total, unit, curve.closed) as usize;
-        let mut ids = Vec::with_capacity(steps + 1);
-        let count = if curve.closed { steps } else { steps + 1 };
-        let (mut edge, mut edge_start) = (0usize, 0.0f64);
-        for s in 0..count {
-            let t = total * s as f64 / steps as f64;
-            while edge + 1 < ne && edge_start + lengths[edge] < t {
-                edge_start += lengths[edge];
-                edge += 1;
-            }
+        let last = points.len() - 1;
+        let mut ids = Vec::with_capacity(points.len());
+        for (s, &(position, edge)) in points.iter().enumerate() {
             let endpoint = if !curve.closed && s == 0 {
                 Some(curve.vertices[0])
-            } else if !curve.closed && s == steps {
+            } else if !curve.closed && s == last {
                 Some(curve.vertices[nv - 1])
             } else {
                 None
@@ -228,15 +275,10 @@ fn sample_curves(
                 ids.push(id);
                 continue;
             }
-            let u = if lengths[edge] > 0.0 {
-                ((t - edge_start) / lengths[edge]).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
             let face = curve.faces[edge];
             let id = out.samples.len() as u32;
             out.samples.push(SurfaceSample {
-                position: pos(edge).lerp(pos(edge + 1), u),
+                position,
                 normal: mesh.face_normal(face as usize),
                 face,
             });
@@ -245,11 +287,16 @@ fn sample_curves(
             }
             ids.push(id);
         }
+        let edges = if feature {
+            &mut out.feature_edges
+        } else {
+            &mut out.edges
+        };
         for k in 0..ids.len() - 1 {
-            out.edges.push([ids[k], ids[k + 1]]);
+            edges.push([ids[k], ids[k + 1]]);
         }
         if curve.closed {
-            out.edges.push([ids[ids.len() - 1], ids[0]]);
+            edges.push([ids[ids.len() - 1], ids[0]]);
         }
     }
     out

@@ -1,0 +1,280 @@
+//! Sharp-feature curves as curves to sample, like the boundary: fixed samples evenly along each
+//! crease from corner to corner, in the output set from the start of the linear scan.
+//!
+//! A crease is a 1-manifold; the spectral measure restricted to it is maximized by even spacing
+//! (the 1-D case of the paper's Sec. 3 analysis: samples on a line are a blue-noise set exactly
+//! when their gaps are equal), so the curve samples are placed at equal arc-length steps, as the
+//! boundary's are. The surface samples then keep away from them through the measure.
+
+use glam::DVec3;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+use crate::mesh::TriMesh;
+use crate::sampling::boundary::{curve_points, BoundaryCurve};
+use crate::surface::features::Features;
+
+/// The least distance between the samples of two feature curves, in units of the spacing
+/// (apart from a corner they share): where two kept curves would come closer, the shorter is
+/// left out. Two curves meeting at a corner at 30° have their first samples about half a
+/// spacing apart, so creases that meet at a corner at 30° or more are kept together.
+pub const CURVE_SAMPLE_GAP: f64 = 0.5;
+
+/// The feature curves of `features` worth sampling at `spacing` (bbox-100 units), as curves with
+/// a face per edge (the face that has the edge in the curve's direction, else the other), and
+/// the boundary `curves` cut at the corners where those feature curves meet them, so that a
+/// crease ending on the boundary ends on a boundary sample. Returns (boundary pieces, feature
+/// pieces).
+///
+/// A feature curve shorter than `spacing` is left out unless both its ends are ends of longer
+/// kept curves (then it only adds the edge between two corners sampled anyway): alone, it
+/// cannot hold a sample between its corners, and two corners closer than the spacing would
+/// only give thin triangles (the folds a scan leaves are such bits). Curves are then taken
+/// longest first, and one whose samples come closer than [`CURVE_SAMPLE_GAP`] spacings to
+/// those of a curve taken before (apart from a shared corner) is left out. Deterministic.
+pub fn feature_pieces(
+    mesh: &TriMesh,
+    curves: &[BoundaryCurve],
+    features: &Features,
+    spacing: f64,
+) -> (Vec<BoundaryCurve>, Vec<BoundaryCurve>) {
+    if features.curves.is_empty() {
+        return (curves.to_vec(), Vec::new());
+    }
+    let mut face_of: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            face_of.insert((t[k], t[(k + 1) % 3]), f as u32);
+        }
+    }
+    let length_of = |c: &crate::surface::features::FeatureCurve| -> f64 {
+        let n = c.vertices.len();
+        let ne = if c.closed { n } else { n - 1 };
+        (0..ne)
+            .map(|k| {
+                mesh.positions[c.vertices[k] as usize]
+                    .distance(mesh.positions[c.vertices[(k + 1) % n] as usize])
+            })
+            .sum()
+    };
+    // Curves long enough for the spacing, then the short ones between two of their ends (an
+    // edge between corners that are sampled anyway).
+    let long: Vec<bool> = features
+        .curves
+        .iter()
+        .map(|c| length_of(c) >= spacing)
+        .collect();
+    let long_ends: FxHashSet<u32> = features
+        .curves
+        .iter()
+        .zip(&long)
+        .filter(|(c, &l)| l && !c.closed)
+        .flat_map(|(c, _)| [c.vertices[0], c.vertices[c.vertices.len() - 1]])
+        .collect();
+    let mut candidates = Vec::new();
+    for (c, &l) in features.curves.iter().zip(&long) {
+        let between_ends = !c.closed
+            && long_ends.contains(&c.vertices[0])
+            && long_ends.contains(&c.vertices[c.vertices.len() - 1]);
+        if !(l || between_ends) {
+            continue;
+        }
+        let n = c.vertices.len();
+        let ne = if c.closed { n } else { n - 1 };
+        let faces: Option<Vec<u32>> = (0..ne)
+            .map(|k| {
+                let (a, b) = (c.vertices[k], c.vertices[(k + 1) % n]);
+                face_of
+                    .get(&(a, b))
+                    .or_else(|| face_of.get(&(b, a)))
+                    .copied()
+            })
+            .collect();
+        if let Some(faces) = faces {
+            candidates.push((
+                length_of(c),
+                BoundaryCurve {
+                    vertices: c.vertices.clone(),
+                    faces,
+                    closed: c.closed,
+                },
+            ));
+        }
+    }
+    // Longest first, each kept only where its samples keep their distance from those of the
+    // curves kept before (apart from a shared corner): two creases closer than the spacing (a
+    // scan's fold beside another, a thin part's rims) would only give thin triangles.
+    candidates.sort_by(|x, y| y.0.total_cmp(&x.0));
+    let gap = CURVE_SAMPLE_GAP * spacing;
+    let cell = |p: DVec3| (p / gap).floor().as_i64vec3().to_array();
+    let mut placed: FxHashMap<[i64; 3], Vec<(DVec3, Option<u32>)>> = FxHashMap::default();
+    let mut pieces = Vec::new();
+    for (_, piece) in candidates {
+        let points = curve_points(mesh, &piece, spacing, |a, b| a.distance(b));
+        let last = points.len().saturating_sub(1);
+        let corner = |k: usize| -> Option<u32> {
+            (!piece.closed && (k == 0 || k == last))
+                .then(|| piece.vertices[if k == 0 { 0 } else { piece.vertices.len() - 1 }])
+        };
+        let clear = points.iter().enumerate().all(|(k, &(p, _))| {
+            let c = cell(p);
+            let here = corner(k);
+            (-1..=1).all(|dx| {
+                (-1..=1).all(|dy| {
+                    (-1..=1).all(|dz| {
+                        placed
+                            .get(&[c[0] + dx, c[1] + dy, c[2] + dz])
+                            .map_or(true, |v| {
+                                v.iter().all(|&(q, at)| {
+                                    (here.is_some() && at == here) || p.distance(q) >= gap
+                                })
+                            })
+                    })
+                })
+            })
+        });
+        if !clear {
+            continue;
+        }
+        for (k, &(p, _)) in points.iter().enumerate() {
+            placed.entry(cell(p)).or_default().push((p, corner(k)));
+        }
+        pieces.push(piece);
+    }
+    // The ends of the kept feature curves, where boundary curves must be cut.
+    let ends: FxHashSet<u32> = pieces
+        .iter()
+        .filter(|p| !p.closed)
+        .flat_map(|p| [p.vertices[0], p.vertices[p.vertices.len() - 1]])
+        .collect();
+    (split_at(curves, &ends), pieces)
+}
+
+/// `curves` cut at the vertices in `at`: a closed curve through k ≥ 1 of them becomes k open
+/// pieces from one to the next (a single one: from it round to itself); an open curve is cut
+/// at each one inside it.
+pub fn split_at(curves: &[BoundaryCurve], at: &FxHashSet<u32>) -> Vec<BoundaryCurve> {
+    let mut out = Vec::with_capacity(curves.len());
+    for curve in curves {
+        let nv = curve.vertices.len();
+        let cuts: Vec<usize> = (0..nv)
+            .filter(|&k| at.contains(&curve.vertices[k]))
+            .filter(|&k| curve.closed || (k > 0 && k + 1 < nv))
+            .collect();
+        if cuts.is_empty() {
+            out.push(curve.clone());
+            continue;
+        }
+        let piece = |from: usize, to: usize| BoundaryCurve {
+            vertices: (from..=to).map(|k| curve.vertices[k % nv]).collect(),
+            faces: (from..to).map(|k| curve.faces[k % nv]).collect(),
+            closed: false,
+        };
+        if curve.closed {
+            for (i, &c) in cuts.iter().enumerate() {
+                let next = cuts[(i + 1) % cuts.len()];
+                out.push(piece(c, if next > c { next } else { next + nv }));
+            }
+        } else {
+            let mut from = 0;
+            for &c in &cuts {
+                out.push(piece(from, c));
+                from = c;
+            }
+            out.push(piece(from, nv - 1));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::boundary::{boundary_curves, sample_curves_and_features};
+    use crate::surface::features::{FeatureCurve, Features};
+    use glam::DVec3;
+
+    /// A unit square in z = 0 folded along x = 0.5 (the half x > 0.5 rises at 60°), as an
+    /// `n × n` grid: one crease from boundary to boundary.
+    fn folded_sheet(n: usize) -> (TriMesh, Vec<u32>) {
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let x = i as f64 / n as f64;
+                let (px, pz) = if x > 0.5 {
+                    (0.5 + (x - 0.5) * 0.5, (x - 0.5) * 3f64.sqrt() / 2.0)
+                } else {
+                    (x, 0.0)
+                };
+                positions.push(DVec3::new(px, j as f64 / n as f64, pz));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = (j * (n + 1) + i) as u32;
+                let w = v + n as u32 + 1;
+                triangles.push([v, v + 1, w + 1]);
+                triangles.push([v, w + 1, w]);
+            }
+        }
+        let crease = (0..=n).map(|j| (j * (n + 1) + n / 2) as u32).collect();
+        (TriMesh::new(positions, triangles), crease)
+    }
+
+    #[test]
+    fn a_crease_is_sampled_evenly_and_cuts_the_boundary_where_it_ends() {
+        let (mesh, crease) = folded_sheet(8);
+        let features = Features {
+            edges: crease
+                .windows(2)
+                .map(|w| [w[0].min(w[1]), w[0].max(w[1])])
+                .collect(),
+            curves: vec![FeatureCurve {
+                vertices: crease.clone(),
+                closed: false,
+            }],
+            corners: vec![crease[0], crease[crease.len() - 1]],
+        };
+        let curves = boundary_curves(&mesh);
+        assert_eq!(curves.len(), 1);
+        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 0.1);
+        assert_eq!(
+            boundary.len(),
+            2,
+            "the loop is cut at the crease's two ends"
+        );
+        assert_eq!(feature.len(), 1);
+        let b = sample_curves_and_features(&mesh, &boundary, &feature, 0.1, None);
+        // 10 steps along the crease (length 1), its ends shared with the boundary.
+        assert_eq!(b.feature_edges.len(), 10);
+        for e in &b.feature_edges {
+            let (p, q) = (
+                b.samples[e[0] as usize].position,
+                b.samples[e[1] as usize].position,
+            );
+            assert!((p.distance(q) - 0.1).abs() < 1e-9);
+            assert!((p.x - 0.5).abs() < 1e-12 && p.z.abs() < 1e-12);
+        }
+        let ends = [b.feature_edges[0][0], b.feature_edges[9][1]];
+        for end in ends {
+            assert_eq!(
+                b.edges.iter().filter(|e| e.contains(&end)).count(),
+                2,
+                "a crease end is a boundary sample"
+            );
+        }
+        // The boundary stays one closed chain of edges through every boundary sample.
+        let mut degree = vec![0; b.samples.len()];
+        for e in &b.edges {
+            degree[e[0] as usize] += 1;
+            degree[e[1] as usize] += 1;
+        }
+        let on_crease_only = (0..b.samples.len()).filter(|&i| degree[i] == 0).count();
+        assert_eq!(on_crease_only, 9);
+        assert!(degree.iter().all(|&d| d == 0 || d == 2));
+        // A crease shorter than the spacing is left out, and the loop stays whole.
+        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 1.5);
+        assert!(feature.is_empty());
+        assert_eq!(boundary, curves);
+    }
+}

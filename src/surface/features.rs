@@ -1,0 +1,444 @@
+//! Sharp features of an input mesh: crease edges, chained into curves, and their corners.
+//!
+//! A feature edge is an interior edge of two faces whose normals differ by at least the feature
+//! angle, and still do at the sampling's scale: the surface within `scale` of the edge, on either
+//! side of it, has mean normals that differ by the feature angle too. The second test is what tells a crease of a part (fandisk, a CSG flange) from the
+//! folds and spikes a scan leaves at the scale of its own triangles (horse, bunny), which are
+//! sharp between two faces but smooth a sample spacing away. Feature edges are chained into
+//! curves that end at corners: vertices where one, three or more feature edges meet, where a
+//! feature curve meets the boundary, or where a curve turns by the feature angle or more.
+//!
+//! # References
+//! The dihedral-angle test is the one of MeshLab's and CGAL's feature detection
+//! (`CGAL::Polygon_mesh_processing::detect_sharp_edges`); the scale test is ours.
+
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+
+use crate::surface::MeshSurface;
+
+/// The default feature angle (degrees): 180, detection off. With creases sampled at 60° the CAD
+/// parts' distance to the input falls 2–5× (fandisk 6000 RMS 0.047 → 0.017), but the organic
+/// models' θmin falls by about 8° (horse 8600 35.6 → 26.7, bunny 9635 34.1 → 25.1: the creases
+/// found there are hoof rims and the tips of ears and tail, thinner than the spacing), so it is
+/// asked for, not assumed. See [`FeatureParams::angle_deg`].
+pub const DEFAULT_FEATURE_ANGLE_DEG: f64 = 180.0;
+
+/// The feature angle (degrees) measured for CAD parts: it finds every crease of fandisk (694 of
+/// its 700 edges over 60° between faces), bracket and flange, and leaves the fandisk's smooth
+/// blends alone (its edges between 20° and 45°).
+pub const CAD_FEATURE_ANGLE_DEG: f64 = 60.0;
+
+/// Parameters of [`detect_features`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FeatureParams {
+    /// The least angle (degrees) between the normals either side of an edge for it to be a
+    /// crease, and the least turn of a feature curve at a vertex for the vertex to be a corner.
+    /// 180 or more turns detection off. Default [`DEFAULT_FEATURE_ANGLE_DEG`].
+    pub angle_deg: f64,
+    /// How far across an edge (bbox-100 units when the mesh is normalized) the surface must
+    /// still show the angle: the sample spacing, so that a crease is one the samples can follow.
+    /// 0 tests the two faces of the edge only.
+    pub scale: f64,
+}
+
+/// A chain of feature edges: input vertex indices in order. An open curve runs from a corner to
+/// a corner; a closed one has no corner and does not repeat its first vertex.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeatureCurve {
+    /// Input vertex indices along the curve.
+    pub vertices: Vec<u32>,
+    /// Whether the curve closes on itself.
+    pub closed: bool,
+}
+
+/// What [`detect_features`] found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Features {
+    /// The feature edges, each `[a, b]` with `a < b`, sorted.
+    pub edges: Vec<[u32; 2]>,
+    /// The edges chained into curves (every feature edge in exactly one curve).
+    pub curves: Vec<FeatureCurve>,
+    /// The corners, ascending: the ends of the open curves.
+    pub corners: Vec<u32>,
+}
+
+impl Features {
+    /// Total length of the feature edges (units of the mesh).
+    pub fn length(&self, positions: &[DVec3]) -> f64 {
+        self.edges
+            .iter()
+            .map(|e| positions[e[0] as usize].distance(positions[e[1] as usize]))
+            .sum()
+    }
+}
+
+/// The sharp features of `surface`'s mesh (see the module docs). The mesh should be oriented
+/// consistently (the pipeline's `orient_consistently`): two faces of an edge with opposite
+/// orientations read as a fold of 180°. Edges of one face (the boundary) or of three or more
+/// (non-manifold) are not feature edges, and degenerate faces give none. Deterministic.
+///
+/// # Runtime
+/// One pass over the edges; for each edge that passes the dihedral test, a walk over the faces
+/// within `scale` of it.
+pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Features {
+    let mesh = surface.mesh();
+    if !(params.angle_deg < 180.0) {
+        return Features::default();
+    }
+    let cos_bound = params.angle_deg.to_radians().cos();
+    // Undirected edge -> the faces that use it (the first two) and how many do.
+    let mut uses: FxHashMap<(u32, u32), ([u32; 2], u32)> = FxHashMap::default();
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let e = uses.entry((a.min(b), a.max(b))).or_insert(([0; 2], 0));
+            if e.1 < 2 {
+                e.0[e.1 as usize] = f as u32;
+            }
+            e.1 += 1;
+        }
+    }
+    let mut boundary_vertex = vec![false; mesh.positions.len()];
+    let mut candidates: Vec<([u32; 2], [u32; 2])> = Vec::new();
+    for (&(a, b), &(faces, n)) in &uses {
+        if n == 1 {
+            boundary_vertex[a as usize] = true;
+            boundary_vertex[b as usize] = true;
+        } else if n == 2 {
+            let (n0, n1) = (surface.face_normal(faces[0]), surface.face_normal(faces[1]));
+            if n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) <= cos_bound {
+                candidates.push(([a, b], faces));
+            }
+        }
+    }
+    candidates.sort_unstable();
+    let mut vertex_faces: Vec<Vec<u32>> = vec![Vec::new(); mesh.positions.len()];
+    if params.scale > 0.0 && !candidates.is_empty() {
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            for &v in t {
+                vertex_faces[v as usize].push(f as u32);
+            }
+        }
+    }
+    let mut edges: Vec<[u32; 2]> = candidates
+        .iter()
+        .filter(|(e, faces)| {
+            sharp_at_scale(surface, &vertex_faces, *e, *faces, params.scale, cos_bound)
+        })
+        .map(|(e, _)| *e)
+        .collect();
+    edges.sort_unstable();
+    let (curves, corners) = chain(&mesh.positions, &edges, &boundary_vertex, cos_bound);
+    Features {
+        edges,
+        curves,
+        corners,
+    }
+}
+
+/// Whether the surface within `scale` of edge `e`'s midpoint still bends by the feature angle
+/// (`cos_bound` its cosine) across the edge: the area-weighted normals of the faces on either
+/// side (faces reached from the edge's own through shared vertices with their centroids within
+/// `scale`, each side the half of that patch nearer one of the two faces' half-planes) at least
+/// the angle apart. True when `scale` is 0.
+fn sharp_at_scale(
+    surface: &MeshSurface,
+    vertex_faces: &[Vec<u32>],
+    e: [u32; 2],
+    faces: [u32; 2],
+    scale: f64,
+    cos_bound: f64,
+) -> bool {
+    if !(scale > 0.0) {
+        return true;
+    }
+    let mesh = surface.mesh();
+    let (pa, pb) = (mesh.positions[e[0] as usize], mesh.positions[e[1] as usize]);
+    let mid = 0.5 * (pa + pb);
+    let along = (pb - pa).normalize_or_zero();
+    let centroid = |f: u32| {
+        let c = mesh.corners(f as usize);
+        (c[0] + c[1] + c[2]) / 3.0
+    };
+    // The direction into a face, across the edge, in the face's plane.
+    let across = |f: u32| -> DVec3 {
+        let d = centroid(f) - mid;
+        (d - along * d.dot(along)).normalize_or_zero()
+    };
+    let split = across(faces[0]) - across(faces[1]);
+    if split == DVec3::ZERO {
+        return false;
+    }
+    let scale_2 = scale * scale;
+    let mut seen: rustc_hash::FxHashSet<u32> = faces.iter().copied().collect();
+    let mut stack: Vec<u32> = faces.to_vec();
+    let mut sides = [DVec3::ZERO; 2];
+    while let Some(f) = stack.pop() {
+        let c = centroid(f);
+        // Area-weighted normal: the cross product's half.
+        let t = mesh.corners(f as usize);
+        let weighted = (t[1] - t[0]).cross(t[2] - t[0]);
+        sides[usize::from((c - mid).dot(split) < 0.0)] += weighted;
+        for &v in &mesh.triangles[f as usize] {
+            for &g in &vertex_faces[v as usize] {
+                if centroid(g).distance_squared(mid) <= scale_2 && seen.insert(g) {
+                    stack.push(g);
+                }
+            }
+        }
+    }
+    let (n0, n1) = (sides[0].normalize_or_zero(), sides[1].normalize_or_zero());
+    n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) <= cos_bound
+}
+
+/// Chains `edges` (sorted) into curves between corners: vertices of feature degree other than
+/// 2, on the boundary, or where the curve turns by more than the angle whose cosine is
+/// `cos_bound`. What is left after the open curves are closed loops without a corner.
+fn chain(
+    positions: &[DVec3],
+    edges: &[[u32; 2]],
+    boundary_vertex: &[bool],
+    cos_bound: f64,
+) -> (Vec<FeatureCurve>, Vec<u32>) {
+    let mut incident: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
+    for (i, e) in edges.iter().enumerate() {
+        incident.entry(e[0]).or_default().push(i);
+        incident.entry(e[1]).or_default().push(i);
+    }
+    let other = |i: usize, v: u32| {
+        if edges[i][0] == v {
+            edges[i][1]
+        } else {
+            edges[i][0]
+        }
+    };
+    let is_corner = |v: u32| -> bool {
+        let inc = &incident[&v];
+        if inc.len() != 2 || boundary_vertex[v as usize] {
+            return true;
+        }
+        let p = positions[v as usize];
+        let a = (p - positions[other(inc[0], v) as usize]).normalize_or_zero();
+        let b = (positions[other(inc[1], v) as usize] - p).normalize_or_zero();
+        a.dot(b) <= cos_bound
+    };
+    let mut corners: Vec<u32> = incident.keys().copied().filter(|&v| is_corner(v)).collect();
+    corners.sort_unstable();
+    let corner_set: rustc_hash::FxHashSet<u32> = corners.iter().copied().collect();
+    let mut used = vec![false; edges.len()];
+    let mut curves = Vec::new();
+    // Walks from `start` along edge `first` until a corner (or back to `start`).
+    let walk = |start: u32, first: usize, used: &mut Vec<bool>| -> FeatureCurve {
+        let mut vertices = vec![start];
+        let (mut v, mut e) = (start, first);
+        loop {
+            used[e] = true;
+            let w = other(e, v);
+            if w == start {
+                return FeatureCurve {
+                    vertices,
+                    closed: !corner_set.contains(&start),
+                };
+            }
+            vertices.push(w);
+            if corner_set.contains(&w) {
+                return FeatureCurve {
+                    vertices,
+                    closed: false,
+                };
+            }
+            match incident[&w].iter().copied().find(|&i| !used[i]) {
+                Some(n) => (v, e) = (w, n),
+                None => {
+                    return FeatureCurve {
+                        vertices,
+                        closed: false,
+                    }
+                }
+            }
+        }
+    };
+    for &c in &corners {
+        for &i in &incident[&c] {
+            if !used[i] {
+                curves.push(walk(c, i, &mut used));
+            }
+        }
+    }
+    for i in 0..edges.len() {
+        if !used[i] {
+            curves.push(walk(edges[i][0], i, &mut used));
+        }
+    }
+    (curves, corners)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::TriMesh;
+
+    /// An axis-aligned box [0, s]³ with each side an `n × n` grid of quads, outward.
+    fn cube(s: f64, n: usize) -> TriMesh {
+        let mut positions: Vec<DVec3> = Vec::new();
+        let mut index: FxHashMap<[i64; 3], u32> = FxHashMap::default();
+        let mut triangles = Vec::new();
+        let mut vertex = |p: [i64; 3], positions: &mut Vec<DVec3>| -> u32 {
+            *index.entry(p).or_insert_with(|| {
+                positions.push(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) * s / n as f64);
+                (positions.len() - 1) as u32
+            })
+        };
+        let n_i = n as i64;
+        for axis in 0..3 {
+            for side in [0, n_i] {
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                for i in 0..n_i {
+                    for j in 0..n_i {
+                        let at = |di: i64, dj: i64| {
+                            let mut p = [0i64; 3];
+                            p[axis] = side;
+                            p[u] = i + di;
+                            p[v] = j + dj;
+                            p
+                        };
+                        let q = [at(0, 0), at(1, 0), at(1, 1), at(0, 1)]
+                            .map(|p| vertex(p, &mut positions));
+                        if side == 0 {
+                            triangles.push([q[0], q[2], q[1]]);
+                            triangles.push([q[0], q[3], q[2]]);
+                        } else {
+                            triangles.push([q[0], q[1], q[2]]);
+                            triangles.push([q[0], q[2], q[3]]);
+                        }
+                    }
+                }
+            }
+        }
+        TriMesh::new(positions, triangles)
+    }
+
+    /// A closed cylinder of radius `r` and height `h` round the z axis: `sides` facets round,
+    /// `rings` bands of quads, caps fanned from their centres. Outward.
+    fn cylinder(r: f64, h: f64, sides: usize, rings: usize) -> TriMesh {
+        let mut positions = Vec::new();
+        for k in 0..=rings {
+            for i in 0..sides {
+                let a = std::f64::consts::TAU * i as f64 / sides as f64;
+                positions.push(DVec3::new(
+                    r * a.cos(),
+                    r * a.sin(),
+                    h * k as f64 / rings as f64,
+                ));
+            }
+        }
+        let at = |k: usize, i: usize| (k * sides + i % sides) as u32;
+        let mut triangles = Vec::new();
+        for k in 0..rings {
+            for i in 0..sides {
+                triangles.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
+                triangles.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
+            }
+        }
+        let bottom = positions.len() as u32;
+        positions.push(DVec3::ZERO);
+        let top = positions.len() as u32;
+        positions.push(DVec3::new(0.0, 0.0, h));
+        for i in 0..sides {
+            triangles.push([bottom, at(0, i + 1), at(0, i)]);
+            triangles.push([top, at(rings, i), at(rings, i + 1)]);
+        }
+        TriMesh::new(positions, triangles)
+    }
+
+    fn detect(mesh: &TriMesh, angle_deg: f64, scale: f64) -> Features {
+        let surface = MeshSurface::new(mesh).unwrap();
+        detect_features(&surface, &FeatureParams { angle_deg, scale })
+    }
+
+    #[test]
+    fn a_cube_has_twelve_curves_and_eight_corners() {
+        let m = cube(100.0, 6);
+        for scale in [0.0, 5.0] {
+            let f = detect(&m, CAD_FEATURE_ANGLE_DEG, scale);
+            assert_eq!(f.edges.len(), 12 * 6, "scale {scale}");
+            assert_eq!(f.curves.len(), 12);
+            assert!(f.curves.iter().all(|c| !c.closed && c.vertices.len() == 7));
+            assert_eq!(f.corners.len(), 8);
+            for &c in &f.corners {
+                let p = m.positions[c as usize];
+                assert!(
+                    [p.x, p.y, p.z].iter().all(|&x| x == 0.0 || x == 100.0),
+                    "{p}"
+                );
+            }
+            assert!((f.length(&m.positions) - 1200.0).abs() < 1e-9);
+        }
+        // Off at 180°.
+        assert!(detect(&m, 180.0, 5.0).edges.is_empty());
+    }
+
+    #[test]
+    fn a_cylinder_has_its_two_rims_as_closed_curves() {
+        let m = cylinder(30.0, 100.0, 48, 10);
+        let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 4.0);
+        assert_eq!(f.curves.len(), 2);
+        assert!(f.corners.is_empty());
+        for c in &f.curves {
+            assert!(c.closed);
+            assert_eq!(c.vertices.len(), 48);
+            let z = m.positions[c.vertices[0] as usize].z;
+            assert!(z == 0.0 || z == 100.0);
+            assert!(c.vertices.iter().all(|&v| m.positions[v as usize].z == z));
+        }
+    }
+
+    #[test]
+    fn a_smooth_sphere_has_no_feature() {
+        let m = crate::mesh::test_meshes::uv_sphere(50.0, 24, 48);
+        assert!(detect(&m, CAD_FEATURE_ANGLE_DEG, 0.0).edges.is_empty());
+    }
+
+    /// A flat square with a narrow sharp ridge across it: a fold at the scale of its own
+    /// triangles is a crease between two faces but not at a sample spacing.
+    #[test]
+    fn a_fold_narrower_than_the_scale_is_not_a_crease() {
+        // Grid 40 × 40 over [0, 100]²; the row of vertices at y = 50 raised by 5 (the ridge's
+        // flanks 2.5 wide: 63° from the plane, 127° between them).
+        let n = 40usize;
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let y = 100.0 * j as f64 / n as f64;
+                let z = if j == n / 2 { 5.0 } else { 0.0 };
+                positions.push(DVec3::new(100.0 * i as f64 / n as f64, y, z));
+            }
+        }
+        let mut triangles = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = (j * (n + 1) + i) as u32;
+                let w = v + n as u32 + 1;
+                triangles.push([v, v + 1, w + 1]);
+                triangles.push([v, w + 1, w]);
+            }
+        }
+        let m = TriMesh::new(positions, triangles);
+        // Between two faces the ridge is sharp: its top and its two feet.
+        assert!(detect(&m, CAD_FEATURE_ANGLE_DEG, 0.0).edges.len() >= n);
+        // At a spacing of 20 (eight grid cells) the surface either side is mostly the flat
+        // square.
+        assert!(detect(&m, CAD_FEATURE_ANGLE_DEG, 20.0).edges.is_empty());
+        // At a spacing of 2 (less than the flanks' width) the ridge is resolved: its top and
+        // feet are three straight creases from boundary to boundary.
+        let resolved = detect(&m, CAD_FEATURE_ANGLE_DEG, 2.0);
+        assert_eq!(resolved.edges.len(), 3 * n);
+        assert_eq!(resolved.curves.len(), 3);
+        assert!(resolved
+            .curves
+            .iter()
+            .all(|c| !c.closed && c.vertices.len() == n + 1));
+        assert_eq!(resolved.corners.len(), 6);
+    }
+}
