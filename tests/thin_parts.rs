@@ -7,77 +7,13 @@
 
 mod common;
 
+use common::{grid_box, grid_box_counts};
+
 use glam::DVec3;
 use spectral_remesh::{
     remesh, self_intersections, topology, Density, GradingParams, RemeshOutput, RemeshParams,
     TriMesh,
 };
-
-/// A closed axis-aligned box from `lo` to `hi`, each face an `n × n` grid, faces outward.
-fn grid_box(lo: DVec3, hi: DVec3, n: usize) -> TriMesh {
-    grid_box_counts(lo, hi, [n; 3])
-}
-
-/// [`grid_box`] with `counts[k]` grid steps along axis k.
-fn grid_box_counts(lo: DVec3, hi: DVec3, counts: [usize; 3]) -> TriMesh {
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    let size = hi - lo;
-    // Each face: an origin corner and two edge vectors whose cross product points outward.
-    let faces = [
-        (
-            lo,
-            DVec3::new(0.0, size.y, 0.0),
-            DVec3::new(size.x, 0.0, 0.0),
-        ),
-        (
-            DVec3::new(lo.x, lo.y, hi.z),
-            DVec3::new(size.x, 0.0, 0.0),
-            DVec3::new(0.0, size.y, 0.0),
-        ),
-        (
-            lo,
-            DVec3::new(size.x, 0.0, 0.0),
-            DVec3::new(0.0, 0.0, size.z),
-        ),
-        (
-            DVec3::new(lo.x, hi.y, lo.z),
-            DVec3::new(0.0, 0.0, size.z),
-            DVec3::new(size.x, 0.0, 0.0),
-        ),
-        (
-            lo,
-            DVec3::new(0.0, 0.0, size.z),
-            DVec3::new(0.0, size.y, 0.0),
-        ),
-        (
-            DVec3::new(hi.x, lo.y, lo.z),
-            DVec3::new(0.0, size.y, 0.0),
-            DVec3::new(0.0, 0.0, size.z),
-        ),
-    ];
-    let steps = |d: DVec3| counts[(0..3).find(|&k| d[k] != 0.0).unwrap_or(0)];
-    for (origin, u, v) in faces {
-        let base = positions.len() as u32;
-        let (nu, nv) = (steps(u), steps(v));
-        for j in 0..=nv {
-            for i in 0..=nu {
-                positions.push(origin + u * (i as f64 / nu as f64) + v * (j as f64 / nv as f64));
-            }
-        }
-        let id = |i: usize, j: usize| base + (j * (nu + 1) + i) as u32;
-        for j in 0..nv {
-            for i in 0..nu {
-                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-    }
-    // The faces' shared edges are welded by position.
-    let mut mesh = TriMesh::new(positions, triangles);
-    mesh.weld_identical_positions();
-    mesh
-}
 
 /// Two meshes as one.
 fn union(a: TriMesh, b: TriMesh) -> TriMesh {
