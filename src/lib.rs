@@ -10,7 +10,7 @@
 //! the report, as the `remesh` command line does. Each stage is also public on its own:
 //!
 //! ```text
-//! read_mesh                      OBJ, PLY, glTF → TriMesh (model units)
+//! read_mesh                      OBJ, PLY, glTF, STL, OFF → TriMesh (model units)
 //!   │
 //! validate_input, Normalization  → bbox 100 (every length below in bbox-100 units)
 //!   │
@@ -133,7 +133,7 @@ mod triangulate;
 // Errors: one enum for the whole crate.
 pub use error::{Error, Result};
 
-// Reading and writing meshes (OBJ, PLY, glTF), atomically.
+// Reading and writing meshes (OBJ, PLY, glTF, STL, OFF), atomically.
 pub use io::{
     read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, MeshFormat, ReadStats,
 };

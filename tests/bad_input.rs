@@ -784,15 +784,15 @@ fn a_density_that_gives_no_triangle_is_a_usage_error_and_writes_nothing() {
 fn outputs_of_a_format_the_command_cannot_write_are_usage_errors() {
     let dir = tempfile::tempdir().unwrap();
     let input = shared("spot.obj");
-    let stl = dir.path().join("out.stl");
+    let unknown = dir.path().join("out.3mf");
     let t = std::time::Instant::now();
     let o = remesh(&[
         input.to_str().unwrap(),
-        stl.to_str().unwrap(),
+        unknown.to_str().unwrap(),
         "--points",
         "2000",
     ]);
-    assert_error(&o, 2, &["out.stl", "unsupported output format"], &stl);
+    assert_error(&o, 2, &["out.3mf", "unsupported output format"], &unknown);
     // Before the remesh, not after it.
     assert!(t.elapsed().as_secs_f64() < 10.0, "{:?}", t.elapsed());
     let points_obj = dir.path().join("points.obj");

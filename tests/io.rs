@@ -221,6 +221,7 @@ fn written_normals(path: &Path) -> Vec<DVec3> {
                 })
                 .collect()
         }
+        MeshFormat::Stl | MeshFormat::Off => panic!("{path:?}: the format has no vertex normals"),
         MeshFormat::Glb | MeshFormat::Gltf => {
             let (doc, buffers, _) = gltf::import(path).unwrap();
             let mesh = doc.meshes().next().unwrap();
@@ -284,6 +285,36 @@ fn round_trips_keep_the_mesh() {
             "spot-out.ply"
         ]
     );
+}
+
+/// Issue 16: the formats CAD parts come in. OFF keeps the mesh exactly (vertices, triangles and
+/// their order); binary STL keeps the triangles corner for corner at `f32` precision, its
+/// corners welded back into the same vertices.
+#[test]
+fn stl_and_off_round_trips_keep_the_mesh() {
+    let (spot, _) = read("spot.obj");
+    let dir = tempfile::tempdir().unwrap();
+    let off = dir.path().join("spot.off");
+    write_mesh(&off, &spot).unwrap();
+    let (back, s) = read_mesh(&off).unwrap();
+    assert_eq!(back, spot);
+    assert_eq!(s.format, MeshFormat::Off);
+    let stl = dir.path().join("spot.stl");
+    write_mesh(&stl, &spot).unwrap();
+    assert_eq!(
+        fs::metadata(&stl).unwrap().len(),
+        84 + 50 * spot.face_count() as u64
+    );
+    let (back, s) = read_mesh(&stl).unwrap();
+    assert_eq!(s.format, MeshFormat::Stl);
+    assert_eq!(s.vertices_read, 3 * spot.face_count());
+    assert_eq!(back.vertex_count(), spot.vertex_count(), "welded back");
+    assert_eq!(back.face_count(), spot.face_count());
+    for f in 0..spot.face_count() {
+        for (a, b) in back.corners(f).iter().zip(spot.corners(f)) {
+            assert!((*a - b).abs().max_element() < 1e-6, "{a} vs {b}");
+        }
+    }
 }
 
 #[test]
@@ -364,7 +395,7 @@ fn write_to_a_missing_directory_fails_cleanly() {
         "only taken.obj/"
     );
     // Unknown output extension.
-    let e = write_mesh(&dir.path().join("out.stl"), &spot).unwrap_err();
+    let e = write_mesh(&dir.path().join("out.3mf"), &spot).unwrap_err();
     assert!(matches!(e, Error::UnsupportedFormat { .. }), "{e}");
 }
 
@@ -900,7 +931,7 @@ fn missing_file_and_unknown_extension() {
 #[test]
 fn empty_files_are_errors() {
     let dir = tempfile::tempdir().unwrap();
-    for ext in ["obj", "ply", "glb", "gltf"] {
+    for ext in ["obj", "ply", "glb", "gltf", "stl", "off"] {
         let path = dir.path().join(format!("empty.{ext}"));
         fs::write(&path, b"").unwrap();
         let e = expect_err(&path);
@@ -1167,7 +1198,7 @@ fn garbage_never_panics() {
                 bytes[at] = next() as u8;
             }
         }
-        for ext in ["obj", "ply", "glb"] {
+        for ext in ["obj", "ply", "glb", "stl", "off"] {
             let path = dir.path().join(format!("g{n}.{ext}"));
             n += 1;
             fs::write(&path, &bytes).unwrap();

@@ -566,7 +566,13 @@ fn a_dash_output_writes_the_mesh_to_standard_output() {
     let sphere = common::icosphere(3);
     std::fs::write(&input, sphere_obj(&sphere)).unwrap();
     let args = ["--points", "300", "--no-distance", "--seed", "3"].map(OsStr::new);
-    for (format, ext) in [(None, "obj"), (Some("ply"), "ply"), (Some("glb"), "glb")] {
+    for (format, ext) in [
+        (None, "obj"),
+        (Some("ply"), "ply"),
+        (Some("glb"), "glb"),
+        (Some("stl"), "stl"),
+        (Some("off"), "off"),
+    ] {
         let file = dir.path().join(format!("file.{ext}"));
         let o = remesh_output(
             &[

@@ -79,7 +79,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     // The output's format is known before any work: an unknown extension is a usage error.
     let to_stdout = is_stdout(&job.output);
     let format = output_format(&job.output, job.format)?;
-    if to_stdout && matches!(format, MeshFormat::Ply | MeshFormat::Glb) {
+    if to_stdout && matches!(format, MeshFormat::Ply | MeshFormat::Glb | MeshFormat::Stl) {
         use std::io::IsTerminal;
         if std::io::stdout().is_terminal() {
             return Err(Error::InvalidParameter {
@@ -109,13 +109,18 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     let (input, stats) = read_mesh(&job.input)?;
     let input_side = input.bbox().map_or(0.0, |b| b.longest_side());
     let (input, up) = into_normal_range(input);
-    if up != 0 && matches!(format, MeshFormat::Gltf | MeshFormat::Glb) {
+    if up != 0 && matches!(format, MeshFormat::Gltf | MeshFormat::Glb | MeshFormat::Stl) {
         return Err(Error::InvalidParameter {
             name: "OUTPUT",
             message: format!(
-                "{}: glTF stores positions as 32-bit floats, which cannot hold the coordinates \
-                 of {} (subnormal numbers); write .obj or .ply",
+                "{}: {} stores positions as 32-bit floats, which cannot hold the coordinates \
+                 of {} (subnormal numbers); write .obj, .ply or .off",
                 job.output.display(),
+                if format == MeshFormat::Stl {
+                    "STL"
+                } else {
+                    "glTF"
+                },
                 job.input.display()
             ),
         });
@@ -156,14 +161,14 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     let mesh_out = scaled_back.as_ref().unwrap_or(&out.mesh);
     let written;
     let checked = match format {
-        MeshFormat::Obj | MeshFormat::Ply if up == 0 => &out.mesh_normalized,
-        MeshFormat::Obj | MeshFormat::Ply => {
+        MeshFormat::Obj | MeshFormat::Ply | MeshFormat::Off if up == 0 => &out.mesh_normalized,
+        MeshFormat::Obj | MeshFormat::Ply | MeshFormat::Off => {
             written = out
                 .normalization
                 .apply_mesh(&scale_by_power_of_two(mesh_out, up));
             &written
         }
-        MeshFormat::Gltf | MeshFormat::Glb => {
+        MeshFormat::Gltf | MeshFormat::Glb | MeshFormat::Stl => {
             written = out.normalization.apply_mesh(&as_written(&out.mesh, format));
             &written
         }

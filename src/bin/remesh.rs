@@ -36,17 +36,18 @@ struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
 
-    /// Input mesh: .obj, .ply, .gltf or .glb.
+    /// Input mesh: .obj, .ply, .gltf, .glb, .stl (binary or ascii) or .off.
     #[arg(required = true)]
     input: Option<PathBuf>,
 
-    /// Output mesh: .obj, .ply, .gltf or .glb (format by extension), or - for standard output
+    /// Output mesh: .obj, .ply, .gltf, .glb, .stl (binary) or .off (format by extension), or -
+    /// for standard output
     /// (OBJ unless --format says otherwise; the report then goes to standard error).
     #[arg(required = true)]
     output: Option<PathBuf>,
 
-    /// The format written to standard output (OUTPUT -): obj (the default), ply, gltf or glb.
-    /// The binary ones (ply, glb) only when asked for, and never to a terminal. With a file,
+    /// The format written to standard output (OUTPUT -): obj (the default), ply, gltf, glb, stl
+    /// or off. The binary ones (ply, glb, stl) only when asked for, and never to a terminal. With a file,
     /// the format is the extension's, and --format must agree with it.
     #[arg(long, value_enum, value_name = "FORMAT")]
     format: Option<OutputFormat>,
@@ -201,6 +202,8 @@ enum OutputFormat {
     Ply,
     Gltf,
     Glb,
+    Stl,
+    Off,
 }
 
 impl From<OutputFormat> for MeshFormat {
@@ -210,6 +213,8 @@ impl From<OutputFormat> for MeshFormat {
             OutputFormat::Ply => MeshFormat::Ply,
             OutputFormat::Gltf => MeshFormat::Gltf,
             OutputFormat::Glb => MeshFormat::Glb,
+            OutputFormat::Stl => MeshFormat::Stl,
+            OutputFormat::Off => MeshFormat::Off,
         }
     }
 }

@@ -14,8 +14,10 @@
 mod atomic;
 mod gltf;
 mod obj;
+mod off;
 pub(crate) mod ply;
 mod polygon;
+mod stl;
 pub(crate) mod temporaries;
 
 use std::fs;
@@ -42,11 +44,15 @@ pub enum MeshFormat {
     Gltf,
     /// glTF 2.0 binary container (`.glb`).
     Glb,
+    /// STL (`.stl`): binary or ascii; a triangle soup whose corners are welded by position.
+    Stl,
+    /// OFF (`.off`), text: CGAL's and geometry processing's plain format.
+    Off,
 }
 
 impl MeshFormat {
     /// The format a file's extension names, compared case-insensitively (`.obj`, `.ply`,
-    /// `.gltf`, `.glb`).
+    /// `.gltf`, `.glb`, `.stl`, `.off`).
     ///
     /// # Errors
     ///
@@ -61,6 +67,8 @@ impl MeshFormat {
             Some("ply") => Ok(MeshFormat::Ply),
             Some("gltf") => Ok(MeshFormat::Gltf),
             Some("glb") => Ok(MeshFormat::Glb),
+            Some("stl") => Ok(MeshFormat::Stl),
+            Some("off") => Ok(MeshFormat::Off),
             _ => Err(Error::UnsupportedFormat {
                 path: path.to_path_buf(),
             }),
@@ -74,6 +82,8 @@ impl MeshFormat {
             MeshFormat::Ply => "ply",
             MeshFormat::Gltf => "gltf",
             MeshFormat::Glb => "glb",
+            MeshFormat::Stl => "stl",
+            MeshFormat::Off => "off",
         }
     }
 }
@@ -123,8 +133,8 @@ impl ReadStats {
     }
 }
 
-/// Reads a triangle mesh from an OBJ, PLY, glTF or GLB file (format by extension), in the
-/// file's units (glTF positions are placed by the scene's node transforms).
+/// Reads a triangle mesh from an OBJ, PLY, glTF, GLB, STL or OFF file (format by extension), in
+/// the file's units (glTF positions are placed by the scene's node transforms).
 ///
 /// Polygons are triangulated in their best-fit plane (concave ones included, see
 /// [`ReadStats::polygons_triangulated`]); points and lines are ignored. After parsing, the mesh is
@@ -147,11 +157,16 @@ impl ReadStats {
 ///   Triangle, strip and fan primitives are read; point and line primitives are counted in
 ///   [`ReadStats::skipped_primitives`]. Buffers may be the GLB binary chunk, data URIs or
 ///   external files beside the `.gltf`. Images are not loaded.
+/// - STL: binary (told by its length: 84 bytes and 50 per triangle, whatever the header says)
+///   or ascii (`solid`); three vertices per triangle, welded by position as below; the stored
+///   facet normals are ignored. Read with the `stl_io` crate.
+/// - OFF: `OFF` (or `COFF`, `NOFF`, `CNOFF`), the counts, `x y z` per vertex and `k i1 … ik`
+///   per face (0-based; extra values such as colours ignored); `#` comments.
 ///
 /// # Errors
 ///
 /// Every error names `path`:
-/// - [`Error::UnsupportedFormat`] for an extension other than the four above;
+/// - [`Error::UnsupportedFormat`] for an extension other than the six above;
 /// - [`Error::Io`] when the file (or an external glTF buffer) cannot be read;
 /// - [`Error::Parse`] when the content does not match the format (with the line, for OBJ and
 ///   ascii PLY header problems where known);
@@ -165,6 +180,8 @@ pub fn read_mesh(path: &Path) -> Result<(TriMesh, ReadStats)> {
         MeshFormat::Obj => obj::read(path, &mut stats)?,
         MeshFormat::Ply => ply::read(path, &mut stats)?,
         MeshFormat::Gltf | MeshFormat::Glb => gltf::read(path, &mut stats)?,
+        MeshFormat::Stl => stl::read(path, &mut stats)?,
+        MeshFormat::Off => off::read(path, &mut stats)?,
     };
     let mesh = finish(path, raw, &mut stats)?;
     Ok((mesh, stats))
@@ -196,6 +213,8 @@ fn check_content(path: &Path, format: MeshFormat) -> Result<()> {
         MeshFormat::Ply => "PLY",
         MeshFormat::Gltf => "glTF (JSON)",
         MeshFormat::Glb => "binary glTF (.glb)",
+        MeshFormat::Stl => "STL",
+        MeshFormat::Off => "OFF",
     };
     let error = |message: String| {
         Err(Error::Parse {
@@ -239,6 +258,8 @@ fn check_content(path: &Path, format: MeshFormat) -> Result<()> {
 ///   bounding box's centre (rounded to `f32`) and positions are stored relative to it, so large
 ///   coordinates (UTM, 5e6) keep the precision of the mesh's size.
 /// - `.gltf`: the same glTF 2.0 asset as JSON, its buffer embedded as a base64 data URI.
+/// - `.stl`: binary STL, corners as `f32`, each triangle with its unit normal.
+/// - `.off`: OFF text with the shortest round-trip `f64` coordinates, `3 a b c` faces.
 ///
 /// The file is written atomically ([`write_atomically`]): to a temporary file in the target's
 /// directory, synced, then renamed onto the target, which an existing file is replaced by.
@@ -293,6 +314,8 @@ pub(crate) fn encode_mesh(path: &Path, mesh: &TriMesh, format: MeshFormat) -> Re
         }
         MeshFormat::Glb => gltf::encode_glb(mesh, &normals).map_err(write_err)?,
         MeshFormat::Gltf => gltf::encode_gltf(mesh, &normals).map_err(write_err)?,
+        MeshFormat::Stl => stl::encode(mesh).map_err(|e| write_err(e.to_string()))?,
+        MeshFormat::Off => off::encode(mesh),
     };
     Ok(bytes)
 }
@@ -304,8 +327,9 @@ pub(crate) fn encode_mesh(path: &Path, mesh: &TriMesh, format: MeshFormat) -> Re
 /// box's centre. Checking this mesh, rather than the one in memory, checks the file.
 pub(crate) fn as_written(mesh: &TriMesh, format: MeshFormat) -> TriMesh {
     match format {
-        MeshFormat::Obj | MeshFormat::Ply => mesh.clone(),
+        MeshFormat::Obj | MeshFormat::Ply | MeshFormat::Off => mesh.clone(),
         MeshFormat::Gltf | MeshFormat::Glb => gltf::as_written(mesh),
+        MeshFormat::Stl => stl::as_written(mesh),
     }
 }
 

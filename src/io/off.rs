@@ -1,0 +1,211 @@
+//! OFF (Object File Format, Geomview): the plain text format of CGAL and of much geometry
+//! processing code. `OFF`, then the vertex, face and edge counts, the vertices (`x y z`, more
+//! values such as colours ignored) and the faces (`k i1 … ik`, 0-based, colours after them
+//! ignored). `#` starts a comment. Our own reader: no well-kept crate reads it, and the format
+//! is a few lines of text.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::polygon::triangulate_polygon;
+use super::{read_file, ReadStats};
+use crate::error::{Error, Result};
+use crate::mesh::TriMesh;
+
+/// Parses the OFF file at `path`: its vertices in file order, its faces triangulated in file
+/// order (polygons in their plane, [`triangulate_polygon`]). Accepts the `OFF` keyword with the
+/// counts on the same line or the next, and the `COFF`, `NOFF`, `CNOFF` variants (the extra
+/// per-vertex values ignored).
+pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
+    let data = read_file(path)?;
+    let text = String::from_utf8_lossy(&data);
+    // Lines without comments, numbered from 1, blank ones skipped.
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.split('#').next().unwrap_or("").trim()))
+        .filter(|(_, l)| !l.is_empty());
+    let err = |line: usize, message: String| Error::parse(path, Some(line), message);
+    let (first_no, first) = lines
+        .next()
+        .ok_or_else(|| Error::parse(path, None, "no OFF header (the file has no content)"))?;
+    let mut head = first.split_whitespace();
+    let keyword = head.next().unwrap_or("");
+    if !matches!(keyword, "OFF" | "COFF" | "NOFF" | "CNOFF") {
+        return Err(err(
+            first_no,
+            format!(
+                "not an OFF file: it starts with `{}`, not `OFF`",
+                short(keyword)
+            ),
+        ));
+    }
+    let rest: Vec<&str> = head.collect();
+    let (counts_no, counts) = if rest.is_empty() {
+        lines
+            .next()
+            .map(|(n, l)| (n, l.split_whitespace().collect::<Vec<_>>()))
+            .ok_or_else(|| err(first_no, "the vertex and face counts are missing".into()))?
+    } else {
+        (first_no, rest)
+    };
+    let count = |k: usize, what: &str| -> Result<usize> {
+        counts
+            .get(k)
+            .ok_or_else(|| err(counts_no, format!("the {what} count is missing")))?
+            .parse::<usize>()
+            .map_err(|_| {
+                err(
+                    counts_no,
+                    format!(
+                        "the {what} count `{}` is not a whole number",
+                        short(counts[k])
+                    ),
+                )
+            })
+    };
+    let (nv, nf) = (count(0, "vertex")?, count(1, "face")?);
+    let mut positions = Vec::with_capacity(nv.min(1 << 24));
+    for k in 0..nv {
+        let (no, line) = lines.next().ok_or_else(|| {
+            Error::parse(
+                path,
+                None,
+                format!("the file ends after {k} of its {nv} vertices"),
+            )
+        })?;
+        let mut p = [0.0f64; 3];
+        let mut tokens = line.split_whitespace();
+        for c in &mut p {
+            let tok = tokens
+                .next()
+                .ok_or_else(|| err(no, "a vertex needs three coordinates".into()))?;
+            *c = tok
+                .parse::<f64>()
+                .map_err(|_| err(no, format!("`{}` is not a number", short(tok))))?;
+        }
+        positions.push(DVec3::from_array(p));
+    }
+    let mut triangles = Vec::with_capacity(nf.min(1 << 24));
+    let mut corners: Vec<u32> = Vec::new();
+    for k in 0..nf {
+        let (no, line) = lines.next().ok_or_else(|| {
+            Error::parse(
+                path,
+                None,
+                format!("the file ends after {k} of its {nf} faces"),
+            )
+        })?;
+        let mut tokens = line.split_whitespace();
+        let index = |tok: Option<&str>| -> Result<u32> {
+            let tok =
+                tok.ok_or_else(|| err(no, "the face has fewer corners than it says".into()))?;
+            let i = tok
+                .parse::<u64>()
+                .map_err(|_| err(no, format!("`{}` is not a vertex index", short(tok))))?;
+            if i >= nv as u64 {
+                return Err(Error::invalid_mesh(
+                    path,
+                    format!("face on line {no} names vertex {i}, but the file has {nv} vertices"),
+                ));
+            }
+            Ok(i as u32)
+        };
+        let size_tok = tokens.next().unwrap_or("");
+        let size: usize = size_tok
+            .parse()
+            .map_err(|_| err(no, format!("`{}` is not a corner count", short(size_tok))))?;
+        corners.clear();
+        for _ in 0..size {
+            corners.push(index(tokens.next())?);
+        }
+        stats.faces_read += usize::from(size >= 3);
+        if size > 3 {
+            stats.polygons_triangulated += 1;
+        }
+        triangles.extend(triangulate_polygon(&positions, &corners));
+    }
+    stats.vertices_read = positions.len();
+    Ok(TriMesh::new(positions, triangles))
+}
+
+/// At most 40 characters of a token, for messages.
+fn short(token: &str) -> String {
+    token.chars().take(40).collect()
+}
+
+/// OFF text of `mesh`: the header, the vertices with Rust's shortest round-trip `f64`
+/// formatting (reading the file back gives the same coordinates), the triangles.
+pub(super) fn encode(mesh: &TriMesh) -> Vec<u8> {
+    let mut s = String::with_capacity(32 * (mesh.positions.len() + mesh.triangles.len()) + 64);
+    let _ = writeln!(s, "OFF");
+    let _ = writeln!(s, "# written by spectral-remesh");
+    let _ = writeln!(s, "{} {} 0", mesh.positions.len(), mesh.triangles.len());
+    for p in &mesh.positions {
+        let _ = writeln!(s, "{:?} {:?} {:?}", p.x, p.y, p.z);
+    }
+    for t in &mesh.triangles {
+        let _ = writeln!(s, "3 {} {} {}", t[0], t[1], t[2]);
+    }
+    s.into_bytes()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read_text(text: &str) -> Result<(TriMesh, ReadStats)> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.off");
+        std::fs::write(&path, text).unwrap();
+        super::super::read_mesh(&path)
+    }
+
+    #[test]
+    fn round_trip_is_exact() {
+        let m = TriMesh::new(
+            vec![
+                DVec3::new(0.1, 0.2, 0.3),
+                DVec3::new(1.0 / 3.0, 0.0, 1e-300),
+                DVec3::new(0.0, 2.5e10, 0.0),
+                DVec3::new(0.0, 0.0, -7.0),
+            ],
+            vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+        );
+        let (back, stats) = read_text(std::str::from_utf8(&encode(&m)).unwrap()).unwrap();
+        assert_eq!(back.positions, m.positions);
+        assert_eq!(back.triangles, m.triangles);
+        assert_eq!((stats.vertices_read, stats.faces_read), (4, 4));
+    }
+
+    #[test]
+    fn quads_comments_colours_and_counts_on_the_keyword_line() {
+        let text = "# a unit square as one quad\nOFF 4 1 0\n0 0 0 255 0 0\n1 0 0\n\n1 1 0\n0 1 0 # last\n4 0 1 2 3 0.5 0.5 0.5\n";
+        let (m, stats) = read_text(text).unwrap();
+        assert_eq!(m.triangles.len(), 2);
+        assert_eq!(stats.polygons_triangulated, 1);
+        assert!((m.area() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_files_are_one_line_errors_naming_the_file_and_line() {
+        for (text, needle) in [
+            ("PLY\n", "m.off:1:"),
+            ("OFF\n3 x 0\n", "m.off:2:"),
+            ("OFF\n3 1 0\n0 0 0\n1 0 0\n", "ends after 2"),
+            (
+                "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n",
+                "names vertex 7",
+            ),
+            ("OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n", "m.off:4:"),
+        ] {
+            let e = read_text(text).unwrap_err().to_string();
+            assert!(
+                e.contains("m.off") && e.contains(needle) && !e.contains('\n'),
+                "{e}"
+            );
+        }
+    }
+}
