@@ -197,10 +197,11 @@ pub use measure::{
 // A kd-tree over fixed points (neighbourhoods of the measure).
 pub use spatial::StaticTree;
 
-// Checks of a mesh: invariants (typed violations), topology, self-intersections.
+// Checks of a mesh: invariants (typed violations), topology, self-intersections, the distance
+// from creases to the output's edges.
 pub use check::{
-    check_invariants, self_intersections, surface_topology, topology, topology_changes,
-    SelfIntersections, Topology, TopologyChange, Violation,
+    check_invariants, crease_distance, self_intersections, surface_topology, topology,
+    topology_changes, CreaseDistance, SelfIntersections, Topology, TopologyChange, Violation,
 };
 
 // The quality report: Table 1's triangle measures, Metro-style distances, stage times.

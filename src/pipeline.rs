@@ -201,6 +201,10 @@ pub struct FeatureStats {
     pub triangulated_edges: usize,
     /// Of those, edges of the output (after the optimization).
     pub kept_edges: usize,
+    /// How far the detected creases (all of them, sampled or not) are from the output's edges
+    /// ([`crease_distance`](crate::check::crease_distance), points every sigma_p / 4; bbox-100
+    /// units); `None` without creases.
+    pub crease_distance: Option<crate::check::CreaseDistance>,
 }
 
 /// The output of [`remesh`].
@@ -456,6 +460,7 @@ pub fn remesh(
         sampled_edges: 0,
         triangulated_edges: 0,
         kept_edges: 0,
+        crease_distance: None,
     };
     timer.lap("features");
     let grading = match params.grading {
@@ -774,6 +779,12 @@ pub fn remesh(
         };
         if done {
             full_history.extend(search_history.iter().copied());
+            let crease_distance = crate::check::crease_distance(
+                &normalized.positions,
+                &features.edges,
+                &mesh_normalized,
+                sigma_p / 4.0,
+            );
             let grading_record = grading
                 .as_ref()
                 .map(|g| g.stats(&mesh_normalized.positions, sigma_ref, &normalization, area));
@@ -810,6 +821,7 @@ pub fn remesh(
                     sampled_edges: feature_edges.len(),
                     triangulated_edges: feature_edges_triangulated,
                     kept_edges: feature_edges_kept,
+                    crease_distance,
                     ..feature_stats.clone()
                 },
                 stray_shells: stray,

@@ -2,11 +2,13 @@
 //! [`Violation`]s), and its self-intersections. These read meshes and never feed the
 //! triangulation.
 
+mod crease_distance;
 mod invariants;
 mod self_intersection;
 mod topology;
 mod topology_change;
 
+pub use crease_distance::{crease_distance, CreaseDistance};
 pub(crate) use invariants::check_all;
 pub use invariants::{check_invariants, Violation};
 pub use self_intersection::{self_intersections, SelfIntersections};
