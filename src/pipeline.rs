@@ -254,7 +254,8 @@ pub struct RemeshOutput {
     /// How each face of `mesh` came in.
     pub face_sources: Vec<crate::triangulate::FaceSource>,
     /// What the restricted Delaunay triangulation did; `None` when the umbrellas made the
-    /// triangles (asked for, or the input's refinement would have been too large).
+    /// triangles (asked for, the input's refinement would have been too large, or it gave no
+    /// triangle).
     pub restricted_delaunay: Option<crate::triangulate::RestrictedDelaunayStats>,
     /// Samples that ended in no triangle and were dropped.
     pub dropped_samples: usize,
@@ -696,6 +697,9 @@ pub fn remesh(
                 triangulate_restricted(&set, &surface, spacing, &params.triangulate, &rd)
             }
         };
+        // No triangle at all (samples scattered over parts far below the refinement's
+        // resolution, such as a small sphere beside a far triangle): the umbrellas instead.
+        let restricted = restricted.filter(|r| !r.0.is_empty());
         let (faces, face_sources, assembly, restricted_delaunay) = match restricted {
             Some((f, s, a, rd)) => (f, s, a, Some(rd)),
             None => {

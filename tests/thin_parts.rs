@@ -212,3 +212,24 @@ fn a_plate_far_thinner_than_the_spacing_stays_one_closed_piece() {
         assert_closed_manifold(&out.mesh, 1, 2, &format!("seed {seed}"));
     }
 }
+
+/// A tube of radius 0.1 and length 100 tessellated in slivers (1 long, 0.04 wide), at 2000
+/// points: the default run keeps it whole, with all its vertices, at every seed. Before the
+/// restricted Delaunay triangulation's refinement budget was raised from 40 to 200 vertices per
+/// sample, the slivers sent it to the umbrellas (the topology sweep's cylinder, tessellated
+/// alike: 40–58 pieces holding 17–22% of the vertices).
+#[test]
+fn a_sliver_tessellated_tube_thinner_than_the_spacing_stays_whole_at_every_seed() {
+    let tube = tube(0.1, 100.0, 16, 1.0);
+    for seed in 1..=5 {
+        let out = run(&tube, 2000, seed, None);
+        let at = format!("seed {seed}");
+        assert!(out.restricted_delaunay.is_some(), "{at}");
+        assert_closed_manifold(&out.mesh, 1, 2, &at);
+        assert_eq!(self_intersections(&out.mesh).pairs, 0, "{at}");
+        let v = out.mesh.positions.len() as f64;
+        assert!((v - 2000.0).abs() <= 20.0, "{at}: {v} vertices");
+        let q = spectral_remesh::triangle_quality(&out.mesh);
+        assert!(q.theta_min >= 25.0, "{at}: θmin {}", q.theta_min);
+    }
+}

@@ -291,7 +291,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     if out.restricted_delaunay.is_none() && params.triangulation != TriangulationMethod::Umbrellas {
         report.notes.push(
             "the samples were connected by tangent-plane umbrellas: the restricted Delaunay \
-             triangulation would have refined this input too far (slivers)"
+             triangulation would have refined this input too far (slivers) or gave no triangle"
                 .into(),
         );
     }
