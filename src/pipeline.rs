@@ -132,7 +132,7 @@ pub struct RemeshParams {
     pub grading: Option<GradingParams>,
     /// The feature angle (degrees) of the sharp-feature detection ([`detect_features`], at the
     /// sample spacing of the first sigma_p): the creases found are sampled evenly along with the
-    /// boundary ([`feature_pieces`]), kept fixed, and their consecutive samples reported as
+    /// boundary (`sampling::features::feature_pieces`), kept fixed, and their consecutive samples reported as
     /// output edges. Default [`DEFAULT_FEATURE_ANGLE_DEG`] (180: off);
     /// [`CAD_FEATURE_ANGLE_DEG`](crate::CAD_FEATURE_ANGLE_DEG) for CAD parts.
     pub feature_angle_deg: f64,

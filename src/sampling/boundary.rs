@@ -120,7 +120,7 @@ pub struct BoundarySamples {
     /// Consecutive samples along a curve, `[from, to]` indices into `samples`, directed with the
     /// surface on the left.
     pub edges: Vec<[u32; 2]>,
-    /// Consecutive samples along a sharp-feature curve ([`sample_curves_and_features`]),
+    /// Consecutive samples along a sharp-feature curve (`sample_curves_and_features`),
     /// `[from, to]` indices into `samples`: edges the output should have, with a face either
     /// side.
     pub feature_edges: Vec<[u32; 2]>,

@@ -125,7 +125,7 @@ pub fn feature_pieces(
                     (-1..=1).all(|dz| {
                         placed
                             .get(&[c[0] + dx, c[1] + dy, c[2] + dz])
-                            .map_or(true, |v| {
+                            .is_none_or(|v| {
                                 v.iter().all(|&(q, at)| {
                                     (here.is_some() && at == here) || p.distance(q) >= gap
                                 })
@@ -198,29 +198,17 @@ mod tests {
     /// A unit square in z = 0 folded along x = 0.5 (the half x > 0.5 rises at 60°), as an
     /// `n × n` grid: one crease from boundary to boundary.
     fn folded_sheet(n: usize) -> (TriMesh, Vec<u32>) {
-        let mut positions = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                let x = i as f64 / n as f64;
-                let (px, pz) = if x > 0.5 {
-                    (0.5 + (x - 0.5) * 0.5, (x - 0.5) * 3f64.sqrt() / 2.0)
-                } else {
-                    (x, 0.0)
-                };
-                positions.push(DVec3::new(px, j as f64 / n as f64, pz));
-            }
-        }
-        let mut triangles = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                let v = (j * (n + 1) + i) as u32;
-                let w = v + n as u32 + 1;
-                triangles.push([v, v + 1, w + 1]);
-                triangles.push([v, w + 1, w]);
-            }
-        }
+        let mesh = crate::mesh::test_meshes::grid(n, |i, j| {
+            let x = i as f64 / n as f64;
+            let (px, pz) = if x > 0.5 {
+                (0.5 + (x - 0.5) * 0.5, (x - 0.5) * 3f64.sqrt() / 2.0)
+            } else {
+                (x, 0.0)
+            };
+            DVec3::new(px, j as f64 / n as f64, pz)
+        });
         let crease = (0..=n).map(|j| (j * (n + 1) + n / 2) as u32).collect();
-        (TriMesh::new(positions, triangles), crease)
+        (mesh, crease)
     }
 
     #[test]

@@ -407,24 +407,10 @@ mod tests {
         // Grid 40 × 40 over [0, 100]²; the row of vertices at y = 50 raised by 5 (the ridge's
         // flanks 2.5 wide: 63° from the plane, 127° between them).
         let n = 40usize;
-        let mut positions = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                let y = 100.0 * j as f64 / n as f64;
-                let z = if j == n / 2 { 5.0 } else { 0.0 };
-                positions.push(DVec3::new(100.0 * i as f64 / n as f64, y, z));
-            }
-        }
-        let mut triangles = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                let v = (j * (n + 1) + i) as u32;
-                let w = v + n as u32 + 1;
-                triangles.push([v, v + 1, w + 1]);
-                triangles.push([v, w + 1, w]);
-            }
-        }
-        let m = TriMesh::new(positions, triangles);
+        let m = crate::mesh::test_meshes::grid(n, |i, j| {
+            let z = if j == n / 2 { 5.0 } else { 0.0 };
+            DVec3::new(100.0 * i as f64 / n as f64, 100.0 * j as f64 / n as f64, z)
+        });
         // Between two faces the ridge is sharp: its top and its two feet.
         assert!(detect(&m, CAD_FEATURE_ANGLE_DEG, 0.0).edges.len() >= n);
         // At a spacing of 20 (eight grid cells) the surface either side is mostly the flat
