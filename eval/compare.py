@@ -38,7 +38,11 @@ DEFAULT_MODELS = [
     ("fandisk.obj", 6000),
     ("spot.obj", 3000),
     ("cow.obj", 3000),
+    ("bracket.obj", 4000),
+    ("flange.obj", 6000),
 ]
+# The CAD parts: where `ours_features` (remesh --feature-angle 60) runs in a full run.
+CAD_MODELS = {"fandisk.obj", "bracket.obj", "flange.obj"}
 COUNT_TOLERANCE = 0.02
 TIMING_RUNS = 3
 
@@ -211,6 +215,7 @@ def run_poisson_bpa(V, F, n, work, input_path):
 METHODS = {
     "ours": ("remesh (spectral sampling)", "count", run_ours),
     "ours_sigma_n": ("remesh --sigma-n 0.75", "count", None),
+    "ours_features": ("remesh --feature-angle 60", "count", None),
     "meshlab_isotropic": ("MeshLab isotropic explicit remeshing (10 it.)", "length", run_meshlab_isotropic),
     "cgal_isotropic": ("CGAL PMP isotropic_remeshing (10 it.)", "length", run_cgal_isotropic),
     "acvd": ("ACVD clustering (pyacvd; VR)", "count", run_acvd),
@@ -222,6 +227,8 @@ METHODS = {
 def adapter(method):
     if method == "ours_sigma_n":
         return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--sigma-n", "0.75"))
+    if method == "ours_features":
+        return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--feature-angle", "60"))
     return METHODS[method][2]
 
 
@@ -387,6 +394,8 @@ def evaluate_model(input_path, n, methods, outdir, log):
     rows = []
     for method in methods:
         if method == "ours_sigma_n" and model != "fandisk.obj" and methods != ["ours_sigma_n"]:
+            continue
+        if method == "ours_features" and model not in CAD_MODELS and methods != ["ours_features"]:
             continue
         label = METHODS[method][0]
         log(f"  {model} at {n}: {label}")
