@@ -10,7 +10,7 @@ use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
 use crate::kernel::Kernel;
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{
-    boundary_curves, boundary_sample_count, curve_length, sample_curves_and_features, BoundaryCurve,
+    boundary_curves, boundary_sample_count, curve_length, sample_curves_and_features,
 };
 use crate::sampling::candidates::surface_candidates;
 use crate::sampling::features::feature_pieces;
@@ -524,19 +524,11 @@ pub fn remesh(
             // to take samples at this spacing.
             let (boundary_pieces, feature_curves) =
                 feature_pieces(&normalized, &curves, &features, spacing);
-            let piece_lengths = |pieces: &[BoundaryCurve]| -> Vec<f64> {
-                pieces
-                    .iter()
-                    .map(|c| curve_length(&normalized, c))
-                    .collect()
-            };
-            let boundary_count =
-                boundary_sample_count(&boundary_pieces, &piece_lengths(&boundary_pieces), spacing)
-                    + boundary_sample_count(
-                        &feature_curves,
-                        &piece_lengths(&feature_curves),
-                        spacing,
-                    );
+            let boundary_count = boundary_sample_count(
+                &normalized,
+                boundary_pieces.iter().chain(&feature_curves),
+                spacing,
+            );
             if !(boundary_count <= boundary_limit) {
                 return Ok((boundary_count.min(usize::MAX as f64) as usize, None));
             }
@@ -697,9 +689,6 @@ pub fn remesh(
                 triangulate_restricted(&set, &surface, spacing, &params.triangulate, &rd)
             }
         };
-        // No triangle at all (samples scattered over parts far below the refinement's
-        // resolution, such as a small sphere beside a far triangle): the umbrellas instead.
-        let restricted = restricted.filter(|r| !r.0.is_empty());
         let (faces, face_sources, assembly, restricted_delaunay) = match restricted {
             Some((f, s, a, rd)) => (f, s, a, Some(rd)),
             None => {

@@ -67,15 +67,19 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
             })
     };
     let (nv, nf) = (count(0, "vertex")?, count(1, "face")?);
-    let mut positions = Vec::with_capacity(nv.min(1 << 24));
-    for k in 0..nv {
-        let (no, line) = lines.next().ok_or_else(|| {
+    // Record `k` of `n` (vertices or faces): the next line with content, with its number.
+    let mut record = |k: usize, n: usize, what: &str| {
+        lines.next().ok_or_else(|| {
             Error::parse(
                 path,
                 None,
-                format!("the file ends after {k} of its {nv} vertices"),
+                format!("the file ends after {k} of its {n} {what}"),
             )
-        })?;
+        })
+    };
+    let mut positions = Vec::with_capacity(nv.min(1 << 24));
+    for k in 0..nv {
+        let (no, line) = record(k, nv, "vertices")?;
         let mut p = [0.0f64; 3];
         let mut tokens = line.split_whitespace();
         for c in &mut p {
@@ -91,13 +95,7 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let mut triangles = Vec::with_capacity(nf.min(1 << 24));
     let mut corners: Vec<u32> = Vec::new();
     for k in 0..nf {
-        let (no, line) = lines.next().ok_or_else(|| {
-            Error::parse(
-                path,
-                None,
-                format!("the file ends after {k} of its {nf} faces"),
-            )
-        })?;
+        let (no, line) = record(k, nf, "faces")?;
         let mut tokens = line.split_whitespace();
         let index = |tok: Option<&str>| -> Result<u32> {
             let tok =

@@ -135,17 +135,21 @@ pub fn curve_length(mesh: &TriMesh, curve: &BoundaryCurve) -> f64 {
         .sum()
 }
 
-/// How many samples [`sample_boundary`] places at `spacing` on curves of these `lengths` (the
-/// closed flags from `curves`), without placing them: the whole-number steps of each curve, at
-/// least 3 on a loop, counting each end of an open chain once per chain (an upper bound there,
-/// as chains that meet share their ends). A float, so that a spacing far below the curves'
-/// length gives a large number rather than an overflow.
-pub fn boundary_sample_count(curves: &[BoundaryCurve], lengths: &[f64], spacing: f64) -> f64 {
+/// How many samples [`sample_boundary`] places at `spacing` on `curves` of `mesh`, without
+/// placing them: the whole-number steps of each curve, at least 3 on a loop, counting each end
+/// of an open chain once per chain (an upper bound there, as chains that meet share their ends).
+/// A float, so that a spacing far below the curves' length gives a large number rather than an
+/// overflow.
+pub fn boundary_sample_count<'a>(
+    mesh: &TriMesh,
+    curves: impl IntoIterator<Item = &'a BoundaryCurve>,
+    spacing: f64,
+) -> f64 {
     curves
-        .iter()
-        .zip(lengths)
-        .filter(|(_, &total)| total > 0.0)
-        .map(|(curve, &total)| {
+        .into_iter()
+        .map(|curve| (curve, curve_length(mesh, curve)))
+        .filter(|(_, total)| *total > 0.0)
+        .map(|(curve, total)| {
             let steps = curve_steps(total, spacing, curve.closed);
             if curve.closed {
                 steps

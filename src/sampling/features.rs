@@ -10,7 +10,7 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
-use crate::sampling::boundary::{curve_points, BoundaryCurve};
+use crate::sampling::boundary::{curve_length, curve_points, BoundaryCurve};
 use crate::surface::features::Features;
 
 /// The least distance between the samples of two feature curves, in units of the spacing
@@ -42,66 +42,33 @@ pub fn feature_pieces(
     if features.curves.is_empty() {
         return (curves.to_vec(), Vec::new());
     }
-    let mut face_of: FxHashMap<(u32, u32), u32> = FxHashMap::default();
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            face_of.insert((t[k], t[(k + 1) % 3]), f as u32);
-        }
-    }
-    let length_of = |c: &crate::surface::features::FeatureCurve| -> f64 {
-        let n = c.vertices.len();
-        let ne = if c.closed { n } else { n - 1 };
-        (0..ne)
-            .map(|k| {
-                mesh.positions[c.vertices[k] as usize]
-                    .distance(mesh.positions[c.vertices[(k + 1) % n] as usize])
-            })
-            .sum()
-    };
+    // The curves as curves to sample, with their lengths.
+    let all: Vec<(f64, BoundaryCurve)> = features
+        .curves
+        .iter()
+        .map(|c| {
+            let piece = BoundaryCurve {
+                vertices: c.vertices.clone(),
+                faces: c.faces.clone(),
+                closed: c.closed,
+            };
+            (curve_length(mesh, &piece), piece)
+        })
+        .collect();
+    let ends = |c: &BoundaryCurve| [c.vertices[0], c.vertices[c.vertices.len() - 1]];
     // Curves long enough for the spacing, then the short ones between two of their ends (an
     // edge between corners that are sampled anyway).
-    let long: Vec<bool> = features
-        .curves
+    let long_ends: FxHashSet<u32> = all
         .iter()
-        .map(|c| length_of(c) >= spacing)
+        .filter(|(l, c)| *l >= spacing && !c.closed)
+        .flat_map(|(_, c)| ends(c))
         .collect();
-    let long_ends: FxHashSet<u32> = features
-        .curves
-        .iter()
-        .zip(&long)
-        .filter(|(c, &l)| l && !c.closed)
-        .flat_map(|(c, _)| [c.vertices[0], c.vertices[c.vertices.len() - 1]])
+    let mut candidates: Vec<(f64, BoundaryCurve)> = all
+        .into_iter()
+        .filter(|(l, c)| {
+            *l >= spacing || (!c.closed && ends(c).iter().all(|v| long_ends.contains(v)))
+        })
         .collect();
-    let mut candidates = Vec::new();
-    for (c, &l) in features.curves.iter().zip(&long) {
-        let between_ends = !c.closed
-            && long_ends.contains(&c.vertices[0])
-            && long_ends.contains(&c.vertices[c.vertices.len() - 1]);
-        if !(l || between_ends) {
-            continue;
-        }
-        let n = c.vertices.len();
-        let ne = if c.closed { n } else { n - 1 };
-        let faces: Option<Vec<u32>> = (0..ne)
-            .map(|k| {
-                let (a, b) = (c.vertices[k], c.vertices[(k + 1) % n]);
-                face_of
-                    .get(&(a, b))
-                    .or_else(|| face_of.get(&(b, a)))
-                    .copied()
-            })
-            .collect();
-        if let Some(faces) = faces {
-            candidates.push((
-                length_of(c),
-                BoundaryCurve {
-                    vertices: c.vertices.clone(),
-                    faces,
-                    closed: c.closed,
-                },
-            ));
-        }
-    }
     // Longest first, each kept only where its samples keep their distance from those of the
     // curves kept before (apart from a shared corner): two creases closer than the spacing (a
     // scan's fold beside another, a thin part's rims) would only give thin triangles.
@@ -192,7 +159,7 @@ pub fn split_at(curves: &[BoundaryCurve], at: &FxHashSet<u32>) -> Vec<BoundaryCu
 mod tests {
     use super::*;
     use crate::sampling::boundary::{boundary_curves, sample_curves_and_features};
-    use crate::surface::features::{FeatureCurve, Features};
+    use crate::surface::features::{detect_features, FeatureParams};
     use glam::DVec3;
 
     /// A unit square in z = 0 folded along x = 0.5 (the half x > 0.5 rises at 60°), as an
@@ -214,17 +181,17 @@ mod tests {
     #[test]
     fn a_crease_is_sampled_evenly_and_cuts_the_boundary_where_it_ends() {
         let (mesh, crease) = folded_sheet(8);
-        let features = Features {
-            edges: crease
-                .windows(2)
-                .map(|w| [w[0].min(w[1]), w[0].max(w[1])])
-                .collect(),
-            curves: vec![FeatureCurve {
-                vertices: crease.clone(),
-                closed: false,
-            }],
-            corners: vec![crease[0], crease[crease.len() - 1]],
-        };
+        // The fold is 60° between faces: a crease at 45°, from boundary to boundary.
+        let surface = crate::surface::MeshSurface::new(&mesh).unwrap();
+        let features = detect_features(
+            &surface,
+            &FeatureParams {
+                angle_deg: 45.0,
+                scale: 0.0,
+            },
+        );
+        assert_eq!(features.curves.len(), 1);
+        assert_eq!(features.curves[0].vertices, crease);
         let curves = boundary_curves(&mesh);
         assert_eq!(curves.len(), 1);
         let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 0.1);

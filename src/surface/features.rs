@@ -15,6 +15,7 @@
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
+use crate::mesh::TriMesh;
 use crate::surface::MeshSurface;
 
 /// The default feature angle (degrees): 180, detection off. With creases sampled at 60° the CAD
@@ -48,6 +49,9 @@ pub struct FeatureParams {
 pub struct FeatureCurve {
     /// Input vertex indices along the curve.
     pub vertices: Vec<u32>,
+    /// For each edge `vertices[k] → vertices[k+1]` (and, for a closed curve, last → first): a
+    /// face on it, the one that has the edge in this direction where one does.
+    pub faces: Vec<u32>,
     /// Whether the curve closes on itself.
     pub closed: bool,
 }
@@ -121,15 +125,14 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
             }
         }
     }
-    let mut edges: Vec<[u32; 2]> = candidates
-        .iter()
+    // Sorted by edge already (the candidates are).
+    let (edges, edge_faces): (Vec<[u32; 2]>, Vec<[u32; 2]>) = candidates
+        .into_iter()
         .filter(|(e, faces)| {
             sharp_at_scale(surface, &vertex_faces, *e, *faces, params.scale, cos_bound)
         })
-        .map(|(e, _)| *e)
-        .collect();
-    edges.sort_unstable();
-    let (curves, corners) = chain(&mesh.positions, &edges, &boundary_vertex, cos_bound);
+        .unzip();
+    let (curves, corners) = chain(mesh, &edges, &edge_faces, &boundary_vertex, cos_bound);
     Features {
         edges,
         curves,
@@ -196,11 +199,26 @@ fn sharp_at_scale(
 /// 2, on the boundary, or where the curve turns by more than the angle whose cosine is
 /// `cos_bound`. What is left after the open curves are closed loops without a corner.
 fn chain(
-    positions: &[DVec3],
+    mesh: &TriMesh,
     edges: &[[u32; 2]],
+    edge_faces: &[[u32; 2]],
     boundary_vertex: &[bool],
     cos_bound: f64,
 ) -> (Vec<FeatureCurve>, Vec<u32>) {
+    let positions = &mesh.positions;
+    // The face of edge `e` that has it as `a → b` (the later one if both do), else the later
+    // one that has `b → a`.
+    let face_along = |e: usize, a: u32, b: u32| -> u32 {
+        let has = |f: u32, a: u32, b: u32| {
+            let t = mesh.triangles[f as usize];
+            (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b)
+        };
+        let [f0, f1] = edge_faces[e];
+        [(f1, a, b), (f0, a, b), (f1, b, a)]
+            .into_iter()
+            .find(|&(f, a, b)| has(f, a, b))
+            .map_or(f0, |(f, _, _)| f)
+    };
     let mut incident: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
     for (i, e) in edges.iter().enumerate() {
         incident.entry(e[0]).or_default().push(i);
@@ -231,32 +249,35 @@ fn chain(
     // Walks from `start` along edge `first` until a corner (or back to `start`).
     let walk = |start: u32, first: usize, used: &mut Vec<bool>| -> FeatureCurve {
         let mut vertices = vec![start];
+        let mut faces = Vec::new();
         let (mut v, mut e) = (start, first);
         loop {
             used[e] = true;
             let w = other(e, v);
+            let closed = w == start && !corner_set.contains(&start);
+            if closed || w != start {
+                faces.push(face_along(e, v, w));
+            }
             if w == start {
                 return FeatureCurve {
                     vertices,
-                    closed: !corner_set.contains(&start),
+                    faces,
+                    closed,
                 };
             }
             vertices.push(w);
             if corner_set.contains(&w) {
-                return FeatureCurve {
-                    vertices,
-                    closed: false,
-                };
+                break;
             }
             match incident[&w].iter().copied().find(|&i| !used[i]) {
                 Some(n) => (v, e) = (w, n),
-                None => {
-                    return FeatureCurve {
-                        vertices,
-                        closed: false,
-                    }
-                }
+                None => break,
             }
+        }
+        FeatureCurve {
+            vertices,
+            faces,
+            closed: false,
         }
     };
     for &c in &corners {
@@ -277,7 +298,6 @@ fn chain(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::TriMesh;
 
     /// An axis-aligned box [0, s]³ with each side an `n × n` grid of quads, outward.
     fn cube(s: f64, n: usize) -> TriMesh {

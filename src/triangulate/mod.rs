@@ -63,7 +63,8 @@ pub fn triangulate(
 /// their Voronoi cells grown over the input mesh, see `restricted_delaunay`), then assembles
 /// and cleans it up as [`triangulate`] does. `spacing`: the sample spacing (units of the
 /// positions). Returns also what the restricted Delaunay step did; `None` when its refinement of
-/// the input would be too large (see [`RestrictedDelaunayParams::max_added_per_sample`]).
+/// the input would be too large (see [`RestrictedDelaunayParams::max_added_per_sample`]) or it
+/// gives no triangle.
 pub fn triangulate_restricted(
     set: &SampleSet,
     surface: &MeshSurface,
@@ -81,7 +82,11 @@ pub fn triangulate_restricted(
         rd_stats = Some(st);
         assemble_candidates(s, voted, params)
     });
-    rd_stats.map(|st| (faces, sources, stats, st))
+    // No triangle at all (samples scattered over parts far below the refinement's resolution,
+    // such as a small sphere beside a far triangle) is no triangulation either.
+    rd_stats
+        .filter(|_| !faces.is_empty())
+        .map(|st| (faces, sources, stats, st))
 }
 
 /// [`Triangulated`] and what the restricted Delaunay step did.
