@@ -41,7 +41,7 @@ DEFAULT_MODELS = [
     ("bracket.obj", 4000),
     ("flange.obj", 6000),
 ]
-# The CAD parts: where `ours_features` (remesh --feature-angle 60) runs in a full run.
+# The CAD parts: where `ours_features` (remesh --feature-angle 55) runs in a full run.
 CAD_MODELS = {"fandisk.obj", "bracket.obj", "flange.obj"}
 COUNT_TOLERANCE = 0.02
 TIMING_RUNS = 3
@@ -215,7 +215,7 @@ def run_poisson_bpa(V, F, n, work, input_path):
 METHODS = {
     "ours": ("remesh (spectral sampling)", "count", run_ours),
     "ours_sigma_n": ("remesh --sigma-n 0.75", "count", None),
-    "ours_features": ("remesh --feature-angle 60", "count", None),
+    "ours_features": ("remesh --feature-angle 55", "count", None),
     "meshlab_isotropic": ("MeshLab isotropic explicit remeshing (10 it.)", "length", run_meshlab_isotropic),
     "cgal_isotropic": ("CGAL PMP isotropic_remeshing (10 it.)", "length", run_cgal_isotropic),
     "acvd": ("ACVD clustering (pyacvd; VR)", "count", run_acvd),
@@ -228,7 +228,7 @@ def adapter(method):
     if method == "ours_sigma_n":
         return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--sigma-n", "0.75"))
     if method == "ours_features":
-        return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--feature-angle", "60"))
+        return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--feature-angle", "55"))
     return METHODS[method][2]
 
 
