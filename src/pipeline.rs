@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
 use crate::kernel::Kernel;
+use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{
     boundary_curves, boundary_sample_count, curve_length, sample_curves_and_features,
@@ -30,6 +31,7 @@ use crate::surface::SurfaceSample;
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
+use crate::triangulate::recover::{recover_edges, RecoverStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{
@@ -199,7 +201,10 @@ pub struct FeatureStats {
     pub sampled_edges: usize,
     /// Of those, edges of the triangulation.
     pub triangulated_edges: usize,
-    /// Of those, edges of the output (after the optimization).
+    /// Of the sampled edges the triangulation left out, those put in afterwards
+    /// ([`recover_edges`](crate::triangulate::recover::recover_edges)).
+    pub recovered_edges: usize,
+    /// Of the sampled edges, edges of the output (after the optimization).
     pub kept_edges: usize,
     /// How far the detected creases (all of them, sampled or not) are from the output's edges
     /// ([`crease_distance`](crate::check::crease_distance), points every sigma_p / 4; bbox-100
@@ -460,6 +465,7 @@ pub fn remesh(
         length: features.length(&normalized.positions),
         sampled_edges: 0,
         triangulated_edges: 0,
+        recovered_edges: 0,
         kept_edges: 0,
         crease_distance: None,
     };
@@ -526,7 +532,9 @@ pub fn remesh(
                 feature_pieces(&normalized, &curves, &features, spacing);
             let boundary_count = boundary_sample_count(
                 &normalized,
-                boundary_pieces.iter().chain(&feature_curves),
+                boundary_pieces
+                    .iter()
+                    .chain(feature_curves.iter().map(|f| &f.curve)),
                 spacing,
             );
             if !(boundary_count <= boundary_limit) {
@@ -698,9 +706,25 @@ pub fn remesh(
         };
         let mut mesh_normalized = TriMesh::new(positions, faces);
         let feature_edges_triangulated = edges_present(&mesh_normalized, &feature_edges);
+        let mut face_sources = face_sources;
+        // Crease edges the triangulation left out (where a crease leaves a corner at a small
+        // angle to another) are put in.
+        let recovery = if feature_edges_triangulated < feature_edges.len() {
+            let mut m: EditMesh<Option<u32>> =
+                EditMesh::from_trimesh(&mesh_normalized, Some, SlotPolicy::Reuse);
+            let stats = recover_edges(&mut m, &feature_edges, None);
+            let (positions, faces, origin) = m.into_parts();
+            mesh_normalized = TriMesh::new(positions, faces);
+            face_sources = origin
+                .iter()
+                .map(|o| o.map_or(FaceSource::Refined, |f| face_sources[f as usize]))
+                .collect();
+            stats
+        } else {
+            RecoverStats::default()
+        };
         timer.lap("triangulate");
         on_stage("optimize");
-        let mut face_sources = face_sources;
         let optimize_stats = match &params.optimize {
             Some(op) => {
                 let fixed: Vec<bool> = (0..samples.len()).map(|i| i < boundary_count).collect();
@@ -709,6 +733,7 @@ pub fn remesh(
                     &surface,
                     &cover_points,
                     &fixed,
+                    &feature_edges,
                     sigma_p,
                     op,
                 );
@@ -813,6 +838,7 @@ pub fn remesh(
                 features: FeatureStats {
                     sampled_edges: feature_edges.len(),
                     triangulated_edges: feature_edges_triangulated,
+                    recovered_edges: recovery.recovered,
                     kept_edges: feature_edges_kept,
                     crease_distance,
                     ..feature_stats.clone()

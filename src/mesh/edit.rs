@@ -81,6 +81,11 @@ pub enum EditError {
         /// The vertex.
         vertex: u32,
     },
+    /// A flip or collapse would remove or move a protected edge (a crease kept as an edge).
+    ProtectedEdge {
+        /// The edge.
+        edge: [u32; 2],
+    },
 }
 
 /// An invariant that [`EditMesh::sanity_check`] found broken.
@@ -179,6 +184,8 @@ pub struct EditMesh<L: Copy = ()> {
     edge: FxHashMap<(u32, u32), u32>,
     /// Directed edges no face may use.
     blocked: FxHashSet<(u32, u32)>,
+    /// Undirected edges `(min, max)` that flips and collapses keep.
+    protected: FxHashSet<(u32, u32)>,
     /// Vertex → the live faces around it.
     around: Vec<Vec<u32>>,
     policy: SlotPolicy,
@@ -195,6 +202,7 @@ impl<L: Copy> EditMesh<L> {
             labels: Vec::new(),
             edge: FxHashMap::default(),
             blocked: FxHashSet::default(),
+            protected: FxHashSet::default(),
             around: vec![Vec::new(); n],
             policy,
         }
@@ -219,6 +227,22 @@ impl<L: Copy> EditMesh<L> {
     /// Blocks the directed edge `a → b`: no face may use it.
     pub fn block_directed_edge(&mut self, a: u32, b: u32) {
         self.blocked.insert((a, b));
+    }
+
+    /// Protects the edge `a`–`b` (whether or not a face uses it yet): no flip removes it and no
+    /// collapse removes or moves it ([`EditError::ProtectedEdge`]). The creases a remesh keeps.
+    pub fn protect_edge(&mut self, a: u32, b: u32) {
+        self.protected.insert((a.min(b), a.max(b)));
+    }
+
+    /// Whether the edge `a`–`b` is protected ([`EditMesh::protect_edge`]).
+    pub fn is_protected(&self, a: u32, b: u32) -> bool {
+        !self.protected.is_empty() && self.protected.contains(&(a.min(b), a.max(b)))
+    }
+
+    /// Whether a protected edge ends at `v`.
+    fn has_protected_edge(&self, v: u32) -> bool {
+        !self.protected.is_empty() && self.ring(v).into_iter().any(|u| self.is_protected(u, v))
     }
 
     /// The number of vertices.
@@ -476,6 +500,9 @@ impl<L: Copy> EditMesh<L> {
     /// blocked direction), or when a new face has no area. Returns the new faces' slots.
     pub fn flip_edge(&mut self, a: u32, b: u32, label: L) -> Result<[u32; 2], EditError> {
         let (f1, f2, c, d) = self.edge_faces(a, b)?;
+        if self.is_protected(a, b) {
+            return Err(EditError::ProtectedEdge { edge: [a, b] });
+        }
         if c == d || self.is_used_or_blocked(c, d) || self.is_used_or_blocked(d, c) {
             return Err(EditError::FlipWouldDuplicateEdge { edge: [c, d] });
         }
@@ -535,6 +562,15 @@ impl<L: Copy> EditMesh<L> {
         label: L,
     ) -> Result<(), EditError> {
         let (f1, f2, c, d) = self.edge_faces(removed, kept)?;
+        // A protected edge at `removed` would go or move; one at `kept` moves unless `kept`
+        // stays where it is.
+        if self.has_protected_edge(removed)
+            || (position != self.positions[kept as usize] && self.has_protected_edge(kept))
+        {
+            return Err(EditError::ProtectedEdge {
+                edge: [removed, kept],
+            });
+        }
         let link = Err(EditError::LinkCondition {
             edge: [removed, kept],
         });

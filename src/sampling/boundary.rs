@@ -10,6 +10,7 @@ use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 use crate::mesh::TriMesh;
+use crate::sampling::features::FeaturePiece;
 use crate::sampling::WidthField;
 use crate::surface::SurfaceSample;
 
@@ -179,7 +180,7 @@ fn curve_steps(total: f64, spacing: f64, closed: bool) -> f64 {
 pub fn sample_curves_and_features(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
-    features: &[BoundaryCurve],
+    features: &[FeaturePiece],
     spacing: f64,
     width: Option<WidthField>,
 ) -> BoundarySamples {
@@ -245,11 +246,33 @@ pub(crate) fn curve_points(
     out
 }
 
-/// The samples of every curve ([`curve_points`]), one shared sample where open curves meet.
+/// The arc length (units of the mesh) from a curve's start to each of its `points` (as
+/// [`curve_points`] gives them: a position and the index of the edge it lies on).
+pub(crate) fn arc_lengths(
+    mesh: &TriMesh,
+    curve: &BoundaryCurve,
+    points: &[(DVec3, usize)],
+) -> Vec<f64> {
+    let nv = curve.vertices.len();
+    let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
+    let mut start = Vec::with_capacity(curve.faces.len() + 1);
+    let mut sum = 0.0;
+    for k in 0..curve.faces.len() {
+        start.push(sum);
+        sum += pos(k).distance(pos(k + 1));
+    }
+    points
+        .iter()
+        .map(|&(p, edge)| start[edge] + pos(edge).distance(p))
+        .collect()
+}
+
+/// The samples of every curve ([`curve_points`]), one shared sample where open curves meet;
+/// the feature pieces without samples on their bare ends (but their corners).
 fn sample_curves(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
-    features: &[BoundaryCurve],
+    features: &[FeaturePiece],
     unit: f64,
     measure: impl Fn(DVec3, DVec3) -> f64,
 ) -> BoundarySamples {
@@ -257,13 +280,24 @@ fn sample_curves(
     let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();
     let all = curves
         .iter()
-        .map(|c| (c, false))
-        .chain(features.iter().map(|c| (c, true)));
-    for (curve, feature) in all {
+        .map(|c| (c, false, [0.0; 2]))
+        .chain(features.iter().map(|f| (&f.curve, true, f.bare)));
+    for (curve, feature, bare) in all {
         let nv = curve.vertices.len();
-        let points = curve_points(mesh, curve, unit, &measure);
+        let mut points = curve_points(mesh, curve, unit, &measure);
         if points.is_empty() {
             continue;
+        }
+        if bare != [0.0; 2] {
+            let arc = arc_lengths(mesh, curve, &points);
+            let (from, to) = (bare[0], curve_length(mesh, curve) - bare[1]);
+            let last = points.len() - 1;
+            let mut k = 0;
+            points.retain(|_| {
+                let keep = k == 0 || k == last || (arc[k] > from && arc[k] < to);
+                k += 1;
+                keep
+            });
         }
         let last = points.len() - 1;
         let mut ids = Vec::with_capacity(points.len());

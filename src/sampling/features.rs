@@ -10,7 +10,7 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
-use crate::sampling::boundary::{curve_length, curve_points, BoundaryCurve};
+use crate::sampling::boundary::{arc_lengths, curve_length, curve_points, BoundaryCurve};
 use crate::surface::features::Features;
 
 /// The least distance between the samples of two feature curves, in units of the spacing
@@ -20,6 +20,38 @@ use crate::surface::features::Features;
 /// at worst (creases round the tail and ear tips, whose samples make thin triangles among
 /// themselves); at 0.85, 28.6 and 33.0; fandisk, bracket and flange the same at both.
 pub const CURVE_SAMPLE_GAP: f64 = 0.85;
+
+/// A feature curve to sample: the curve, and the arc length (bbox-100 units) at its start and at
+/// its end that gets no sample but the corner (`bare`), where it leaves a corner at a small
+/// angle to a curve kept before it (see [`feature_pieces`]). Its first edge then runs from the
+/// corner to its first sample beyond that length, along the crease.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeaturePiece {
+    /// The crease, as a curve with a face per edge.
+    pub curve: BoundaryCurve,
+    /// Arc length without samples at the start and at the end (0 for none).
+    pub bare: [f64; 2],
+}
+
+/// Which of an open curve's samples to keep, given which are `clear` of the samples of curves
+/// kept before: every clear one, where the crowded ones are the first few after the start or
+/// the last few before the end (leaving a corner at a small angle to another curve). None when
+/// a corner, a closed curve's sample, or a sample with clear ones on both sides is crowded (the
+/// curve runs beside another), or when every sample between the corners is.
+fn trim_at_ends(clear: &[bool], closed: bool) -> Option<Vec<bool>> {
+    if clear.iter().all(|&c| c) {
+        return Some(clear.to_vec());
+    }
+    let n = clear.len();
+    if closed || n < 2 || !clear[0] || !clear[n - 1] {
+        return None;
+    }
+    let first_clear = (1..n - 1).find(|&k| clear[k])?;
+    let last_clear = (1..n - 1).rev().find(|&k| clear[k])?;
+    (first_clear..=last_clear)
+        .all(|k| clear[k])
+        .then(|| clear.to_vec())
+}
 
 /// The feature curves of `features` worth sampling at `spacing` (bbox-100 units), as curves with
 /// a face per edge (the face that has the edge in the curve's direction, else the other), and
@@ -32,13 +64,16 @@ pub const CURVE_SAMPLE_GAP: f64 = 0.85;
 /// cannot hold a sample between its corners, and two corners closer than the spacing would
 /// only give thin triangles (the folds a scan leaves are such bits). Curves are then taken
 /// longest first, and one whose samples come closer than [`CURVE_SAMPLE_GAP`] spacings to
-/// those of a curve taken before (apart from a shared corner) is left out. Deterministic.
+/// those of a curve taken before (apart from a shared corner) is left out, unless the crowded
+/// samples are only its first or last few, where it leaves a corner at a small angle to a kept
+/// curve: those are left out and the rest kept (a [`FeaturePiece`]'s `bare` ends; the angle at
+/// such a corner is the input's, and its triangles cannot have a larger one). Deterministic.
 pub fn feature_pieces(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
     features: &Features,
     spacing: f64,
-) -> (Vec<BoundaryCurve>, Vec<BoundaryCurve>) {
+) -> (Vec<BoundaryCurve>, Vec<FeaturePiece>) {
     if features.curves.is_empty() {
         return (curves.to_vec(), Vec::new());
     }
@@ -84,36 +119,64 @@ pub fn feature_pieces(
             (!piece.closed && (k == 0 || k == last))
                 .then(|| piece.vertices[if k == 0 { 0 } else { piece.vertices.len() - 1 }])
         };
-        let clear = points.iter().enumerate().all(|(k, &(p, _))| {
-            let c = cell(p);
-            let here = corner(k);
-            (-1..=1).all(|dx| {
-                (-1..=1).all(|dy| {
-                    (-1..=1).all(|dz| {
-                        placed
-                            .get(&[c[0] + dx, c[1] + dy, c[2] + dz])
-                            .is_none_or(|v| {
-                                v.iter().all(|&(q, at)| {
-                                    (here.is_some() && at == here) || p.distance(q) >= gap
+        let clear: Vec<bool> = points
+            .iter()
+            .enumerate()
+            .map(|(k, &(p, _))| {
+                let c = cell(p);
+                let here = corner(k);
+                (-1..=1).all(|dx| {
+                    (-1..=1).all(|dy| {
+                        (-1..=1).all(|dz| {
+                            placed
+                                .get(&[c[0] + dx, c[1] + dy, c[2] + dz])
+                                .is_none_or(|v| {
+                                    v.iter().all(|&(q, at)| {
+                                        (here.is_some() && at == here) || p.distance(q) >= gap
+                                    })
                                 })
-                            })
+                        })
                     })
                 })
             })
-        });
-        if !clear {
-            continue;
-        }
+            .collect();
+        // Where the curve leaves a corner at a small angle to a curve kept before, its first
+        // samples crowd that curve's: they are left out, and the curve's first edge runs from
+        // the corner to its first clear sample (still on the crease). A crowded sample
+        // anywhere else (a crease beside another along its length) leaves the whole curve out.
+        let keep = match trim_at_ends(&clear, piece.closed) {
+            Some(keep) => keep,
+            None => continue,
+        };
         for (k, &(p, _)) in points.iter().enumerate() {
-            placed.entry(cell(p)).or_default().push((p, corner(k)));
+            if keep[k] {
+                placed.entry(cell(p)).or_default().push((p, corner(k)));
+            }
         }
-        pieces.push(piece);
+        // The bare lengths: halfway between the last left-out sample and the next kept one.
+        let mut bare = [0.0; 2];
+        if keep.iter().any(|&k| !k) {
+            let arc = arc_lengths(mesh, &piece, &points);
+            let total = curve_length(mesh, &piece);
+            if let Some(k) = (1..points.len()).find(|&k| keep[k]).filter(|&k| k > 1) {
+                bare[0] = 0.5 * (arc[k - 1] + arc[k]);
+            }
+            if let Some(k) = (0..last).rev().find(|&k| keep[k]).filter(|&k| k + 1 < last) {
+                bare[1] = total - 0.5 * (arc[k] + arc[k + 1]);
+            }
+        }
+        pieces.push(FeaturePiece { curve: piece, bare });
     }
     // The ends of the kept feature curves, where boundary curves must be cut.
     let ends: FxHashSet<u32> = pieces
         .iter()
-        .filter(|p| !p.closed)
-        .flat_map(|p| [p.vertices[0], p.vertices[p.vertices.len() - 1]])
+        .filter(|p| !p.curve.closed)
+        .flat_map(|p| {
+            [
+                p.curve.vertices[0],
+                p.curve.vertices[p.curve.vertices.len() - 1],
+            ]
+        })
         .collect();
     (split_at(curves, &ends), pieces)
 }

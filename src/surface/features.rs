@@ -13,7 +13,7 @@
 //! (`CGAL::Polygon_mesh_processing::detect_sharp_edges`); the scale test is ours.
 
 use glam::DVec3;
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
 use crate::surface::MeshSurface;
@@ -120,20 +120,55 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
         }
     }
     candidates.sort_unstable();
-    let mut vertex_faces: Vec<Vec<u32>> = vec![Vec::new(); mesh.positions.len()];
-    if params.scale > 0.0 && !candidates.is_empty() {
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            for &v in t {
-                vertex_faces[v as usize].push(f as u32);
+    // The scale test, in two steps (hysteresis, as in Canny's edge detection): an edge is a
+    // crease when the surface a spacing either side of it bends by the angle; and an edge joined
+    // through a chain of such edges to a crease is one too when the smooth sheets beside it (not
+    // crossing any other dihedral candidate) bend by the angle. The second step keeps a crease
+    // whole up to a corner where it meets another at a small angle (within a spacing of the
+    // corner, a patch either side takes in the sheet beyond the other crease), and leaves alone
+    // a fold narrower than the spacing that no crease leads to (its flanks are sheets between
+    // candidates too).
+    let none = FxHashSet::default();
+    let mut sharp: Vec<bool> = candidates
+        .iter()
+        .map(|(e, faces)| {
+            sharp_at_scale(surface, &uses, &none, *e, *faces, params.scale, cos_bound)
+        })
+        .collect();
+    if params.scale > 0.0 && sharp.iter().any(|&s| !s) {
+        let barriers: FxHashSet<(u32, u32)> =
+            candidates.iter().map(|(e, _)| (e[0], e[1])).collect();
+        let mut at_vertex: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
+        for (i, (e, _)) in candidates.iter().enumerate() {
+            at_vertex.entry(e[0]).or_default().push(i);
+            at_vertex.entry(e[1]).or_default().push(i);
+        }
+        // Grown from the creases, one vertex at a time; each edge tested at most once.
+        let mut tested = sharp.clone();
+        let mut stack: Vec<usize> = (0..candidates.len()).filter(|&i| sharp[i]).collect();
+        while let Some(i) = stack.pop() {
+            for v in candidates[i].0 {
+                for &j in &at_vertex[&v] {
+                    if tested[j] {
+                        continue;
+                    }
+                    tested[j] = true;
+                    let (e, faces) = candidates[j];
+                    if sharp_at_scale(surface, &uses, &barriers, e, faces, params.scale, cos_bound)
+                    {
+                        sharp[j] = true;
+                        stack.push(j);
+                    }
+                }
             }
         }
     }
     // Sorted by edge already (the candidates are).
     let (edges, edge_faces): (Vec<[u32; 2]>, Vec<[u32; 2]>) = candidates
-        .into_iter()
-        .filter(|(e, faces)| {
-            sharp_at_scale(surface, &vertex_faces, *e, *faces, params.scale, cos_bound)
-        })
+        .iter()
+        .zip(&sharp)
+        .filter(|(_, &s)| s)
+        .map(|(c, _)| *c)
         .unzip();
     let (curves, corners) = chain(mesh, &edges, &edge_faces, &boundary_vertex, cos_bound);
     Features {
@@ -145,12 +180,16 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
 
 /// Whether the surface within `scale` of edge `e`'s midpoint still bends by the feature angle
 /// (`cos_bound` its cosine) across the edge: the area-weighted normals of the faces on either
-/// side (faces reached from the edge's own through shared vertices with their centroids within
-/// `scale`, each side the half of that patch nearer one of the two faces' half-planes) at least
-/// the angle apart. True when `scale` is 0.
+/// side at least the angle apart. The patch is grown from the edge's two faces across edges to
+/// faces whose centroids are within `scale`, never across another dihedral candidate (one of
+/// `barriers`): so near a corner where creases meet, each side is the smooth sheet beside the
+/// edge and not a sheet beyond another crease. Each face of the patch counts on the side of the
+/// edge it lies on (the half of the patch nearer one of the two faces' half-planes). True when
+/// `scale` is 0.
 fn sharp_at_scale(
     surface: &MeshSurface,
-    vertex_faces: &[Vec<u32>],
+    uses: &FxHashMap<(u32, u32), ([u32; 2], u32)>,
+    barriers: &FxHashSet<(u32, u32)>,
     e: [u32; 2],
     faces: [u32; 2],
     scale: f64,
@@ -177,22 +216,51 @@ fn sharp_at_scale(
         return false;
     }
     let scale_2 = scale * scale;
-    let mut seen: rustc_hash::FxHashSet<u32> = faces.iter().copied().collect();
-    let mut stack: Vec<u32> = faces.to_vec();
-    let mut sides = [DVec3::ZERO; 2];
-    while let Some(f) = stack.pop() {
-        let c = centroid(f);
-        // Area-weighted normal: the cross product's half.
-        let t = mesh.corners(f as usize);
-        let weighted = (t[1] - t[0]).cross(t[2] - t[0]);
-        sides[usize::from((c - mid).dot(split) < 0.0)] += weighted;
-        for &v in &mesh.triangles[f as usize] {
-            for &g in &vertex_faces[v as usize] {
-                if centroid(g).distance_squared(mid) <= scale_2 && seen.insert(g) {
-                    stack.push(g);
+    // Each side's patch: grown from its face, across edges other than the dihedral candidates
+    // (the edge itself included), to faces whose centroids are within `scale`. A bit per side.
+    let mut reached: FxHashMap<u32, u8> = FxHashMap::default();
+    for (side, &seed) in faces.iter().enumerate() {
+        let bit = 1u8 << side;
+        *reached.entry(seed).or_default() |= bit;
+        let mut stack = vec![seed];
+        while let Some(f) = stack.pop() {
+            let tri = mesh.triangles[f as usize];
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                if barriers.contains(&key) {
+                    continue;
+                }
+                let Some(&(pair, 2)) = uses.get(&key) else {
+                    continue;
+                };
+                for g in pair {
+                    if centroid(g).distance_squared(mid) <= scale_2 {
+                        let r = reached.entry(g).or_default();
+                        if *r & bit == 0 {
+                            *r |= bit;
+                            stack.push(g);
+                        }
+                    }
                 }
             }
         }
+    }
+    // A face reached from one side only counts on that side; one reached from both (round the
+    // end of a crease, or across a fold that is not one) on the side of the edge it lies on.
+    let mut sides = [DVec3::ZERO; 2];
+    let mut patch: Vec<(u32, u8)> = reached.into_iter().collect();
+    patch.sort_unstable();
+    for (f, bits) in patch {
+        let t = mesh.corners(f as usize);
+        // Area-weighted normal: the cross product's half.
+        let weighted = (t[1] - t[0]).cross(t[2] - t[0]);
+        let side = match bits {
+            1 => 0,
+            2 => 1,
+            _ => usize::from((centroid(f) - mid).dot(split) < 0.0),
+        };
+        sides[side] += weighted;
     }
     let (n0, n1) = (sides[0].normalize_or_zero(), sides[1].normalize_or_zero());
     n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) <= cos_bound

@@ -4,6 +4,7 @@
 pub mod cleanup;
 mod flip;
 pub mod optimize;
+pub mod recover;
 pub mod refine;
 pub mod restricted_delaunay;
 pub mod stray_shells;

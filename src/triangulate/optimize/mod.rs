@@ -243,7 +243,8 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// (the input, same units): covers the input points of `cover_points` that are farther than
 /// `params.cover_distance_sigma_p` · `sigma_p` from it, then flips edges and relaxes vertices
 /// around the triangles with Q below `params.q_below`. Vertices with `fixed[v]` (boundary
-/// samples) do not move; boundary edges are not flipped. New vertices are appended, so
+/// samples) do not move; boundary edges are not flipped, and the `protected` edges (the creases
+/// kept as edges) are neither flipped nor collapsed. New vertices are appended, so
 /// existing indices stay valid; vertices merged away by a collapse are left unreferenced.
 /// Returns what was done and, for each face of the result, the index of the face of `mesh` it
 /// still is (`None` for a new or changed face). Deterministic.
@@ -281,12 +282,16 @@ pub fn optimize(
     surface: &MeshSurface,
     cover_points: &[DVec3],
     fixed: &[bool],
+    protected: &[[u32; 2]],
     sigma_p: f64,
     params: &OptimizeParams,
 ) -> (OptimizeStats, Vec<Option<u32>>) {
     let params = &Limits::new(params, sigma_p);
     let mut stats = OptimizeStats::default();
     let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
+    for &[a, b] in protected {
+        m.protect_edge(a, b);
+    }
     let mut fixed = fixed.to_vec();
     fixed.resize(m.vertex_count(), false);
     let short = params.short_edge_ratio * median_edge_length(&m);
@@ -396,7 +401,7 @@ mod tests {
         mesh.positions[v] += DVec3::new(0.8, 0.1, 0.0);
         let before = triangle_quality(&mesh);
         let fixed: Vec<bool> = vec![false; mesh.vertex_count()];
-        let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, 1.0, &no_cover());
+        let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, &[], 1.0, &no_cover());
         let after = triangle_quality(&mesh);
         assert!(stats.moves + stats.flips + stats.collapses > 0);
         assert!(
@@ -419,7 +424,7 @@ mod tests {
         let original = mesh.positions.clone();
         let mut fixed = vec![false; mesh.vertex_count()];
         fixed[3 * 7 + 3] = true;
-        let (_, origin) = optimize(&mut mesh, &surface, &[], &fixed, 1.0, &no_cover());
+        let (_, origin) = optimize(&mut mesh, &surface, &[], &fixed, &[], 1.0, &no_cover());
         assert_eq!(origin.len(), mesh.face_count());
         assert!(origin.iter().any(|o| o.is_none()) && origin.iter().any(|o| o.is_some()));
         assert_eq!(mesh.positions[3], original[3]);
@@ -461,7 +466,7 @@ mod tests {
         let t0 = topology(&mesh);
         assert!(t0.is_manifold() && t0.euler_characteristic == 1);
         let fixed = vec![false; mesh.vertex_count()];
-        let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, 1.0, &no_cover());
+        let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, &[], 1.0, &no_cover());
         assert!(stats.collapses >= 1, "{stats:?}");
         assert_manifold_disk(&mut mesh);
         assert!(triangle_quality(&mesh).theta_min > 30.0);
@@ -508,6 +513,7 @@ mod tests {
             &surface,
             &input.positions,
             &fixed,
+            &[],
             1.0,
             &OptimizeParams::default(),
         );

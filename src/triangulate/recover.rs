@@ -1,0 +1,319 @@
+//! Recovery of required edges missing from a triangulation: the creases' consecutive samples,
+//! which the restricted Delaunay triangulation connects wherever their Voronoi cells meet but not
+//! where a crease leaves a corner at a small angle to another (the cells of the two creases'
+//! samples crowd each other out there).
+//!
+//! The edge insertion of constrained Delaunay triangulation (Anglada, "An improved incremental
+//! algorithm for constructing restricted Delaunay triangulations", Computers & Graphics 21(2),
+//! 1997; Shewchuk, "Constrained Delaunay tetrahedralizations and provably good boundary
+//! recovery", IMR 2002, Sec. 2), on a surface: the faces that the segment between the two ends
+//! crosses are found by a walk from one end in the plane normal to the mean normal of the faces
+//! around the ends, cut out, and the two sides of the cavity triangulated again (ear clipping,
+//! the best-shaped ear first) with the segment as an edge. Where that projection is not
+//! one-to-one on the faces it touches, or the walk meets a vertex on the segment, the edge stays
+//! missing (the report counts it).
+
+use glam::{DVec2, DVec3};
+use robust::{orient2d, Coord};
+
+use crate::geometry::triangle::triangle_angles_deg;
+use crate::mesh::edit::{starting_at, EditMesh};
+
+/// The longest walk (faces crossed) one edge may take: a segment crossing more faces than this
+/// is not a crease edge between neighbouring samples.
+const MAX_CROSSED_FACES: usize = 64;
+
+/// What [`recover_edges`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RecoverStats {
+    /// Required edges that were not in the mesh.
+    pub missing: usize,
+    /// Of those, the ones put in.
+    pub recovered: usize,
+}
+
+/// Puts each edge of `edges` (vertex pairs of `m`) that is not in `m` into it, where its
+/// segment crosses a near-planar strip of faces (see the module's description), and protects
+/// every edge of `edges` that is then in `m` ([`EditMesh::protect_edge`]). New faces get
+/// `label`. Deterministic (edges in the order given).
+pub fn recover_edges<L: Copy>(m: &mut EditMesh<L>, edges: &[[u32; 2]], label: L) -> RecoverStats {
+    let mut stats = RecoverStats::default();
+    for &[a, b] in edges {
+        if a == b {
+            continue;
+        }
+        if !m.has_edge(a, b) {
+            stats.missing += 1;
+            if insert_edge(m, a, b, label) {
+                stats.recovered += 1;
+            }
+        }
+        if m.has_edge(a, b) {
+            m.protect_edge(a, b);
+        }
+    }
+    stats
+}
+
+/// Inserts the edge `a`–`b` by re-triangulating the faces its segment crosses. False (the mesh
+/// unchanged) when that cannot be done cleanly.
+fn insert_edge<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
+    // The projection plane: normal to the area-weighted mean normal of the faces at both ends.
+    let mut normal = DVec3::ZERO;
+    for &v in &[a, b] {
+        for &f in m.faces_around(v) {
+            let Some(t) = m.face(f) else { continue };
+            let [p, q, r] = m.corners(t);
+            normal += (q - p).cross(r - p);
+        }
+    }
+    let Some(n) = normal.try_normalize() else {
+        return false;
+    };
+    let (u, v) = n.any_orthonormal_pair();
+    let origin = m.position(a);
+    let proj = |x: u32| -> DVec2 {
+        let d = m.position(x) - origin;
+        DVec2::new(d.dot(u), d.dot(v))
+    };
+    let orient = |p: DVec2, q: DVec2, r: DVec2| {
+        orient2d(
+            Coord { x: p.x, y: p.y },
+            Coord { x: q.x, y: q.y },
+            Coord { x: r.x, y: r.y },
+        )
+    };
+    let ccw = |t: [u32; 3]| orient(proj(t[0]), proj(t[1]), proj(t[2])) > 0.0;
+    // The fans at both ends must project one-to-one (every face counter-clockwise).
+    for &end in &[a, b] {
+        if m.is_boundary_vertex(end) {
+            return false;
+        }
+        for &f in m.faces_around(end) {
+            if m.face(f).is_some_and(|t| !ccw(t)) {
+                return false;
+            }
+        }
+    }
+    let (pa, pb) = (proj(a), proj(b));
+    // The face at `a` whose corner the segment leaves through: [a, x, y] with x right of the
+    // segment and y left of it.
+    let Some((first, x, y)) = m.faces_around(a).iter().find_map(|&f| {
+        let t = starting_at(m.face(f)?, a);
+        let (px, py) = (proj(t[1]), proj(t[2]));
+        (orient(pa, pb, px) < 0.0 && orient(pa, pb, py) > 0.0).then_some((f, t[1], t[2]))
+    }) else {
+        return false;
+    };
+    let mut cavity = vec![first];
+    let (mut right, mut left) = (vec![x], vec![y]);
+    // The crossed edge, as the face behind it has it: right → left.
+    let (mut r, mut l) = (x, y);
+    loop {
+        if cavity.len() > MAX_CROSSED_FACES {
+            return false;
+        }
+        let Some(f) = m.face_on(l, r) else {
+            return false;
+        };
+        let Some(t) = m.face(f) else { return false };
+        if !ccw(t) {
+            return false;
+        }
+        cavity.push(f);
+        let z = starting_at(t, l)[2];
+        if z == b {
+            break;
+        }
+        let side = orient(pa, pb, proj(z));
+        if side > 0.0 {
+            left.push(z);
+            l = z;
+        } else if side < 0.0 {
+            right.push(z);
+            r = z;
+        } else {
+            // A vertex on the segment.
+            return false;
+        }
+    }
+    // The two sides, counter-clockwise: a, b, then the left chain back; b, a, then the right
+    // chain forward.
+    let mut left_polygon = vec![a, b];
+    left_polygon.extend(left.iter().rev());
+    let mut right_polygon = vec![b, a];
+    right_polygon.extend(right.iter());
+    let mut triangles = Vec::new();
+    for polygon in [&left_polygon, &right_polygon] {
+        let points: Vec<DVec2> = polygon.iter().map(|&x| proj(x)).collect();
+        let Some(ears) = ear_clip(&points, |k| m.position(polygon[k])) else {
+            return false;
+        };
+        triangles.extend(ears.into_iter().map(|t| t.map(|k| polygon[k])));
+    }
+    // Cut the cavity out and fill it; put the old faces back if the new ones do not fit.
+    let old: Vec<[u32; 3]> = cavity.iter().filter_map(|&f| m.face(f)).collect();
+    if old.len() != cavity.len() {
+        return false;
+    }
+    let labels: Vec<L> = cavity.iter().map(|&f| m.label(f)).collect();
+    for &f in &cavity {
+        if m.remove_face(f).is_err() {
+            return false;
+        }
+    }
+    if m.fill_hole(&triangles, label).is_ok() {
+        return true;
+    }
+    for (t, l) in old.into_iter().zip(labels) {
+        // The faces were there a moment ago: they fit again.
+        let _ = m.add_face(t, l);
+    }
+    false
+}
+
+/// Ear clipping of the simple counter-clockwise polygon `points` (in the projection plane),
+/// the ear whose 3-D triangle (`corner` gives the positions) has the largest smallest angle
+/// first. Triangles as index triples into `points`. None when no ear is left before the end
+/// (the polygon is not simple in the projection).
+fn ear_clip(points: &[DVec2], corner: impl Fn(usize) -> DVec3) -> Option<Vec<[usize; 3]>> {
+    let orient = |p: DVec2, q: DVec2, r: DVec2| {
+        orient2d(
+            Coord { x: p.x, y: p.y },
+            Coord { x: q.x, y: q.y },
+            Coord { x: r.x, y: r.y },
+        )
+    };
+    let mut ring: Vec<usize> = (0..points.len()).collect();
+    let mut out = Vec::with_capacity(points.len().saturating_sub(2));
+    while ring.len() > 3 {
+        let n = ring.len();
+        let mut best: Option<(f64, usize)> = None;
+        for i in 0..n {
+            let (p, q, r) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+            if orient(points[p], points[q], points[r]) <= 0.0 {
+                continue;
+            }
+            // No other corner inside or on the ear.
+            let blocked = ring.iter().any(|&s| {
+                s != p
+                    && s != q
+                    && s != r
+                    && orient(points[p], points[q], points[s]) >= 0.0
+                    && orient(points[q], points[r], points[s]) >= 0.0
+                    && orient(points[r], points[p], points[s]) >= 0.0
+            });
+            if blocked {
+                continue;
+            }
+            let a = triangle_angles_deg([corner(p), corner(q), corner(r)]);
+            let score = a[0].min(a[1]).min(a[2]);
+            if best.is_none_or(|(s, _)| score > s) {
+                best = Some((score, i));
+            }
+        }
+        let (_, i) = best?;
+        let n = ring.len();
+        out.push([ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]]);
+        ring.remove(i);
+    }
+    if ring.len() == 3 {
+        if orient(points[ring[0]], points[ring[1]], points[ring[2]]) <= 0.0 {
+            return None;
+        }
+        out.push([ring[0], ring[1], ring[2]]);
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::edit::{EditError, SlotPolicy};
+    use crate::mesh::test_meshes::grid;
+
+    const N: usize = 8;
+
+    fn index(i: usize, j: usize) -> u32 {
+        (j * (N + 1) + i) as u32
+    }
+
+    /// The summed area vectors of the live faces.
+    fn area(m: &EditMesh<()>) -> DVec3 {
+        m.live_faces()
+            .0
+            .iter()
+            .map(|&t| {
+                let [p, q, r] = m.corners(t);
+                0.5 * (q - p).cross(r - p)
+            })
+            .sum()
+    }
+
+    #[test]
+    fn a_missing_edge_across_a_grid_is_put_in_protected_and_the_surface_kept() {
+        // A flat grid folded by 90° along j = 4 (a crease), and a segment from (2, 3) to (6, 5)
+        // across it that no edge follows: it crosses several faces on both sheets.
+        for fold in [0.0f64, 90.0] {
+            let (s, c) = fold.to_radians().sin_cos();
+            let mesh = grid(N, |i, j| {
+                let y = j as f64 - 4.0;
+                if y <= 0.0 {
+                    DVec3::new(i as f64, y, 0.0)
+                } else {
+                    DVec3::new(i as f64, y * c, y * s)
+                }
+            });
+            let mut m: EditMesh<()> = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+            let (a, b) = (index(3, 4), index(6, 5));
+            assert!(!m.has_edge(a, b));
+            let before = area(&m);
+            let stats = recover_edges(&mut m, &[[a, b]], ());
+            assert_eq!(
+                stats,
+                RecoverStats {
+                    missing: 1,
+                    recovered: 1
+                },
+                "fold {fold}"
+            );
+            assert!(m.has_edge(a, b));
+            m.sanity_check().unwrap();
+            // The same surface (the cavity's two sides are planar pieces of it when the segment
+            // runs in one sheet; across the fold the area vector is kept to rounding only when
+            // flat, so the flat case checks it).
+            if fold == 0.0 {
+                assert!((area(&m) - before).length() < 1e-9);
+            }
+            assert_eq!(m.live_faces().0.len(), 2 * N * N);
+            // Flips and collapses keep it.
+            assert!(matches!(
+                m.flip_edge(a, b, ()),
+                Err(EditError::ProtectedEdge { .. })
+            ));
+            let p = m.position(a);
+            assert!(m.collapse_edge(a, b, p, ()).is_err());
+        }
+    }
+
+    #[test]
+    fn an_edge_through_a_vertex_or_at_the_boundary_is_left_out() {
+        let mesh = grid(N, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let mut m: EditMesh<()> = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+        // (2, 2) to (4, 6) passes through (3, 4); (0, 2) to (3, 3) starts on the boundary.
+        let stats = recover_edges(
+            &mut m,
+            &[[index(2, 2), index(4, 6)], [index(0, 2), index(3, 3)]],
+            (),
+        );
+        assert_eq!(
+            stats,
+            RecoverStats {
+                missing: 2,
+                recovered: 0
+            }
+        );
+        m.sanity_check().unwrap();
+        assert_eq!(m.live_faces().0.len(), 2 * N * N);
+    }
+}
