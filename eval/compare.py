@@ -41,8 +41,13 @@ DEFAULT_MODELS = [
     ("bracket.obj", 4000),
     ("flange.obj", 6000),
 ]
-# The CAD parts: where `ours_features` (remesh --feature-angle 55) runs in a full run.
+# The feature angle of the feature-preserving settings (ours_features, cgal_features,
+# botsch_features): the library's CAD_FEATURE_ANGLE_DEG.
+CAD_FEATURE_ANGLE = 20
+# The CAD parts: where `ours_features` (remesh --feature-angle 20) runs in a full run.
 CAD_MODELS = {"fandisk.obj", "bracket.obj", "flange.obj"}
+# The feature-preserving settings, run on the CAD parts only in a full run.
+FEATURE_METHODS = {"ours_features", "cgal_features", "botsch_features"}
 COUNT_TOLERANCE = 0.02
 TIMING_RUNS = 3
 
@@ -172,6 +177,81 @@ def run_cgal_isotropic(V, F, h, work, input_path):
     return V2, F2, seconds
 
 
+def feature_halfedges(P, angle_deg):
+    """The halfedges of CGAL polyhedron `P` on edges whose two facets' normals differ by at least
+    `angle_deg` (one halfedge per edge): CGAL's detect_sharp_edges test, which the Python
+    bindings do not expose."""
+
+    def normal(f):
+        h = f.halfedge() if hasattr(f, "halfedge") else None
+        if h is None:
+            return None
+        p = [h.vertex().point(), h.next().vertex().point(), h.next().next().vertex().point()]
+        a = np.array([[q.x(), q.y(), q.z()] for q in p])
+        n = np.cross(a[1] - a[0], a[2] - a[0])
+        length = np.linalg.norm(n)
+        return n / length if length > 0 else None
+
+    cos_bound = math.cos(math.radians(angle_deg))
+    out, seen = [], set()
+    for h in P.halfedges():
+        if h.is_border_edge() or h.id() in seen:
+            continue
+        seen.add(h.id())
+        seen.add(h.opposite().id())
+        n0, n1 = normal(h.facet()), normal(h.opposite().facet())
+        if n0 is not None and n1 is not None and float(n0 @ n1) <= cos_bound:
+            out.append(h)
+    return out
+
+
+def run_cgal_features(V, F, h, work, input_path):
+    """CGAL's isotropic remeshing with the edges sharper than CAD_FEATURE_ANGLE constrained
+    (split allowed, never flipped or collapsed off the feature), as CGAL's own example does."""
+    from CGAL import CGAL_Polygon_mesh_processing as PMP
+    from CGAL.CGAL_Polyhedron_3 import Polyhedron_3
+
+    src = Path(work) / "cgal_in.off"
+    write_off(src, V, F)
+    P = Polyhedron_3(str(src))
+    if P.size_of_facets() == 0:
+        raise RuntimeError("CGAL could not read the input as a polyhedral surface (non-manifold?)")
+    for i, hh in enumerate(P.halfedges()):
+        hh.set_id(i)
+    constrained = feature_halfedges(P, CAD_FEATURE_ANGLE)
+    faces = [f for f in P.facets()]
+    t = time.perf_counter()
+    PMP.isotropic_remeshing(faces, float(h), P, 10, constrained, False)
+    seconds = time.perf_counter() - t
+    dst = Path(work) / "cgal_out.off"
+    P.write_to_file(str(dst))
+    lines = dst.read_text().split("\n")
+    header = [x for x in lines if x.strip() and not x.startswith("#")]
+    nv, nf = map(int, header[1].split()[:2])
+    V2 = np.array([[float(c) for c in l.split()[:3]] for l in header[2 : 2 + nv]])
+    F2 = np.array([[int(c) for c in l.split()[1:4]] for l in header[2 + nv : 2 + nv + nf]], dtype=np.int64)
+    return V2, F2, seconds
+
+
+def run_botsch_features(V, F, h, work, input_path):
+    """gpytoolbox's Botsch-Kobbelt remeshing with its feature-edge detection at
+    CAD_FEATURE_ANGLE (feature edges kept)."""
+    import gpytoolbox as gpy
+
+    t = time.perf_counter()
+    V2, F2 = gpy.remesh_botsch(
+        V,
+        F.astype(np.int32),
+        i=10,
+        h=float(h),
+        project=True,
+        detect_feature_edges=True,
+        feature_dihedral_threshold=float(CAD_FEATURE_ANGLE),
+    )
+    seconds = time.perf_counter() - t
+    return V2, F2.astype(np.int64), seconds
+
+
 def run_acvd(V, F, n, work, input_path):
     import pyacvd
     import pyvista as pv
@@ -215,11 +295,21 @@ def run_poisson_bpa(V, F, n, work, input_path):
 METHODS = {
     "ours": ("remesh (spectral sampling)", "count", run_ours),
     "ours_sigma_n": ("remesh --sigma-n 0.75", "count", None),
-    "ours_features": ("remesh --feature-angle 55", "count", None),
+    "ours_features": ("remesh --feature-angle 20", "count", None),
     "meshlab_isotropic": ("MeshLab isotropic explicit remeshing (10 it.)", "length", run_meshlab_isotropic),
     "cgal_isotropic": ("CGAL PMP isotropic_remeshing (10 it.)", "length", run_cgal_isotropic),
+    "cgal_features": (
+        "CGAL PMP isotropic_remeshing, edges over 20° constrained (10 it.)",
+        "length",
+        run_cgal_features,
+    ),
     "acvd": ("ACVD clustering (pyacvd; VR)", "count", run_acvd),
     "botsch": ("Botsch-Kobbelt (gpytoolbox remesh_botsch, 10 it.)", "length", run_botsch),
+    "botsch_features": (
+        "Botsch-Kobbelt, feature edges over 20° kept (gpytoolbox, 10 it.)",
+        "length",
+        run_botsch_features,
+    ),
     "poisson_bpa": ("MeshLab Poisson-disk + ball pivoting", "count", run_poisson_bpa),
 }
 
@@ -228,7 +318,9 @@ def adapter(method):
     if method == "ours_sigma_n":
         return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--sigma-n", "0.75"))
     if method == "ours_features":
-        return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--feature-angle", "55"))
+        return lambda V, F, p, w, i: run_ours(
+            V, F, p, w, i, extra=("--feature-angle", str(CAD_FEATURE_ANGLE))
+        )
     return METHODS[method][2]
 
 
@@ -395,7 +487,7 @@ def evaluate_model(input_path, n, methods, outdir, log):
     for method in methods:
         if method == "ours_sigma_n" and model != "fandisk.obj" and methods != ["ours_sigma_n"]:
             continue
-        if method == "ours_features" and model not in CAD_MODELS and methods != ["ours_features"]:
+        if method in FEATURE_METHODS and model not in CAD_MODELS and len(methods) > 1:
             continue
         label = METHODS[method][0]
         log(f"  {model} at {n}: {label}")

@@ -31,7 +31,7 @@ use crate::surface::SurfaceSample;
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
-use crate::triangulate::recover::{recover_edges, RecoverStats};
+use crate::triangulate::recover::{close_slits, recover_edges, RecoverStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{
@@ -202,7 +202,7 @@ pub struct FeatureStats {
     /// Of those, edges of the triangulation.
     pub triangulated_edges: usize,
     /// Of the sampled edges the triangulation left out, those put in afterwards
-    /// ([`recover_edges`](crate::triangulate::recover::recover_edges)).
+    /// (`triangulate::recover::recover_edges`).
     pub recovered_edges: usize,
     /// Of the sampled edges, edges of the output (after the optimization).
     pub kept_edges: usize,
@@ -697,7 +697,7 @@ pub fn remesh(
                 triangulate_restricted(&set, &surface, spacing, &params.triangulate, &rd)
             }
         };
-        let (faces, face_sources, assembly, restricted_delaunay) = match restricted {
+        let (faces, face_sources, mut assembly, restricted_delaunay) = match restricted {
             Some((f, s, a, rd)) => (f, s, a, Some(rd)),
             None => {
                 let (f, s, a) = triangulate(&set, &params.triangulate);
@@ -708,10 +708,13 @@ pub fn remesh(
         let feature_edges_triangulated = edges_present(&mesh_normalized, &feature_edges);
         let mut face_sources = face_sources;
         // Crease edges the triangulation left out (where a crease leaves a corner at a small
-        // angle to another) are put in.
-        let recovery = if feature_edges_triangulated < feature_edges.len() {
+        // angle to another) are put in, and slits along graded creases (one sheet's faces
+        // skipping a sample) closed.
+        let recovery = if !feature_edges.is_empty() {
             let mut m: EditMesh<Option<u32>> =
                 EditMesh::from_trimesh(&mesh_normalized, Some, SlotPolicy::Reuse);
+            let slits = close_slits(&mut m, None);
+            assembly.holes_left = assembly.holes_left.saturating_sub(slits);
             let stats = recover_edges(&mut m, &feature_edges, None);
             let (positions, faces, origin) = m.into_parts();
             mesh_normalized = TriMesh::new(positions, faces);

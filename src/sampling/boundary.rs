@@ -10,7 +10,7 @@ use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 use crate::mesh::TriMesh;
-use crate::sampling::features::FeaturePiece;
+use crate::sampling::features::{graded_points, FeaturePiece};
 use crate::sampling::WidthField;
 use crate::surface::SurfaceSample;
 
@@ -185,10 +185,12 @@ pub fn sample_curves_and_features(
     width: Option<WidthField>,
 ) -> BoundarySamples {
     let Some(width) = width else {
-        return sample_curves(mesh, curves, features, spacing, |a, b| a.distance(b));
+        return sample_curves(mesh, curves, features, spacing, spacing, |a, b| {
+            a.distance(b)
+        });
     };
     // Per edge, its steps: the trapezoid rule in 1/w, in units of one step.
-    sample_curves(mesh, curves, features, 1.0, |a, b| {
+    sample_curves(mesh, curves, features, 1.0, spacing, |a, b| {
         0.5 * a.distance(b) * (1.0 / width(a).max(1e-6) + 1.0 / width(b).max(1e-6)) / spacing
     })
 }
@@ -197,7 +199,7 @@ pub fn sample_curves_and_features(
 /// `spacing` (bbox-100 units) as a whole number of steps allows: a closed loop gets at least 3,
 /// and the ends of open chains are shared between the chains that meet there.
 pub fn sample_boundary(mesh: &TriMesh, curves: &[BoundaryCurve], spacing: f64) -> BoundarySamples {
-    sample_curves(mesh, curves, &[], spacing, |a, b| a.distance(b))
+    sample_curves(mesh, curves, &[], spacing, spacing, |a, b| a.distance(b))
 }
 
 /// The points of one curve at equal steps of a measure along it: `measure(a, b)` of each edge
@@ -246,59 +248,32 @@ pub(crate) fn curve_points(
     out
 }
 
-/// The arc length (units of the mesh) from a curve's start to each of its `points` (as
-/// [`curve_points`] gives them: a position and the index of the edge it lies on).
-pub(crate) fn arc_lengths(
-    mesh: &TriMesh,
-    curve: &BoundaryCurve,
-    points: &[(DVec3, usize)],
-) -> Vec<f64> {
-    let nv = curve.vertices.len();
-    let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
-    let mut start = Vec::with_capacity(curve.faces.len() + 1);
-    let mut sum = 0.0;
-    for k in 0..curve.faces.len() {
-        start.push(sum);
-        sum += pos(k).distance(pos(k + 1));
-    }
-    points
-        .iter()
-        .map(|&(p, edge)| start[edge] + pos(edge).distance(p))
-        .collect()
-}
-
 /// The samples of every curve ([`curve_points`]), one shared sample where open curves meet;
-/// the feature pieces without samples on their bare ends (but their corners).
+/// the feature pieces with graded ends at their own points ([`graded_points`] at `spacing`).
 fn sample_curves(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
     features: &[FeaturePiece],
     unit: f64,
+    spacing: f64,
     measure: impl Fn(DVec3, DVec3) -> f64,
 ) -> BoundarySamples {
     let mut out = BoundarySamples::default();
     let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();
     let all = curves
         .iter()
-        .map(|c| (c, false, [0.0; 2]))
-        .chain(features.iter().map(|f| (&f.curve, true, f.bare)));
-    for (curve, feature, bare) in all {
+        .map(|c| (c, None))
+        .chain(features.iter().map(|f| (&f.curve, Some(f))));
+    for (curve, feature) in all {
         let nv = curve.vertices.len();
-        let mut points = curve_points(mesh, curve, unit, &measure);
+        let points = match feature {
+            Some(f) if f.graded.iter().any(|g| !g.is_empty()) => graded_points(mesh, f, spacing),
+            _ => curve_points(mesh, curve, unit, &measure),
+        };
         if points.is_empty() {
             continue;
         }
-        if bare != [0.0; 2] {
-            let arc = arc_lengths(mesh, curve, &points);
-            let (from, to) = (bare[0], curve_length(mesh, curve) - bare[1]);
-            let last = points.len() - 1;
-            let mut k = 0;
-            points.retain(|_| {
-                let keep = k == 0 || k == last || (arc[k] > from && arc[k] < to);
-                k += 1;
-                keep
-            });
-        }
+        let feature = feature.is_some();
         let last = points.len() - 1;
         let mut ids = Vec::with_capacity(points.len());
         for (s, &(position, edge)) in points.iter().enumerate() {

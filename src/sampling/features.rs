@@ -10,7 +10,7 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
-use crate::sampling::boundary::{arc_lengths, curve_length, curve_points, BoundaryCurve};
+use crate::sampling::boundary::{curve_length, curve_points, BoundaryCurve};
 use crate::surface::features::Features;
 
 /// The least distance between the samples of two feature curves, in units of the spacing
@@ -21,36 +21,132 @@ use crate::surface::features::Features;
 /// themselves); at 0.85, 28.6 and 33.0; fandisk, bracket and flange the same at both.
 pub const CURVE_SAMPLE_GAP: f64 = 0.85;
 
-/// A feature curve to sample: the curve, and the arc length (bbox-100 units) at its start and at
-/// its end that gets no sample but the corner (`bare`), where it leaves a corner at a small
-/// angle to a curve kept before it (see [`feature_pieces`]). Its first edge then runs from the
-/// corner to its first sample beyond that length, along the crease.
+/// The smallest angle (degrees) between two creases leaving a corner that the sampling grades
+/// towards (see [`feature_pieces`]); at a smaller one the shorter crease is left out, as it would
+/// take too many samples (about 1 / angle) to follow both.
+pub const MIN_GRADED_CORNER_DEG: f64 = 8.0;
+
+/// A feature curve to sample: the curve, and at each end where it leaves a corner at a small
+/// angle to another kept curve, the arc lengths from that end (bbox-100 units, decreasing) of
+/// the samples graded towards the corner (see [`feature_pieces`]); empty where the samples are
+/// even up to the end.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeaturePiece {
     /// The crease, as a curve with a face per edge.
     pub curve: BoundaryCurve,
-    /// Arc length without samples at the start and at the end (0 for none).
-    pub bare: [f64; 2],
+    /// Per end (start, end): the graded samples' distances along the curve from that end, the
+    /// first the farthest (where the even spacing starts).
+    pub graded: [Vec<f64>; 2],
 }
 
-/// Which of an open curve's samples to keep, given which are `clear` of the samples of curves
-/// kept before: every clear one, where the crowded ones are the first few after the start or
-/// the last few before the end (leaving a corner at a small angle to another curve). None when
-/// a corner, a closed curve's sample, or a sample with clear ones on both sides is crowded (the
-/// curve runs beside another), or when every sample between the corners is.
-fn trim_at_ends(clear: &[bool], closed: bool) -> Option<Vec<bool>> {
+impl FeaturePiece {
+    /// The arc lengths from the start (units of the mesh) of the samples of a piece of length
+    /// `total` with graded ends at `spacing`: 0, the start's graded samples, even steps as close
+    /// to `spacing` as a whole number allows in between, the end's graded samples, `total`.
+    /// Only for open curves with a graded end.
+    pub(crate) fn arcs(&self, total: f64, spacing: f64) -> Vec<f64> {
+        let r0 = self.graded[0].first().copied().unwrap_or(0.0);
+        let r1 = self.graded[1].first().copied().unwrap_or(0.0);
+        let middle = (total - r0 - r1).max(0.0);
+        let steps = (middle / spacing).round().max(1.0) as usize;
+        let mut out = vec![0.0];
+        out.extend(self.graded[0].iter().rev().copied());
+        for k in 1..steps {
+            out.push(r0 + middle * k as f64 / steps as f64);
+        }
+        out.extend(self.graded[1].iter().map(|&r| total - r));
+        out.push(total);
+        out.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * total.max(1.0));
+        out
+    }
+}
+
+/// The distances from a corner (decreasing, the first `reach`) of the samples graded towards a
+/// corner where two creases meet at `angle` (radians): the gap between the creases at distance
+/// r is 2 r sin(angle / 2), and each step inward shrinks by the same factor 1 + 2 sin(angle / 2),
+/// so that the strip between the two creases is cut into trapezoids whose legs equal their
+/// shorter side (their triangles keep angles near 60° and above the corner's); down to half
+/// the spacing, where the triangle at the corner (isosceles, the corner's angle at its apex)
+/// takes over. `reach` is where the gap is the spacing, at most `cap`.
+fn graded_distances(angle: f64, spacing: f64, cap: f64) -> Vec<f64> {
+    let g = 2.0 * (0.5 * angle).sin();
+    let ratio = 1.0 + g;
+    let reach = (spacing / g).min(cap);
+    let mut out = vec![reach];
+    let mut r = reach / ratio;
+    while r >= 0.5 * spacing && out.len() < 64 {
+        out.push(r);
+        r /= ratio;
+    }
+    out
+}
+
+/// Whether the crowded samples of an open curve (those not `clear` of the samples of curves kept
+/// before) are only its first few after the start or its last few before the end (where it
+/// leaves a corner at a small angle to another curve). False when a corner, a closed curve's
+/// sample, or a sample with clear ones on both sides is crowded (the curve runs beside
+/// another), or when every sample between the corners is.
+fn crowded_only_at_ends(clear: &[bool], closed: bool) -> bool {
     if clear.iter().all(|&c| c) {
-        return Some(clear.to_vec());
+        return true;
     }
     let n = clear.len();
     if closed || n < 2 || !clear[0] || !clear[n - 1] {
-        return None;
+        return false;
     }
-    let first_clear = (1..n - 1).find(|&k| clear[k])?;
-    let last_clear = (1..n - 1).rev().find(|&k| clear[k])?;
-    (first_clear..=last_clear)
-        .all(|k| clear[k])
-        .then(|| clear.to_vec())
+    let (Some(first), Some(last)) = (
+        (1..n - 1).find(|&k| clear[k]),
+        (1..n - 1).rev().find(|&k| clear[k]),
+    ) else {
+        return false;
+    };
+    (first..=last).all(|k| clear[k])
+}
+
+/// The point at arc length `arc` along `curve` (clamped to its ends), with the index of the edge
+/// it lies on.
+fn point_at_arc(mesh: &TriMesh, curve: &BoundaryCurve, arc: f64) -> (DVec3, usize) {
+    let nv = curve.vertices.len();
+    let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
+    let ne = curve.faces.len();
+    let mut start = 0.0;
+    for k in 0..ne {
+        let l = pos(k).distance(pos(k + 1));
+        if arc <= start + l || k + 1 == ne {
+            let u = if l > 0.0 {
+                ((arc - start) / l).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            return (pos(k).lerp(pos(k + 1), u), k);
+        }
+        start += l;
+    }
+    (pos(0), 0)
+}
+
+/// The points of a feature piece with graded ends ([`FeaturePiece::arcs`]), corners exact.
+pub(crate) fn graded_points(
+    mesh: &TriMesh,
+    piece: &FeaturePiece,
+    spacing: f64,
+) -> Vec<(DVec3, usize)> {
+    let total = curve_length(mesh, &piece.curve);
+    let arcs = piece.arcs(total, spacing);
+    let last = arcs.len() - 1;
+    let nv = piece.curve.vertices.len();
+    arcs.iter()
+        .enumerate()
+        .map(|(k, &a)| {
+            let (p, e) = point_at_arc(mesh, &piece.curve, a);
+            let p = match k {
+                0 => mesh.positions[piece.curve.vertices[0] as usize],
+                k if k == last => mesh.positions[piece.curve.vertices[nv - 1] as usize],
+                _ => p,
+            };
+            (p, e)
+        })
+        .collect()
 }
 
 /// The feature curves of `features` worth sampling at `spacing` (bbox-100 units), as curves with
@@ -65,9 +161,11 @@ fn trim_at_ends(clear: &[bool], closed: bool) -> Option<Vec<bool>> {
 /// only give thin triangles (the folds a scan leaves are such bits). Curves are then taken
 /// longest first, and one whose samples come closer than [`CURVE_SAMPLE_GAP`] spacings to
 /// those of a curve taken before (apart from a shared corner) is left out, unless the crowded
-/// samples are only its first or last few, where it leaves a corner at a small angle to a kept
-/// curve: those are left out and the rest kept (a [`FeaturePiece`]'s `bare` ends; the angle at
-/// such a corner is the input's, and its triangles cannot have a larger one). Deterministic.
+/// samples are only its first or last few and the curves they crowd leave the same corner at
+/// [`MIN_GRADED_CORNER_DEG`] or more: then both are graded towards that corner (samples at the
+/// same distances from it on both, their steps shrinking with the gap between the creases:
+/// [`FeaturePiece::graded`]), so the triangles between them keep the corner's angle, which no
+/// triangle there can exceed. Deterministic.
 pub fn feature_pieces(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
@@ -110,63 +208,170 @@ pub fn feature_pieces(
     candidates.sort_by(|x, y| y.0.total_cmp(&x.0));
     let gap = CURVE_SAMPLE_GAP * spacing;
     let cell = |p: DVec3| (p / gap).floor().as_i64vec3().to_array();
-    let mut placed: FxHashMap<[i64; 3], Vec<(DVec3, Option<u32>)>> = FxHashMap::default();
-    let mut pieces = Vec::new();
-    for (_, piece) in candidates {
-        let points = curve_points(mesh, &piece, spacing, |a, b| a.distance(b));
+    // The samples placed so far, by cell: position, the corner it is at (if any), which kept
+    // curve it belongs to and that curve's generation (a curve graded later is placed again).
+    type Placed = (DVec3, Option<u32>, usize, u32);
+    let mut placed: FxHashMap<[i64; 3], Vec<Placed>> = FxHashMap::default();
+    // The kept curves and their generations.
+    let mut kept: Vec<(FeaturePiece, u32)> = Vec::new();
+    // Whether an open curve ends at the vertex `v` (a corner's own sample is not crowded by the
+    // samples of curves leaving it, which may be graded towards it).
+    let ends_at = |c: &BoundaryCurve, v: u32| {
+        !c.closed && (c.vertices[0] == v || c.vertices[c.vertices.len() - 1] == v)
+    };
+    let end_vertex = |c: &BoundaryCurve, k: usize, last: usize| -> Option<u32> {
+        (!c.closed && (k == 0 || k == last))
+            .then(|| c.vertices[if k == 0 { 0 } else { c.vertices.len() - 1 }])
+    };
+    let points_of = |piece: &FeaturePiece| -> Vec<(DVec3, usize)> {
+        if piece.graded.iter().all(|g| g.is_empty()) {
+            curve_points(mesh, &piece.curve, spacing, |a, b| a.distance(b))
+        } else {
+            graded_points(mesh, piece, spacing)
+        }
+    };
+    let place = |placed: &mut FxHashMap<[i64; 3], Vec<Placed>>,
+                 piece: &FeaturePiece,
+                 index: usize,
+                 generation: u32| {
+        let points = points_of(piece);
         let last = points.len().saturating_sub(1);
-        let corner = |k: usize| -> Option<u32> {
-            (!piece.closed && (k == 0 || k == last))
-                .then(|| piece.vertices[if k == 0 { 0 } else { piece.vertices.len() - 1 }])
-        };
-        let clear: Vec<bool> = points
-            .iter()
-            .enumerate()
-            .map(|(k, &(p, _))| {
-                let c = cell(p);
-                let here = corner(k);
-                (-1..=1).all(|dx| {
-                    (-1..=1).all(|dy| {
-                        (-1..=1).all(|dz| {
-                            placed
-                                .get(&[c[0] + dx, c[1] + dy, c[2] + dz])
-                                .is_none_or(|v| {
-                                    v.iter().all(|&(q, at)| {
-                                        (here.is_some() && at == here) || p.distance(q) >= gap
-                                    })
-                                })
-                        })
-                    })
-                })
-            })
-            .collect();
-        // Where the curve leaves a corner at a small angle to a curve kept before, its first
-        // samples crowd that curve's: they are left out, and the curve's first edge runs from
-        // the corner to its first clear sample (still on the crease). A crowded sample
-        // anywhere else (a crease beside another along its length) leaves the whole curve out.
-        let keep = match trim_at_ends(&clear, piece.closed) {
-            Some(keep) => keep,
-            None => continue,
-        };
         for (k, &(p, _)) in points.iter().enumerate() {
-            if keep[k] {
-                placed.entry(cell(p)).or_default().push((p, corner(k)));
+            placed.entry(cell(p)).or_default().push((
+                p,
+                end_vertex(&piece.curve, k, last),
+                index,
+                generation,
+            ));
+        }
+    };
+    // The direction a curve leaves its end `at` (0: start, 1: end): towards its point a spacing
+    // along (or half its length, if shorter).
+    let leaving = |curve: &BoundaryCurve, at: usize| -> DVec3 {
+        let total = curve_length(mesh, curve);
+        let arc = spacing.min(0.5 * total);
+        let (p, _) = point_at_arc(mesh, curve, if at == 0 { arc } else { total - arc });
+        let nv = curve.vertices.len();
+        let corner = mesh.positions[curve.vertices[if at == 0 { 0 } else { nv - 1 }] as usize];
+        (p - corner).normalize_or_zero()
+    };
+    'curves: for (length, curve) in candidates {
+        let mut piece = FeaturePiece {
+            curve,
+            graded: [Vec::new(), Vec::new()],
+        };
+        // Up to two rounds: the even samples; then, where the first or last few crowd a curve
+        // kept before that leaves the same corner (a small angle between them), both curves
+        // graded towards that corner.
+        let mut regrade: Vec<(usize, usize, Vec<f64>)> = Vec::new();
+        for round in 0..2 {
+            let points = points_of(&piece);
+            let last = points.len().saturating_sub(1);
+            // For each sample, the kept curves whose samples it crowds (apart from a shared
+            // corner).
+            let crowded: Vec<Vec<usize>> = points
+                .iter()
+                .enumerate()
+                .map(|(k, &(p, _))| {
+                    let c = cell(p);
+                    let here = end_vertex(&piece.curve, k, last);
+                    let mut owners = Vec::new();
+                    for dx in -1..=1 {
+                        for dy in -1..=1 {
+                            for dz in -1..=1 {
+                                let Some(v) = placed.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                                    continue;
+                                };
+                                for &(q, at, i, generation) in v {
+                                    if kept[i].1 == generation
+                                        && !(here.is_some() && at == here)
+                                        && !here.is_some_and(|v| ends_at(&kept[i].0.curve, v))
+                                        && p.distance(q) < gap
+                                        && !regrade.iter().any(|r| r.0 == i)
+                                    {
+                                        owners.push(i);
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    owners.sort_unstable();
+                    owners.dedup();
+                    owners
+                })
+                .collect();
+            let clear: Vec<bool> = crowded.iter().map(|o| o.is_empty()).collect();
+            if clear.iter().all(|&c| c) {
+                break;
+            }
+            // A crowded sample anywhere but in a run at an end (a crease beside another
+            // along its length), or still crowded after grading: the curve is left out.
+            if round == 1 || !crowded_only_at_ends(&clear, piece.curve.closed) {
+                continue 'curves;
+            }
+            for end in [0usize, 1] {
+                let run: Vec<usize> = if end == 0 {
+                    (1..last).take_while(|&k| !clear[k]).collect()
+                } else {
+                    (1..last).rev().take_while(|&k| !clear[k]).collect()
+                };
+                if run.is_empty() {
+                    continue;
+                }
+                let at = end_vertex(&piece.curve, if end == 0 { 0 } else { last }, last);
+                let mut owners: Vec<usize> = run
+                    .iter()
+                    .flat_map(|&k| crowded[k].iter().copied())
+                    .collect();
+                owners.sort_unstable();
+                owners.dedup();
+                // Each crowded curve must leave the same corner.
+                let mut grading: Option<Vec<f64>> = None;
+                for &i in &owners {
+                    let other = &kept[i].0;
+                    let nv = other.curve.vertices.len();
+                    let other_end = match at {
+                        Some(v) if !other.curve.closed && other.curve.vertices[0] == v => 0,
+                        Some(v) if !other.curve.closed && other.curve.vertices[nv - 1] == v => 1,
+                        _ => continue 'curves,
+                    };
+                    let angle =
+                        leaving(&piece.curve, end).angle_between(leaving(&other.curve, other_end));
+                    if !(angle >= MIN_GRADED_CORNER_DEG.to_radians()) {
+                        continue 'curves;
+                    }
+                    // The other curve's grading at that corner, if it has one, is the one to
+                    // pair with; else both get one for this angle.
+                    let distances = if other.graded[other_end].is_empty() {
+                        let cap = 0.45 * length.min(curve_length(mesh, &other.curve));
+                        graded_distances(angle, spacing, cap)
+                    } else {
+                        other.graded[other_end].clone()
+                    };
+                    if grading.as_ref().is_none_or(|g| distances[0] > g[0]) {
+                        grading = Some(distances.clone());
+                    }
+                    if other.graded[other_end].is_empty() {
+                        regrade.push((i, other_end, distances));
+                    }
+                }
+                if let Some(g) = grading {
+                    piece.graded[end] = g;
+                }
             }
         }
-        // The bare lengths: halfway between the last left-out sample and the next kept one.
-        let mut bare = [0.0; 2];
-        if keep.iter().any(|&k| !k) {
-            let arc = arc_lengths(mesh, &piece, &points);
-            let total = curve_length(mesh, &piece);
-            if let Some(k) = (1..points.len()).find(|&k| keep[k]).filter(|&k| k > 1) {
-                bare[0] = 0.5 * (arc[k - 1] + arc[k]);
-            }
-            if let Some(k) = (0..last).rev().find(|&k| keep[k]).filter(|&k| k + 1 < last) {
-                bare[1] = total - 0.5 * (arc[k] + arc[k + 1]);
-            }
+        // The curves graded for this one are placed again.
+        for (i, end, distances) in regrade {
+            kept[i].0.graded[end] = distances;
+            kept[i].1 += 1;
+            let (piece_i, generation) = (kept[i].0.clone(), kept[i].1);
+            place(&mut placed, &piece_i, i, generation);
         }
-        pieces.push(FeaturePiece { curve: piece, bare });
+        let index = kept.len();
+        place(&mut placed, &piece, index, 0);
+        kept.push((piece, 0));
     }
+    let pieces: Vec<FeaturePiece> = kept.into_iter().map(|(p, _)| p).collect();
     // The ends of the kept feature curves, where boundary curves must be cut.
     let ends: FxHashSet<u32> = pieces
         .iter()
@@ -296,5 +501,97 @@ mod tests {
         let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 1.5);
         assert!(feature.is_empty());
         assert_eq!(boundary, curves);
+    }
+
+    /// Two straight creases leaving the corner (0, 30) of a 60 × 60 grid, one along the row
+    /// j = 30 and one rising 1 in 3 (18.4° between them): both are kept, graded alike towards
+    /// the corner, and their samples pair up across the strip between them.
+    #[test]
+    fn creases_at_a_small_angle_are_graded_towards_their_corner() {
+        use crate::surface::features::FeatureCurve;
+        let n = 60;
+        let mesh = crate::mesh::test_meshes::grid(n, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let row: Vec<u32> = (0..=n).map(|i| at(i, 30)).collect();
+        let rising: Vec<u32> = (0..=20).map(|k| at(3 * k, 30 + k)).collect();
+        let curve = |vertices: Vec<u32>| FeatureCurve {
+            faces: vec![0; vertices.len() - 1],
+            vertices,
+            closed: false,
+        };
+        let features = Features {
+            edges: Vec::new(),
+            curves: vec![curve(row), curve(rising)],
+            corners: vec![at(0, 30), at(60, 30), at(60, 50)],
+        };
+        let spacing = 2.0;
+        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing);
+        assert_eq!(pieces.len(), 2, "both creases are kept");
+        let angle = (1.0f64 / 3.0).atan();
+        let expected = graded_distances(angle, spacing, f64::INFINITY);
+        for p in &pieces {
+            assert_eq!(p.graded[0].len(), expected.len());
+            for (a, b) in p.graded[0].iter().zip(&expected) {
+                assert!((a - b).abs() < 1e-9, "{:?}", p.graded[0]);
+            }
+        }
+        assert_eq!(pieces[0].graded[0], pieces[1].graded[0], "the same on both");
+        assert!(pieces.iter().all(|p| p.graded[1].is_empty()));
+        // The graded part: from where the gap is the spacing down to half the spacing, each
+        // step inward shrinking by 1 + gap / r.
+        let g = 2.0 * (0.5 * angle).sin();
+        assert!((expected[0] - spacing / g).abs() < 1e-12);
+        assert!(*expected.last().unwrap() >= 0.5 * spacing);
+        for w in expected.windows(2) {
+            assert!((w[0] / w[1] - (1.0 + g)).abs() < 1e-12);
+        }
+        let b = sample_curves_and_features(&mesh, &[], &pieces, spacing, None);
+        // One shared corner sample; samples at equal distances from it on both creases.
+        let corner = DVec3::new(0.0, 30.0, 0.0);
+        let dist = |s: &crate::surface::SurfaceSample| s.position.distance(corner);
+        let on_row: Vec<f64> = b
+            .samples
+            .iter()
+            .filter(|s| s.position.y == 30.0)
+            .map(dist)
+            .collect();
+        let on_rising: Vec<f64> = b
+            .samples
+            .iter()
+            .filter(|s| s.position.y > 30.0)
+            .map(dist)
+            .collect();
+        for r in &expected {
+            assert!(
+                on_row.iter().any(|d| (d - r).abs() < 1e-9),
+                "{r} on the row"
+            );
+            assert!(
+                on_rising.iter().any(|d| (d - r).abs() < 1e-9),
+                "{r} on the rising crease"
+            );
+        }
+        // Beyond the graded part the steps are even and within 10% of the spacing.
+        for e in &b.feature_edges {
+            let (p, q) = (
+                b.samples[e[0] as usize].position,
+                b.samples[e[1] as usize].position,
+            );
+            let far = p.distance(corner).min(q.distance(corner)) >= expected[0] - 1e-9;
+            if far {
+                assert!(
+                    (p.distance(q) / spacing - 1.0).abs() <= 0.1,
+                    "{}",
+                    p.distance(q)
+                );
+            }
+        }
+        // Without the second crease, the row is sampled evenly up to the corner.
+        let alone = Features {
+            curves: vec![features.curves[0].clone()],
+            ..features.clone()
+        };
+        let (_, pieces) = feature_pieces(&mesh, &[], &alone, spacing);
+        assert!(pieces[0].graded.iter().all(|g| g.is_empty()));
     }
 }

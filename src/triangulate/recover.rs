@@ -55,6 +55,55 @@ pub fn recover_edges<L: Copy>(m: &mut EditMesh<L>, edges: &[[u32; 2]], label: L)
     stats
 }
 
+/// Closes the slits a triangulation can leave along a crease with graded samples: a hole of
+/// three edges whose corners lie on a line (one crease sample between two others, which one
+/// sheet's faces skip). The face across the hole's long side is split at the middle corner.
+/// Returns how many were closed. Deterministic.
+pub fn close_slits<L: Copy>(m: &mut EditMesh<L>, label: L) -> usize {
+    let half = m.boundary_half_edges();
+    let missing: rustc_hash::FxHashSet<(u32, u32)> = half.iter().copied().collect();
+    let mut from: rustc_hash::FxHashMap<u32, Vec<u32>> = rustc_hash::FxHashMap::default();
+    for &(p, q) in &half {
+        from.entry(p).or_default().push(q);
+    }
+    let mut closed = 0;
+    for &(p, q) in &half {
+        let Some(rs) = from.get(&q) else { continue };
+        for &r in rs {
+            // Each hole once: from its smallest corner.
+            if !missing.contains(&(r, p)) || p > q || p > r {
+                continue;
+            }
+            let corners = [p, q, r].map(|v| m.position(v));
+            if !crate::geometry::triangle::is_degenerate_triangle(corners) {
+                continue;
+            }
+            // The longest side u → v (a missing direction) and the corner w between.
+            let sides = [(p, q, r), (q, r, p), (r, p, q)];
+            let (u, v, w) = sides
+                .into_iter()
+                .max_by(|x, y| {
+                    let l = |s: &(u32, u32, u32)| m.position(s.0).distance(m.position(s.1));
+                    l(x).total_cmp(&l(y))
+                })
+                .unwrap_or((p, q, r));
+            let Some(f) = m.face_on(v, u) else { continue };
+            let Some(t) = m.face(f) else { continue };
+            let x = starting_at(t, v)[2];
+            let l = m.label(f);
+            if m.remove_face(f).is_err() {
+                continue;
+            }
+            if m.fill_hole(&[[v, w, x], [w, u, x]], label).is_ok() {
+                closed += 1;
+            } else {
+                let _ = m.add_face(t, l);
+            }
+        }
+    }
+    closed
+}
+
 /// Inserts the edge `a`–`b` by re-triangulating the faces its segment crosses. False (the mesh
 /// unchanged) when that cannot be done cleanly.
 fn insert_edge<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
@@ -315,5 +364,30 @@ mod tests {
         );
         m.sanity_check().unwrap();
         assert_eq!(m.live_faces().0.len(), 2 * N * N);
+    }
+
+    #[test]
+    fn a_slit_along_a_line_of_three_vertices_is_closed() {
+        // a, w, b on the x axis; one face above spans a–b, two below meet at w.
+        let positions = vec![
+            DVec3::new(0.0, 0.0, 0.0),  // a
+            DVec3::new(2.0, 0.0, 0.0),  // b
+            DVec3::new(1.0, 0.0, 0.0),  // w
+            DVec3::new(1.0, 1.0, 0.0),  // x
+            DVec3::new(1.0, -1.0, 0.0), // y
+        ];
+        let mesh = crate::mesh::TriMesh::new(positions, vec![[0, 1, 3], [0, 4, 2], [2, 4, 1]]);
+        let mut m: EditMesh<()> = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+        assert!(!m.has_edge(2, 3));
+        assert_eq!(close_slits(&mut m, ()), 1);
+        m.sanity_check().unwrap();
+        assert_eq!(m.live_faces().0.len(), 4);
+        // Both halves of the line now have a face on either side.
+        for (p, q) in [(0, 2), (2, 1)] {
+            assert!(m.face_on(p, q).is_some() && m.face_on(q, p).is_some());
+        }
+        assert!(!m.has_edge(0, 1));
+        // Nothing else to close.
+        assert_eq!(close_slits(&mut m, ()), 0);
     }
 }
