@@ -46,7 +46,8 @@ DEFAULT_MODELS = [
 CAD_FEATURE_ANGLE = 20
 # The CAD parts: where `ours_features` (remesh --feature-angle 20) runs in a full run.
 CAD_MODELS = {"fandisk.obj", "bracket.obj", "flange.obj"}
-# The feature-preserving settings, run on the CAD parts only in a full run.
+# The feature-preserving settings, run on the CAD parts only in a full run (on any model when
+# asked for with --methods).
 FEATURE_METHODS = {"ours_features", "cgal_features", "botsch_features"}
 COUNT_TOLERANCE = 0.02
 TIMING_RUNS = 3
@@ -487,7 +488,7 @@ def evaluate_model(input_path, n, methods, outdir, log):
     for method in methods:
         if method == "ours_sigma_n" and model != "fandisk.obj" and methods != ["ours_sigma_n"]:
             continue
-        if method in FEATURE_METHODS and model not in CAD_MODELS and len(methods) > 1:
+        if method in FEATURE_METHODS and model not in CAD_MODELS and methods == list(METHODS):
             continue
         label = METHODS[method][0]
         log(f"  {model} at {n}: {label}")
