@@ -173,7 +173,8 @@ fn curve_steps(total: f64, spacing: f64, closed: bool) -> f64 {
 /// [`sample_boundary`] on the boundary curves and on sharp-feature curves together (the pieces
 /// of [`feature_pieces`](crate::sampling::features::feature_pieces), given as curves with a face
 /// per edge): one sample shared where curves meet, the feature curves' consecutive samples in
-/// `feature_edges` rather than `edges`. With a `width` field the spacing follows it: the samples
+/// `feature_edges` rather than `edges`. The boundary at `spacing`, the feature curves at
+/// `feature_spacing` (bbox-100 units). With a `width` field the spacing follows it: the samples
 /// are at equal steps of ∫ ds / (`width(x)` · `spacing`) along each curve (the width taken at
 /// the curve's vertices, linear in between), their number that integral rounded (at least 3 on
 /// a loop, 1 step on a chain).
@@ -182,15 +183,17 @@ pub fn sample_curves_and_features(
     curves: &[BoundaryCurve],
     features: &[FeaturePiece],
     spacing: f64,
+    feature_spacing: f64,
     width: Option<WidthField>,
 ) -> BoundarySamples {
+    let scale = feature_spacing / spacing;
     let Some(width) = width else {
-        return sample_curves(mesh, curves, features, spacing, spacing, |a, b| {
+        return sample_curves(mesh, curves, features, spacing, spacing, scale, |a, b| {
             a.distance(b)
         });
     };
     // Per edge, its steps: the trapezoid rule in 1/w, in units of one step.
-    sample_curves(mesh, curves, features, 1.0, spacing, |a, b| {
+    sample_curves(mesh, curves, features, 1.0, spacing, scale, |a, b| {
         0.5 * a.distance(b) * (1.0 / width(a).max(1e-6) + 1.0 / width(b).max(1e-6)) / spacing
     })
 }
@@ -199,7 +202,9 @@ pub fn sample_curves_and_features(
 /// `spacing` (bbox-100 units) as a whole number of steps allows: a closed loop gets at least 3,
 /// and the ends of open chains are shared between the chains that meet there.
 pub fn sample_boundary(mesh: &TriMesh, curves: &[BoundaryCurve], spacing: f64) -> BoundarySamples {
-    sample_curves(mesh, curves, &[], spacing, spacing, |a, b| a.distance(b))
+    sample_curves(mesh, curves, &[], spacing, spacing, 1.0, |a, b| {
+        a.distance(b)
+    })
 }
 
 /// The points of one curve at equal steps of a measure along it: `measure(a, b)` of each edge
@@ -249,13 +254,15 @@ pub(crate) fn curve_points(
 }
 
 /// The samples of every curve ([`curve_points`]), one shared sample where open curves meet;
-/// the feature pieces with graded ends at their own points ([`graded_points`] at `spacing`).
+/// the feature pieces at `feature_scale` times the boundary's steps, those with graded ends at
+/// their own points ([`graded_points`]).
 fn sample_curves(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
     features: &[FeaturePiece],
     unit: f64,
     spacing: f64,
+    feature_scale: f64,
     measure: impl Fn(DVec3, DVec3) -> f64,
 ) -> BoundarySamples {
     let mut out = BoundarySamples::default();
@@ -267,8 +274,11 @@ fn sample_curves(
     for (curve, feature) in all {
         let nv = curve.vertices.len();
         let points = match feature {
-            Some(f) if f.graded.iter().any(|g| !g.is_empty()) => graded_points(mesh, f, spacing),
-            _ => curve_points(mesh, curve, unit, &measure),
+            Some(f) if f.graded.iter().any(|g| !g.is_empty()) => {
+                graded_points(mesh, f, spacing * feature_scale)
+            }
+            Some(_) => curve_points(mesh, curve, unit * feature_scale, &measure),
+            None => curve_points(mesh, curve, unit, &measure),
         };
         if points.is_empty() {
             continue;

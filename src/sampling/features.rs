@@ -469,7 +469,7 @@ mod tests {
             "the loop is cut at the crease's two ends"
         );
         assert_eq!(feature.len(), 1);
-        let b = sample_curves_and_features(&mesh, &boundary, &feature, 0.1, None);
+        let b = sample_curves_and_features(&mesh, &boundary, &feature, 0.1, 0.1, None);
         // 10 steps along the crease (length 1), its ends shared with the boundary.
         assert_eq!(b.feature_edges.len(), 10);
         for e in &b.feature_edges {
@@ -545,7 +545,7 @@ mod tests {
         for w in expected.windows(2) {
             assert!((w[0] / w[1] - (1.0 + g)).abs() < 1e-12);
         }
-        let b = sample_curves_and_features(&mesh, &[], &pieces, spacing, None);
+        let b = sample_curves_and_features(&mesh, &[], &pieces, spacing, spacing, None);
         // One shared corner sample; samples at equal distances from it on both creases.
         let corner = DVec3::new(0.0, 30.0, 0.0);
         let dist = |s: &crate::surface::SurfaceSample| s.position.distance(corner);
