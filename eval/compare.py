@@ -155,29 +155,6 @@ def run_meshlab_isotropic(V, F, h, work, input_path):
     return m.vertex_matrix(), m.face_matrix().astype(np.int64), seconds
 
 
-def run_cgal_isotropic(V, F, h, work, input_path):
-    from CGAL import CGAL_Polygon_mesh_processing as PMP
-    from CGAL.CGAL_Polyhedron_3 import Polyhedron_3
-
-    src = Path(work) / "cgal_in.off"
-    write_off(src, V, F)
-    P = Polyhedron_3(str(src))
-    if P.size_of_facets() == 0:
-        raise RuntimeError("CGAL could not read the input as a polyhedral surface (non-manifold?)")
-    faces = [f for f in P.facets()]
-    t = time.perf_counter()
-    PMP.isotropic_remeshing(faces, float(h), P, 10)
-    seconds = time.perf_counter() - t
-    dst = Path(work) / "cgal_out.off"
-    P.write_to_file(str(dst))
-    lines = dst.read_text().split("\n")
-    header = [x for x in lines if x.strip() and not x.startswith("#")]
-    nv, nf = map(int, header[1].split()[:2])
-    V2 = np.array([[float(c) for c in l.split()[:3]] for l in header[2 : 2 + nv]])
-    F2 = np.array([[int(c) for c in l.split()[1:4]] for l in header[2 + nv : 2 + nv + nf]], dtype=np.int64)
-    return V2, F2, seconds
-
-
 def feature_halfedges(P, angle_deg):
     """The halfedges of CGAL polyhedron `P` on edges whose two facets' normals differ by at least
     `angle_deg` (one halfedge per edge): CGAL's detect_sharp_edges test, which the Python
@@ -206,9 +183,10 @@ def feature_halfedges(P, angle_deg):
     return out
 
 
-def run_cgal_features(V, F, h, work, input_path):
-    """CGAL's isotropic remeshing with the edges sharper than CAD_FEATURE_ANGLE constrained
-    (split allowed, never flipped or collapsed off the feature), as CGAL's own example does."""
+def run_cgal_isotropic(V, F, h, work, input_path, feature_angle=None):
+    """CGAL's isotropic remeshing, 10 iterations; with `feature_angle`, the edges whose facets'
+    normals differ by that much or more constrained (split allowed, never flipped or collapsed
+    off the feature), as CGAL's own example does."""
     from CGAL import CGAL_Polygon_mesh_processing as PMP
     from CGAL.CGAL_Polyhedron_3 import Polyhedron_3
 
@@ -217,12 +195,17 @@ def run_cgal_features(V, F, h, work, input_path):
     P = Polyhedron_3(str(src))
     if P.size_of_facets() == 0:
         raise RuntimeError("CGAL could not read the input as a polyhedral surface (non-manifold?)")
-    for i, hh in enumerate(P.halfedges()):
-        hh.set_id(i)
-    constrained = feature_halfedges(P, CAD_FEATURE_ANGLE)
+    constrained = None
+    if feature_angle is not None:
+        for i, hh in enumerate(P.halfedges()):
+            hh.set_id(i)
+        constrained = feature_halfedges(P, feature_angle)
     faces = [f for f in P.facets()]
     t = time.perf_counter()
-    PMP.isotropic_remeshing(faces, float(h), P, 10, constrained, False)
+    if constrained is None:
+        PMP.isotropic_remeshing(faces, float(h), P, 10)
+    else:
+        PMP.isotropic_remeshing(faces, float(h), P, 10, constrained, False)
     seconds = time.perf_counter() - t
     dst = Path(work) / "cgal_out.off"
     P.write_to_file(str(dst))
@@ -234,23 +217,9 @@ def run_cgal_features(V, F, h, work, input_path):
     return V2, F2, seconds
 
 
-def run_botsch_features(V, F, h, work, input_path):
-    """gpytoolbox's Botsch-Kobbelt remeshing with its feature-edge detection at
-    CAD_FEATURE_ANGLE (feature edges kept)."""
-    import gpytoolbox as gpy
-
-    t = time.perf_counter()
-    V2, F2 = gpy.remesh_botsch(
-        V,
-        F.astype(np.int32),
-        i=10,
-        h=float(h),
-        project=True,
-        detect_feature_edges=True,
-        feature_dihedral_threshold=float(CAD_FEATURE_ANGLE),
-    )
-    seconds = time.perf_counter() - t
-    return V2, F2.astype(np.int64), seconds
+def run_cgal_features(V, F, h, work, input_path):
+    """run_cgal_isotropic with the edges sharper than CAD_FEATURE_ANGLE constrained."""
+    return run_cgal_isotropic(V, F, h, work, input_path, feature_angle=CAD_FEATURE_ANGLE)
 
 
 def run_acvd(V, F, n, work, input_path):
@@ -271,13 +240,23 @@ def run_acvd(V, F, n, work, input_path):
     return np.asarray(out.points, dtype=np.float64), faces.astype(np.int64), seconds
 
 
-def run_botsch(V, F, h, work, input_path):
+def run_botsch(V, F, h, work, input_path, feature_angle=None):
+    """gpytoolbox's Botsch-Kobbelt remeshing, 10 iterations; with `feature_angle`, its own
+    feature-edge detection at that dihedral angle (feature edges kept)."""
     import gpytoolbox as gpy
 
+    features = {}
+    if feature_angle is not None:
+        features = dict(detect_feature_edges=True, feature_dihedral_threshold=float(feature_angle))
     t = time.perf_counter()
-    V2, F2 = gpy.remesh_botsch(V, F.astype(np.int32), i=10, h=float(h), project=True)
+    V2, F2 = gpy.remesh_botsch(V, F.astype(np.int32), i=10, h=float(h), project=True, **features)
     seconds = time.perf_counter() - t
     return V2, F2.astype(np.int64), seconds
+
+
+def run_botsch_features(V, F, h, work, input_path):
+    """run_botsch with feature edges detected at CAD_FEATURE_ANGLE."""
+    return run_botsch(V, F, h, work, input_path, feature_angle=CAD_FEATURE_ANGLE)
 
 
 def run_poisson_bpa(V, F, n, work, input_path):
