@@ -10,12 +10,14 @@
 //! crosses are found by a walk from one end in the plane normal to the mean normal of the faces
 //! around the ends, cut out, and the two sides of the cavity triangulated again (ear clipping,
 //! the best-shaped ear first) with the segment as an edge. Where that projection is not
-//! one-to-one on the faces it touches, or the walk meets a vertex on the segment, the edge stays
-//! missing (the report counts it).
+//! one-to-one on the faces it touches, the walk meets a vertex on the segment, or a new
+//! triangle would be a sliver (an angle below `RECOVERY_MIN_ANGLE_DEG`: a vertex a hair off the
+//! segment), the edge stays missing (the report counts it).
 
 use glam::{DVec2, DVec3};
 use robust::{orient2d, Coord};
 
+use crate::geometry::tolerance::RECOVERY_MIN_ANGLE_DEG;
 use crate::geometry::triangle::triangle_angles_deg;
 use crate::mesh::edit::{starting_at, EditMesh};
 
@@ -199,6 +201,14 @@ fn insert_edge<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
             return false;
         };
         triangles.extend(ears.into_iter().map(|t| t.map(|k| polygon[k])));
+    }
+    // No sliver for a vertex a hair off the segment: the edge stays out instead.
+    let sliver = triangles.iter().any(|&t| {
+        let a = triangle_angles_deg(m.corners(t));
+        a[0].min(a[1]).min(a[2]) < RECOVERY_MIN_ANGLE_DEG
+    });
+    if sliver {
+        return false;
     }
     // Cut the cavity out and fill it; put the old faces back if the new ones do not fit.
     let old: Vec<[u32; 3]> = cavity.iter().filter_map(|&f| m.face(f)).collect();
@@ -389,5 +399,32 @@ mod tests {
         assert!(!m.has_edge(0, 1));
         // Nothing else to close.
         assert_eq!(close_slits(&mut m, ()), 0);
+    }
+
+    #[test]
+    fn an_edge_past_a_vertex_a_hair_off_it_is_left_out_rather_than_make_a_sliver() {
+        // (2, 2) to (4, 6) passes through (3, 4); move that vertex a hair aside.
+        let mesh = grid(N, |i, j| {
+            let x = if (i, j) == (3, 4) {
+                3.0 + 1e-4
+            } else {
+                i as f64
+            };
+            DVec3::new(x, j as f64, 0.0)
+        });
+        let mut m: EditMesh<()> = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+        let stats = recover_edges(&mut m, &[[index(2, 2), index(4, 6)]], ());
+        assert_eq!(stats.recovered, 0);
+        m.sanity_check().unwrap();
+        let worst = m
+            .live_faces()
+            .0
+            .iter()
+            .map(|&t| {
+                let a = triangle_angles_deg(m.corners(t));
+                a[0].min(a[1]).min(a[2])
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(worst > 40.0, "{worst}");
     }
 }
