@@ -232,6 +232,54 @@ fn fandisk_at_6000_is_a_closed_manifold() {
     assert_closed_genus_0(&r, "fandisk");
 }
 
+/// With `--feature-angle`, the report says what was found and kept, in the notes and in
+/// `extra.features`; without it, neither says anything of creases.
+#[test]
+fn the_report_states_the_sharp_features_found_and_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r, _) = run(
+        "fandisk.obj",
+        "fandisk-features.obj",
+        6000,
+        &["--no-distance", "--feature-angle", "20"],
+        dir.path(),
+    );
+    let notes: Vec<&str> = r["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|n| n.as_str())
+        .collect();
+    let note = notes
+        .iter()
+        .find(|n| n.starts_with("sharp features at 20°"))
+        .unwrap_or_else(|| panic!("no sharp-feature note in {notes:?}"));
+    let edges = int(&r, &["extra", "features", "edges"]);
+    assert!(
+        edges > 0 && note.contains(&format!("{edges} crease edges")),
+        "{note}"
+    );
+    let sampled = int(&r, &["extra", "features", "sampled_edges"]);
+    assert_eq!(int(&r, &["extra", "features", "kept_edges"]), sampled);
+    assert!(
+        note.contains(&format!("all {sampled} crease edges")),
+        "{note}"
+    );
+    let (r, _) = run(
+        "fandisk.obj",
+        "fandisk-plain.obj",
+        2000,
+        &["--no-distance"],
+        dir.path(),
+    );
+    assert!(r["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|n| !n.as_str().unwrap_or("").contains("sharp features")));
+    assert_eq!(int(&r, &["extra", "features", "edges"]), 0);
+}
+
 /// What already holds on cow: a manifold within 1% of the count with no boundary edge, and the
 /// input's non-manifold vertex said in the notes.
 #[test]

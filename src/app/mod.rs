@@ -394,6 +394,9 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             out.dropped_samples
         ));
     }
+    if let Some(note) = features_note(&out.features) {
+        report.notes.push(note);
+    }
     if out.assembly.holes_left > 0 {
         report.notes.push(format!(
             "{} holes of the triangulation could not be closed",
@@ -785,4 +788,40 @@ mod tests {
         .unwrap_err();
         assert_eq!(e.exit_code(), 2);
     }
+}
+
+/// The report's line on the sharp features of a remesh with `--feature-angle`: what was found,
+/// what the output keeps and how far the creases are from its edges. None when detection was
+/// off.
+fn features_note(f: &crate::pipeline::FeatureStats) -> Option<String> {
+    if !(f.angle_deg < 180.0) {
+        return None;
+    }
+    if f.edges == 0 {
+        return Some(format!(
+            "sharp features at {}°: no crease found",
+            f.angle_deg
+        ));
+    }
+    let kept = if f.kept_edges == f.sampled_edges {
+        format!(
+            "all {} crease edges of the samples are output edges",
+            f.sampled_edges
+        )
+    } else {
+        format!(
+            "{} of the samples' {} crease edges are output edges",
+            f.kept_edges, f.sampled_edges
+        )
+    };
+    let distance = f.crease_distance.as_ref().map_or(String::new(), |d| {
+        format!(
+            "; the creases are within {:.3} of the output's edges (bbox-100)",
+            d.max
+        )
+    });
+    Some(format!(
+        "sharp features at {}°: {} crease edges in {} curves ({} closed), {} corners; {kept}{distance}",
+        f.angle_deg, f.edges, f.curves, f.closed_curves, f.corners
+    ))
 }
