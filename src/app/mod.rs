@@ -762,34 +762,6 @@ fn round_up_2(n: f64) -> u64 {
     ((n / scale).ceil() * scale) as u64
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The panic path, injected: one line with the message and the place, the internal exit code.
-    #[test]
-    fn a_panic_becomes_one_internal_error_line() {
-        let e = catch_panics::<()>(|| panic!("injected\nover two lines")).unwrap_err();
-        let line = e.to_string();
-        assert!(matches!(e, Error::Internal { stage: "panic", .. }), "{e:?}");
-        assert_eq!(e.exit_code(), 1);
-        assert_eq!(line.lines().count(), 1, "{line}");
-        assert!(line.contains("injected over two lines"), "{line}");
-        assert!(line.contains("src/app/mod.rs:"), "{line}");
-        assert!(line.contains("a bug: please report it"), "{line}");
-        // Errors and results pass through.
-        assert_eq!(catch_panics(|| Ok(3)).unwrap(), 3);
-        let e = catch_panics::<()>(|| {
-            Err(Error::InvalidParameter {
-                name: "--points",
-                message: "x".into(),
-            })
-        })
-        .unwrap_err();
-        assert_eq!(e.exit_code(), 2);
-    }
-}
-
 /// The report's line on the sharp features of a remesh with `--feature-angle`: what was found,
 /// what the output keeps and how far the creases are from its edges. None when detection was
 /// off.
@@ -824,4 +796,32 @@ fn features_note(f: &crate::pipeline::FeatureStats) -> Option<String> {
         "sharp features at {}°: {} crease edges in {} curves ({} closed), {} corners; {kept}{distance}",
         f.angle_deg, f.edges, f.curves, f.closed_curves, f.corners
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The panic path, injected: one line with the message and the place, the internal exit code.
+    #[test]
+    fn a_panic_becomes_one_internal_error_line() {
+        let e = catch_panics::<()>(|| panic!("injected\nover two lines")).unwrap_err();
+        let line = e.to_string();
+        assert!(matches!(e, Error::Internal { stage: "panic", .. }), "{e:?}");
+        assert_eq!(e.exit_code(), 1);
+        assert_eq!(line.lines().count(), 1, "{line}");
+        assert!(line.contains("injected over two lines"), "{line}");
+        assert!(line.contains("src/app/mod.rs:"), "{line}");
+        assert!(line.contains("a bug: please report it"), "{line}");
+        // Errors and results pass through.
+        assert_eq!(catch_panics(|| Ok(3)).unwrap(), 3);
+        let e = catch_panics::<()>(|| {
+            Err(Error::InvalidParameter {
+                name: "--points",
+                message: "x".into(),
+            })
+        })
+        .unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+    }
 }
