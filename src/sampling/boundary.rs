@@ -129,11 +129,16 @@ pub struct BoundarySamples {
 
 /// The arc length of `curve` (bbox-100 units when `mesh` is normalized).
 pub fn curve_length(mesh: &TriMesh, curve: &BoundaryCurve) -> f64 {
+    edge_lengths(mesh, curve).iter().sum()
+}
+
+/// The length of each edge `k → k+1` of `curve` (units of the mesh).
+pub(crate) fn edge_lengths(mesh: &TriMesh, curve: &BoundaryCurve) -> Vec<f64> {
     let nv = curve.vertices.len();
     let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
     (0..curve.faces.len())
         .map(|k| pos(k).distance(pos(k + 1)))
-        .sum()
+        .collect()
 }
 
 /// How many samples [`sample_boundary`] places at `spacing` on `curves` of `mesh`, without
@@ -228,29 +233,47 @@ pub(crate) fn curve_points(
     }
     let steps = curve_steps(total, unit, curve.closed) as usize;
     let count = if curve.closed { steps } else { steps + 1 };
-    let mut out = Vec::with_capacity(count);
-    let (mut edge, mut edge_start) = (0usize, 0.0f64);
-    for s in 0..count {
-        let t = total * s as f64 / steps as f64;
-        while edge + 1 < ne && edge_start + lengths[edge] < t {
-            edge_start += lengths[edge];
-            edge += 1;
-        }
-        let u = if lengths[edge] > 0.0 {
-            ((t - edge_start) / lengths[edge]).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let p = if !curve.closed && s == steps {
-            pos(nv - 1)
-        } else if s == 0 {
-            pos(0)
-        } else {
-            pos(edge).lerp(pos(edge + 1), u)
-        };
-        out.push((p, edge));
+    let mut out = points_along(
+        mesh,
+        curve,
+        &lengths,
+        (0..count).map(|s| total * s as f64 / steps as f64),
+    );
+    out[0].0 = pos(0);
+    if !curve.closed {
+        out[steps].0 = pos(nv - 1);
     }
     out
+}
+
+/// The points of `curve` at the positions `targets` along it (non-decreasing, in the units of
+/// `lengths`, the length of each edge `k → k+1`), each with the index of the edge it lies on:
+/// linear in the length within an edge, clamped to the curve's ends. One walk along the curve.
+pub(crate) fn points_along(
+    mesh: &TriMesh,
+    curve: &BoundaryCurve,
+    lengths: &[f64],
+    targets: impl IntoIterator<Item = f64>,
+) -> Vec<(DVec3, usize)> {
+    let nv = curve.vertices.len();
+    let ne = lengths.len();
+    let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
+    let (mut edge, mut edge_start) = (0usize, 0.0f64);
+    targets
+        .into_iter()
+        .map(|t| {
+            while edge + 1 < ne && edge_start + lengths[edge] < t {
+                edge_start += lengths[edge];
+                edge += 1;
+            }
+            let u = if lengths[edge] > 0.0 {
+                ((t - edge_start) / lengths[edge]).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (pos(edge).lerp(pos(edge + 1), u), edge)
+        })
+        .collect()
 }
 
 /// The samples of every curve ([`curve_points`]), one shared sample where open curves meet;

@@ -10,7 +10,9 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
-use crate::sampling::boundary::{curve_length, curve_points, BoundaryCurve};
+use crate::sampling::boundary::{
+    curve_length, curve_points, edge_lengths, points_along, BoundaryCurve,
+};
 use crate::surface::features::Features;
 
 /// The least distance between the samples of two feature curves, in units of the spacing
@@ -103,50 +105,19 @@ fn crowded_only_at_ends(clear: &[bool], closed: bool) -> bool {
     (first..=last).all(|k| clear[k])
 }
 
-/// The point at arc length `arc` along `curve` (clamped to its ends), with the index of the edge
-/// it lies on.
-fn point_at_arc(mesh: &TriMesh, curve: &BoundaryCurve, arc: f64) -> (DVec3, usize) {
-    let nv = curve.vertices.len();
-    let pos = |k: usize| mesh.positions[curve.vertices[k % nv] as usize];
-    let ne = curve.faces.len();
-    let mut start = 0.0;
-    for k in 0..ne {
-        let l = pos(k).distance(pos(k + 1));
-        if arc <= start + l || k + 1 == ne {
-            let u = if l > 0.0 {
-                ((arc - start) / l).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            return (pos(k).lerp(pos(k + 1), u), k);
-        }
-        start += l;
-    }
-    (pos(0), 0)
-}
-
 /// The points of a feature piece with graded ends ([`FeaturePiece::arcs`]), corners exact.
 pub(crate) fn graded_points(
     mesh: &TriMesh,
     piece: &FeaturePiece,
     spacing: f64,
 ) -> Vec<(DVec3, usize)> {
-    let total = curve_length(mesh, &piece.curve);
-    let arcs = piece.arcs(total, spacing);
-    let last = arcs.len() - 1;
-    let nv = piece.curve.vertices.len();
-    arcs.iter()
-        .enumerate()
-        .map(|(k, &a)| {
-            let (p, e) = point_at_arc(mesh, &piece.curve, a);
-            let p = match k {
-                0 => mesh.positions[piece.curve.vertices[0] as usize],
-                k if k == last => mesh.positions[piece.curve.vertices[nv - 1] as usize],
-                _ => p,
-            };
-            (p, e)
-        })
-        .collect()
+    let lengths = edge_lengths(mesh, &piece.curve);
+    let arcs = piece.arcs(lengths.iter().sum(), spacing);
+    let mut points = points_along(mesh, &piece.curve, &lengths, arcs);
+    let (last, nv) = (points.len() - 1, piece.curve.vertices.len());
+    points[0].0 = mesh.positions[piece.curve.vertices[0] as usize];
+    points[last].0 = mesh.positions[piece.curve.vertices[nv - 1] as usize];
+    points
 }
 
 /// The feature curves of `features` worth sampling at `spacing` (bbox-100 units), as curves with
@@ -232,9 +203,9 @@ pub fn feature_pieces(
     };
     let place = |placed: &mut FxHashMap<[i64; 3], Vec<Placed>>,
                  piece: &FeaturePiece,
+                 points: &[(DVec3, usize)],
                  index: usize,
                  generation: u32| {
-        let points = points_of(piece);
         let last = points.len().saturating_sub(1);
         for (k, &(p, _)) in points.iter().enumerate() {
             placed.entry(cell(p)).or_default().push((
@@ -248,9 +219,11 @@ pub fn feature_pieces(
     // The direction a curve leaves its end `at` (0: start, 1: end): towards its point a spacing
     // along (or half its length, if shorter).
     let leaving = |curve: &BoundaryCurve, at: usize| -> DVec3 {
-        let total = curve_length(mesh, curve);
+        let lengths = edge_lengths(mesh, curve);
+        let total: f64 = lengths.iter().sum();
         let arc = spacing.min(0.5 * total);
-        let (p, _) = point_at_arc(mesh, curve, if at == 0 { arc } else { total - arc });
+        let target = if at == 0 { arc } else { total - arc };
+        let (p, _) = points_along(mesh, curve, &lengths, [target])[0];
         let nv = curve.vertices.len();
         let corner = mesh.positions[curve.vertices[if at == 0 { 0 } else { nv - 1 }] as usize];
         (p - corner).normalize_or_zero()
@@ -264,8 +237,9 @@ pub fn feature_pieces(
         // kept before that leaves the same corner (a small angle between them), both curves
         // graded towards that corner.
         let mut regrade: Vec<(usize, usize, Vec<f64>)> = Vec::new();
+        let mut points = Vec::new();
         for round in 0..2 {
-            let points = points_of(&piece);
+            points = points_of(&piece);
             let last = points.len().saturating_sub(1);
             // For each sample, the kept curves whose samples it crowds (apart from a shared
             // corner).
@@ -365,10 +339,10 @@ pub fn feature_pieces(
             kept[i].0.graded[end] = distances;
             kept[i].1 += 1;
             let (piece_i, generation) = (kept[i].0.clone(), kept[i].1);
-            place(&mut placed, &piece_i, i, generation);
+            place(&mut placed, &piece_i, &points_of(&piece_i), i, generation);
         }
         let index = kept.len();
-        place(&mut placed, &piece, index, 0);
+        place(&mut placed, &piece, &points, index, 0);
         kept.push((piece, 0));
     }
     let pieces: Vec<FeaturePiece> = kept.into_iter().map(|(p, _)| p).collect();

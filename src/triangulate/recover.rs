@@ -16,9 +16,10 @@
 
 use glam::{DVec2, DVec3};
 use robust::{orient2d, Coord};
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::geometry::tolerance::RECOVERY_MIN_ANGLE_DEG;
-use crate::geometry::triangle::triangle_angles_deg;
+use crate::geometry::triangle::{is_degenerate_triangle, triangle_angles_deg};
 use crate::mesh::edit::{starting_at, EditMesh};
 
 /// The longest walk (faces crossed) one edge may take: a segment crossing more faces than this
@@ -63,8 +64,8 @@ pub fn recover_edges<L: Copy>(m: &mut EditMesh<L>, edges: &[[u32; 2]], label: L)
 /// Returns how many were closed. Deterministic.
 pub fn close_slits<L: Copy>(m: &mut EditMesh<L>, label: L) -> usize {
     let half = m.boundary_half_edges();
-    let missing: rustc_hash::FxHashSet<(u32, u32)> = half.iter().copied().collect();
-    let mut from: rustc_hash::FxHashMap<u32, Vec<u32>> = rustc_hash::FxHashMap::default();
+    let missing: FxHashSet<(u32, u32)> = half.iter().copied().collect();
+    let mut from: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     for &(p, q) in &half {
         from.entry(p).or_default().push(q);
     }
@@ -77,7 +78,7 @@ pub fn close_slits<L: Copy>(m: &mut EditMesh<L>, label: L) -> usize {
                 continue;
             }
             let corners = [p, q, r].map(|v| m.position(v));
-            if !crate::geometry::triangle::is_degenerate_triangle(corners) {
+            if !is_degenerate_triangle(corners) {
                 continue;
             }
             // The longest side u → v (a missing direction) and the corner w between.
@@ -126,13 +127,6 @@ fn insert_edge<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
     let proj = |x: u32| -> DVec2 {
         let d = m.position(x) - origin;
         DVec2::new(d.dot(u), d.dot(v))
-    };
-    let orient = |p: DVec2, q: DVec2, r: DVec2| {
-        orient2d(
-            Coord { x: p.x, y: p.y },
-            Coord { x: q.x, y: q.y },
-            Coord { x: r.x, y: r.y },
-        )
     };
     let ccw = |t: [u32; 3]| orient(proj(t[0]), proj(t[1]), proj(t[2])) > 0.0;
     // The fans at both ends must project one-to-one (every face counter-clockwise).
@@ -231,18 +225,20 @@ fn insert_edge<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
     false
 }
 
+/// The orientation of the triangle p, q, r in the plane (positive: counter-clockwise), exact.
+fn orient(p: DVec2, q: DVec2, r: DVec2) -> f64 {
+    orient2d(
+        Coord { x: p.x, y: p.y },
+        Coord { x: q.x, y: q.y },
+        Coord { x: r.x, y: r.y },
+    )
+}
+
 /// Ear clipping of the simple counter-clockwise polygon `points` (in the projection plane),
 /// the ear whose 3-D triangle (`corner` gives the positions) has the largest smallest angle
 /// first. Triangles as index triples into `points`. None when no ear is left before the end
 /// (the polygon is not simple in the projection).
 fn ear_clip(points: &[DVec2], corner: impl Fn(usize) -> DVec3) -> Option<Vec<[usize; 3]>> {
-    let orient = |p: DVec2, q: DVec2, r: DVec2| {
-        orient2d(
-            Coord { x: p.x, y: p.y },
-            Coord { x: q.x, y: q.y },
-            Coord { x: r.x, y: r.y },
-        )
-    };
     let mut ring: Vec<usize> = (0..points.len()).collect();
     let mut out = Vec::with_capacity(points.len().saturating_sub(2));
     while ring.len() > 3 {
