@@ -172,6 +172,16 @@ impl Default for RemeshParams {
     }
 }
 
+/// The sources of the faces of an edited mesh: a face that is still face `f` of the mesh before
+/// (`origin`, as `EditMesh::into_parts` gives it) keeps `sources[f]`; a new or changed one is
+/// `Refined`.
+fn carried_sources(origin: &[Option<u32>], sources: &[FaceSource]) -> Vec<FaceSource> {
+    origin
+        .iter()
+        .map(|o| o.map_or(FaceSource::Refined, |f| sources[f as usize]))
+        .collect()
+}
+
 /// How many of `edges` (vertex pairs, either direction) are edges of a face of `mesh`.
 fn edges_present(mesh: &TriMesh, edges: &[[u32; 2]]) -> usize {
     let mut have: rustc_hash::FxHashSet<(u32, u32)> = rustc_hash::FxHashSet::default();
@@ -727,10 +737,7 @@ pub fn remesh(
             let stats = recover_edges(&mut m, &feature_edges, None);
             let (positions, faces, origin) = m.into_parts();
             mesh_normalized = TriMesh::new(positions, faces);
-            face_sources = origin
-                .iter()
-                .map(|o| o.map_or(FaceSource::Refined, |f| face_sources[f as usize]))
-                .collect();
+            face_sources = carried_sources(&origin, &face_sources);
             stats
         } else {
             RecoverStats::default()
@@ -749,10 +756,7 @@ pub fn remesh(
                     sigma_p,
                     op,
                 );
-                face_sources = origin
-                    .iter()
-                    .map(|o| o.map_or(FaceSource::Refined, |f| face_sources[f as usize]))
-                    .collect();
+                face_sources = carried_sources(&origin, &face_sources);
                 st
             }
             None => OptimizeStats::default(),
