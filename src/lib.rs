@@ -157,6 +157,11 @@ pub use surface::local_feature_size::{
     local_feature_size, LfsParams, LocalFeatureSize, MAX_LFS_SAMPLES,
 };
 // Sharp features of the input: crease edges, curves and corners.
+pub use sampling::crease_band::{CreaseBand, CREASE_BAND_PER_SPACING};
+pub use surface::curvature::{
+    Curvature, CurvatureParams, CurvatureWidths, CAD_CHORD_ERROR, CURVATURE_GRADATION,
+    CURVATURE_MAX_BEND_DEG,
+};
 pub use surface::features::{
     detect_features, FeatureCurve, FeatureParams, Features, CAD_FEATURE_ANGLE_DEG,
     DEFAULT_FEATURE_ANGLE_DEG,

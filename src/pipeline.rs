@@ -14,6 +14,7 @@ use crate::sampling::boundary::{
     boundary_curves, boundary_sample_count, curve_length, sample_curves_and_features,
 };
 use crate::sampling::candidates::surface_candidates;
+use crate::sampling::crease_band::CreaseBand;
 use crate::sampling::features::feature_pieces;
 use crate::sampling::gradient_ascent::{
     gradient_ascent_graded, GradientAscentParams, GradientAscentResult,
@@ -24,6 +25,7 @@ use crate::sampling::linear_scan::{
 };
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::sampling::WidthField;
+use crate::surface::curvature::{Curvature, CurvatureParams, CurvatureWidths};
 use crate::surface::features::{detect_features, FeatureParams, DEFAULT_FEATURE_ANGLE_DEG};
 use crate::surface::winding::BuriedTest;
 use crate::surface::MeshSurface;
@@ -31,7 +33,7 @@ use crate::surface::SurfaceSample;
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
-use crate::triangulate::recover::{close_slits, recover_edges, RecoverStats};
+use crate::triangulate::recover::{close_slits, flip_crease_slivers, recover_edges, RecoverStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{
@@ -140,6 +142,8 @@ pub struct RemeshParams {
     /// Hausdorff distance (median of seeds 1-5 from 0.449 to 0.508, at the ears) although it
     /// keeps the topology of thin parts at low counts.
     pub grading: Option<GradingParams>,
+    /// Sample density graded by curvature (`None`, the default: one sigma_p everywhere).
+    pub curvature: Option<CurvatureParams>,
     /// The feature angle (degrees) of the sharp-feature detection ([`detect_features`], at the
     /// sample spacing of the first sigma_p): the creases found are sampled evenly along with the
     /// boundary (`sampling::features::feature_pieces`), kept fixed, and their consecutive samples reported as
@@ -165,6 +169,7 @@ impl Default for RemeshParams {
             optimize: Some(OptimizeParams::default()),
             untangle: UntangleParams::default(),
             grading: None,
+            curvature: None,
             feature_angle_deg: DEFAULT_FEATURE_ANGLE_DEG,
             count_tolerance: 0.005,
             seed: 1,
@@ -488,6 +493,9 @@ pub fn remesh(
         crease_distance: None,
     };
     timer.lap("features");
+    let curvature = params
+        .curvature
+        .map(|p| (Curvature::new(&normalized, &[]), p));
     let grading = match params.grading {
         Some(g) => {
             on_stage("local feature size");
@@ -533,13 +541,17 @@ pub fn remesh(
         // With grading, the widths are those for sigma_ref (held fixed through a search, so the
         // count falls like sigma_p^-2 as without grading; see the search below).
         // The candidates' widths for one sigma_ref, taken once for a round's evaluations.
-        let pool_widths = |g: &Grading, sigma_ref: f64| -> Vec<f64> {
-            pool.par_iter()
-                .map(|c| g.width(c.position, sigma_ref))
-                .collect()
+        let pool_widths =
+            |w: &Widths| -> Vec<f64> { pool.par_iter().map(|c| w.width(c.position)).collect() };
+        let widths_at = |sigma_ref: f64| Widths {
+            grading: grading.as_ref(),
+            curvature: curvature.as_ref().map(|(c, p)| {
+                CurvatureWidths::new(c, &pool, sigma_ref, p.chord_error, p.min_width)
+            }),
+            sigma_ref,
         };
         let scan = |sigma_p: f64,
-                    sigma_ref: f64,
+                    widths: &Widths,
                     pool_widths: Option<&[f64]>|
          -> Result<(usize, Option<ScanWithBoundary>)> {
             let kernel = Kernel::new(sigma_p, params.sigma_n)?;
@@ -547,8 +559,14 @@ pub fn remesh(
             let feature_spacing = FEATURE_SPACING_PER_SIGMA * sigma_p;
             // The boundary curves, cut where creases end on them, and the creases long enough
             // to take samples at their spacing.
-            let (boundary_pieces, feature_curves) =
-                feature_pieces(&normalized, &curves, &features, feature_spacing);
+            let width = widths.active().then_some(|p: DVec3| widths.width(p));
+            let (boundary_pieces, feature_curves) = feature_pieces(
+                &normalized,
+                &curves,
+                &features,
+                feature_spacing,
+                width.as_ref().map(|f| f as WidthField),
+            );
             let boundary_count = boundary_sample_count(&normalized, &boundary_pieces, spacing)
                 + boundary_sample_count(
                     &normalized,
@@ -558,9 +576,6 @@ pub fn remesh(
             if !(boundary_count <= boundary_limit) {
                 return Ok((boundary_count.min(usize::MAX as f64) as usize, None));
             }
-            let width = grading
-                .as_ref()
-                .map(|g| move |p: DVec3| g.width(p, sigma_ref));
             let b = sample_curves_and_features(
                 &normalized,
                 &boundary_pieces,
@@ -569,23 +584,25 @@ pub fn remesh(
                 feature_spacing,
                 width.as_ref().map(|f| f as WidthField),
             );
-            let r = match &grading {
-                Some(g) => linear_scan_graded(
+            let r = if widths.active() {
+                linear_scan_graded(
                     &kernel,
                     &pool,
                     pool_widths,
                     &b.samples,
-                    Some(&|p| g.width(p, sigma_ref)),
+                    Some(&|p| widths.width(p)),
                     &params.linear_scan,
-                ),
-                None => linear_scan(&kernel, &pool, &b.samples, &params.linear_scan),
+                )
+            } else {
+                linear_scan(&kernel, &pool, &b.samples, &params.linear_scan)
             };
             Ok((r.samples.len(), Some((r, b.edges, b.feature_edges))))
         };
         let (sigma_p, target_reached, search_history, value) = match density {
             Target::SigmaP(s) => {
-                let widths = grading.as_ref().map(|g| pool_widths(g, s));
-                let (count, value) = scan(s, s, widths.as_deref())?;
+                let w = widths_at(s);
+                let pool_w = w.active().then(|| pool_widths(&w));
+                let (count, value) = scan(s, &w, pool_w.as_deref())?;
                 (s, true, vec![(s, count)], value)
             }
             Target::Points(_) => {
@@ -602,10 +619,11 @@ pub fn remesh(
                 let mut round_start = start;
                 let mut round = 0;
                 loop {
-                    let widths = grading.as_ref().map(|g| pool_widths(g, sigma_ref));
+                    let w = widths_at(sigma_ref);
+                    let pool_w = w.active().then(|| pool_widths(&w));
                     let mut failure = None;
                     let r = find_sigma_p(&search, round_start, |s| {
-                        match scan(s, sigma_ref, widths.as_deref()) {
+                        match scan(s, &w, pool_w.as_deref()) {
                             Ok(v) => v,
                             Err(e) => {
                                 failure = Some(e);
@@ -621,7 +639,8 @@ pub fn remesh(
                     let moved = (r.sigma_p / sigma_ref).ln().abs() > 0.1;
                     let widths_change = grading
                         .as_ref()
-                        .is_some_and(|g| g.grades_below(sigma_ref.max(r.sigma_p)));
+                        .is_some_and(|g| g.grades_below(sigma_ref.max(r.sigma_p)))
+                        || w.curvature.as_ref().is_some_and(CurvatureWidths::grades);
                     if round >= 3 || !moved || !widths_change {
                         break (r.sigma_p, r.reached, history, r.value);
                     }
@@ -658,15 +677,29 @@ pub fn remesh(
             measured,
         } = scan_result;
         let before_ascent = buried_test.as_ref().map(|_| samples.clone());
-        let width_field = grading
-            .as_ref()
-            .map(|g| move |p: DVec3| g.width(p, sigma_ref));
+        let widths = widths_at(sigma_ref);
+        let width_field = widths.active().then_some(|p: DVec3| widths.width(p));
+        // Surface samples keep out of a band along the sampled creases.
+        let band = {
+            let positions: Vec<DVec3> = samples[..boundary_count]
+                .iter()
+                .map(|s| s.position)
+                .collect();
+            let step = 0.05 * FEATURE_SPACING_PER_SIGMA * sigma_p;
+            CreaseBand::new(
+                &positions,
+                &feature_edges,
+                FEATURE_SPACING_PER_SIGMA * sigma_p,
+                step,
+            )
+        };
         let ga = gradient_ascent_graded(
             &kernel,
             &surface,
             &mut samples,
             boundary_count,
             width_field.as_ref().map(|f| f as WidthField),
+            band.as_ref(),
             &params.gradient_ascent,
             params.seed,
         );
@@ -735,6 +768,7 @@ pub fn remesh(
             let slits = close_slits(&mut m, None);
             assembly.holes_left = assembly.holes_left.saturating_sub(slits);
             let stats = recover_edges(&mut m, &feature_edges, None);
+            flip_crease_slivers(&mut m, None);
             let (positions, faces, origin) = m.into_parts();
             mesh_normalized = TriMesh::new(positions, faces);
             face_sources = carried_sources(&origin, &face_sources);
@@ -885,4 +919,31 @@ pub fn remesh(
         });
     }
     Ok(output)
+}
+
+/// The kernel width field of one remesh round: the grading by thickness and the grading by
+/// curvature, for the global `sigma_ref`, the smaller of the two.
+struct Widths<'a> {
+    grading: Option<&'a Grading>,
+    curvature: Option<CurvatureWidths>,
+    sigma_ref: f64,
+}
+
+impl Widths<'_> {
+    /// Whether any grading is on.
+    fn active(&self) -> bool {
+        self.grading.is_some() || self.curvature.is_some()
+    }
+
+    /// The relative width at `p` (1 with no grading).
+    fn width(&self, p: DVec3) -> f64 {
+        let mut w: f64 = 1.0;
+        if let Some(g) = self.grading {
+            w = w.min(g.width(p, self.sigma_ref));
+        }
+        if let Some(c) = &self.curvature {
+            w = w.min(c.width(p));
+        }
+        w
+    }
 }

@@ -5,7 +5,9 @@ mod common;
 
 use common::grid_box_counts;
 use glam::DVec3;
-use spectral_remesh::{remesh, Density, RemeshParams, TriMesh, CAD_FEATURE_ANGLE_DEG};
+use spectral_remesh::{
+    remesh, CurvatureParams, Density, RemeshParams, TriMesh, CAD_FEATURE_ANGLE_DEG,
+};
 
 /// The largest distance from points along the box's 12 edges (20 per edge) to the nearest
 /// edge of `mesh`.
@@ -233,5 +235,124 @@ fn fandisk_keeps_its_creases_within_the_hausdorff_bound_at_every_seed() {
             t.is_closed_manifold() && t.genus == Some(0),
             "seed {seed}: {t:?}"
         );
+    }
+}
+
+/// A closed disc-shaped cylinder round the z axis, radius `r`, height `h`: `sides` facets round,
+/// `rings` bands, the caps as rings of triangles `rings_cap` deep to the centre. Oriented
+/// outward.
+fn disc(r: f64, h: f64, sides: usize, rings: usize, rings_cap: usize) -> TriMesh {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let ring = |z: f64, radius: f64, positions: &mut Vec<DVec3>| -> u32 {
+        let start = positions.len() as u32;
+        for i in 0..sides {
+            let a = std::f64::consts::TAU * i as f64 / sides as f64;
+            positions.push(DVec3::new(radius * a.cos(), radius * a.sin(), z));
+        }
+        start
+    };
+    let band = |a: u32, b: u32, triangles: &mut Vec<[u32; 3]>| {
+        // Quads between ring a (below / outside) and ring b, split along a diagonal.
+        for i in 0..sides as u32 {
+            let j = (i + 1) % sides as u32;
+            triangles.push([a + i, a + j, b + j]);
+            triangles.push([a + i, b + j, b + i]);
+        }
+    };
+    // The side, bottom to top.
+    let side: Vec<u32> = (0..=rings)
+        .map(|k| ring(h * k as f64 / rings as f64, r, &mut positions))
+        .collect();
+    for k in 0..rings {
+        band(side[k], side[k + 1], &mut triangles);
+    }
+    // The caps: rings inward, then a fan to the centre.
+    for (z, outer, up) in [(h, side[rings], true), (0.0, side[0], false)] {
+        let mut prev = outer;
+        for k in 1..rings_cap {
+            let next = ring(z, r * (1.0 - k as f64 / rings_cap as f64), &mut positions);
+            let start = triangles.len();
+            band(prev, next, &mut triangles);
+            if !up {
+                for t in &mut triangles[start..] {
+                    t.swap(1, 2);
+                }
+            }
+            prev = next;
+        }
+        let centre = positions.len() as u32;
+        positions.push(DVec3::new(0.0, 0.0, z));
+        for i in 0..sides as u32 {
+            let j = (i + 1) % sides as u32;
+            triangles.push(if up {
+                [prev + i, prev + j, centre]
+            } else {
+                [prev + j, prev + i, centre]
+            });
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+#[test]
+fn with_the_chord_error_a_curved_side_gets_finer_samples_and_a_closer_surface() {
+    // A disc of radius 40 and height 10: a curved side between two large flat caps.
+    let (r, h) = (40.0, 10.0);
+    let input = disc(r, h, 240, 6, 24);
+    // The largest distance of an output face's centroid on the side from the true cylinder
+    // (the chord error there; the input's facets are within 0.004 of it), and the side's share
+    // of the vertices (a vertex within 0.04 of the cylinder, the facets' sag being 0.0034).
+    let side = |mesh: &TriMesh| -> (f64, f64) {
+        let scale = 100.0 / (2.0 * r);
+        let mut worst: f64 = 0.0;
+        for f in 0..mesh.triangles.len() {
+            let p = mesh.corners(f);
+            let on_side = p
+                .iter()
+                .all(|q| (q.truncate().length() - r).abs() < 1e-3 * r);
+            if on_side {
+                let c = (p[0] + p[1] + p[2]) / 3.0;
+                worst = worst.max((r - c.truncate().length()) * scale);
+            }
+        }
+        let on_side = mesh
+            .positions
+            .iter()
+            .filter(|q| (q.truncate().length() - r).abs() < 1e-3 * r)
+            .count();
+        (worst, on_side as f64 / mesh.positions.len() as f64)
+    };
+    for seed in 1..=3 {
+        let base = RemeshParams {
+            density: Density::Points(3000),
+            feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
+            seed,
+            ..Default::default()
+        };
+        let graded = RemeshParams {
+            curvature: Some(CurvatureParams::default()),
+            ..base
+        };
+        let even = remesh(&input, &base, &|_| {}).expect("remesh");
+        let fine = remesh(&input, &graded, &|_| {}).expect("remesh");
+        let (e_even, share_even) = side(&even.mesh);
+        let (e_fine, share_fine) = side(&fine.mesh);
+        // The side takes more of the samples, and its chord error falls (the count is the
+        // same: the samples come from the caps, which have no chord error at any spacing).
+        assert!(
+            share_fine > 1.3 * share_even,
+            "seed {seed}: side share {share_even} -> {share_fine}"
+        );
+        assert!(
+            e_fine < 0.75 * e_even,
+            "seed {seed}: chord error {e_even} -> {e_fine}"
+        );
+        let v = fine.mesh.positions.len() as f64;
+        assert!((v - 3000.0).abs() <= 30.0, "seed {seed}: {v} vertices");
+        // The rims stay output edges.
+        let f = &fine.features;
+        assert_eq!(f.curves, 2, "seed {seed}: {f:?}");
+        assert!(f.kept_edges == f.sampled_edges, "seed {seed}: {f:?}");
     }
 }

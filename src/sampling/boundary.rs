@@ -192,24 +192,17 @@ pub fn sample_curves_and_features(
     width: Option<WidthField>,
 ) -> BoundarySamples {
     let scale = feature_spacing / spacing;
-    let Some(width) = width else {
-        return sample_curves(mesh, curves, features, spacing, spacing, scale, |a, b| {
-            a.distance(b)
-        });
-    };
-    // Per edge, its steps: the trapezoid rule in 1/w, in units of one step.
-    sample_curves(mesh, curves, features, 1.0, spacing, scale, |a, b| {
-        0.5 * a.distance(b) * (1.0 / width(a).max(1e-6) + 1.0 / width(b).max(1e-6)) / spacing
-    })
+    match width {
+        None => sample_curves(mesh, curves, features, spacing, spacing, scale, None),
+        Some(_) => sample_curves(mesh, curves, features, 1.0, spacing, scale, width),
+    }
 }
 
 /// Places samples along every boundary curve of `mesh` at equal arc-length steps as close to
 /// `spacing` (bbox-100 units) as a whole number of steps allows: a closed loop gets at least 3,
 /// and the ends of open chains are shared between the chains that meet there.
 pub fn sample_boundary(mesh: &TriMesh, curves: &[BoundaryCurve], spacing: f64) -> BoundarySamples {
-    sample_curves(mesh, curves, &[], spacing, spacing, 1.0, |a, b| {
-        a.distance(b)
-    })
+    sample_curves(mesh, curves, &[], spacing, spacing, 1.0, None)
 }
 
 /// The points of one curve at equal steps of a measure along it: `measure(a, b)` of each edge
@@ -286,8 +279,14 @@ fn sample_curves(
     unit: f64,
     spacing: f64,
     feature_scale: f64,
-    measure: impl Fn(DVec3, DVec3) -> f64,
+    width: Option<WidthField>,
 ) -> BoundarySamples {
+    // Per edge: its length, or with a width field its steps (the trapezoid rule in 1/w, in
+    // units of one step of `spacing`).
+    let measure = |a: DVec3, b: DVec3| match width {
+        None => a.distance(b),
+        Some(w) => 0.5 * a.distance(b) * (1.0 / w(a).max(1e-6) + 1.0 / w(b).max(1e-6)) / spacing,
+    };
     let mut out = BoundarySamples::default();
     let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();
     let all = curves
@@ -298,10 +297,10 @@ fn sample_curves(
         let nv = curve.vertices.len();
         let points = match feature {
             Some(f) if f.graded.iter().any(|g| !g.is_empty()) => {
-                graded_points(mesh, f, spacing * feature_scale)
+                graded_points(mesh, f, spacing * feature_scale, width)
             }
-            Some(_) => curve_points(mesh, curve, unit * feature_scale, &measure),
-            None => curve_points(mesh, curve, unit, &measure),
+            Some(_) => curve_points(mesh, curve, unit * feature_scale, measure),
+            None => curve_points(mesh, curve, unit, measure),
         };
         if points.is_empty() {
             continue;

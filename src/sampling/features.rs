@@ -13,6 +13,7 @@ use crate::mesh::TriMesh;
 use crate::sampling::boundary::{
     curve_length, curve_points, edge_lengths, points_along, BoundaryCurve,
 };
+use crate::sampling::WidthField;
 use crate::surface::features::Features;
 
 /// The least distance between the samples of two feature curves, in units of the spacing
@@ -55,6 +56,33 @@ impl FeaturePiece {
         out.extend(self.graded[0].iter().rev().copied());
         for k in 1..steps {
             out.push(r0 + middle * k as f64 / steps as f64);
+        }
+        out.extend(self.graded[1].iter().map(|&r| total - r));
+        out.push(total);
+        out.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * total.max(1.0));
+        out
+    }
+
+    /// [`FeaturePiece::arcs`] with the even steps between the graded ends taken in a measure
+    /// along the curve (edge `k` has length `lengths[k]` and measure `measures[k]`, in units of
+    /// length): as many steps as `spacing` fits into the middle part's measure, equal in it.
+    pub(crate) fn arcs_in_measure(
+        &self,
+        lengths: &[f64],
+        measures: &[f64],
+        spacing: f64,
+    ) -> Vec<f64> {
+        let total: f64 = lengths.iter().sum();
+        let r0 = self.graded[0].first().copied().unwrap_or(0.0);
+        let r1 = self.graded[1].first().copied().unwrap_or(0.0);
+        let m0 = convert(lengths, measures, r0, true);
+        let m1 = convert(lengths, measures, (total - r1).max(r0), true);
+        let steps = ((m1 - m0) / spacing).round().max(1.0) as usize;
+        let mut out = vec![0.0];
+        out.extend(self.graded[0].iter().rev().copied());
+        for k in 1..steps {
+            let m = m0 + (m1 - m0) * k as f64 / steps as f64;
+            out.push(convert(lengths, measures, m, false));
         }
         out.extend(self.graded[1].iter().map(|&r| total - r));
         out.push(total);
@@ -105,19 +133,60 @@ fn crowded_only_at_ends(clear: &[bool], closed: bool) -> bool {
     (first..=last).all(|k| clear[k])
 }
 
-/// The points of a feature piece with graded ends ([`FeaturePiece::arcs`]), corners exact.
+/// The points of a feature piece with graded ends ([`FeaturePiece::arcs`]), corners exact. With
+/// a `width` field the even steps between the graded ends follow it (equal steps of ∫ ds / w,
+/// the width taken at the curve's vertices, linear in between, as on the other curves); the
+/// graded distances stay as they are (they were set at the corner's width).
 pub(crate) fn graded_points(
     mesh: &TriMesh,
     piece: &FeaturePiece,
     spacing: f64,
+    width: Option<WidthField>,
 ) -> Vec<(DVec3, usize)> {
     let lengths = edge_lengths(mesh, &piece.curve);
-    let arcs = piece.arcs(lengths.iter().sum(), spacing);
+    let total: f64 = lengths.iter().sum();
+    let arcs = match width {
+        None => piece.arcs(total, spacing),
+        Some(w) => {
+            let nv = piece.curve.vertices.len();
+            let pos = |k: usize| mesh.positions[piece.curve.vertices[k % nv] as usize];
+            let measures: Vec<f64> = (0..lengths.len())
+                .map(|k| {
+                    0.5 * lengths[k] * (1.0 / w(pos(k)).max(1e-6) + 1.0 / w(pos(k + 1)).max(1e-6))
+                })
+                .collect();
+            piece.arcs_in_measure(&lengths, &measures, spacing)
+        }
+    };
     let mut points = points_along(mesh, &piece.curve, &lengths, arcs);
     let (last, nv) = (points.len() - 1, piece.curve.vertices.len());
     points[0].0 = mesh.positions[piece.curve.vertices[0] as usize];
     points[last].0 = mesh.positions[piece.curve.vertices[nv - 1] as usize];
     points
+}
+
+/// Along a curve of edge `lengths` whose edges have `measures`, the measure at arc length `t`
+/// (`to_measure`) or the arc length at measure `m` (`!to_measure`), linear within an edge.
+fn convert(lengths: &[f64], measures: &[f64], x: f64, to_measure: bool) -> f64 {
+    let (from, to) = if to_measure {
+        (lengths, measures)
+    } else {
+        (measures, lengths)
+    };
+    let (mut a, mut b) = (0.0, 0.0);
+    for k in 0..from.len() {
+        if a + from[k] >= x || k + 1 == from.len() {
+            let u = if from[k] > 0.0 {
+                ((x - a) / from[k]).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            return b + u * to[k];
+        }
+        a += from[k];
+        b += to[k];
+    }
+    0.0
 }
 
 /// The feature curves of `features` worth sampling at `spacing` (bbox-100 units), as curves with
@@ -142,7 +211,9 @@ pub fn feature_pieces(
     curves: &[BoundaryCurve],
     features: &Features,
     spacing: f64,
+    width: Option<WidthField>,
 ) -> (Vec<BoundaryCurve>, Vec<FeaturePiece>) {
+    let w = |p: DVec3| width.map_or(1.0, |f| f(p).max(1e-6));
     if features.curves.is_empty() {
         return (curves.to_vec(), Vec::new());
     }
@@ -160,17 +231,32 @@ pub fn feature_pieces(
         })
         .collect();
     let ends = |c: &BoundaryCurve| [c.vertices[0], c.vertices[c.vertices.len() - 1]];
+    // Whether a curve of length `l` is long enough for the spacing: in ∫ ds / w with a width
+    // field (the local spacing is w · spacing).
+    let long_enough = |l: f64, c: &BoundaryCurve| match width {
+        None => l >= spacing,
+        Some(_) => {
+            let nv = c.vertices.len();
+            let pos = |k: usize| mesh.positions[c.vertices[k % nv] as usize];
+            let m: f64 = (0..c.faces.len())
+                .map(|k| {
+                    0.5 * pos(k).distance(pos(k + 1)) * (1.0 / w(pos(k)) + 1.0 / w(pos(k + 1)))
+                })
+                .sum();
+            m >= spacing
+        }
+    };
     // Curves long enough for the spacing, then the short ones between two of their ends (an
     // edge between corners that are sampled anyway).
     let long_ends: FxHashSet<u32> = all
         .iter()
-        .filter(|(l, c)| *l >= spacing && !c.closed)
+        .filter(|(l, c)| long_enough(*l, c) && !c.closed)
         .flat_map(|(_, c)| ends(c))
         .collect();
     let mut candidates: Vec<(f64, BoundaryCurve)> = all
         .into_iter()
         .filter(|(l, c)| {
-            *l >= spacing || (!c.closed && ends(c).iter().all(|v| long_ends.contains(v)))
+            long_enough(*l, c) || (!c.closed && ends(c).iter().all(|v| long_ends.contains(v)))
         })
         .collect();
     // Longest first, each kept only where its samples keep their distance from those of the
@@ -196,9 +282,14 @@ pub fn feature_pieces(
     };
     let points_of = |piece: &FeaturePiece| -> Vec<(DVec3, usize)> {
         if piece.graded.iter().all(|g| g.is_empty()) {
-            curve_points(mesh, &piece.curve, spacing, |a, b| a.distance(b))
+            match width {
+                None => curve_points(mesh, &piece.curve, spacing, |a, b| a.distance(b)),
+                Some(_) => curve_points(mesh, &piece.curve, 1.0, |a, b| {
+                    0.5 * a.distance(b) * (1.0 / w(a) + 1.0 / w(b)) / spacing
+                }),
+            }
         } else {
-            graded_points(mesh, piece, spacing)
+            graded_points(mesh, piece, spacing, width)
         }
     };
     let place = |placed: &mut FxHashMap<[i64; 3], Vec<Placed>>,
@@ -260,7 +351,7 @@ pub fn feature_pieces(
                                     if kept[i].1 == generation
                                         && !(here.is_some() && at == here)
                                         && !here.is_some_and(|v| ends_at(&kept[i].0.curve, v))
-                                        && p.distance(q) < gap
+                                        && p.distance(q) < gap * w(p).min(w(q))
                                         && !regrade.iter().any(|r| r.0 == i)
                                     {
                                         owners.push(i);
@@ -318,7 +409,8 @@ pub fn feature_pieces(
                     // pair with; else both get one for this angle.
                     let distances = if other.graded[other_end].is_empty() {
                         let cap = 0.45 * length.min(curve_length(mesh, &other.curve));
-                        graded_distances(angle, spacing, cap)
+                        let corner = mesh.positions[at.unwrap_or(0) as usize];
+                        graded_distances(angle, spacing * w(corner), cap)
                     } else {
                         other.graded[other_end].clone()
                     };
@@ -436,7 +528,7 @@ mod tests {
         assert_eq!(features.curves[0].vertices, crease);
         let curves = boundary_curves(&mesh);
         assert_eq!(curves.len(), 1);
-        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 0.1);
+        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 0.1, None);
         assert_eq!(
             boundary.len(),
             2,
@@ -472,7 +564,7 @@ mod tests {
         assert_eq!(on_crease_only, 9);
         assert!(degree.iter().all(|&d| d == 0 || d == 2));
         // A crease shorter than the spacing is left out, and the loop stays whole.
-        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 1.5);
+        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 1.5, None);
         assert!(feature.is_empty());
         assert_eq!(boundary, curves);
     }
@@ -499,7 +591,7 @@ mod tests {
             corners: vec![at(0, 30), at(60, 30), at(60, 50)],
         };
         let spacing = 2.0;
-        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing);
+        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing, None);
         assert_eq!(pieces.len(), 2, "both creases are kept");
         let angle = (1.0f64 / 3.0).atan();
         let expected = graded_distances(angle, spacing, f64::INFINITY);
@@ -565,7 +657,7 @@ mod tests {
             curves: vec![features.curves[0].clone()],
             ..features.clone()
         };
-        let (_, pieces) = feature_pieces(&mesh, &[], &alone, spacing);
+        let (_, pieces) = feature_pieces(&mesh, &[], &alone, spacing, None);
         assert!(pieces[0].graded.iter().all(|g| g.is_empty()));
     }
 }

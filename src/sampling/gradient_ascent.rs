@@ -7,6 +7,7 @@ use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 #[cfg(doc)]
 use crate::measure::measure_and_gradient_graded;
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
+use crate::sampling::crease_band::CreaseBand;
 use crate::sampling::WidthField;
 use crate::spatial::StaticTree;
 use crate::surface::Projection;
@@ -85,7 +86,7 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
     params: &GradientAscentParams,
     seed: u64,
 ) -> GradientAscentResult {
-    gradient_ascent_graded(kernel, surface, samples, fixed, None, params, seed)
+    gradient_ascent_graded(kernel, surface, samples, fixed, None, None, params, seed)
 }
 
 /// [`gradient_ascent`] with a graded kernel: each sample's width is `width(position)`, taken
@@ -93,14 +94,18 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
 /// piecewise constant, so its gradient is zero almost everywhere): the step is that of
 /// [`measure_and_gradient_graded`] with ∇w = 0, scaled by w² (the gradient of s grows as 1/w
 /// where the kernel is w times narrower, and a step should be w times shorter), and the
-/// largest move is `max_move_sigma_p` · w · sigma_p. With `width` `None` (or 1 everywhere) this
-/// is [`gradient_ascent`] exactly.
+/// largest move is `max_move_sigma_p` · w · sigma_p. With a `band` (the sampled sharp-feature
+/// curves), a move into it towards a feature curve is not taken ([`CreaseBand::refuses`]), so no
+/// sample reaches or crosses a crease. With `width` and `band` `None` (or a width of 1
+/// everywhere) this is [`gradient_ascent`] exactly.
+#[allow(clippy::too_many_arguments)] // the two optional fields (width, band) beside eq. 11's inputs
 pub fn gradient_ascent_graded<S: Projection + ?Sized>(
     kernel: &Kernel,
     surface: &S,
     samples: &mut [SurfaceSample],
     fixed: usize,
     width: Option<WidthField>,
+    band: Option<&CreaseBand>,
     params: &GradientAscentParams,
     seed: u64,
 ) -> GradientAscentResult {
@@ -150,6 +155,7 @@ pub fn gradient_ascent_graded<S: Projection + ?Sized>(
                     &lists[i - fixed],
                     i,
                     samples[i],
+                    band,
                     params,
                     &mut ws,
                     &mut near,
@@ -189,6 +195,7 @@ pub fn gradient_ascent_graded<S: Projection + ?Sized>(
                         &lists[i - fixed],
                         i,
                         old,
+                        band,
                         params,
                         ws,
                         near,
@@ -226,6 +233,7 @@ fn move_one<S: Projection + ?Sized>(
     list: &[u32],
     i: usize,
     old: SurfaceSample,
+    band: Option<&CreaseBand>,
     params: &GradientAscentParams,
     ws: &mut MeasureWorkspace,
     near: &mut Vec<(f64, KernelPoint)>,
@@ -265,6 +273,9 @@ fn move_one<S: Projection + ?Sized>(
         }
         delta *= 0.5;
         moved = project(delta);
+    }
+    if band.is_some_and(|b| b.refuses(old.position, moved.position, w)) {
+        return (old, 0.0, s);
     }
     (moved, moved.position.distance(old.position), s)
 }

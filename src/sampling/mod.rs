@@ -4,6 +4,7 @@
 
 pub mod boundary;
 pub mod candidates;
+pub mod crease_band;
 pub mod features;
 pub mod gradient_ascent;
 pub mod grading;

@@ -1,5 +1,6 @@
 //! The input surface the samples live on, and projection onto it.
 
+pub mod curvature;
 pub mod features;
 pub mod local_feature_size;
 pub mod mesh_projection;

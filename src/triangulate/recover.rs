@@ -26,6 +26,11 @@ use crate::mesh::edit::{starting_at, EditMesh};
 /// is not a crease edge between neighbouring samples.
 const MAX_CROSSED_FACES: usize = 64;
 
+/// The angle (degrees) at the middle of three consecutive crease samples above which a face on
+/// them lies along the crease (its smallest angle is below 30°) and its long side is flipped
+/// ([`flip_crease_slivers`]).
+const CREASE_SLIVER_DEG: f64 = 120.0;
+
 /// What [`recover_edges`] did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct RecoverStats {
@@ -105,6 +110,52 @@ pub fn close_slits<L: Copy>(m: &mut EditMesh<L>, label: L) -> usize {
         }
     }
     closed
+}
+
+/// Flips the long side of the faces that lie along a crease: three consecutive crease samples
+/// (two protected edges meeting at the middle one) joined by a face whose angle at the middle is
+/// over [`CREASE_SLIVER_DEG`], when the two faces after the flip have a larger smallest angle
+/// than the two before. The face across the long side takes the middle sample instead, and the
+/// crease keeps both edges. A flip that the mesh refuses (the new edge already there) leaves the
+/// face. Returns how many were flipped. Deterministic.
+pub fn flip_crease_slivers<L: Copy>(m: &mut EditMesh<L>, label: L) -> usize {
+    let (faces, _) = m.live_faces();
+    let mut flipped = 0;
+    for t in faces {
+        if !m.has_edge(t[0], t[1]) || !m.has_edge(t[1], t[2]) || !m.has_edge(t[2], t[0]) {
+            continue;
+        }
+        let angles = triangle_angles_deg(m.corners(t));
+        if !(angles[0].max(angles[1]).max(angles[2]) > CREASE_SLIVER_DEG) {
+            continue;
+        }
+        // The middle corner: the largest angle, its two sides crease edges.
+        let k = (0..3)
+            .max_by(|&i, &j| angles[i].total_cmp(&angles[j]))
+            .unwrap_or(0);
+        let (w, u, v) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+        if m.is_protected(u, v) || !m.is_protected(w, u) || !m.is_protected(v, w) {
+            continue;
+        }
+        // The face across u–v, [v, u, d]; after the flip [u, d, w] and [v, w, d].
+        let Some(d) = m
+            .face_on(v, u)
+            .and_then(|f| m.face(f))
+            .map(|t| starting_at(t, v)[2])
+        else {
+            continue;
+        };
+        let smallest = |t: [u32; 3]| {
+            let a = triangle_angles_deg(m.corners(t));
+            a[0].min(a[1]).min(a[2])
+        };
+        let before = smallest(t).min(smallest([v, u, d]));
+        let after = smallest([u, d, w]).min(smallest([v, w, d]));
+        if after > before && m.flip_edge(u, v, label).is_ok() {
+            flipped += 1;
+        }
+    }
+    flipped
 }
 
 /// Inserts the edge `a`–`b` by re-triangulating the faces its segment crosses. False (the mesh
@@ -370,6 +421,40 @@ mod tests {
         );
         m.sanity_check().unwrap();
         assert_eq!(m.live_faces().0.len(), 2 * N * N);
+    }
+
+    #[test]
+    fn a_face_along_three_crease_samples_has_its_long_side_flipped() {
+        // a, w, v consecutive crease samples (w 0.1 off the line, 169° at it); the face a–v–w
+        // lies along the crease, the face below takes a–v, two above meet at e.
+        let positions = vec![
+            DVec3::new(0.0, 0.0, 0.0),  // a
+            DVec3::new(2.0, 0.0, 0.0),  // v
+            DVec3::new(1.0, 0.1, 0.0),  // w
+            DVec3::new(1.0, -1.0, 0.0), // d
+            DVec3::new(1.0, 1.0, 0.0),  // e
+        ];
+        let faces = vec![[0, 1, 2], [1, 0, 3], [0, 2, 4], [2, 1, 4]];
+        let mesh = crate::mesh::TriMesh::new(positions, faces);
+        let mut m: EditMesh<()> = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+        // Unprotected, the crease is not known: nothing is flipped.
+        assert_eq!(flip_crease_slivers(&mut m, ()), 0);
+        m.protect_edge(0, 2);
+        m.protect_edge(2, 1);
+        assert_eq!(flip_crease_slivers(&mut m, ()), 1);
+        m.sanity_check().unwrap();
+        assert!(!m.has_edge(0, 1) && m.has_edge(2, 3));
+        assert!(m.has_edge(0, 2) && m.has_edge(2, 1));
+        let (faces, _) = m.live_faces();
+        let smallest = faces
+            .iter()
+            .map(|&t| {
+                let a = triangle_angles_deg(m.corners(t));
+                a[0].min(a[1]).min(a[2])
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(smallest > 30.0, "{smallest}"); // 5.7° before the flip
+        assert_eq!(flip_crease_slivers(&mut m, ()), 0);
     }
 
     #[test]

@@ -1,0 +1,115 @@
+//! The band along the sampled sharp-feature curves that the gradient ascent keeps surface
+//! samples out of (issue 16: "gradient ascent never moves a surface sample across a feature
+//! curve"). The projection onto the input takes every point beyond a convex crease to the crease
+//! line itself, so a surface sample pushed towards a crease would land on it, between two crease
+//! samples: the crease edge there could then only be put in as a sliver. A move that ends within
+//! [`CREASE_BAND_PER_SPACING`] local spacings of a feature edge, and nearer to it than where the
+//! sample was, is not taken; crossing a crease means passing through its band, wider than the
+//! longest move (`GradientAscentParams::max_move_sigma_p`, 0.25 spacing), so it is refused too.
+
+use glam::DVec3;
+
+use crate::spatial::StaticTree;
+
+/// The half-width of the band, in units of the local spacing w · sigma_p: a sample at that
+/// distance from the middle of a crease edge of 1.15 spacings sees it under 2 · atan(0.35 /
+/// 0.575) = 63°, and the triangle it makes with the edge has 31° at the edge's ends; a sample
+/// where the sampling puts it (an equilateral triangle on the edge) is 1.0 spacing away.
+pub const CREASE_BAND_PER_SPACING: f64 = 0.35;
+
+/// Points along the feature edges of a sample set, for the distance to them.
+pub struct CreaseBand {
+    tree: StaticTree,
+    /// The feature curves' spacing where the width is 1 (bbox-100 units).
+    spacing: f64,
+    /// The largest gap between consecutive points along an edge (the distance is low by at
+    /// most half of it).
+    step: f64,
+}
+
+impl CreaseBand {
+    /// The band of the segments `edges` (index pairs into `positions`, bbox-100 units), sampled
+    /// at `spacing` where the kernel width is 1 (w · `spacing` where it is w), with points along
+    /// each edge at most `step` apart. `None` without edges or for a step that is not positive.
+    pub fn new(positions: &[DVec3], edges: &[[u32; 2]], spacing: f64, step: f64) -> Option<Self> {
+        if edges.is_empty() || !(step > 0.0) {
+            return None;
+        }
+        let mut points = Vec::new();
+        for &[a, b] in edges {
+            let (p, q) = (positions[a as usize], positions[b as usize]);
+            let n = (p.distance(q) / step).ceil().max(1.0) as usize;
+            points.extend((0..=n).map(|k| p.lerp(q, k as f64 / n as f64)));
+        }
+        Some(CreaseBand {
+            tree: StaticTree::new(&points),
+            spacing,
+            step,
+        })
+    }
+
+    /// The distance from `x` to the nearest feature edge (bbox-100 units), to within half the
+    /// step.
+    pub fn distance(&self, x: DVec3) -> f64 {
+        let mut near = Vec::with_capacity(1);
+        self.tree.nearest_n(x, 1, &mut near);
+        near.first().map_or(f64::INFINITY, |&(_, d2)| d2.sqrt())
+    }
+
+    /// Whether a move from `from` to `to` of a sample of relative kernel width `width` is
+    /// refused: it ends inside the band (half-width [`CREASE_BAND_PER_SPACING`] · `width` ·
+    /// spacing) and nearer to a feature edge than it started.
+    pub fn refuses(&self, from: DVec3, to: DVec3, width: f64) -> bool {
+        let d = self.distance(to);
+        d < CREASE_BAND_PER_SPACING * width * self.spacing
+            && d < self.distance(from) - 0.5 * self.step
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn moves_into_the_band_are_refused_and_moves_out_of_it_taken() {
+        // A crease along the x axis from 0 to 4, sampled at 1.
+        let positions: Vec<DVec3> = (0..5).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
+        let edges = [[0, 1], [1, 2], [2, 3], [3, 4]];
+        let band = CreaseBand::new(&positions, &edges, 1.0, 0.01).unwrap();
+        assert!((band.distance(DVec3::new(1.5, 0.3, 0.0)) - 0.3).abs() < 0.01);
+        let spacing = 1.0;
+        // At half the width, the band is half as wide.
+        assert!(!band.refuses(DVec3::new(2.5, 0.5, 0.0), DVec3::new(2.5, 0.2, 0.0), 0.5));
+        // Towards the crease and into the band: refused.
+        assert!(band.refuses(
+            DVec3::new(2.5, 0.5, 0.0),
+            DVec3::new(2.5, 0.2, 0.0),
+            spacing
+        ));
+        // Onto it, from outside: refused.
+        assert!(band.refuses(
+            DVec3::new(2.5, 0.4, 0.0),
+            DVec3::new(2.5, 0.0, 0.0),
+            spacing
+        ));
+        // Across it: refused.
+        assert!(band.refuses(
+            DVec3::new(2.5, 0.4, 0.0),
+            DVec3::new(2.5, -0.3, 0.0),
+            spacing
+        ));
+        // Along it outside the band, or away from it inside the band: taken.
+        assert!(!band.refuses(
+            DVec3::new(1.5, 0.5, 0.0),
+            DVec3::new(2.5, 0.5, 0.0),
+            spacing
+        ));
+        assert!(!band.refuses(
+            DVec3::new(2.5, 0.1, 0.0),
+            DVec3::new(2.5, 0.2, 0.0),
+            spacing
+        ));
+        // No edges, no band.
+        assert!(CreaseBand::new(&positions, &[], 1.0, 0.01).is_none());
+    }
+}
