@@ -48,7 +48,7 @@ CAD_FEATURE_ANGLE = 20
 CAD_MODELS = {"fandisk.obj", "bracket.obj", "flange.obj"}
 # The feature-preserving settings, run on the CAD parts only in a full run (on any model when
 # asked for with --methods).
-FEATURE_METHODS = {"ours_features", "cgal_features", "botsch_features"}
+FEATURE_METHODS = {"ours_features", "ours_features_fit", "cgal_features", "botsch_features"}
 COUNT_TOLERANCE = 0.02
 TIMING_RUNS = 3
 
@@ -276,6 +276,8 @@ METHODS = {
     "ours": ("remesh (spectral sampling)", "count", run_ours),
     "ours_sigma_n": ("remesh --sigma-n 0.75", "count", None),
     "ours_features": ("remesh --feature-angle 20", "count", None),
+    "ours_features_fit": ("remesh --feature-angle 20 --fit", "count", None),
+    "ours_fit": ("remesh --fit (least-squares vertices)", "count", None),
     "meshlab_isotropic": ("MeshLab isotropic explicit remeshing (10 it.)", "length", run_meshlab_isotropic),
     "cgal_isotropic": ("CGAL PMP isotropic_remeshing (10 it.)", "length", run_cgal_isotropic),
     "cgal_features": (
@@ -301,6 +303,12 @@ def adapter(method):
         return lambda V, F, p, w, i: run_ours(
             V, F, p, w, i, extra=("--feature-angle", str(CAD_FEATURE_ANGLE))
         )
+    if method == "ours_features_fit":
+        return lambda V, F, p, w, i: run_ours(
+            V, F, p, w, i, extra=("--feature-angle", str(CAD_FEATURE_ANGLE), "--fit")
+        )
+    if method == "ours_fit":
+        return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--fit",))
     return METHODS[method][2]
 
 

@@ -146,7 +146,7 @@ pub use mesh::{orient_consistently, Aabb, Normalization, OrientStats, TriMesh};
 // The pipeline in one call.
 pub use pipeline::{
     remesh, validate_input, Density, FeatureStats, RemeshOutput, RemeshParams,
-    BOUNDARY_SPACING_PER_SIGMA, MAX_POINTS, SAMPLES_PER_SIGMA2,
+    BOUNDARY_SPACING_PER_SIGMA, FIT_ITERATIONS, MAX_POINTS, SAMPLES_PER_SIGMA2,
 };
 pub use timing::Stage;
 
@@ -184,6 +184,7 @@ pub use sampling::WidthField;
 
 // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
 // optimization against the input, the separation of crossing faces.
+pub use triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
 pub use triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
 pub use triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 pub use triangulate::{

@@ -6,7 +6,7 @@ mod common;
 use common::grid_box_counts;
 use glam::DVec3;
 use spectral_remesh::{
-    remesh, CurvatureParams, Density, RemeshParams, TriMesh, CAD_FEATURE_ANGLE_DEG,
+    remesh, CurvatureParams, Density, RemeshParams, TriMesh, CAD_FEATURE_ANGLE_DEG, FIT_ITERATIONS,
 };
 
 /// The largest distance from points along the box's 12 edges (20 per edge) to the nearest
@@ -354,5 +354,59 @@ fn with_the_chord_error_a_curved_side_gets_finer_samples_and_a_closer_surface() 
         let f = &fine.features;
         assert_eq!(f.curves, 2, "seed {seed}: {f:?}");
         assert!(f.kept_edges == f.sampled_edges, "seed {seed}: {f:?}");
+    }
+}
+
+#[test]
+fn the_least_squares_fit_lowers_the_sag_and_leaves_rims_and_flat_caps_in_place() {
+    let (r, h) = (40.0, 10.0);
+    let input = disc(r, h, 240, 6, 24);
+    let scale = 100.0 / (2.0 * r);
+    // The largest distance of a side face's centroid from the cylinder, in bbox-100 units.
+    let sag = |mesh: &TriMesh| -> f64 {
+        let mut worst: f64 = 0.0;
+        for f in 0..mesh.triangles.len() {
+            let p = mesh.corners(f);
+            if p.iter().all(|q| q.z > 1e-9 && q.z < h - 1e-9)
+                || p.iter().all(|q| (q.truncate().length() - r).abs() < 0.5)
+            {
+                let c = (p[0] + p[1] + p[2]) / 3.0;
+                worst = worst.max((c.truncate().length() - r).abs() * scale);
+            }
+        }
+        worst
+    };
+    for seed in 1..=3 {
+        let base = RemeshParams {
+            density: Density::Points(3000),
+            feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
+            seed,
+            ..Default::default()
+        };
+        let fitted = RemeshParams {
+            fit_iterations: FIT_ITERATIONS,
+            ..base
+        };
+        let plain = remesh(&input, &base, &|_| {}).expect("remesh");
+        let fit = remesh(&input, &fitted, &|_| {}).expect("remesh");
+        // The same samples and faces, moved: the fit comes after the connectivity is final.
+        assert_eq!(plain.mesh.triangles, fit.mesh.triangles, "seed {seed}");
+        let stats = fit.fit.expect("fit stats");
+        assert!(stats.moved > 0, "seed {seed}");
+        // On the side, the sag of a face falls to about 2/3 (a chord's peak minus its mean).
+        let (s0, s1) = (sag(&plain.mesh), sag(&fit.mesh));
+        assert!(s1 < 0.8 * s0, "seed {seed}: sag {s0} -> {s1}");
+        for (p, q) in plain.mesh.positions.iter().zip(&fit.mesh.positions) {
+            let on_rim = (p.truncate().length() - r).abs() < 1e-3 * r
+                && (p.z.abs() < 1e-9 || (p.z - h).abs() < 1e-9);
+            let on_cap = p.z.abs() < 1e-9 || (p.z - h).abs() < 1e-9;
+            if on_rim {
+                // A crease sample stays where it was.
+                assert_eq!(p, q, "seed {seed}");
+            } else if on_cap {
+                // A flat cap's vertex stays in its plane.
+                assert!((p.z - q.z).abs() < 1e-9, "seed {seed}: {p} -> {q}");
+            }
+        }
     }
 }

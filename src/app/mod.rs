@@ -307,6 +307,9 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         "features".into(),
         serde_json::to_value(&out.features).unwrap_or_default(),
     );
+    if let Some(fit) = out.fit {
+        extra.insert("fit".into(), serde_json::to_value(fit).unwrap_or_default());
+    }
     extra.insert("input_vertices".into(), input.vertex_count().into());
     extra.insert("input_faces".into(), input.face_count().into());
     if up != 0 {
