@@ -15,7 +15,7 @@ use crate::sampling::boundary::{
 };
 use crate::sampling::candidates::surface_candidates;
 use crate::sampling::crease_band::CreaseBand;
-use crate::sampling::features::feature_pieces;
+use crate::sampling::features::{corner_width, feature_pieces, graded_corners, GradedCorner};
 use crate::sampling::gradient_ascent::{
     gradient_ascent_graded, GradientAscentParams, GradientAscentResult,
 };
@@ -55,7 +55,12 @@ pub enum Density {
 
 /// A linear scan's result with the edges between its fixed curve samples: boundary edges, then
 /// feature edges.
-type ScanWithBoundary = (LinearScanResult, Vec<[u32; 2]>, Vec<[u32; 2]>);
+type ScanWithBoundary = (
+    LinearScanResult,
+    Vec<[u32; 2]>,
+    Vec<[u32; 2]>,
+    Vec<GradedCorner>,
+);
 
 /// [`Density`] resolved for one input: a vertex count or sigma_p.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -588,15 +593,53 @@ pub fn remesh(
             if !(boundary_count <= boundary_limit) {
                 return Ok((boundary_count.min(usize::MAX as f64) as usize, None));
             }
+            // Around a corner that creases are graded towards, the other curves and the surface
+            // samples are graded too (corner_width).
+            let corners = graded_corners(&normalized, &feature_curves, feature_spacing);
+            let with_corners = |p: DVec3| {
+                widths
+                    .width(p)
+                    .min(corner_width(&corners, p, feature_spacing))
+            };
+            let curve_width: Option<WidthField> = if !corners.is_empty() {
+                Some(&with_corners)
+            } else {
+                width.as_ref().map(|f| f as WidthField)
+            };
             let b = sample_curves_and_features(
                 &normalized,
                 &boundary_pieces,
                 &feature_curves,
                 spacing,
                 feature_spacing,
-                width.as_ref().map(|f| f as WidthField),
+                curve_width,
             );
-            let r = if widths.active() {
+            let r = if !corners.is_empty() {
+                let w = |p: DVec3| {
+                    widths
+                        .width(p)
+                        .min(corner_width(&corners, p, feature_spacing))
+                };
+                let pool_w: Vec<f64> = pool
+                    .par_iter()
+                    .enumerate()
+                    .map(|(i, c)| {
+                        pool_widths.map_or(1.0, |pw| pw[i]).min(corner_width(
+                            &corners,
+                            c.position,
+                            feature_spacing,
+                        ))
+                    })
+                    .collect();
+                linear_scan_graded(
+                    &kernel,
+                    &pool,
+                    Some(&pool_w),
+                    &b.samples,
+                    Some(&w),
+                    &params.linear_scan,
+                )
+            } else if widths.active() {
                 linear_scan_graded(
                     &kernel,
                     &pool,
@@ -608,7 +651,10 @@ pub fn remesh(
             } else {
                 linear_scan(&kernel, &pool, &b.samples, &params.linear_scan)
             };
-            Ok((r.samples.len(), Some((r, b.edges, b.feature_edges))))
+            Ok((
+                r.samples.len(),
+                Some((r, b.edges, b.feature_edges, corners)),
+            ))
         };
         let (sigma_p, target_reached, search_history, value) = match density {
             Target::SigmaP(s) => {
@@ -661,7 +707,7 @@ pub fn remesh(
                 }
             }
         };
-        let Some((scan_result, boundary_edges, feature_edges)) = value else {
+        let Some((scan_result, boundary_edges, feature_edges, corners)) = value else {
             // Even the best sigma_p tried puts more samples on the boundary curves than the
             // bound (loops need 3 samples each, however short).
             let (name, what) = match density {
@@ -690,7 +736,12 @@ pub fn remesh(
         } = scan_result;
         let before_ascent = buried_test.as_ref().map(|_| samples.clone());
         let widths = widths_at(sigma_ref);
-        let width_field = widths.active().then_some(|p: DVec3| widths.width(p));
+        let corner_spacing = FEATURE_SPACING_PER_SIGMA * sigma_p;
+        let width_field = (widths.active() || !corners.is_empty()).then_some(|p: DVec3| {
+            widths
+                .width(p)
+                .min(corner_width(&corners, p, corner_spacing))
+        });
         // Surface samples keep out of a band along the sampled creases.
         let band = {
             let positions: Vec<DVec3> = samples[..boundary_count]

@@ -192,6 +192,48 @@ fn creases_meeting_at_a_small_angle_are_kept_up_to_their_corner_with_its_angle()
         let q = spectral_remesh::triangle_quality(&out.mesh);
         assert!(q.theta_min >= 15.0, "seed {seed}: θmin {}", q.theta_min);
         assert!(spectral_remesh::topology(&out.mesh).is_closed_manifold());
+        // The triangles below 30° are all within the graded reach of the two 20° corners
+        // (spacing / (2 sin 10°), the spacing 1.15 sigma_p): elsewhere every angle is 30° or more.
+        let min_x = input
+            .positions
+            .iter()
+            .map(|p| p.x)
+            .fold(f64::INFINITY, f64::min);
+        let (z0, z1) = input
+            .positions
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.z), hi.max(p.z))
+            });
+        let apexes: Vec<DVec3> = input
+            .positions
+            .iter()
+            .copied()
+            .filter(|p| p.x == min_x && (p.z == z0 || p.z == z1))
+            .collect();
+        assert_eq!(apexes.len(), 2);
+        // The output is in the input's units; sigma_p is in bbox-100 units.
+        let bbox = spectral_remesh::Aabb::of(&input.positions).expect("bbox");
+        let to_model = (bbox.max - bbox.min).max_element() / 100.0;
+        let spacing = 1.15 * out.sigma_p * to_model;
+        let reach = spacing / (2.0 * 10f64.to_radians().sin());
+        for f in 0..out.mesh.triangles.len() {
+            let p = out.mesh.corners(f);
+            let smallest = (0..3)
+                .map(|k| {
+                    let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+                    (b - a).angle_between(c - a).to_degrees()
+                })
+                .fold(f64::INFINITY, f64::min);
+            if smallest < 30.0 {
+                let centroid = (p[0] + p[1] + p[2]) / 3.0;
+                let near = apexes.iter().any(|a| a.distance(centroid) < reach);
+                assert!(
+                    near,
+                    "seed {seed}: face {f} has {smallest:.1}° at {centroid}, beyond {reach} of the corners"
+                );
+            }
+        }
     }
 }
 

@@ -111,6 +111,95 @@ fn graded_distances(angle: f64, spacing: f64, cap: f64) -> Vec<f64> {
     out
 }
 
+/// The smallest relative width [`corner_width`] gives (a quarter of the spacing, as the thickness
+/// grading's): the graded samples nearest a corner are closer still, but there the corner's own
+/// triangle takes over.
+pub const CORNER_MIN_WIDTH: f64 = 0.5;
+
+/// A corner that feature pieces are graded towards ([`graded_corners`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GradedCorner {
+    /// Its position (bbox-100 units).
+    pub position: DVec3,
+    /// g = 2 sin(angle / 2): the gap between two of its creases at distance r is g r (the largest
+    /// g of its graded pieces: the widest angle, the gentlest grading).
+    pub g: f64,
+    /// The unit directions its graded pieces leave it in.
+    pub directions: Vec<DVec3>,
+}
+
+/// The corners that feature pieces are graded towards: from each graded end, its corner, the
+/// direction it leaves it in (towards its nearest graded sample) and g = d0 / d1 − 1 from its two
+/// farthest graded distances (the steps shrink by 1 + g), or spacing / d0 with a single one (d0
+/// is where the gap is the spacing). One entry per corner.
+pub fn graded_corners(mesh: &TriMesh, pieces: &[FeaturePiece], spacing: f64) -> Vec<GradedCorner> {
+    let mut out: Vec<(u32, GradedCorner)> = Vec::new();
+    for piece in pieces {
+        let nv = piece.curve.vertices.len();
+        let lengths = edge_lengths(mesh, &piece.curve);
+        let total: f64 = lengths.iter().sum();
+        for (end, d) in piece.graded.iter().enumerate() {
+            let (Some(&d0), Some(&nearest)) = (d.first(), d.last()) else {
+                continue;
+            };
+            let g = match d.get(1) {
+                Some(&d1) if d1 > 0.0 => d0 / d1 - 1.0,
+                _ => spacing / d0,
+            };
+            if !(g > 0.0) {
+                continue;
+            }
+            let v = piece.curve.vertices[if end == 0 { 0 } else { nv - 1 }];
+            let corner = mesh.positions[v as usize];
+            let arc = if end == 0 { nearest } else { total - nearest };
+            let (p, _) = points_along(mesh, &piece.curve, &lengths, [arc])[0];
+            let direction = (p - corner).normalize_or_zero();
+            match out.iter_mut().find(|(u, _)| *u == v) {
+                Some((_, c)) => {
+                    c.g = c.g.max(g);
+                    c.directions.push(direction);
+                }
+                None => out.push((
+                    v,
+                    GradedCorner {
+                        position: corner,
+                        g,
+                        directions: vec![direction],
+                    },
+                )),
+            }
+        }
+    }
+    out.into_iter().map(|(_, c)| c).collect()
+}
+
+/// The relative kernel width at `x` that matches the graded creases around `corners` (from
+/// [`graded_corners`]): at distance r from a corner the graded steps are about g r, so the width
+/// is g r / `spacing`, between [`CORNER_MIN_WIDTH`] and 1; the smallest over the corners. With
+/// it, the surface samples on the sheets beside two graded creases are as close as the creases'
+/// samples, and the triangles between them keep their shape. Between two of a corner's creases
+/// (x seen from the corner within their angle) the width is 1: that strip takes no surface
+/// sample, the creases' graded samples make its triangles.
+pub fn corner_width(corners: &[GradedCorner], x: DVec3, spacing: f64) -> f64 {
+    corners
+        .iter()
+        .map(|c| {
+            let v = (x - c.position).normalize_or_zero();
+            let between = c.directions.iter().enumerate().any(|(i, &a)| {
+                c.directions[i + 1..].iter().any(|&b| {
+                    let ab = a.angle_between(b);
+                    v.angle_between(a) + v.angle_between(b) <= ab + 1e-3
+                })
+            });
+            if between {
+                1.0
+            } else {
+                (c.g * x.distance(c.position) / spacing).clamp(CORNER_MIN_WIDTH, 1.0)
+            }
+        })
+        .fold(1.0, f64::min)
+}
+
 /// Whether the crowded samples of an open curve (those not `clear` of the samples of curves kept
 /// before) are only its first few after the start or its last few before the end (where it
 /// leaves a corner at a small angle to another curve). False when a corner, a closed curve's
