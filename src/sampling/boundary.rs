@@ -269,6 +269,12 @@ pub(crate) fn points_along(
         .collect()
 }
 
+/// The length of the edge a–b in a width field, ∫ ds / w by the trapezoid rule (the width
+/// taken at both ends, at least 1e-6): the steps it takes at a spacing of 1 where w is 1.
+pub(crate) fn width_steps(width: WidthField, a: DVec3, b: DVec3) -> f64 {
+    0.5 * a.distance(b) * (1.0 / width(a).max(1e-6) + 1.0 / width(b).max(1e-6))
+}
+
 /// The samples of every curve ([`curve_points`]), one shared sample where open curves meet;
 /// the feature pieces at `feature_scale` times the boundary's steps, those with graded ends at
 /// their own points ([`graded_points`]).
@@ -285,7 +291,7 @@ fn sample_curves(
     // units of one step of `spacing`).
     let measure = |a: DVec3, b: DVec3| match width {
         None => a.distance(b),
-        Some(w) => 0.5 * a.distance(b) * (1.0 / w(a).max(1e-6) + 1.0 / w(b).max(1e-6)) / spacing,
+        Some(w) => width_steps(w, a, b) / spacing,
     };
     let mut out = BoundarySamples::default();
     let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();

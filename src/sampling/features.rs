@@ -11,7 +11,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
 use crate::sampling::boundary::{
-    curve_length, curve_points, edge_lengths, points_along, BoundaryCurve,
+    curve_length, curve_points, edge_lengths, points_along, width_steps, BoundaryCurve,
 };
 use crate::sampling::WidthField;
 use crate::surface::features::Features;
@@ -240,9 +240,7 @@ pub(crate) fn graded_points(
             let nv = piece.curve.vertices.len();
             let pos = |k: usize| mesh.positions[piece.curve.vertices[k % nv] as usize];
             let measures: Vec<f64> = (0..lengths.len())
-                .map(|k| {
-                    0.5 * lengths[k] * (1.0 / w(pos(k)).max(1e-6) + 1.0 / w(pos(k + 1)).max(1e-6))
-                })
+                .map(|k| width_steps(w, pos(k), pos(k + 1)))
                 .collect();
             piece.arcs_in_measure(&lengths, &measures, spacing)
         }
@@ -324,13 +322,11 @@ pub fn feature_pieces(
     // field (the local spacing is w · spacing).
     let long_enough = |l: f64, c: &BoundaryCurve| match width {
         None => l >= spacing,
-        Some(_) => {
+        Some(f) => {
             let nv = c.vertices.len();
             let pos = |k: usize| mesh.positions[c.vertices[k % nv] as usize];
             let m: f64 = (0..c.faces.len())
-                .map(|k| {
-                    0.5 * pos(k).distance(pos(k + 1)) * (1.0 / w(pos(k)) + 1.0 / w(pos(k + 1)))
-                })
+                .map(|k| width_steps(f, pos(k), pos(k + 1)))
                 .sum();
             m >= spacing
         }
@@ -373,8 +369,8 @@ pub fn feature_pieces(
         if piece.graded.iter().all(|g| g.is_empty()) {
             match width {
                 None => curve_points(mesh, &piece.curve, spacing, |a, b| a.distance(b)),
-                Some(_) => curve_points(mesh, &piece.curve, 1.0, |a, b| {
-                    0.5 * a.distance(b) * (1.0 / w(a) + 1.0 / w(b)) / spacing
+                Some(f) => curve_points(mesh, &piece.curve, 1.0, |a, b| {
+                    width_steps(f, a, b) / spacing
                 }),
             }
         } else {
