@@ -199,21 +199,8 @@ mod tests {
     /// of height `band`, each quad split along a diagonal; then a flat square of side `2 r`
     /// beside it (x from `3 r` to `5 r`, z = 0), as a separate sheet.
     fn cylinder_and_plane(r: f64, sides: usize, rings: usize, band: f64) -> TriMesh {
-        let mut positions = Vec::new();
-        for k in 0..=rings {
-            for i in 0..sides {
-                let a = std::f64::consts::TAU * i as f64 / sides as f64;
-                positions.push(DVec3::new(r * a.cos(), r * a.sin(), band * k as f64));
-            }
-        }
-        let at = |k: usize, i: usize| (k * sides + i % sides) as u32;
-        let mut triangles = Vec::new();
-        for k in 0..rings {
-            for i in 0..sides {
-                triangles.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
-                triangles.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
-            }
-        }
+        let cylinder = crate::test_shapes::open_cylinder(r, sides, rings, band);
+        let (mut positions, mut triangles) = (cylinder.positions, cylinder.triangles);
         let n = 8;
         let base = positions.len() as u32;
         for j in 0..=n {

@@ -416,25 +416,9 @@ mod tests {
     /// A closed cylinder of radius `r` and height `h` round the z axis: `sides` facets round,
     /// `rings` bands of quads, caps fanned from their centres. Outward.
     fn cylinder(r: f64, h: f64, sides: usize, rings: usize) -> TriMesh {
-        let mut positions = Vec::new();
-        for k in 0..=rings {
-            for i in 0..sides {
-                let a = std::f64::consts::TAU * i as f64 / sides as f64;
-                positions.push(DVec3::new(
-                    r * a.cos(),
-                    r * a.sin(),
-                    h * k as f64 / rings as f64,
-                ));
-            }
-        }
+        let side = crate::test_shapes::open_cylinder(r, sides, rings, h / rings as f64);
+        let (mut positions, mut triangles) = (side.positions, side.triangles);
         let at = |k: usize, i: usize| (k * sides + i % sides) as u32;
-        let mut triangles = Vec::new();
-        for k in 0..rings {
-            for i in 0..sides {
-                triangles.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
-                triangles.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
-            }
-        }
         let bottom = positions.len() as u32;
         positions.push(DVec3::ZERO);
         let top = positions.len() as u32;

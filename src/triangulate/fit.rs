@@ -164,26 +164,7 @@ mod tests {
     use super::*;
     use std::f64::consts::PI;
 
-    /// An open cylinder of radius `r` round the z axis, `sides` facets round, `rings` bands of
-    /// height `band`, quads split along a diagonal; outward.
-    fn cylinder(r: f64, sides: usize, rings: usize, band: f64) -> TriMesh {
-        let mut positions = Vec::new();
-        for k in 0..=rings {
-            for i in 0..sides {
-                let a = std::f64::consts::TAU * i as f64 / sides as f64;
-                positions.push(DVec3::new(r * a.cos(), r * a.sin(), band * k as f64));
-            }
-        }
-        let at = |k: usize, i: usize| (k * sides + i % sides) as u32;
-        let mut triangles = Vec::new();
-        for k in 0..rings {
-            for i in 0..sides {
-                triangles.push([at(k, i), at(k, i + 1), at(k + 1, i + 1)]);
-                triangles.push([at(k, i), at(k + 1, i + 1), at(k + 1, i)]);
-            }
-        }
-        TriMesh::new(positions, triangles)
-    }
+    use crate::test_shapes::open_cylinder as cylinder;
 
     /// The largest and the RMS distance of points spread evenly over the faces of `mesh` that use
     /// no `fixed` vertex from the cylinder of radius `r`.
