@@ -127,8 +127,6 @@ mod report;
 mod sampling;
 mod spatial;
 mod surface;
-#[cfg(test)]
-mod test_shapes;
 mod timing;
 mod triangulate;
 

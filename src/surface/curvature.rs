@@ -194,28 +194,21 @@ impl Default for CurvatureParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::test_meshes::{grid, open_cylinder};
 
     /// A cylinder of radius `r` round the z axis, open, `sides` facets round and `rings` bands
     /// of height `band`, each quad split along a diagonal; then a flat square of side `2 r`
     /// beside it (x from `3 r` to `5 r`, z = 0), as a separate sheet.
     fn cylinder_and_plane(r: f64, sides: usize, rings: usize, band: f64) -> TriMesh {
-        let cylinder = crate::test_shapes::open_cylinder(r, sides, rings, band);
+        let cylinder = open_cylinder(r, sides, rings, band);
         let (mut positions, mut triangles) = (cylinder.positions, cylinder.triangles);
-        let n = 8;
+        let plane = grid(8, |i, j| {
+            let (u, v) = (i as f64 / 8.0, j as f64 / 8.0);
+            DVec3::new(3.0 * r + 2.0 * r * u, 2.0 * r * v, 0.0)
+        });
         let base = positions.len() as u32;
-        for j in 0..=n {
-            for i in 0..=n {
-                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-                positions.push(DVec3::new(3.0 * r + 2.0 * r * u, 2.0 * r * v, 0.0));
-            }
-        }
-        let g = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
-        for j in 0..n {
-            for i in 0..n {
-                triangles.push([g(i, j), g(i + 1, j), g(i + 1, j + 1)]);
-                triangles.push([g(i, j), g(i + 1, j + 1), g(i, j + 1)]);
-            }
-        }
+        positions.extend(plane.positions);
+        triangles.extend(plane.triangles.iter().map(|t| t.map(|v| v + base)));
         TriMesh::new(positions, triangles)
     }
 

@@ -416,7 +416,7 @@ mod tests {
     /// A closed cylinder of radius `r` and height `h` round the z axis: `sides` facets round,
     /// `rings` bands of quads, caps fanned from their centres. Outward.
     fn cylinder(r: f64, h: f64, sides: usize, rings: usize) -> TriMesh {
-        let side = crate::test_shapes::open_cylinder(r, sides, rings, h / rings as f64);
+        let side = crate::mesh::test_meshes::open_cylinder(r, sides, rings, h / rings as f64);
         let (mut positions, mut triangles) = (side.positions, side.triangles);
         let at = |k: usize, i: usize| (k * sides + i % sides) as u32;
         let bottom = positions.len() as u32;

@@ -164,7 +164,7 @@ mod tests {
     use super::*;
     use std::f64::consts::PI;
 
-    use crate::test_shapes::open_cylinder as cylinder;
+    use crate::mesh::test_meshes::{grid, open_cylinder as cylinder};
 
     /// The largest and the RMS distance of points spread evenly over the faces of `mesh` that use
     /// no `fixed` vertex from the cylinder of radius `r`.
@@ -233,26 +233,13 @@ mod tests {
     #[test]
     fn a_flat_part_does_not_move() {
         // A plane as both input and output (the output coarser): every residual is zero.
-        let grid = |n: usize| {
-            let mut positions = Vec::new();
-            for j in 0..=n {
-                for i in 0..=n {
-                    positions
-                        .push(DVec3::new(i as f64 / n as f64, j as f64 / n as f64, 0.0) * 10.0);
-                }
-            }
-            let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-            let mut triangles = Vec::new();
-            for j in 0..n {
-                for i in 0..n {
-                    triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                    triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-                }
-            }
-            TriMesh::new(positions, triangles)
+        let plane = |n: usize| {
+            grid(n, |i, j| {
+                DVec3::new(i as f64 / n as f64, j as f64 / n as f64, 0.0) * 10.0
+            })
         };
-        let surface = MeshSurface::new(&grid(20)).unwrap();
-        let mut out = grid(5);
+        let surface = MeshSurface::new(&plane(20)).unwrap();
+        let mut out = plane(5);
         let before = out.positions.clone();
         let stats = fit_to_surface(&mut out, &surface, &vec![false; before.len()], 3);
         assert_eq!(out.positions, before);
