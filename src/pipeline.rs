@@ -2,6 +2,8 @@
 //! search for a target count) → gradient ascent + projection → triangulate → clean up → back to
 //! model units.
 
+use std::borrow::Cow;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -596,56 +598,41 @@ pub fn remesh(
             // Around a corner that creases are graded towards, the other curves and the surface
             // samples are graded too (corner_width).
             let corners = graded_corners(&normalized, &feature_curves, feature_spacing);
-            let with_corners = |p: DVec3| {
-                widths
-                    .width(p)
-                    .min(corner_width(&corners, p, feature_spacing))
-            };
-            let curve_width: Option<WidthField> = if !corners.is_empty() {
-                Some(&with_corners)
-            } else {
-                width.as_ref().map(|f| f as WidthField)
-            };
+            let graded = widths.active() || !corners.is_empty();
+            let w = |p: DVec3| widths.at(p, &corners, feature_spacing);
+            let field: Option<WidthField> = graded.then_some(&w);
             let b = sample_curves_and_features(
                 &normalized,
                 &boundary_pieces,
                 &feature_curves,
                 spacing,
                 feature_spacing,
-                curve_width,
+                field,
             );
-            let r = if !corners.is_empty() {
-                let w = |p: DVec3| {
-                    widths
-                        .width(p)
-                        .min(corner_width(&corners, p, feature_spacing))
+            let r = if graded {
+                // The candidates' widths: the round's, lowered around the graded corners.
+                let pool_w: Option<Cow<[f64]>> = if corners.is_empty() {
+                    pool_widths.map(Cow::Borrowed)
+                } else {
+                    Some(Cow::Owned(
+                        pool.par_iter()
+                            .enumerate()
+                            .map(|(i, c)| {
+                                pool_widths.map_or(1.0, |pw| pw[i]).min(corner_width(
+                                    &corners,
+                                    c.position,
+                                    feature_spacing,
+                                ))
+                            })
+                            .collect(),
+                    ))
                 };
-                let pool_w: Vec<f64> = pool
-                    .par_iter()
-                    .enumerate()
-                    .map(|(i, c)| {
-                        pool_widths.map_or(1.0, |pw| pw[i]).min(corner_width(
-                            &corners,
-                            c.position,
-                            feature_spacing,
-                        ))
-                    })
-                    .collect();
                 linear_scan_graded(
                     &kernel,
                     &pool,
-                    Some(&pool_w),
+                    pool_w.as_deref(),
                     &b.samples,
-                    Some(&w),
-                    &params.linear_scan,
-                )
-            } else if widths.active() {
-                linear_scan_graded(
-                    &kernel,
-                    &pool,
-                    pool_widths,
-                    &b.samples,
-                    Some(&|p| widths.width(p)),
+                    field,
                     &params.linear_scan,
                 )
             } else {
@@ -656,12 +643,14 @@ pub fn remesh(
                 Some((r, b.edges, b.feature_edges, corners)),
             ))
         };
-        let (sigma_p, target_reached, search_history, value) = match density {
+        // The search's answer, with the widths of its last round (those of sigma_ref, which the
+        // gradient ascent takes too).
+        let (sigma_p, target_reached, search_history, value, widths) = match density {
             Target::SigmaP(s) => {
                 let w = widths_at(s);
                 let pool_w = w.active().then(|| pool_widths(&w));
                 let (count, value) = scan(s, &w, pool_w.as_deref())?;
-                (s, true, vec![(s, count)], value)
+                (s, true, vec![(s, count)], value, w)
             }
             Target::Points(_) => {
                 // The widths depend on sigma_p; a search over sigma_p with them moving could
@@ -700,7 +689,7 @@ pub fn remesh(
                         .is_some_and(|g| g.grades_below(sigma_ref.max(r.sigma_p)))
                         || w.curvature.as_ref().is_some_and(CurvatureWidths::grades);
                     if round >= 3 || !moved || !widths_change {
-                        break (r.sigma_p, r.reached, history, r.value);
+                        break (r.sigma_p, r.reached, history, r.value, w);
                     }
                     sigma_ref = r.sigma_p;
                     round_start = r.sigma_p;
@@ -735,25 +724,20 @@ pub fn remesh(
             measured,
         } = scan_result;
         let before_ascent = buried_test.as_ref().map(|_| samples.clone());
-        let widths = widths_at(sigma_ref);
-        let corner_spacing = FEATURE_SPACING_PER_SIGMA * sigma_p;
-        let width_field = (widths.active() || !corners.is_empty()).then_some(|p: DVec3| {
-            widths
-                .width(p)
-                .min(corner_width(&corners, p, corner_spacing))
-        });
+        let feature_spacing = FEATURE_SPACING_PER_SIGMA * sigma_p;
+        let width_field = (widths.active() || !corners.is_empty())
+            .then_some(|p: DVec3| widths.at(p, &corners, feature_spacing));
         // Surface samples keep out of a band along the sampled creases.
         let band = {
             let positions: Vec<DVec3> = samples[..boundary_count]
                 .iter()
                 .map(|s| s.position)
                 .collect();
-            let step = 0.05 * FEATURE_SPACING_PER_SIGMA * sigma_p;
             CreaseBand::new(
                 &positions,
                 &feature_edges,
-                FEATURE_SPACING_PER_SIGMA * sigma_p,
-                step,
+                feature_spacing,
+                0.05 * feature_spacing,
             )
         };
         let ga = gradient_ascent_graded(
@@ -1019,5 +1003,11 @@ impl Widths<'_> {
             w = w.min(c.width(p));
         }
         w
+    }
+
+    /// [`Widths::width`] lowered around graded `corners` ([`corner_width`] at the creases'
+    /// `spacing`).
+    fn at(&self, p: DVec3, corners: &[GradedCorner], spacing: f64) -> f64 {
+        self.width(p).min(corner_width(corners, p, spacing))
     }
 }
