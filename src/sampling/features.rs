@@ -52,15 +52,10 @@ impl FeaturePiece {
         let r1 = self.graded[1].first().copied().unwrap_or(0.0);
         let middle = (total - r0 - r1).max(0.0);
         let steps = (middle / spacing).round().max(1.0) as usize;
-        let mut out = vec![0.0];
-        out.extend(self.graded[0].iter().rev().copied());
-        for k in 1..steps {
-            out.push(r0 + middle * k as f64 / steps as f64);
-        }
-        out.extend(self.graded[1].iter().map(|&r| total - r));
-        out.push(total);
-        out.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * total.max(1.0));
-        out
+        self.with_graded_ends(
+            total,
+            (1..steps).map(|k| r0 + middle * k as f64 / steps as f64),
+        )
     }
 
     /// [`FeaturePiece::arcs`] with the even steps between the graded ends taken in a measure
@@ -78,12 +73,21 @@ impl FeaturePiece {
         let m0 = convert(lengths, measures, r0, true);
         let m1 = convert(lengths, measures, (total - r1).max(r0), true);
         let steps = ((m1 - m0) / spacing).round().max(1.0) as usize;
+        self.with_graded_ends(
+            total,
+            (1..steps).map(|k| {
+                let m = m0 + (m1 - m0) * k as f64 / steps as f64;
+                convert(lengths, measures, m, false)
+            }),
+        )
+    }
+
+    /// The arc lengths of a piece of length `total`: 0, the start's graded samples, the
+    /// `middle` ones, the end's graded samples, `total` (coincident ones once).
+    fn with_graded_ends(&self, total: f64, middle: impl Iterator<Item = f64>) -> Vec<f64> {
         let mut out = vec![0.0];
         out.extend(self.graded[0].iter().rev().copied());
-        for k in 1..steps {
-            let m = m0 + (m1 - m0) * k as f64 / steps as f64;
-            out.push(convert(lengths, measures, m, false));
-        }
+        out.extend(middle);
         out.extend(self.graded[1].iter().map(|&r| total - r));
         out.push(total);
         out.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * total.max(1.0));
@@ -111,9 +115,10 @@ fn graded_distances(angle: f64, spacing: f64, cap: f64) -> Vec<f64> {
     out
 }
 
-/// The smallest relative width [`corner_width`] gives (a quarter of the spacing, as the thickness
+/// The smallest relative width [`corner_width`] gives (half the spacing, as the curvature
 /// grading's): the graded samples nearest a corner are closer still, but there the corner's own
-/// triangle takes over.
+/// triangle takes over (at a quarter, the wedge of `tests/features.rs` lost crease edges where a
+/// third crease meets its corner).
 pub const CORNER_MIN_WIDTH: f64 = 0.5;
 
 /// A corner that feature pieces are graded towards ([`graded_corners`]).
@@ -134,7 +139,10 @@ pub struct GradedCorner {
 /// is where the gap is the spacing). One entry per corner.
 pub fn graded_corners(mesh: &TriMesh, pieces: &[FeaturePiece], spacing: f64) -> Vec<GradedCorner> {
     let mut out: Vec<(u32, GradedCorner)> = Vec::new();
-    for piece in pieces {
+    for piece in pieces
+        .iter()
+        .filter(|p| p.graded.iter().any(|g| !g.is_empty()))
+    {
         let nv = piece.curve.vertices.len();
         let lengths = edge_lengths(mesh, &piece.curve);
         let total: f64 = lengths.iter().sum();
@@ -184,6 +192,10 @@ pub fn corner_width(corners: &[GradedCorner], x: DVec3, spacing: f64) -> f64 {
     corners
         .iter()
         .map(|c| {
+            let graded = c.g * x.distance(c.position) / spacing;
+            if graded >= 1.0 {
+                return 1.0;
+            }
             let v = (x - c.position).normalize_or_zero();
             let between = c.directions.iter().enumerate().any(|(i, &a)| {
                 c.directions[i + 1..].iter().any(|&b| {
@@ -194,7 +206,7 @@ pub fn corner_width(corners: &[GradedCorner], x: DVec3, spacing: f64) -> f64 {
             if between {
                 1.0
             } else {
-                (c.g * x.distance(c.position) / spacing).clamp(CORNER_MIN_WIDTH, 1.0)
+                graded.max(CORNER_MIN_WIDTH)
             }
         })
         .fold(1.0, f64::min)
@@ -331,18 +343,26 @@ pub fn feature_pieces(
             m >= spacing
         }
     };
+    let all: Vec<(f64, BoundaryCurve, bool)> = all
+        .into_iter()
+        .map(|(l, c)| {
+            let long = long_enough(l, &c);
+            (l, c, long)
+        })
+        .collect();
     // Curves long enough for the spacing, then the short ones between two of their ends (an
     // edge between corners that are sampled anyway).
     let long_ends: FxHashSet<u32> = all
         .iter()
-        .filter(|(l, c)| long_enough(*l, c) && !c.closed)
-        .flat_map(|(_, c)| ends(c))
+        .filter(|(_, c, long)| *long && !c.closed)
+        .flat_map(|(_, c, _)| ends(c))
         .collect();
     let mut candidates: Vec<(f64, BoundaryCurve)> = all
         .into_iter()
-        .filter(|(l, c)| {
-            long_enough(*l, c) || (!c.closed && ends(c).iter().all(|v| long_ends.contains(v)))
+        .filter(|(_, c, long)| {
+            *long || (!c.closed && ends(c).iter().all(|v| long_ends.contains(v)))
         })
+        .map(|(l, c, _)| (l, c))
         .collect();
     // Longest first, each kept only where its samples keep their distance from those of the
     // curves kept before (apart from a shared corner): two creases closer than the spacing (a
