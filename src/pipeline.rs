@@ -512,9 +512,7 @@ pub fn remesh(
         crease_distance: None,
     };
     timer.lap("features");
-    let curvature = params
-        .curvature
-        .map(|p| (Curvature::new(&normalized, &[]), p));
+    let curvature = params.curvature.map(|p| (Curvature::new(&surface, &[]), p));
     let grading = match params.grading {
         Some(g) => {
             on_stage("local feature size");

@@ -2,6 +2,7 @@
 //! Sec. 7 of the paper (longest side scaled to 100).
 
 use glam::DVec3;
+use rustc_hash::FxHashMap;
 
 /// An indexed triangle mesh: `positions` is `V × 3` (model units, or bbox-100 units after
 /// [`Normalization::apply`]), `triangles` is `F × 3` indices into `positions`, counter-clockwise
@@ -127,6 +128,24 @@ impl TriMesh {
     /// Bounding box of the vertices; `None` for an empty mesh.
     pub fn bbox(&self) -> Option<Aabb> {
         Aabb::of(&self.positions)
+    }
+
+    /// Each undirected edge `(a, b)`, `a < b`, with the first two faces that use it (in face
+    /// order; the second is 0 when only one does) and how many do: 1 on a boundary, 2 inside a
+    /// manifold, more on a non-manifold edge.
+    pub fn edge_uses(&self) -> FxHashMap<(u32, u32), ([u32; 2], u32)> {
+        let mut uses: FxHashMap<(u32, u32), ([u32; 2], u32)> = FxHashMap::default();
+        for (f, t) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let e = uses.entry((a.min(b), a.max(b))).or_insert(([0; 2], 0));
+                if e.1 < 2 {
+                    e.0[e.1 as usize] = f as u32;
+                }
+                e.1 += 1;
+            }
+        }
+        uses
     }
 
     /// Unit vertex normals, `V × 3`: the angle-weighted average of the incident face normals

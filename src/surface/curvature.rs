@@ -19,11 +19,10 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
-use rustc_hash::{FxHashMap, FxHashSet};
+use rustc_hash::FxHashSet;
 
-use crate::mesh::TriMesh;
 use crate::spatial::StaticTree;
-use crate::surface::SurfaceSample;
+use crate::surface::{MeshSurface, SurfaceSample};
 
 /// The bend (degrees) from which an edge is not read as curvature: a fold that sharp (a box's
 /// 90°, a hexagonal prism's 60°) is a shape's edge, kept as a crease or not at all, not a
@@ -45,29 +44,17 @@ pub struct Curvature {
 }
 
 impl Curvature {
-    /// The curvature of `mesh`'s faces (1 / mesh units), the edges in `creases` (`[a, b]` with
+    /// The curvature of the faces of `surface`'s mesh (1 / mesh units), the edges in `creases` (`[a, b]` with
     /// `a < b`; the pipeline passes none, see [`CURVATURE_MAX_BEND_DEG`]) and the edges bending
     /// by [`CURVATURE_MAX_BEND_DEG`] or more left out. Edges with other than two faces, or a face
     /// of zero area, give no curvature.
-    pub fn new(mesh: &TriMesh, creases: &[[u32; 2]]) -> Self {
+    pub fn new(surface: &MeshSurface, creases: &[[u32; 2]]) -> Self {
+        let mesh = surface.mesh();
         let creases: FxHashSet<[u32; 2]> = creases.iter().copied().collect();
         // A bend within a hair of the bound counts as reaching it (a regular hexagon's normals
         // are 60° apart up to rounding).
         let cos_max = (CURVATURE_MAX_BEND_DEG - 0.01).to_radians().cos();
-        // The faces of each edge; an edge with other than two gives no curvature.
-        let mut edge_faces: FxHashMap<[u32; 2], Vec<u32>> = FxHashMap::default();
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                edge_faces
-                    .entry([a.min(b), a.max(b)])
-                    .or_default()
-                    .push(f as u32);
-            }
-        }
-        let normals: Vec<DVec3> = (0..mesh.triangles.len())
-            .map(|f| mesh.face_cross(f).normalize_or_zero())
-            .collect();
+        let uses = mesh.edge_uses();
         let faces = (0..mesh.triangles.len())
             .map(|f| {
                 let t = mesh.triangles[f];
@@ -83,11 +70,17 @@ impl Curvature {
                     if creases.contains(&key) {
                         continue;
                     }
-                    let g = match edge_faces.get(&key).map(Vec::as_slice) {
-                        Some(&[x, y]) => (if x as usize == f { y } else { x }) as usize,
+                    let g = match uses.get(&(key[0], key[1])) {
+                        Some(&([x, y], 2)) => {
+                            if x as usize == f {
+                                y
+                            } else {
+                                x
+                            }
+                        }
                         _ => continue,
                     };
-                    let (n0, n1) = (normals[f], normals[g]);
+                    let (n0, n1) = (surface.face_normal(f as u32), surface.face_normal(g));
                     if n0 == DVec3::ZERO || n1 == DVec3::ZERO {
                         continue;
                     }
@@ -195,6 +188,7 @@ impl Default for CurvatureParams {
 mod tests {
     use super::*;
     use crate::mesh::test_meshes::{grid, open_cylinder};
+    use crate::mesh::TriMesh;
 
     /// A cylinder of radius `r` round the z axis, open, `sides` facets round and `rings` bands
     /// of height `band`, each quad split along a diagonal; then a flat square of side `2 r`
@@ -220,7 +214,7 @@ mod tests {
         let facet = 2.0 * r * (std::f64::consts::PI / sides as f64).sin();
         for band in [facet, 4.0 * facet] {
             let mesh = cylinder_and_plane(r, sides, 6, band);
-            let c = Curvature::new(&mesh, &[]);
+            let c = Curvature::new(&MeshSurface::new(&mesh).unwrap(), &[]);
             let on_cylinder = 2 * sides * 6;
             // The rows at the open rims lack a neighbour across the rim, which is no bend.
             for f in 0..on_cylinder {
@@ -237,7 +231,7 @@ mod tests {
                 [a.min(b), a.max(b)]
             })
             .collect();
-        let c = Curvature::new(&mesh, &creases);
+        let c = Curvature::new(&MeshSurface::new(&mesh).unwrap(), &creases);
         assert!(c.faces.iter().all(|&k| k < 1e-9 || k * r < 0.6));
     }
 
@@ -245,12 +239,12 @@ mod tests {
     fn a_bend_of_a_shape_edge_is_not_curvature() {
         // A hexagonal prism's sides: 60° apart, a shape's edges, not facets of a curved part.
         let mesh = cylinder_and_plane(5.0, 6, 2, 3.0);
-        let c = Curvature::new(&mesh, &[]);
+        let c = Curvature::new(&MeshSurface::new(&mesh).unwrap(), &[]);
         // (Two triangles of one flat facet bend by rounding only.)
         assert!(c.faces.iter().all(|&k| k < 1e-6), "{:?}", c.faces);
         // A 12-sided one (30°) is a curved part.
         let mesh = cylinder_and_plane(5.0, 12, 2, 3.0);
-        let c = Curvature::new(&mesh, &[]);
+        let c = Curvature::new(&MeshSurface::new(&mesh).unwrap(), &[]);
         assert!(c.faces[..48].iter().all(|&k| k > 0.01));
     }
 
@@ -259,7 +253,7 @@ mod tests {
         let (r, sides) = (5.0, 96);
         let facet = 2.0 * r * (std::f64::consts::PI / sides as f64).sin();
         let mesh = cylinder_and_plane(r, sides, 12, facet);
-        let c = Curvature::new(&mesh, &[]);
+        let c = Curvature::new(&MeshSurface::new(&mesh).unwrap(), &[]);
         // A point at every face's centroid.
         let points: Vec<SurfaceSample> = (0..mesh.triangles.len())
             .map(|f| {

@@ -98,17 +98,7 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     }
     let cos_bound = params.angle_deg.to_radians().cos();
     // Undirected edge -> the faces that use it (the first two) and how many do.
-    let mut uses: FxHashMap<(u32, u32), ([u32; 2], u32)> = FxHashMap::default();
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            let e = uses.entry((a.min(b), a.max(b))).or_insert(([0; 2], 0));
-            if e.1 < 2 {
-                e.0[e.1 as usize] = f as u32;
-            }
-            e.1 += 1;
-        }
-    }
+    let uses = mesh.edge_uses();
     let mut boundary_vertex = vec![false; mesh.positions.len()];
     let mut candidates: Vec<([u32; 2], [u32; 2])> = Vec::new();
     for (&(a, b), &(faces, n)) in &uses {
