@@ -54,6 +54,13 @@ pub fn triangle_angles_deg(p: [DVec3; 3]) -> [f64; 3] {
     })
 }
 
+/// The smallest of [`triangle_angles_deg`], degrees.
+#[inline]
+pub fn triangle_min_angle_deg(p: [DVec3; 3]) -> f64 {
+    let a = triangle_angles_deg(p);
+    a[0].min(a[1]).min(a[2])
+}
+
 /// The shape quality of a triangle, `Q = 6 S / (√3 p h)` with `S` its area, `p` its
 /// half-perimeter and `h` its longest edge: 1 for the equilateral triangle, tending to 0 as the
 /// triangle degenerates; dimensionless. A degenerate triangle ([`is_degenerate_triangle`]) has

@@ -6,7 +6,7 @@
 //! the optimizer: the new faces stay on the input surface).
 
 use crate::geometry::tolerance::FLIP_MIN_ANGLE_GAIN_DEG;
-use crate::geometry::triangle::triangle_angles_deg;
+use crate::geometry::triangle::triangle_min_angle_deg;
 use crate::mesh::edit::{starting_at, EditMesh};
 
 /// A flip that the max-min rule asks for: the edge `x`–`y` with faces `old = [[x, y, c],
@@ -23,8 +23,7 @@ pub(crate) struct FlipCandidate {
 
 /// The smallest angle of the triangle `t`, degrees.
 fn min_angle<L: Copy>(m: &EditMesh<L>, t: [u32; 3]) -> f64 {
-    let a = triangle_angles_deg(m.corners(t));
-    a[0].min(a[1]).min(a[2])
+    triangle_min_angle_deg(m.corners(t))
 }
 
 /// The flip of the edge `x`–`y` when the max-min rule asks for it: the edge is interior, `c`–`d`

@@ -19,7 +19,9 @@ use robust::{orient2d, Coord};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::geometry::tolerance::RECOVERY_MIN_ANGLE_DEG;
-use crate::geometry::triangle::{is_degenerate_triangle, triangle_angles_deg};
+use crate::geometry::triangle::{
+    is_degenerate_triangle, triangle_angles_deg, triangle_min_angle_deg,
+};
 use crate::mesh::edit::{starting_at, EditMesh};
 
 /// The longest walk (faces crossed) one edge may take: a segment crossing more faces than this
@@ -145,10 +147,7 @@ pub fn flip_crease_slivers<L: Copy>(m: &mut EditMesh<L>, label: L) -> usize {
         else {
             continue;
         };
-        let smallest = |t: [u32; 3]| {
-            let a = triangle_angles_deg(m.corners(t));
-            a[0].min(a[1]).min(a[2])
-        };
+        let smallest = |t: [u32; 3]| triangle_min_angle_deg(m.corners(t));
         let before = smallest(t).min(smallest([v, u, d]));
         let after = smallest([u, d, w]).min(smallest([v, w, d]));
         if after > before && m.flip_edge(u, v, label).is_ok() {
@@ -248,10 +247,9 @@ fn insert_edge<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
         triangles.extend(ears.into_iter().map(|t| t.map(|k| polygon[k])));
     }
     // No sliver for a vertex a hair off the segment: the edge stays out instead.
-    let sliver = triangles.iter().any(|&t| {
-        let a = triangle_angles_deg(m.corners(t));
-        a[0].min(a[1]).min(a[2]) < RECOVERY_MIN_ANGLE_DEG
-    });
+    let sliver = triangles
+        .iter()
+        .any(|&t| triangle_min_angle_deg(m.corners(t)) < RECOVERY_MIN_ANGLE_DEG);
     if sliver {
         return false;
     }
@@ -312,8 +310,7 @@ fn ear_clip(points: &[DVec2], corner: impl Fn(usize) -> DVec3) -> Option<Vec<[us
             if blocked {
                 continue;
             }
-            let a = triangle_angles_deg([corner(p), corner(q), corner(r)]);
-            let score = a[0].min(a[1]).min(a[2]);
+            let score = triangle_min_angle_deg([corner(p), corner(q), corner(r)]);
             if best.is_none_or(|(s, _)| score > s) {
                 best = Some((score, i));
             }
@@ -448,10 +445,7 @@ mod tests {
         let (faces, _) = m.live_faces();
         let smallest = faces
             .iter()
-            .map(|&t| {
-                let a = triangle_angles_deg(m.corners(t));
-                a[0].min(a[1]).min(a[2])
-            })
+            .map(|&t| triangle_min_angle_deg(m.corners(t)))
             .fold(f64::INFINITY, f64::min);
         assert!(smallest > 30.0, "{smallest}"); // 5.7° before the flip
         assert_eq!(flip_crease_slivers(&mut m, ()), 0);
@@ -501,10 +495,7 @@ mod tests {
             .live_faces()
             .0
             .iter()
-            .map(|&t| {
-                let a = triangle_angles_deg(m.corners(t));
-                a[0].min(a[1]).min(a[2])
-            })
+            .map(|&t| triangle_min_angle_deg(m.corners(t)))
             .fold(f64::INFINITY, f64::min);
         assert!(worst > 40.0, "{worst}");
     }

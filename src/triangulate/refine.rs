@@ -224,7 +224,7 @@ pub(super) fn insert_loose_samples<L: Copy>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::triangle::triangle_angles_deg;
+    use crate::geometry::triangle::triangle_min_angle_deg;
     use crate::mesh::edit::SlotPolicy;
 
     fn builder(positions: &[DVec3]) -> EditMesh<()> {
@@ -236,8 +236,7 @@ mod tests {
     }
 
     fn min_angle(b: &EditMesh<()>, t: [u32; 3]) -> f64 {
-        let a = triangle_angles_deg(b.corners(t));
-        a[0].min(a[1]).min(a[2])
+        triangle_min_angle_deg(b.corners(t))
     }
 
     /// A hexagon fan around a centre, with one long thin diagonal forced in: the flips must

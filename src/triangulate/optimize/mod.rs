@@ -10,7 +10,7 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 
 use super::flip::max_min_flips;
-use crate::geometry::triangle::{triangle_angles_deg, triangle_q};
+use crate::geometry::triangle::{triangle_min_angle_deg, triangle_q};
 use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::mesh_projection::MeshSurface;
@@ -149,8 +149,7 @@ pub(super) fn normal(m: &Mesh, t: [u32; 3]) -> DVec3 {
 }
 
 pub(super) fn min_angle(m: &Mesh, t: [u32; 3]) -> f64 {
-    let a = triangle_angles_deg(m.corners(t));
-    a[0].min(a[1]).min(a[2])
+    triangle_min_angle_deg(m.corners(t))
 }
 
 pub(super) fn q(m: &Mesh, t: [u32; 3]) -> f64 {
