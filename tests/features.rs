@@ -6,8 +6,27 @@ mod common;
 use common::grid_box_counts;
 use glam::DVec3;
 use spectral_remesh::{
-    remesh, CurvatureParams, Density, RemeshParams, TriMesh, CAD_FEATURE_ANGLE_DEG, FIT_ITERATIONS,
+    remesh, CurvatureParams, Density, FeatureStats, RemeshParams, TriMesh, CAD_FEATURE_ANGLE_DEG,
+    FIT_ITERATIONS,
 };
+
+/// A remesh at `points` with the CAD feature angle, at `seed`.
+fn cad(points: usize, seed: u64) -> RemeshParams {
+    RemeshParams {
+        density: Density::Points(points),
+        feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
+        seed,
+        ..Default::default()
+    }
+}
+
+/// Creases were sampled and every sampled crease edge is an output edge.
+fn assert_every_crease_edge_kept(f: &FeatureStats, seed: u64) {
+    assert!(
+        f.sampled_edges > 0 && f.kept_edges == f.sampled_edges,
+        "seed {seed}: {f:?}"
+    );
+}
 
 /// The largest distance from points along the box's 12 edges (20 per edge) to the nearest
 /// edge of `mesh`.
@@ -57,19 +76,11 @@ fn a_boxs_edges_are_output_edges_at_every_seed_with_the_feature_angle() {
     let (lo, hi) = (DVec3::ZERO, DVec3::new(100.0, 60.0, 40.0));
     let input = grid_box_counts(lo, hi, [20, 12, 8]);
     for seed in 1..=5 {
-        let params = RemeshParams {
-            density: Density::Points(2000),
-            feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
-            seed,
-            ..Default::default()
-        };
+        let params = cad(2000, seed);
         let out = remesh(&input, &params, &|_| {}).expect("remesh");
         let f = &out.features;
         assert_eq!((f.curves, f.corners), (12, 8), "seed {seed}: {f:?}");
-        assert!(
-            f.sampled_edges > 0 && f.kept_edges == f.sampled_edges,
-            "seed {seed}: {f:?}"
-        );
+        assert_every_crease_edge_kept(f, seed);
         let v = out.mesh.positions.len() as f64;
         assert!((v - 2000.0).abs() <= 20.0, "seed {seed}: {v} vertices");
         let d = box_edges_to_mesh_edges(lo, hi, &out.mesh);
@@ -171,19 +182,11 @@ fn creases_meeting_at_a_small_angle_are_kept_up_to_their_corner_with_its_angle()
     let input = wedge();
     assert!(spectral_remesh::topology(&input).is_closed_manifold());
     for seed in 1..=5 {
-        let params = RemeshParams {
-            density: Density::Points(3000),
-            feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
-            seed,
-            ..Default::default()
-        };
+        let params = cad(3000, seed);
         let out = remesh(&input, &params, &|_| {}).expect("remesh");
         let f = &out.features;
         assert_eq!((f.curves, f.corners), (9, 6), "seed {seed}: {f:?}");
-        assert!(
-            f.sampled_edges > 0 && f.kept_edges == f.sampled_edges,
-            "seed {seed}: {f:?}"
-        );
+        assert_every_crease_edge_kept(f, seed);
         let d = f.crease_distance.expect("creases").max;
         assert!(
             d < 1e-6,
@@ -248,18 +251,10 @@ fn fandisk_keeps_its_creases_within_the_hausdorff_bound_at_every_seed() {
         .expect("fandisk")
         .0;
     for seed in 1..=5 {
-        let params = RemeshParams {
-            density: Density::Points(6000),
-            feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
-            seed,
-            ..Default::default()
-        };
+        let params = cad(6000, seed);
         let out = remesh(&input, &params, &|_| {}).expect("remesh");
         let f = &out.features;
-        assert!(
-            f.sampled_edges > 0 && f.kept_edges == f.sampled_edges,
-            "seed {seed}: {f:?}"
-        );
+        assert_every_crease_edge_kept(f, seed);
         let d = spectral_remesh::surface_distance(
             &out.mesh_normalized,
             &out.input_normalized,
@@ -366,12 +361,7 @@ fn with_the_chord_error_a_curved_side_gets_finer_samples_and_a_closer_surface() 
         (worst, on_side as f64 / mesh.positions.len() as f64)
     };
     for seed in 1..=3 {
-        let base = RemeshParams {
-            density: Density::Points(3000),
-            feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
-            seed,
-            ..Default::default()
-        };
+        let base = cad(3000, seed);
         let graded = RemeshParams {
             curvature: Some(CurvatureParams::default()),
             ..base
@@ -419,12 +409,7 @@ fn the_least_squares_fit_lowers_the_sag_and_leaves_rims_and_flat_caps_in_place()
         worst
     };
     for seed in 1..=3 {
-        let base = RemeshParams {
-            density: Density::Points(3000),
-            feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
-            seed,
-            ..Default::default()
-        };
+        let base = cad(3000, seed);
         let fitted = RemeshParams {
             fit_iterations: FIT_ITERATIONS,
             ..base
