@@ -296,19 +296,19 @@ METHODS = {
 }
 
 
+# The settings of remesh besides `ours`: the extra arguments of each.
+OURS_VARIANTS = {
+    "ours_sigma_n": ("--sigma-n", "0.75"),
+    "ours_features": ("--feature-angle", str(CAD_FEATURE_ANGLE)),
+    "ours_features_fit": ("--feature-angle", str(CAD_FEATURE_ANGLE), "--fit"),
+    "ours_fit": ("--fit",),
+}
+
+
 def adapter(method):
-    if method == "ours_sigma_n":
-        return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--sigma-n", "0.75"))
-    if method == "ours_features":
-        return lambda V, F, p, w, i: run_ours(
-            V, F, p, w, i, extra=("--feature-angle", str(CAD_FEATURE_ANGLE))
-        )
-    if method == "ours_features_fit":
-        return lambda V, F, p, w, i: run_ours(
-            V, F, p, w, i, extra=("--feature-angle", str(CAD_FEATURE_ANGLE), "--fit")
-        )
-    if method == "ours_fit":
-        return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=("--fit",))
+    if method in OURS_VARIANTS:
+        extra = OURS_VARIANTS[method]
+        return lambda V, F, p, w, i: run_ours(V, F, p, w, i, extra=extra)
     return METHODS[method][2]
 
 
