@@ -34,6 +34,7 @@ use crate::surface::MeshSurface;
 use crate::surface::SurfaceSample;
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
+use crate::triangulate::fit::AngleBounds;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
 use crate::triangulate::recover::{close_slits, flip_crease_slivers, recover_edges, RecoverStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
@@ -119,9 +120,9 @@ const MAX_GRADING_POINTS: f64 = 200_000.0;
 /// themselves at a tip (4 make a tetrahedron), not a part of the surface.
 const STRAY_SHELL_VERTICES: usize = 8;
 
-/// The iterations of the least-squares fit the command line's `--fit` asks for: the RMS distance
-/// is within 2% of its limit after 3 (flange at 6000 with --feature-angle 20: 0.0158 unfitted,
-/// 0.0090 after 1, 0.0089 after 3 and 5).
+/// The iterations of the least-squares fit, by default: the RMS distance is within 2% of its
+/// limit after 3 (flange at 6000 with --feature-angle 20: 0.0158 unfitted, 0.0090 after 1, 0.0089
+/// after 3 and 5).
 pub const FIT_ITERATIONS: usize = 3;
 
 /// The most output points [`remesh`] takes: 20 million (with 10 candidates per sample the
@@ -157,8 +158,8 @@ pub struct RemeshParams {
     /// Sample density graded by curvature (`None`, the default: one sigma_p everywhere).
     pub curvature: Option<CurvatureParams>,
     /// Iterations of the least-squares fit of the output's vertices to the input along their
-    /// normals ([`fit_to_surface`](crate::fit_to_surface); 0, the default: the vertices stay on
-    /// the input; the command line's `--fit` takes [`FIT_ITERATIONS`]).
+    /// normals ([`fit_to_surface`](crate::fit_to_surface); default [`FIT_ITERATIONS`]; 0: the
+    /// vertices stay on the input, as in the paper, and the command line's `--no-fit`).
     pub fit_iterations: usize,
     /// The feature angle (degrees) of the sharp-feature detection ([`detect_features`], at the
     /// sample spacing of the first sigma_p): the creases found are sampled evenly along with the
@@ -186,7 +187,7 @@ impl Default for RemeshParams {
             untangle: UntangleParams::default(),
             grading: None,
             curvature: None,
-            fit_iterations: 0,
+            fit_iterations: FIT_ITERATIONS,
             feature_angle_deg: DEFAULT_FEATURE_ANGLE_DEG,
             count_tolerance: 0.005,
             seed: 1,
@@ -857,6 +858,11 @@ pub fn remesh(
                 &surface,
                 &fixed,
                 params.fit_iterations,
+                // The fit keeps the angles the last pass of optimize reached.
+                params.optimize.as_ref().map(|op| AngleBounds {
+                    min_deg: op.final_theta_deg,
+                    max_deg: op.final_theta_max_deg,
+                }),
             )
         });
         let untangle_stats = untangle(&mut mesh_normalized, &fixed, sigma_p, &params.untangle);

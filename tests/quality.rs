@@ -227,6 +227,7 @@ fn empty_mesh_gives_zeros() {
         TriangleQuality {
             theta_min: 0.0,
             theta_min_ave: 0.0,
+            theta_max: 0.0,
             q_min: 0.0,
             q_ave: 0.0,
             pct_theta_below_30: 0.0,

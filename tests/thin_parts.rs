@@ -103,7 +103,14 @@ fn two_boxes_close_together_stay_two_closed_boxes_at_every_seed() {
 #[test]
 fn a_tube_too_thin_for_the_count_is_named_with_a_count_that_resolves_it() {
     let tube = tube(0.1, 100.0, 16, 1.0);
-    let out = run(&tube, 2000, 1, Some(GradingParams::default()));
+    // The samples on the input (no least-squares fit), so the region's box is the tube's.
+    let params = RemeshParams {
+        density: Density::Points(2000),
+        grading: Some(GradingParams::default()),
+        fit_iterations: 0,
+        ..RemeshParams::default()
+    };
+    let out = remesh(&tube, &params, &|_| {}).expect("remesh");
     let g = out.grading.as_ref().expect("grading on");
     assert!(g.unresolved_samples > 0);
     let region = g

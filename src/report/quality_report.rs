@@ -192,6 +192,7 @@ impl fmt::Display for QualityReport {
         row(f, "faces measured", t.faces_measured.to_string())?;
         row(f, "θmin (deg)", format!("{:.2}", t.theta_min))?;
         row(f, "θmin,ave (deg)", format!("{:.2}", t.theta_min_ave))?;
+        row(f, "θmax (deg)", format!("{:.2}", t.theta_max))?;
         row(f, "Qmin", format!("{:.4}", t.q_min))?;
         row(f, "Qave", format!("{:.4}", t.q_ave))?;
         row(

@@ -13,6 +13,7 @@ use crate::mesh::TriMesh;
 /// - `theta_min` (θmin): the smallest angle of the mesh, min over triangles of the triangle's
 ///   smallest angle.
 /// - `theta_min_ave` (θmin,ave): the mean over triangles of each triangle's smallest angle.
+/// - `theta_max` (θmax): the largest angle of the mesh (180° for a degenerate triangle).
 /// - `q_min`, `q_ave` (Qmin, Qave): min and mean over triangles of [`triangle_q`].
 /// - `pct_theta_below_30` (%θ<30): percent of *triangles* whose smallest angle is below 30°
 ///   (strictly, no tolerance) — the Table 1 column "θ < 30°".
@@ -31,6 +32,8 @@ pub struct TriangleQuality {
     pub theta_min: f64,
     /// θmin,ave: the mean over triangles of the smallest angle of each triangle, in degrees.
     pub theta_min_ave: f64,
+    /// θmax: the largest angle of the mesh, in degrees.
+    pub theta_max: f64,
     /// Qmin: the smallest triangle quality `6S/(√3 p h)`.
     pub q_min: f64,
     /// Qave: the mean triangle quality.
@@ -54,6 +57,7 @@ pub fn triangle_quality(mesh: &TriMesh) -> TriangleQuality {
     let mut measured = 0usize;
     let mut theta_min = f64::INFINITY;
     let mut theta_sum = 0.0;
+    let mut theta_max = 0.0f64;
     let mut q_min = f64::INFINITY;
     let mut q_sum = 0.0;
     let mut triangles_below = 0usize;
@@ -70,11 +74,16 @@ pub fn triangle_quality(mesh: &TriMesh) -> TriangleQuality {
         let angles = triangle_angles_deg(p);
         angles_below += angles.iter().filter(|&&a| a < 30.0).count();
         let repeated = t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
-        let (tmin, q) = if repeated || is_degenerate_triangle(p) {
-            (0.0, 0.0)
+        let (tmin, tmax, q) = if repeated || is_degenerate_triangle(p) {
+            (0.0, 180.0, 0.0)
         } else {
-            (angles[0].min(angles[1]).min(angles[2]), triangle_q(p))
+            (
+                angles[0].min(angles[1]).min(angles[2]),
+                angles[0].max(angles[1]).max(angles[2]),
+                triangle_q(p),
+            )
         };
+        theta_max = theta_max.max(tmax);
         theta_min = theta_min.min(tmin);
         theta_sum += tmin;
         q_min = q_min.min(q);
@@ -90,6 +99,7 @@ pub fn triangle_quality(mesh: &TriMesh) -> TriangleQuality {
     TriangleQuality {
         theta_min,
         theta_min_ave: theta_sum / m,
+        theta_max,
         q_min,
         q_ave: q_sum / m,
         pct_theta_below_30: 100.0 * triangles_below as f64 / m,

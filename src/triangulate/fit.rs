@@ -21,6 +21,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::geometry::self_intersection::intersecting_pairs;
+use crate::geometry::triangle::triangle_angles_deg;
 use crate::mesh::TriMesh;
 use crate::surface::MeshSurface;
 
@@ -66,17 +68,48 @@ pub struct FitStats {
     pub max_offset: f64,
 }
 
+/// The angles a fit keeps: a face whose angles were within `[min_deg, max_deg]` stays so, and
+/// one that was not gets no worse (degrees).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AngleBounds {
+    /// The smallest angle kept, degrees.
+    pub min_deg: f64,
+    /// The largest angle kept, degrees.
+    pub max_deg: f64,
+}
+
+impl AngleBounds {
+    /// The face's angle score: min(θmin, `min_deg` + `max_deg` − θmax), below `min_deg` exactly
+    /// when an angle is out of bounds.
+    pub fn score(&self, corners: [DVec3; 3]) -> f64 {
+        let a = triangle_angles_deg(corners);
+        let (lo, hi) = (a[0].min(a[1]).min(a[2]), a[0].max(a[1]).max(a[2]));
+        lo.min(self.min_deg + self.max_deg - hi)
+    }
+}
+
 /// Moves the vertices of `mesh` not `fixed` along their normals so that the faces approximate
-/// `surface` in the least-squares sense (see the module), in `iterations` Jacobi steps.
-/// Parallel and deterministic. `fixed` has one entry per vertex.
+/// `surface` in the least-squares sense (see the module), in `iterations` Jacobi steps. With
+/// `bounds`, a step's move is undone for the corners of every face it would take out of the
+/// angle bounds (or further out). Parallel and deterministic. `fixed` has one entry per vertex.
 pub fn fit_to_surface(
     mesh: &mut TriMesh,
     surface: &MeshSurface,
     fixed: &[bool],
     iterations: usize,
+    bounds: Option<AngleBounds>,
 ) -> FitStats {
     let n = mesh.positions.len();
     let start = mesh.positions.clone();
+    // The faces that cross another before the fit: the fit makes no new crossing.
+    let crossing_before = crossing_faces(mesh);
+    // Each face's angle score before the fit: what the bounds keep.
+    let score_before: Vec<f64> = match &bounds {
+        Some(b) => (0..mesh.triangles.len())
+            .map(|f| b.score(mesh.corners(f)))
+            .collect(),
+        None => Vec::new(),
+    };
     let normals = mesh.vertex_normals();
     // Each vertex's shortest edge, for the bound on its offset.
     let mut shortest = vec![f64::INFINITY; n];
@@ -133,17 +166,35 @@ pub fn fit_to_surface(
                 sum[v as usize].1 += w;
             }
         }
+        let previous = offset.clone();
         for v in 0..n {
             let (r, w) = sum[v];
             if fixed[v] || !(w > 0.0) || normals[v] == DVec3::ZERO {
                 continue;
             }
-            // The residual is along the faces' normals; the move is along the vertex's.
+            // The residual is along the faces' normals; the move is along the vertex's. A
+            // residual at rounding level (a flat part) moves nothing: the vertex stays exactly on
+            // the input, where the later stages' exact tests see it as it was.
             let bound = FIT_MAX_SHIFT * shortest[v];
+            if (r / w).abs() <= 1e-9 * shortest[v] {
+                continue;
+            }
             offset[v] = (offset[v] + r / w).clamp(-bound, bound);
             mesh.positions[v] = start[v] + offset[v] * normals[v];
         }
+        if let Some(b) = &bounds {
+            keep_angles(
+                mesh,
+                b,
+                &score_before,
+                &start,
+                &normals,
+                &previous,
+                &mut offset,
+            );
+        }
     }
+    undo_new_crossings(mesh, &start, &crossing_before);
     let moved: Vec<f64> = (0..n)
         .filter(|&v| mesh.positions[v] != start[v])
         .map(|v| mesh.positions[v].distance(start[v]))
@@ -156,6 +207,87 @@ pub fn fit_to_surface(
             moved.iter().sum::<f64>() / moved.len() as f64
         },
         max_offset: moved.iter().copied().fold(0.0, f64::max),
+    }
+}
+
+/// The faces of `mesh` that cross another face, sorted.
+fn crossing_faces(mesh: &TriMesh) -> Vec<u32> {
+    let mut faces: Vec<u32> = intersecting_pairs(&mesh.positions, &mesh.triangles)
+        .into_iter()
+        .flatten()
+        .collect();
+    faces.sort_unstable();
+    faces.dedup();
+    faces
+}
+
+/// Puts the corners of every face that crosses another after the fit and did not before back
+/// where they started (a fit on both sides of a thin part can bring its sheets together), until
+/// no new crossing is left.
+fn undo_new_crossings(mesh: &mut TriMesh, start: &[DVec3], crossing_before: &[u32]) {
+    loop {
+        let new: Vec<u32> = crossing_faces(mesh)
+            .into_iter()
+            .filter(|f| crossing_before.binary_search(f).is_err())
+            .collect();
+        let mut undone = false;
+        for f in new {
+            for v in mesh.triangles[f as usize] {
+                let v = v as usize;
+                if mesh.positions[v] != start[v] {
+                    mesh.positions[v] = start[v];
+                    undone = true;
+                }
+            }
+        }
+        if !undone {
+            return;
+        }
+    }
+}
+
+/// Undoes this step's move (back to the offsets `previous`) at the corners of every face whose
+/// angle score fell below the bound and below `score_before`, until none is left (an undone
+/// corner can take a neighbouring face out in turn; at most a few rounds, then every move of
+/// the step is undone).
+fn keep_angles(
+    mesh: &mut TriMesh,
+    bounds: &AngleBounds,
+    score_before: &[f64],
+    start: &[DVec3],
+    normals: &[DVec3],
+    previous: &[f64],
+    offset: &mut [f64],
+) {
+    const ROUNDS: usize = 8;
+    let broken = |mesh: &TriMesh| -> Vec<usize> {
+        (0..mesh.triangles.len())
+            .filter(|&f| {
+                let s = bounds.score(mesh.corners(f));
+                s < bounds.min_deg && s < score_before[f] - 1e-9
+            })
+            .collect()
+    };
+    for round in 0..=ROUNDS {
+        let faces = broken(mesh);
+        if faces.is_empty() {
+            return;
+        }
+        let undo: Vec<usize> = if round < ROUNDS {
+            let mut v: Vec<usize> = faces
+                .iter()
+                .flat_map(|&f| mesh.triangles[f].map(|u| u as usize))
+                .collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        } else {
+            (0..offset.len()).collect()
+        };
+        for v in undo {
+            offset[v] = previous[v];
+            mesh.positions[v] = start[v] + offset[v] * normals[v];
+        }
     }
 }
 
@@ -209,7 +341,7 @@ mod tests {
         let free = vec![false; coarse.positions.len()];
         let before = coarse.positions.clone();
         let (worst0, rms0) = distances(&coarse, &free, r);
-        let stats = fit_to_surface(&mut coarse, &surface, &free, 3);
+        let stats = fit_to_surface(&mut coarse, &surface, &free, 3, None);
         let (worst1, rms1) = distances(&coarse, &free, r);
         // A parabolic sag of δ: largest distance δ → 2/3 δ, RMS 0.73 δ → 0.30 δ.
         assert!(worst1 < 0.75 * worst0, "largest {worst0} -> {worst1}");
@@ -225,7 +357,7 @@ mod tests {
         // A fixed vertex (the bottom ring, a boundary) stays where it is.
         let mut coarse = cylinder(r, 24, 4, 4.0);
         let fixed: Vec<bool> = (0..coarse.positions.len()).map(|v| v < 24).collect();
-        let stats = fit_to_surface(&mut coarse, &surface, &fixed, 3);
+        let stats = fit_to_surface(&mut coarse, &surface, &fixed, 3, None);
         assert_eq!(coarse.positions[..24], before[..24]);
         assert_eq!(stats.moved, coarse.positions.len() - 24);
     }
@@ -241,7 +373,7 @@ mod tests {
         let surface = MeshSurface::new(&plane(20)).unwrap();
         let mut out = plane(5);
         let before = out.positions.clone();
-        let stats = fit_to_surface(&mut out, &surface, &vec![false; before.len()], 3);
+        let stats = fit_to_surface(&mut out, &surface, &vec![false; before.len()], 3, None);
         assert_eq!(out.positions, before);
         assert_eq!(stats.moved, 0);
     }

@@ -62,7 +62,7 @@ pub(super) fn mend_faces(
         let mut small: Vec<(f64, u32)> = live
             .iter()
             .zip(&slots)
-            .map(|(&t, &f)| (min_angle(m, t), f))
+            .map(|(&t, &f)| (angle_score(m, t, params), f))
             .filter(|&(a, _)| a < bound)
             .collect();
         small.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
@@ -94,7 +94,7 @@ pub(super) fn mend_faces(
             // without a crossing or a new angle below the bound; there, a covering vertex may
             // go too. A face with a small angle is mended by one that raises that angle.
             let crossing = guard.crosses(m, &[t], &[f]);
-            if !crossing && min_angle(m, t) >= bound {
+            if !crossing && angle_score(m, t, params) >= bound {
                 continue;
             }
             let stays = |m: &Mesh, v: u32| (is_fixed(v) && !crossing) || m.is_boundary_vertex(v);
@@ -138,7 +138,7 @@ pub(super) fn mend_faces(
                 if stays(m, v) {
                     continue;
                 }
-                for q in move_targets(m, surface, v, bound) {
+                for q in move_targets(m, surface, v, params) {
                     offer(try_move(m, &guard, v, q, params), Op::Move(v, q));
                 }
             }
@@ -170,10 +170,10 @@ pub(super) fn mend_faces(
 }
 
 /// The smallest angle of the faces `t`, degrees (infinity for none).
-fn worst_angle(m: &Mesh, faces: impl IntoIterator<Item = [u32; 3]>) -> f64 {
+fn worst_angle(m: &Mesh, faces: impl IntoIterator<Item = [u32; 3]>, params: &Limits) -> f64 {
     faces
         .into_iter()
-        .map(|t| min_angle(m, t))
+        .map(|t| angle_score(m, t, params))
         .fold(f64::INFINITY, f64::min)
 }
 
@@ -209,8 +209,8 @@ fn try_flip(
     let new_off = new_mid
         .distance
         .max(distance_to(m, flip.new, old_mid.position));
-    let old = worst_angle(m, flip.old);
-    let new = worst_angle(m, flip.new);
+    let old = worst_angle(m, flip.old, params);
+    let new = worst_angle(m, flip.new, params);
     if new_off > params.collapse_offset.max(old_off) {
         return None;
     }
@@ -240,7 +240,7 @@ fn try_collapse(
         .chain([&f1, &f2])
         .map(|&g| face(m, g))
         .collect();
-    let old = worst_angle(m, old_faces.iter().copied());
+    let old = worst_angle(m, old_faces.iter().copied(), params);
     let old_normals: Vec<DVec3> = involved.iter().map(|&g| normal(m, face(m, g))).collect();
     let (pa, pb) = (m.position(removed), m.position(kept));
     let new_faces: Vec<[u32; 3]> = involved
@@ -252,7 +252,7 @@ fn try_collapse(
     let turned = turned(m, &new_faces, &old_normals, cos_turn);
     let near = distance_to(m, new_faces.iter().copied(), pa) <= params.collapse_offset
         && distance_to(m, new_faces.iter().copied(), pb) <= params.collapse_offset;
-    let new = worst_angle(m, new_faces.iter().copied());
+    let new = worst_angle(m, new_faces.iter().copied(), params);
     let mut replaced = involved.clone();
     replaced.extend([f1, f2]);
     let ok = !turned && near && !guard.crosses(m, &new_faces, &replaced);
@@ -264,7 +264,7 @@ fn try_collapse(
 /// Where a move of `v` is tried: towards the centroid of its neighbours and towards the apex of
 /// the equilateral triangle on the far edge of each of its faces with an angle below `bound`
 /// (all the way, half and a quarter of the way), projected onto the surface.
-fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, bound: f64) -> Vec<DVec3> {
+fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits) -> Vec<DVec3> {
     let old = m.position(v);
     let ring = m.ring(v);
     if ring.is_empty() {
@@ -278,7 +278,7 @@ fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, bound: f64) -> Vec<DVec
     let mut aims = vec![centroid];
     for &f in m.faces_around(v) {
         let t = starting_at(face(m, f), v);
-        if min_angle(m, t) >= bound {
+        if angle_score(m, t, params) >= params.final_theta_deg {
             continue;
         }
         aims.extend(equilateral_apex(old, m.position(t[1]), m.position(t[2])));
@@ -300,13 +300,13 @@ fn try_move(
 ) -> Option<(f64, f64)> {
     let slots = m.faces_around(v).to_vec();
     let faces: Vec<[u32; 3]> = slots.iter().map(|&f| face(m, f)).collect();
-    let old = worst_angle(m, faces.iter().copied());
+    let old = worst_angle(m, faces.iter().copied(), params);
     let old_normals: Vec<DVec3> = faces.iter().map(|&t| normal(m, t)).collect();
     let p = m.position(v);
     m.relocate_vertex(v, q).ok()?;
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let turned = turned(m, &faces, &old_normals, cos_turn);
-    let new = worst_angle(m, faces.iter().copied());
+    let new = worst_angle(m, faces.iter().copied(), params);
     let ok = !turned
         && distance_to(m, faces.iter().copied(), p) <= params.collapse_offset
         && !guard.crosses(m, &faces, &slots);
@@ -383,7 +383,11 @@ mod tests {
 
     /// The smallest angle of the live faces, degrees.
     fn theta_min(m: &Mesh) -> f64 {
-        worst_angle(m, m.live_faces().0)
+        m.live_faces()
+            .0
+            .into_iter()
+            .map(|t| min_angle(m, t))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// A flat `n × n` grid of unit squares as the mesh to mend (every face labelled with its

@@ -10,7 +10,7 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 
 use super::flip::max_min_flips;
-use crate::geometry::triangle::{triangle_min_angle_deg, triangle_q};
+use crate::geometry::triangle::{triangle_angles_deg, triangle_min_angle_deg, triangle_q};
 use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::mesh_projection::MeshSurface;
@@ -19,11 +19,18 @@ mod angles;
 mod collapse;
 mod cover;
 mod relax;
+mod smooth;
 
 use angles::mend_faces;
 use collapse::collapse_short;
 use cover::cover;
 use relax::{flip_poor, relax_poor};
+use smooth::smooth;
+pub use smooth::SmoothStats;
+
+/// The iterations of the tangential relaxation with valence flips by default: horse at 8600
+/// (seed 1) reaches Qave 0.942 after 5 and 0.944 after 10, from 0.903 without.
+pub const SMOOTH_ITERATIONS: usize = 10;
 
 /// Parameters of [`optimize`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,8 +62,16 @@ pub struct OptimizeParams {
     /// The last pass mends the faces whose smallest angle is still below this, degrees
     /// (default 30), and the faces that cross another.
     pub final_theta_deg: f64,
+    /// The last pass also mends the faces whose largest angle is above this, degrees
+    /// (default 100): it works on the angle score min(θmin, `final_theta_deg` +
+    /// `final_theta_max_deg` − θmax), which is below `final_theta_deg` exactly when an angle is
+    /// out of bounds.
+    pub final_theta_max_deg: f64,
     /// Rounds of the last pass at most (default 4).
     pub final_rounds: usize,
+    /// Iterations of the tangential relaxation with valence flips before covering (`smooth.rs`;
+    /// default [`SMOOTH_ITERATIONS`], 0 turns it off).
+    pub smooth_iterations: usize,
 }
 
 impl Default for OptimizeParams {
@@ -71,8 +86,10 @@ impl Default for OptimizeParams {
             cover_rounds: 3,
             short_edge_ratio: 0.5,
             collapse_offset_sigma_p: 0.25,
-            final_theta_deg: 30.0,
+            final_theta_deg: 35.0,
+            final_theta_max_deg: 100.0,
             final_rounds: 4,
+            smooth_iterations: SMOOTH_ITERATIONS,
         }
     }
 }
@@ -101,8 +118,12 @@ pub(super) struct Limits {
     pub(super) collapse_offset: f64,
     /// [`OptimizeParams::final_theta_deg`], degrees.
     pub(super) final_theta_deg: f64,
+    /// [`OptimizeParams::final_theta_max_deg`], degrees.
+    pub(super) final_theta_max_deg: f64,
     /// [`OptimizeParams::final_rounds`].
     pub(super) final_rounds: usize,
+    /// [`OptimizeParams::smooth_iterations`].
+    pub(super) smooth_iterations: usize,
 }
 
 impl Limits {
@@ -118,7 +139,9 @@ impl Limits {
             short_edge_ratio: params.short_edge_ratio,
             collapse_offset: params.collapse_offset_sigma_p * sigma_p,
             final_theta_deg: params.final_theta_deg,
+            final_theta_max_deg: params.final_theta_max_deg,
             final_rounds: params.final_rounds,
+            smooth_iterations: params.smooth_iterations,
         }
     }
 }
@@ -137,6 +160,8 @@ pub struct OptimizeStats {
     /// Operations of the last pass on the faces with a small angle or a crossing (flips,
     /// collapses, moves).
     pub mends: usize,
+    /// What the tangential relaxation with valence flips did.
+    pub smooth: SmoothStats,
 }
 
 /// The mesh being optimized: each face labelled with the index of the input face it still is
@@ -154,6 +179,13 @@ pub(super) fn min_angle(m: &Mesh, t: [u32; 3]) -> f64 {
 
 pub(super) fn q(m: &Mesh, t: [u32; 3]) -> f64 {
     triangle_q(m.corners(t))
+}
+
+/// The last pass's angle score of `t` (see [`OptimizeParams::final_theta_max_deg`]), degrees.
+pub(super) fn angle_score(m: &Mesh, t: [u32; 3], params: &Limits) -> f64 {
+    let a = triangle_angles_deg(m.corners(t));
+    let (lo, hi) = (a[0].min(a[1]).min(a[2]), a[0].max(a[1]).max(a[2]));
+    lo.min(params.final_theta_deg + params.final_theta_max_deg - hi)
 }
 
 /// The shape score the operations maximize at their worst face: Q and the smallest angle, each
@@ -295,6 +327,7 @@ pub fn optimize(
     fixed.resize(m.vertex_count(), false);
     let short = params.short_edge_ratio * median_edge_length(&m);
     let mut watch = None;
+    stats.smooth = smooth(&mut m, surface, &fixed, params, params.smooth_iterations);
     for round in 0..params.cover_rounds.max(1) {
         if params.cover_distance.is_finite() {
             let added = cover(&mut m, cover_points, &mut watch, params);
@@ -402,7 +435,7 @@ mod tests {
         let fixed: Vec<bool> = vec![false; mesh.vertex_count()];
         let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, &[], 1.0, &no_cover());
         let after = triangle_quality(&mesh);
-        assert!(stats.moves + stats.flips + stats.collapses > 0);
+        assert!(stats.moves + stats.flips + stats.collapses + stats.smooth.moves > 0);
         assert!(
             after.q_min > before.q_min + 0.2,
             "{} -> {}",
@@ -518,6 +551,8 @@ mod tests {
         );
         assert!(stats.covered >= 1, "{stats:?}");
         assert!(mesh.positions.contains(&apex));
+        // Vertices merged away by a collapse are left unreferenced (see `optimize`).
+        mesh.remove_unreferenced_vertices();
         let t = topology(&mesh);
         assert!(
             t.is_closed_manifold() && t.euler_characteristic == 2,

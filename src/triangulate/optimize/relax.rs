@@ -23,7 +23,19 @@ pub(super) fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &Limits) ->
     }
     edges.sort_unstable();
     edges.dedup();
-    max_min_flips(m, &edges, None, |m, flip| {
+    flip_all(m, surface, params, &edges)
+}
+
+/// Max-min angle flips ([`max_min_flips`]) of `edges`, in order, where the new faces face the
+/// way the old ones did and stay within `max_offset` of the surface. Returns the number of
+/// flips.
+pub(super) fn flip_all(
+    m: &mut Mesh,
+    surface: &MeshSurface,
+    params: &Limits,
+    edges: &[(u32, u32)],
+) -> usize {
+    max_min_flips(m, edges, None, |m, flip| {
         let [t1, t2] = flip.old;
         let [new1, new2] = flip.new;
         let (x, y, c, d) = (t1[0], t1[1], t1[2], t2[2]);
