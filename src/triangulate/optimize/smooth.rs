@@ -25,7 +25,7 @@ use super::*;
 /// undone (measured on horse at 8600: Qave 0.937 without valence flips, 0.944 with them).
 const VALENCE_FLIP_MIN_ANGLE_DEG: f64 = 20.0;
 
-/// What [`smooth`] did.
+/// What the finishing relaxation (`optimize`'s first step, [`OptimizeParams::smooth_iterations`]) did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct SmoothStats {
     /// Valence flips.
