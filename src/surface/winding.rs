@@ -8,9 +8,9 @@ use parry3d_f64::query::{Ray, RayCast};
 use rayon::prelude::*;
 
 use super::front_regions::FrontRegions;
-use crate::check::{self_intersections, topology};
+use crate::check::topology;
+use crate::geometry::self_intersection::{face_boxes, has_intersecting_pair};
 use crate::geometry::tolerance::BURIED_OFFSET;
-use crate::geometry::triangle::is_degenerate_face;
 use crate::mesh::TriMesh;
 
 /// The directions of the crossing-count rays: fixed, unit length, far from every axis and
@@ -49,39 +49,42 @@ pub struct RayWinding<'a> {
     normals: Vec<DVec3>,
     /// Whether each face is in the BVH (counted by the rays).
     counted: Vec<bool>,
+    /// The counted faces with their bounding boxes (the BVH's leaves).
+    boxes: Vec<(usize, Aabb)>,
 }
 
 impl<'a> RayWinding<'a> {
     /// The structure over `mesh`'s faces (degenerate faces and faces with an index out of range
-    /// or a non-finite corner are left out).
+    /// or a non-finite corner are left out: [`face_boxes`]).
     pub fn new(mesh: &'a TriMesh) -> Self {
-        let n = mesh.positions.len();
-        let boxes: Vec<(usize, Aabb)> = (0..mesh.triangles.len())
-            .filter(|&f| {
-                let t = mesh.triangles[f];
-                t.iter()
-                    .all(|&i| (i as usize) < n && mesh.positions[i as usize].is_finite())
-                    && !is_degenerate_face(&mesh.positions, mesh.triangles[f])
-            })
-            .map(|f| {
-                let [a, b, c] = mesh.corners(f);
-                (f, Aabb::new(a.min(b).min(c), a.max(b).max(c)))
-            })
-            .collect();
+        let boxes = face_boxes(&mesh.positions, &mesh.triangles);
         let bvh = Bvh::from_iter(BvhBuildStrategy::Binned, boxes.iter().copied());
-        let normals = (0..mesh.triangles.len())
-            .map(|f| mesh.face_normal(f))
-            .collect();
+        // Only the counted faces' corners are read: the others may have an index out of range.
         let mut counted = vec![false; mesh.triangles.len()];
+        let mut normals = vec![DVec3::ZERO; mesh.triangles.len()];
         for &(f, _) in &boxes {
             counted[f] = true;
+            normals[f] = mesh.face_normal(f);
         }
         RayWinding {
             mesh,
             bvh,
             normals,
             counted,
+            boxes,
         }
+    }
+
+    /// Whether two of the counted faces that share no vertex meet: the test of
+    /// [`self_intersections`](crate::check::self_intersections) (`pairs > 0`), on this
+    /// structure's BVH (the same one), stopping at the first pair.
+    pub(crate) fn crosses_itself(&self) -> bool {
+        has_intersecting_pair(
+            &self.bvh,
+            &self.boxes,
+            &self.mesh.positions,
+            &self.mesh.triangles,
+        )
     }
 
     /// How many faces the mesh has (counted or not).
@@ -257,18 +260,20 @@ enum Probed {
 
 impl<'a> BuriedTest<'a> {
     /// The test for `mesh` (bbox-100 units), or `None` when no point of it can be buried: it
-    /// does not intersect itself ([`self_intersections`]). `points` is how many points will be
-    /// tested: an open mesh is tested with the generalized winding number, O(F) per point, and
-    /// gets `None` when F · points exceeds `MAX_OPEN_WORK` (4e8); a closed one gets the regions
-    /// in front of its surface when there are at least `MIN_POINTS_PER_FACE_FOR_REGIONS` (0.5)
-    /// points per face.
+    /// does not intersect itself ([`self_intersections`](crate::check::self_intersections)).
+    /// `points` is how many points will be tested: an open mesh is tested with the generalized
+    /// winding number, O(F) per point, and gets `None` when F · points exceeds `MAX_OPEN_WORK`
+    /// (4e8); a closed one gets the regions in front of its surface when there are at least
+    /// `MIN_POINTS_PER_FACE_FOR_REGIONS` (0.5) points per face.
     pub fn new(mesh: &'a TriMesh, points: usize) -> Option<Self> {
-        if self_intersections(mesh).pairs == 0 {
+        // The BVH of the ray count serves the test for self-intersections too.
+        let rays = RayWinding::new(mesh);
+        if !rays.crosses_itself() {
             return None;
         }
         let orientation = if mesh.signed_volume() < 0.0 { -1 } else { 1 };
         let winding = if topology(mesh).boundary_edges == 0 {
-            Some(RayWinding::new(mesh))
+            Some(rays)
         } else if (mesh.triangles.len() as f64) * (points as f64) <= MAX_OPEN_WORK {
             None
         } else {
@@ -559,5 +564,20 @@ mod tests {
         }
         // Too few points for the regions to pay off: point by point.
         assert!(BuriedTest::new(&m, 10).unwrap().regions.is_none());
+    }
+
+    #[test]
+    fn a_face_with_an_index_out_of_range_is_left_out() {
+        let a = cuboid(DVec3::ZERO, DVec3::splat(2.0));
+        let b = cuboid(DVec3::splat(1.0), DVec3::splat(3.0));
+        let mut m = union_of(&a, &b);
+        m.triangles.push([0, 1, 999]);
+        let w = RayWinding::new(&m);
+        assert!(w.crosses_itself() && !w.counts(24));
+        assert_eq!(w.winding_number(DVec3::splat(1.5)), 2);
+        // Apart: no test, without reading the bad face's corners.
+        let mut apart = a.clone();
+        apart.triangles.push([0, 1, 999]);
+        assert!(BuriedTest::new(&apart, 1000).is_none());
     }
 }
