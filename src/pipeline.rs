@@ -463,15 +463,26 @@ pub fn remesh(
     let mut buried_candidates = 0;
     let mut input_points: Vec<DVec3> = normalized.positions.clone();
     if let Some(test) = &buried_test {
-        buried_candidates = test.remove_buried(&mut pool, |c| (c.position, c.normal));
-        let mut vertices: Vec<(DVec3, DVec3)> = normalized
+        buried_candidates = test.remove_buried(&mut pool, |c| (c.position, c.normal, Some(c.face)));
+        // Each vertex with a face it is a corner of (its first).
+        let mut vertex_face = vec![None; normalized.positions.len()];
+        for (f, t) in normalized.triangles.iter().enumerate().rev() {
+            for &v in t {
+                if let Some(slot) = vertex_face.get_mut(v as usize) {
+                    *slot = Some(f as u32);
+                }
+            }
+        }
+        let mut vertices: Vec<(DVec3, DVec3, Option<u32>)> = normalized
             .positions
             .iter()
             .copied()
             .zip(normalized.vertex_normals())
+            .zip(vertex_face)
+            .map(|((p, n), f)| (p, n, f))
             .collect();
         test.remove_buried(&mut vertices, |&v| v);
-        input_points = vertices.into_iter().map(|(p, _)| p).collect();
+        input_points = vertices.into_iter().map(|(p, _, _)| p).collect();
     }
     // Input-surface points the optimization keeps within its cover distance of the output.
     let cover_points: Vec<DVec3> = input_points
@@ -756,7 +767,7 @@ pub fn remesh(
             let buried = test.buried(
                 &samples
                     .iter()
-                    .map(|s| (s.position, s.normal))
+                    .map(|s| (s.position, s.normal, Some(s.face)))
                     .collect::<Vec<_>>(),
             );
             for (i, b) in buried.iter().enumerate() {

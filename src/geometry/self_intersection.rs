@@ -32,21 +32,8 @@ pub fn intersecting_pairs_counted(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
 ) -> (Vec<[u32; 2]>, usize) {
-    let n = positions.len();
     let corners = |f: usize| triangles[f].map(|i| positions[i as usize]);
-    let valid = |f: usize| {
-        let t = triangles[f];
-        t.iter().all(|&i| (i as usize) < n)
-            && t.iter().all(|&i| positions[i as usize].is_finite())
-            && !is_degenerate_face(positions, t)
-    };
-    let boxes: Vec<(usize, Aabb)> = (0..triangles.len())
-        .filter(|&f| valid(f))
-        .map(|f| {
-            let [a, b, c] = corners(f);
-            (f, Aabb::new(a.min(b).min(c), a.max(b).max(c)))
-        })
-        .collect();
+    let boxes = face_boxes(positions, triangles);
     if boxes.len() < 2 {
         return (Vec::new(), 0);
     }
@@ -85,7 +72,89 @@ pub fn intersecting_pairs_counted(
     (pairs, candidates)
 }
 
+/// The faces the search of [`intersecting_pairs_counted`] takes (every index in range, every
+/// corner finite, not [`is_degenerate_face`]), in order, each with its bounding box.
+pub(crate) fn face_boxes(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<(usize, Aabb)> {
+    let n = positions.len();
+    (0..triangles.len())
+        .filter(|&f| {
+            let t = triangles[f];
+            t.iter().all(|&i| (i as usize) < n)
+                && t.iter().all(|&i| positions[i as usize].is_finite())
+                && !is_degenerate_face(positions, t)
+        })
+        .map(|f| {
+            let [a, b, c] = triangles[f].map(|i| positions[i as usize]);
+            (f, Aabb::new(a.min(b).min(c), a.max(b).max(c)))
+        })
+        .collect()
+}
+
+/// Whether [`intersecting_pairs_counted`] would find at least one pair, given `boxes`
+/// ([`face_boxes`] of the same faces) and a BVH over them (leaf data: the face index): the same
+/// tests, stopping at the first pair found. In parallel; the answer does not depend on the
+/// order.
+pub(crate) fn has_intersecting_pair(
+    bvh: &Bvh,
+    boxes: &[(usize, Aabb)],
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> bool {
+    let corners = |f: usize| triangles[f].map(|i| positions[i as usize]);
+    boxes.par_chunks(CHUNK).any(|chunk| {
+        chunk.iter().any(|&(f, aabb)| {
+            let tf = triangles[f];
+            bvh.intersect_aabb(&aabb).any(|g| {
+                let g = g as usize;
+                g > f
+                    && !tf.iter().any(|i| triangles[g].contains(i))
+                    && triangles_intersect(corners(f), corners(g))
+            })
+        })
+    })
+}
+
 /// The intersecting pairs of [`intersecting_pairs_counted`], without the count of tests.
 pub fn intersecting_pairs(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
     intersecting_pairs_counted(positions, triangles).0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes::{cuboid, uv_sphere};
+
+    #[test]
+    fn the_early_stopping_test_agrees_with_the_count() {
+        let has = |m: &crate::mesh::TriMesh| {
+            let boxes = face_boxes(&m.positions, &m.triangles);
+            let bvh = Bvh::from_iter(BvhBuildStrategy::Binned, boxes.iter().copied());
+            has_intersecting_pair(&bvh, &boxes, &m.positions, &m.triangles)
+        };
+        let mut sphere = uv_sphere(1.0, 12, 24);
+        assert!(!has(&sphere));
+        assert!(intersecting_pairs(&sphere.positions, &sphere.triangles).is_empty());
+        // A vertex pushed through the far side: its fan crosses faces there.
+        let k = 2 + 5 * 24;
+        sphere.positions[k] = -1.5 * sphere.positions[k];
+        assert!(has(&sphere));
+        assert!(!intersecting_pairs(&sphere.positions, &sphere.triangles).is_empty());
+        // Two boxes: apart, touching at a face (non-adjacent faces sharing points), crossing.
+        for (lo, crossing) in [(3.0, false), (2.0, true), (1.0, true)] {
+            let mut m = cuboid(DVec3::ZERO, DVec3::splat(2.0));
+            let b = cuboid(DVec3::splat(lo), DVec3::splat(lo + 2.0));
+            let off = m.positions.len() as u32;
+            m.positions.extend(b.positions);
+            m.triangles
+                .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+            assert_eq!(has(&m), crossing, "{lo}");
+            assert_eq!(
+                !intersecting_pairs(&m.positions, &m.triangles).is_empty(),
+                crossing
+            );
+        }
+        // Fewer than two faces.
+        let one = crate::mesh::TriMesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]);
+        assert!(!has(&one));
+    }
 }

@@ -13,7 +13,10 @@ fn c3(p: DVec3) -> Coord3D<f64> {
 }
 
 /// The sign of orient3d(a, b, c, d): exact (Shewchuk's adaptive predicate, the `robust` crate).
-fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
+/// Nonzero exactly when the four points are not coplanar; two points d, e lie strictly on the
+/// same side of the plane through a, b, c exactly when orient(a, b, c, d) == orient(a, b, c, e)
+/// != 0.
+pub(crate) fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
     let v = orient3d(c3(a), c3(b), c3(c), c3(d));
     if v > 0.0 {
         1

@@ -2,6 +2,7 @@
 
 pub mod curvature;
 pub mod features;
+pub(crate) mod front_regions;
 pub mod local_feature_size;
 pub mod mesh_projection;
 pub mod winding;
