@@ -1,5 +1,5 @@
-"""Side-by-side comparison of remesh with MeshLab, CGAL, ACVD and Botsch-Kobbelt remeshers at the
-same vertex count, measured by one ruler (`remesh quality --ref INPUT --json`).
+"""Side-by-side comparison of remesh with MeshLab, CGAL, ACVD, Botsch-Kobbelt and geogram remeshers at
+the same vertex count, measured by one ruler (`remesh quality --ref INPUT --json`).
 
 Run through eval/run (it sets up the venv and builds remesh):
 
@@ -7,8 +7,9 @@ Run through eval/run (it sets up the venv and builds remesh):
     eval/run --quick              # spot at 3000: ours and MeshLab only (CI)
     eval/run path/to/model.ply:5000 other.obj:20000
 
-Writes eval/results/RESULTS.md, results.json and PNG pictures (close-ups and minimum-angle
-histograms); the remeshed meshes go to eval/results/tmp (not committed).
+Writes eval/results/RESULTS.md, results.json and PNG pictures (per model: every method's mesh whole
+and zoomed on a hard region, and histograms of the smallest and largest triangle angles); the
+remeshed meshes go to eval/results/tmp (not committed).
 """
 
 import argparse
@@ -18,10 +19,12 @@ import os
 import statistics
 import subprocess
 import sys
+import tarfile
 import tempfile
 import time
 import traceback
 import warnings
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -48,20 +51,64 @@ CAD_FEATURE_ANGLE = 20
 CAD_MODELS = {"fandisk.obj", "bracket.obj", "flange.obj"}
 # The feature-preserving settings, run on the CAD parts only in a full run (on any model when
 # asked for with --methods).
-FEATURE_METHODS = {"ours_features", "ours_features_fit", "cgal_features", "botsch_features"}
+FEATURE_METHODS = {"ours_features", "cgal_features", "botsch_features"}
 COUNT_TOLERANCE = 0.02
 TIMING_RUNS = 3
 
-# Close-up regions, the same for every method of a model: a cube (centre, half-width, in bbox-100
-# units of the input) on a part that tells remeshers apart: the horse's ear tips, the cow's tail
-# beside the rump. Other models: a cube of CLOSEUP_HALF_WIDTH around the input's top (largest
-# y), moved CLOSEUP_DROP down.
+# The camera of a model's pictures, the same for every method: (up axis, azimuth, elevation in
+# degrees), looking at the model orthographically. Azimuth 0 looks from the axis after `up` in
+# x, y, z order (from +z when y is up, from +x when z is up; azimuth 90 from the next one);
+# elevation lifts the eye towards `up`. Models not listed: DEFAULT_VIEW.
+VIEWS = {
+    "horse.obj": ("z", 30, 25),
+    "cow.obj": ("y", -140, 15),
+    "spot.obj": ("y", 120, 20),
+    "fandisk.obj": ("z", 30, 30),
+    "bracket.obj": ("z", 30, 30),
+    "flange.obj": ("z", 30, 35),
+}
+DEFAULT_VIEW = ("y", 30, 20)
+# The zoom, the same for every method of a model: a square window (centre, half-width, in bbox-100
+# units of the input) seen by the model's camera, on a part that tells remeshers apart: the
+# horse's ear tips, the cow's tail beside the rump; on the CAD parts, creases meeting at corners:
+# fandisk's front edge over its steps and arch, a hole of the bracket's base, a bolt hole of the
+# flange (rim, bore and the disk's top). Other models: CLOSEUP_HALF_WIDTH around the input's top
+# (largest coordinate along the camera's up axis), moved CLOSEUP_DROP down.
 CLOSEUPS = {
     "horse.obj": ((-6.0, 43.0, 39.0), 5.0),
     "cow.obj": ((-43.0, 10.0, 0.0), 9.0),
+    "fandisk.obj": ((44.0, 8.0, 18.0), 12.0),
+    "bracket.obj": ((8.3, 13.3, -28.3), 10.0),
+    "flange.obj": ((37.5, 0.0, -6.2), 10.0),
 }
 CLOSEUP_HALF_WIDTH = 10.0
 CLOSEUP_DROP = 5.0
+# The height of a method's row in the views picture, inches (at 80 dpi; saved as JPEG, quality 80, so
+# a model's picture of a dozen methods stays near 1 MB).
+VIEW_HEIGHT = 5.0
+
+# The verdict columns: each compared between `ours` and the best reference tool, with whether a
+# higher value is better.
+VERDICT_COLUMNS = {
+    "theta_min": True,
+    "theta_min_ave": True,
+    "theta_max": False,
+    "q_min": True,
+    "q_ave": True,
+    "pct_theta_below_30": False,
+    "p30": False,
+    "hausdorff": False,
+    "rms": False,
+}
+# Reference tools left out of the best reference: MeshLab's Poisson-disk + ball pivoting leaves
+# holes, so its triangles are not a remesh of the whole surface.
+NOT_IN_BEST_REFERENCE = {"poisson_bpa"}
+
+# geogram's CVT remeshing: the version of the `geogram` PyPI package whose wheel (headers and the
+# static libgeogram.a) and sdist (the HLBFGS sources the wheel's library lacks) build
+# eval/geogram_cvt.cpp into eval/.build/ on first use.
+GEOGRAM_VERSION = "0.0.7"
+BUILD = HERE / ".build"
 
 # The paper's Table 1 (Öztireli, Alexa, Gross 2010): model, points, method, θmin, θmin,ave,
 # Qmin, Qave, %θ<30, time (s).
@@ -259,6 +306,54 @@ def run_botsch_features(V, F, h, work, input_path):
     return run_botsch(V, F, h, work, input_path, feature_angle=CAD_FEATURE_ANGLE)
 
 
+def build_geogram_cvt():
+    """The path of the geogram_cvt tool, built on first use (and again when eval/geogram_cvt.cpp is
+    newer than it) into eval/.build/: pip downloads the `geogram` wheel (headers, static
+    libgeogram.a and its bundled TBB) and sdist (for the HLBFGS sources and
+    lbfgs_optimizers.cpp: the wheel's library is built without HLBFGS), then the C++ compiler
+    ($CXX, default c++) links them with OpenMP."""
+    source = HERE / "geogram_cvt.cpp"
+    tool = BUILD / "geogram_cvt"
+    if tool.exists() and tool.stat().st_mtime >= source.stat().st_mtime:
+        return tool
+    downloads, tree = BUILD / "downloads", BUILD / "geogram"
+    pip = [sys.executable, "-m", "pip", "download", f"geogram=={GEOGRAM_VERSION}", "--no-deps", "-q"]
+    subprocess.run([*pip, "-d", str(downloads), "--only-binary", ":all:"], check=True)
+    subprocess.run([*pip, "-d", str(downloads), "--no-binary", "geogram"], check=True)
+    with zipfile.ZipFile(next(downloads.glob(f"geogram-{GEOGRAM_VERSION}-*.whl"))) as z:
+        z.extractall(tree)
+    lib = "src/extern/geogram/src/lib/geogram/"
+    wanted = (f"{lib}third_party/HLBFGS/", f"{lib}numerics/lbfgs_optimizers.cpp")
+    with tarfile.open(downloads / f"geogram-{GEOGRAM_VERSION}.tar.gz") as t:
+        members = [m for m in t.getmembers() if any(w in m.name for w in wanted)]
+        t.extractall(tree / "sdist", members=members, filter="data")
+    sources = sorted(str(p) for p in (tree / "sdist").rglob("*.cpp"))
+    libs = tree / "geogram.libs"
+    built = tool.with_suffix(".part")
+    compile_ = [os.environ.get("CXX", "c++"), "-O2", "-std=c++17", "-fopenmp", "-DGEOGRAM_WITH_HLBFGS"]
+    compile_ += [f"-I{tree / 'include' / 'geogram1'}", str(source), *sources, str(tree / "lib64" / "libgeogram.a")]
+    compile_ += [str(next(libs.glob("libtbb*.so*"))), f"-Wl,-rpath,{libs}", "-lpthread", "-ldl", "-o", str(built)]
+    out = subprocess.run(compile_, capture_output=True, text=True)
+    if out.returncode != 0:
+        raise RuntimeError(f"building geogram_cvt failed: {out.stderr.strip().splitlines()[-1:]}")
+    built.rename(tool)
+    return tool
+
+
+def run_geogram_cvt(V, F, n, work, input_path):
+    """geogram's remesh_smooth at n points (5 Lloyd and 30 Newton iterations, vorpalite's defaults)
+    through eval/geogram_cvt.cpp, on the input written as OBJ; seconds: the whole process, reading
+    and writing included, as for ours."""
+    tool = build_geogram_cvt()
+    src, dst = Path(work) / "geogram_in.obj", Path(work) / "geogram_out.obj"
+    write_obj(src, V, F)
+    t = time.perf_counter()
+    subprocess.run([str(tool), str(src), str(dst), str(int(n))], check=True, capture_output=True)
+    seconds = time.perf_counter() - t
+    V2, F2 = read_mesh(dst)
+    return V2, F2, seconds
+
+
 def run_poisson_bpa(V, F, n, work, input_path):
     import pymeshlab
 
@@ -276,8 +371,7 @@ METHODS = {
     "ours": ("remesh (spectral sampling)", "count", run_ours),
     "ours_sigma_n": ("remesh --sigma-n 0.75", "count", None),
     "ours_features": ("remesh --feature-angle 20", "count", None),
-    "ours_features_fit": ("remesh --feature-angle 20 --fit", "count", None),
-    "ours_fit": ("remesh --fit (least-squares vertices)", "count", None),
+    "ours_paper": ("remesh --smooth 0 --no-fit (the paper's pipeline)", "count", None),
     "meshlab_isotropic": ("MeshLab isotropic explicit remeshing (10 it.)", "length", run_meshlab_isotropic),
     "cgal_isotropic": ("CGAL PMP isotropic_remeshing (10 it.)", "length", run_cgal_isotropic),
     "cgal_features": (
@@ -292,7 +386,19 @@ METHODS = {
         "length",
         run_botsch_features,
     ),
+    "geogram_cvt": ("geogram CVT (remesh_smooth)", "count", run_geogram_cvt),
     "poisson_bpa": ("MeshLab Poisson-disk + ball pivoting", "count", run_poisson_bpa),
+}
+# The reference tools' short names, for the best-reference cells.
+SHORT_NAMES = {
+    "meshlab_isotropic": "MeshLab",
+    "cgal_isotropic": "CGAL",
+    "cgal_features": "CGAL, features",
+    "acvd": "ACVD",
+    "botsch": "Botsch-Kobbelt",
+    "botsch_features": "Botsch-Kobbelt, features",
+    "geogram_cvt": "geogram CVT",
+    "poisson_bpa": "Poisson-disk + BPA",
 }
 
 
@@ -300,8 +406,7 @@ METHODS = {
 OURS_VARIANTS = {
     "ours_sigma_n": ("--sigma-n", "0.75"),
     "ours_features": ("--feature-angle", str(CAD_FEATURE_ANGLE)),
-    "ours_features_fit": ("--feature-angle", str(CAD_FEATURE_ANGLE), "--fit"),
-    "ours_fit": ("--fit",),
+    "ours_paper": ("--smooth", "0", "--no-fit"),
 }
 
 
@@ -358,77 +463,133 @@ def normalize(V, ref_V):
     return (V - (lo + hi) / 2) * (100.0 / (hi - lo).max())
 
 
-def closeup_png(model, rows, ref_V, path):
+def view_rotation(model):
+    """The camera of `model`'s pictures (its VIEWS entry) as a rotation: rows are the view's right,
+    up and towards-the-viewer directions in model coordinates."""
+    up, azim, elev = VIEWS.get(model, DEFAULT_VIEW)
+    k = "xyz".index(up)
+    u, a, b = np.eye(3)[k], np.eye(3)[(k + 1) % 3], np.eye(3)[(k + 2) % 3]
+    az, el = math.radians(azim), math.radians(elev)
+    towards = math.cos(el) * (math.cos(az) * a + math.sin(az) * b) + math.sin(el) * u
+    right = np.cross(u, towards)
+    right /= np.linalg.norm(right)
+    return np.stack([right, np.cross(towards, right), towards])
+
+
+def zoom_region(model, ref_V):
+    """The zoom of `model`'s pictures: (centre, half-width) in bbox-100 units, the same for every
+    method (see CLOSEUPS)."""
+    if model in CLOSEUPS:
+        return np.array(CLOSEUPS[model][0]), CLOSEUPS[model][1]
+    Vn = normalize(ref_V, ref_V)
+    up = np.eye(3)["xyz".index(VIEWS.get(model, DEFAULT_VIEW)[0])]
+    return Vn[np.argmax(Vn @ up)] - CLOSEUP_DROP * up, CLOSEUP_HALF_WIDTH
+
+
+def draw_mesh(ax, V, F, R, window, linewidth):
+    """Draws the triangles F of V (bbox-100 units) seen by the camera R, orthographically, back to
+    front (painter's order), shaded by a light over the viewer's left shoulder, with their edges,
+    into the 2D axes `ax` framed to `window` (x0, x1, y0, y1 in view units). The whole mesh is
+    drawn; only faces wholly outside the window (with a margin) are left out, for speed: they
+    would draw nothing inside it."""
+    from matplotlib.collections import PolyCollection
+
+    P = V @ R.T
+    T = P[F]
+    x0, x1, y0, y1 = window
+    margin = 0.02 * (x1 - x0)
+    lo, hi = T.min(1), T.max(1)
+    keep = (hi[:, 0] >= x0 - margin) & (lo[:, 0] <= x1 + margin) & (hi[:, 1] >= y0 - margin) & (lo[:, 1] <= y1 + margin)
+    T = T[keep]
+    T = T[np.argsort(T[:, :, 2].mean(1), kind="stable")]
+    n = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    light = np.array([-0.4, 0.5, 0.77])
+    shade = 0.25 + 0.75 * np.abs(n @ (light / np.linalg.norm(light)))
+    colors = np.stack([0.95 * shade, 0.75 * shade, 0.55 * shade, np.ones_like(shade)], 1)
+    ax.add_collection(PolyCollection(T[:, :, :2], facecolors=colors, edgecolors=(0, 0, 0, 0.55), linewidths=linewidth))
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+
+
+def views_jpg(model, rows, ref_V, path):
+    """One row per method: its whole mesh with the wireframe (left; the zoom's window outlined) and
+    the zoom (right), both from the model's camera (VIEWS), the same frame for every method."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from matplotlib.patches import Rectangle
 
-    if model in CLOSEUPS:
-        c, half = np.array(CLOSEUPS[model][0]), CLOSEUPS[model][1]
-    else:
-        Vn = normalize(ref_V, ref_V)
-        c = Vn[np.argmax(Vn[:, 1])] - np.array([0.0, CLOSEUP_DROP, 0.0])
-        half = CLOSEUP_HALF_WIDTH
     shown = [r for r in rows if r.get("mesh_file")]
     if not shown:
         return
-    cols = min(4, len(shown))
-    nrows = math.ceil(len(shown) / cols) if shown else 1
-    fig = plt.figure(figsize=(4.5 * cols, 4.7 * nrows))
-    light = np.array([0.4, 0.3, 0.85])
-    light /= np.linalg.norm(light)
-    for k, r in enumerate(shown):
+    R = view_rotation(model)
+    centre, half = zoom_region(model, ref_V)
+    P = normalize(ref_V, ref_V) @ R.T
+    lo, hi = P.min(0), P.max(0)
+    mid, rad = (lo + hi) / 2, 0.52 * (hi - lo)
+    whole = (mid[0] - rad[0], mid[0] + rad[0], mid[1] - rad[1], mid[1] + rad[1])
+    c = centre @ R.T
+    zoom = (c[0] - half, c[0] + half, c[1] - half, c[1] + half)
+    # Rows of VIEW_HEIGHT inches: the whole view as wide as the model is, the zoom square.
+    aspect = rad[0] / rad[1]
+    fig, axes = plt.subplots(
+        len(shown),
+        2,
+        figsize=(VIEW_HEIGHT * (aspect + 1), VIEW_HEIGHT * len(shown) + 0.4),
+        squeeze=False,
+        gridspec_kw=dict(width_ratios=(aspect, 1)),
+    )
+    for (left, right), r in zip(axes, shown):
         V, F = read_mesh(r["mesh_file"])
         V = normalize(V, ref_V)
-        T = V[F]
-        keep = np.abs(T.mean(1) - c).max(1) < half
-        T = T[keep]
-        if len(T) == 0:
-            continue
-        n = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
-        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
-        shade = 0.25 + 0.75 * np.abs(n @ light)
-        colors = np.stack([0.95 * shade, 0.75 * shade, 0.55 * shade, np.ones_like(shade)], 1)
-        ax = fig.add_subplot(nrows, cols, k + 1, projection="3d")
-        ax.add_collection3d(Poly3DCollection(T, facecolors=colors, edgecolor=(0, 0, 0, 0.6), linewidths=0.3))
-        # Frame what is there (the cube's corners are mostly empty).
-        lo, hi = T.reshape(-1, 3).min(0), T.reshape(-1, 3).max(0)
-        mid, rad = (lo + hi) / 2, 0.5 * (hi - lo).max()
-        ax.set_xlim(mid[0] - rad, mid[0] + rad)
-        ax.set_ylim(mid[1] - rad, mid[1] + rad)
-        ax.set_zlim(mid[2] - rad, mid[2] + rad)
-        ax.set_box_aspect((1, 1, 1))
-        ax.view_init(elev=15, azim=60)
-        ax.set_axis_off()
-        ax.set_title(f"{r['method']}\n{r['vertices']} v, θmin {r['theta_min']:.1f}°, Qmin {r['q_min']:.2f}", fontsize=9)
-    fig.suptitle(f"{model}: the same close-up region for every method", fontsize=11)
-    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.9, wspace=0.0, hspace=0.15)
-    fig.savefig(path, dpi=90)
+        draw_mesh(left, V, F, R, whole, 0.1)
+        outline = Rectangle((zoom[0], zoom[2]), 2 * half, 2 * half, fill=False, edgecolor="tab:red", linewidth=1.2)
+        left.add_patch(outline)
+        draw_mesh(right, V, F, R, zoom, 0.5)
+        stats = f"{r['vertices']} v, θmin {r['theta_min']:.1f}°, θmax {r['theta_max']:.1f}°, Qmin {r['q_min']:.2f}"
+        left.set_title(f"{r['method']}\n{stats}", fontsize=9)
+        right.set_title("zoom: the red square", fontsize=9)
+    fig.suptitle(f"{model}: every method from the same camera, whole and zoomed", fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.4 / (VIEW_HEIGHT * len(shown) + 0.4)))
+    fig.savefig(path, dpi=80, pil_kwargs={"quality": 80})
     plt.close(fig)
 
 
-def histogram_png(model, rows, path):
+# The angle histograms: per kind, the triangle's angle taken, the bins (degrees), the word for it and
+# where a dotted line goes.
+ANGLE_HISTOGRAMS = {
+    "min": (np.min, np.linspace(0, 60, 61), "smallest", 30),
+    "max": (np.max, np.linspace(60, 180, 121), "largest", 90),
+}
+
+
+def histogram_png(model, rows, path, kind):
+    """The histogram of every method's triangle smallest (kind "min") or largest ("max") angles,
+    log scale."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    reduce, bins, word, line = ANGLE_HISTOGRAMS[kind]
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    bins = np.linspace(0, 60, 61)
     for r in rows:
         if not r.get("mesh_file"):
             continue
-        amin = triangle_angles(*read_mesh(r["mesh_file"])).min(1)
-        color = plt.get_cmap("tab10")(list(METHODS).index(r["key"]))
-        ax.hist(amin, bins=bins, histtype="step", density=True, linewidth=1.4, label=r["method"], color=color)
-    ax.axvline(30, color="grey", linestyle=":", linewidth=1)
-    ax.set_xlabel("smallest angle of a triangle (degrees)")
+        angles = reduce(triangle_angles(*read_mesh(r["mesh_file"])), axis=1)
+        i = list(METHODS).index(r["key"])
+        color = plt.get_cmap("tab20")(2 * i % 20 + 2 * i // 20)  # tab10's colours, then their light shades
+        ax.hist(angles, bins=bins, histtype="step", density=True, linewidth=1.4, label=r["method"], color=color)
+    ax.axvline(line, color="grey", linestyle=":", linewidth=1)
+    ax.set_xlabel(f"{word} angle of a triangle (degrees)")
     ax.set_ylabel("fraction of triangles per degree (log)")
     ax.set_yscale("log")
     ax.set_ylim(1e-5, 0.3)
-    ax.set_title(f"{model}: triangle minimum angles")
+    ax.set_title(f"{model}: triangle {word} angles")
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
@@ -444,6 +605,7 @@ COLUMNS = [
     ("faces", "F", "{}"),
     ("theta_min", "θmin", "{:.2f}"),
     ("theta_min_ave", "θmin,ave", "{:.2f}"),
+    ("theta_max", "θmax", "{:.2f}"),
     ("q_min", "Qmin", "{:.3f}"),
     ("q_ave", "Qave", "{:.4f}"),
     ("pct_theta_below_30", "%θ<30", "{:.3f}"),
@@ -465,6 +627,64 @@ def fmt_row(r):
         v = r.get(key)
         cells.append("–" if v is None else f.format(v))
     return "| " + " | ".join(cells) + " |"
+
+
+def verdicts(rows):
+    """Per VERDICT_COLUMNS column: `ours`'s value, the best value among the reference tools (the
+    methods not of ours and not in NOT_IN_BEST_REFERENCE, failed rows left out) and its tool, and
+    the verdict: "beaten" (ours is better), "tied" (equal at the table's precision), "not beaten";
+    ours and the verdict are None when ours failed. Columns no reference tool has are left out."""
+    ours = next((r for r in rows if r["key"] == "ours" and not r.get("failed")), None)
+    references = [
+        r
+        for r in rows
+        if not r["key"].startswith("ours") and r["key"] not in NOT_IN_BEST_REFERENCE and not r.get("failed")
+    ]
+    formats = {key: f for key, _, f in COLUMNS}
+    out = {}
+    for key, higher in VERDICT_COLUMNS.items():
+        values = [r for r in references if r.get(key) is not None]
+        if not values:
+            continue
+        best = (max if higher else min)(values, key=lambda r: r[key])
+        mine = ours.get(key) if ours else None
+        if mine is None:
+            verdict = None
+        elif formats[key].format(mine) == formats[key].format(best[key]):
+            verdict = "tied"
+        else:
+            verdict = "beaten" if (mine > best[key]) == higher else "not beaten"
+        out[key] = {
+            "ours": mine,
+            "best": best[key],
+            "best_tool": SHORT_NAMES[best["key"]],
+            "best_count_within_2pct": best["count_within_2pct"],
+            "verdict": verdict,
+        }
+    return out
+
+
+def verdict_markdown(v):
+    """The best-reference row and the verdict lines of one model's table, from verdicts()."""
+    labels = {key: (label, f) for key, label, f in COLUMNS}
+    cells = []
+    for key, _, _ in COLUMNS:
+        if key == "method":
+            cells.append("**best reference**")
+        elif key in v:
+            c = v[key]
+            mark = "" if c["best_count_within_2pct"] else "*"
+            cells.append(f"{labels[key][1].format(c['best'])} ({c['best_tool']}{mark})")
+        else:
+            cells.append("")
+    row = "| " + " | ".join(cells) + " |"
+    lines = []
+    for key, c in v.items():
+        label, f = labels[key]
+        ours = "failed" if c["ours"] is None else f.format(c["ours"])
+        verdict = c["verdict"] or "ours failed"
+        lines.append(f"- {label}: ours {ours} vs best reference {f.format(c['best'])} ({c['best_tool']}): {verdict}")
+    return row, lines
 
 
 def evaluate_model(input_path, n, methods, outdir, log):
@@ -500,6 +720,7 @@ def evaluate_model(input_path, n, methods, outdir, log):
                 faces=topo["faces"],
                 theta_min=t["theta_min"],
                 theta_min_ave=t["theta_min_ave"],
+                theta_max=t["theta_max"] if "theta_max" in t else triangle_angles(*read_mesh(mesh_file)).max(),
                 q_min=t["q_min"],
                 q_ave=t["q_ave"],
                 pct_theta_below_30=t["pct_theta_below_30"],
@@ -571,9 +792,19 @@ def main():
             continue
         model, rows, (V, F) = evaluate_model(path, n, methods, outdir, log)
         stem = Path(model).stem
-        closeup_png(model, rows, V, outdir / f"{stem}-closeup.png")
-        histogram_png(model, rows, outdir / f"{stem}-min-angles.png")
-        results.append({"model": model, "target": n, "input_vertices": len(V), "input_faces": len(F), "rows": rows})
+        views_jpg(model, rows, V, outdir / f"{stem}-views.jpg")
+        for kind in ANGLE_HISTOGRAMS:
+            histogram_png(model, rows, outdir / f"{stem}-{kind}-angles.png", kind)
+        results.append(
+            {
+                "model": model,
+                "target": n,
+                "input_vertices": len(V),
+                "input_faces": len(F),
+                "rows": rows,
+                "verdicts": verdicts(rows),
+            }
+        )
     elapsed = time.perf_counter() - started
 
     for res in results:
@@ -596,14 +827,19 @@ def write_markdown(path, results, elapsed, quick):
         f"Generated by `eval/run{' --quick' if quick else ''}` in {elapsed:.0f} s on this machine. Every output is "
         "measured by one ruler, `remesh quality --ref INPUT --json` (distances in bbox-100 units of the input, "
         "two-sided, 200,000 random samples per side plus the vertices). Seconds: the remesh call alone, wall clock, "
-        f"median of {TIMING_RUNS} (ours: the whole `remesh` process with reading and writing). × ours: seconds "
-        "relative to ours. Each tool's parameter was searched so its output has the target vertex count within 2%; "
-        "a count outside 2% is marked with *."
+        f"median of {TIMING_RUNS} (ours and geogram CVT: the whole process with reading and writing). × ours: "
+        "seconds relative to ours. Each tool's parameter was searched so its output has the target vertex count "
+        "within 2%; a count outside 2% is marked with *. θmax: the largest angle of the mesh. Best reference: per "
+        "column, the best value among the reference tools (every method but remesh's rows; not MeshLab Poisson-disk "
+        "+ ball pivoting, which leaves holes), with the tool; the lines under each table say whether ours (`remesh`, "
+        "default settings) beats it: higher is better for θmin, θmin,ave, Qmin and Qave, lower for θmax, %θ<30, "
+        "P30, Hausdorff and RMS; tied is equal at the table's precision."
     )
     lines.append("")
     lines.append(f"Tools: pymeshlab {pymeshlab.__version__ if hasattr(pymeshlab, '__version__') else '2025.7.post1'}, "
                  "cgal 6.0.1 (Python bindings), pyacvd 0.4.0, gpytoolbox 0.3.8, trimesh "
-                 f"{trimesh.__version__}. See eval/README.md for parameters and caveats.")
+                 f"{trimesh.__version__}, geogram {GEOGRAM_VERSION} (PyPI wheel's static library, built into a "
+                 "command-line tool). See eval/README.md for parameters and caveats.")
     lines.append("")
     header = "| " + " | ".join(c[1] for c in COLUMNS) + " |"
     sep = "|" + "---|" * len(COLUMNS)
@@ -615,7 +851,16 @@ def write_markdown(path, results, elapsed, quick):
             if not r.get("failed") and not r.get("count_within_2pct"):
                 row = row.replace(f"| {r['vertices']} |", f"| {r['vertices']}* |", 1)
             lines.append(row)
-        lines += ["", f"![{stem} close-up]({stem}-closeup.png)", "", f"![{stem} minimum angles]({stem}-min-angles.png)", ""]
+        best_row, verdict_lines = verdict_markdown(res["verdicts"])
+        lines += [best_row, "", "Ours against the best reference tool:", "", *verdict_lines, ""]
+        lines += [
+            f"![{stem}: every method whole and zoomed]({stem}-views.jpg)",
+            "",
+            f"![{stem} smallest angles]({stem}-min-angles.png)",
+            "",
+            f"![{stem} largest angles]({stem}-max-angles.png)",
+            "",
+        ]
     # The paper's Table 1 layout.
     lines += ["## The paper's Table 1 beside ours", ""]
     lines += ["| Model | Num Pts | Method | θmin | θmin,ave | Qmin | Qave | θ<30° | Time (s) |", "|---|---|---|---|---|---|---|---|---|"]
