@@ -149,9 +149,8 @@ fn relax(
             }
             let mut d = weighted / area - old;
             d -= n * n.dot(d);
-            let sp = surface.closest_point(old + d)?;
-            (sp.distance <= 4.0 * params.max_offset && surface.smooth_normal(&sp).dot(n) >= 0.5)
-                .then_some((v, sp.position))
+            let sp = surface.closest_point_within(old + d, 4.0 * params.max_offset)?;
+            (surface.smooth_normal(&sp).dot(n) >= 0.5).then_some((v, sp.position))
         })
         .collect();
     let mut moves = 0;
