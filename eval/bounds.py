@@ -11,7 +11,6 @@ eval/results/bounds/bounds.md and bounds.json.
 
 import argparse
 import json
-import os
 import statistics
 import subprocess
 import sys
@@ -21,21 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent
-SHARED = ROOT.parent / "shared" / "data"
-REMESH = os.environ.get("REMESH_BIN", str(ROOT / "target" / "release" / "remesh"))
+from compare import DEFAULT_MODELS, HERE, REMESH, SHARED
 
-# The models of the eval harness and their counts (eval/compare.py's DEFAULT_MODELS).
-MODELS = [
-    ("horse", 8600),
-    ("stanford-bunny", 9635),
-    ("fandisk", 6000),
-    ("spot", 3000),
-    ("cow", 3000),
-    ("bracket", 4000),
-    ("flange", 6000),
-]
+# The models of the eval harness and their counts, by name.
+MODELS = [(Path(m).stem, n) for m, n in DEFAULT_MODELS]
 THETA_MIN, THETA_MAX, Q_AVE, HAUSDORFF_PCT_DIAG, COUNT_PCT = 35.0, 100.0, 0.94, 0.2, 1.0
 
 

@@ -413,6 +413,16 @@ pub(crate) mod test_meshes {
     use super::TriMesh;
     use glam::DVec3;
 
+    /// The two meshes as one (the second's vertices after the first's).
+    pub fn union_of(a: &TriMesh, b: &TriMesh) -> TriMesh {
+        let mut m = a.clone();
+        let off = m.positions.len() as u32;
+        m.positions.extend(b.positions.iter().copied());
+        m.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+        m
+    }
+
     /// `n` nearly evenly spread unit vectors: the Fibonacci spiral (z from 1 to -1, longitude
     /// advancing by the golden angle).
     pub fn fibonacci_sphere(n: usize) -> Vec<DVec3> {

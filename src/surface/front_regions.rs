@@ -508,17 +508,8 @@ fn near_box(winding: &RayWinding, f: usize) -> Aabb {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::{cuboid, uv_sphere};
+    use crate::mesh::test_meshes::{cuboid, union_of, uv_sphere};
     use crate::mesh::TriMesh;
-
-    fn union_of(a: &TriMesh, b: &TriMesh) -> TriMesh {
-        let mut m = a.clone();
-        let off = m.positions.len() as u32;
-        m.positions.extend(b.positions.iter().copied());
-        m.triangles
-            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
-        m
-    }
 
     fn shifted(m: &TriMesh, by: DVec3) -> TriMesh {
         TriMesh::new(

@@ -398,17 +398,8 @@ impl<'a> BuriedTest<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::{cuboid, uv_sphere};
+    use crate::mesh::test_meshes::{cuboid, union_of, uv_sphere};
     use crate::sampling::candidates::surface_candidates;
-
-    fn union_of(a: &TriMesh, b: &TriMesh) -> TriMesh {
-        let mut m = a.clone();
-        let off = m.positions.len() as u32;
-        m.positions.extend(b.positions.iter().copied());
-        m.triangles
-            .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
-        m
-    }
 
     #[test]
     fn winding_numbers_count_the_layers_of_solid() {
