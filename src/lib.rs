@@ -184,7 +184,8 @@ pub use sampling::WidthField;
 
 // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
 // optimization against the input, the separation of crossing faces.
-pub use triangulate::fit::{fit_to_surface, AngleBounds, FitStats, FIT_MAX_SHIFT};
+pub use geometry::triangle::AngleBounds;
+pub use triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
 pub use triangulate::optimize::{
     optimize, OptimizeParams, OptimizeStats, SmoothStats, SMOOTH_ITERATIONS,
 };

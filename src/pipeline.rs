@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
+use crate::geometry::triangle::AngleBounds;
 use crate::kernel::Kernel;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
@@ -34,7 +35,6 @@ use crate::surface::MeshSurface;
 use crate::surface::SurfaceSample;
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
-use crate::triangulate::fit::AngleBounds;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
 use crate::triangulate::recover::{close_slits, flip_crease_slivers, recover_edges, RecoverStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};

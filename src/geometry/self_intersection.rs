@@ -119,6 +119,52 @@ pub fn intersecting_pairs(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u
     intersecting_pairs_counted(positions, triangles).0
 }
 
+/// The faces of `triangles` that cross another face ([`intersecting_pairs`]), each as its corners
+/// sorted (so a face keeps its name when an edit mesh moves it to another slot), sorted.
+pub(crate) fn crossing_faces(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let mut faces: Vec<[u32; 3]> = intersecting_pairs(positions, triangles)
+        .into_iter()
+        .flatten()
+        .map(|i| {
+            let mut t = triangles[i as usize];
+            t.sort_unstable();
+            t
+        })
+        .collect();
+    faces.sort_unstable();
+    faces.dedup();
+    faces
+}
+
+/// Puts the corners of every face that crosses another and is not in `before` (from
+/// [`crossing_faces`]) back at `start`, until no new crossing is left: how a stage that moves
+/// vertices (the finishing relaxation, the least-squares fit, either of which can bring the two
+/// sides of a thin part together) takes back the moves that made a crossing.
+pub(crate) fn undo_new_crossings(
+    positions: &mut [DVec3],
+    triangles: &[[u32; 3]],
+    start: &[DVec3],
+    before: &[[u32; 3]],
+) {
+    loop {
+        let mut undone = false;
+        for t in crossing_faces(positions, triangles) {
+            if before.binary_search(&t).is_ok() {
+                continue;
+            }
+            for v in t.map(|v| v as usize) {
+                if positions[v] != start[v] {
+                    positions[v] = start[v];
+                    undone = true;
+                }
+            }
+        }
+        if !undone {
+            return;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

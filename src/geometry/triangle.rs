@@ -84,6 +84,26 @@ pub fn triangle_q(p: [DVec3; 3]) -> f64 {
     6.0 * s / (3f64.sqrt() * half_perimeter * h)
 }
 
+/// Bounds on a triangle's angles, degrees: what the last pass of the optimization works towards
+/// and what the least-squares fit keeps (a face within them stays so, one outside gets no worse).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AngleBounds {
+    /// The smallest angle kept, degrees.
+    pub min_deg: f64,
+    /// The largest angle kept, degrees.
+    pub max_deg: f64,
+}
+
+impl AngleBounds {
+    /// The face's angle score: min(θmin, `min_deg` + `max_deg` − θmax), below `min_deg` exactly
+    /// when an angle is out of bounds.
+    pub fn score(&self, corners: [DVec3; 3]) -> f64 {
+        let a = triangle_angles_deg(corners);
+        let (lo, hi) = (a[0].min(a[1]).min(a[2]), a[0].max(a[1]).max(a[2]));
+        lo.min(self.min_deg + self.max_deg - hi)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -21,8 +21,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::geometry::self_intersection::intersecting_pairs;
-use crate::geometry::triangle::triangle_angles_deg;
+use crate::geometry::self_intersection::{crossing_faces, undo_new_crossings};
+use crate::geometry::triangle::AngleBounds;
 use crate::mesh::TriMesh;
 use crate::surface::MeshSurface;
 
@@ -68,26 +68,6 @@ pub struct FitStats {
     pub max_offset: f64,
 }
 
-/// The angles a fit keeps: a face whose angles were within `[min_deg, max_deg]` stays so, and
-/// one that was not gets no worse (degrees).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AngleBounds {
-    /// The smallest angle kept, degrees.
-    pub min_deg: f64,
-    /// The largest angle kept, degrees.
-    pub max_deg: f64,
-}
-
-impl AngleBounds {
-    /// The face's angle score: min(θmin, `min_deg` + `max_deg` − θmax), below `min_deg` exactly
-    /// when an angle is out of bounds.
-    pub fn score(&self, corners: [DVec3; 3]) -> f64 {
-        let a = triangle_angles_deg(corners);
-        let (lo, hi) = (a[0].min(a[1]).min(a[2]), a[0].max(a[1]).max(a[2]));
-        lo.min(self.min_deg + self.max_deg - hi)
-    }
-}
-
 /// Moves the vertices of `mesh` not `fixed` along their normals so that the faces approximate
 /// `surface` in the least-squares sense (see the module), in `iterations` Jacobi steps. With
 /// `bounds`, a step's move is undone for the corners of every face it would take out of the
@@ -102,7 +82,7 @@ pub fn fit_to_surface(
     let n = mesh.positions.len();
     let start = mesh.positions.clone();
     // The faces that cross another before the fit: the fit makes no new crossing.
-    let crossing_before = crossing_faces(mesh);
+    let crossing_before = crossing_faces(&mesh.positions, &mesh.triangles);
     // Each face's angle score before the fit: what the bounds keep.
     let score_before: Vec<f64> = match &bounds {
         Some(b) => (0..mesh.triangles.len())
@@ -194,7 +174,12 @@ pub fn fit_to_surface(
             );
         }
     }
-    undo_new_crossings(mesh, &start, &crossing_before);
+    undo_new_crossings(
+        &mut mesh.positions,
+        &mesh.triangles,
+        &start,
+        &crossing_before,
+    );
     let moved: Vec<f64> = (0..n)
         .filter(|&v| mesh.positions[v] != start[v])
         .map(|v| mesh.positions[v].distance(start[v]))
@@ -207,42 +192,6 @@ pub fn fit_to_surface(
             moved.iter().sum::<f64>() / moved.len() as f64
         },
         max_offset: moved.iter().copied().fold(0.0, f64::max),
-    }
-}
-
-/// The faces of `mesh` that cross another face, sorted.
-fn crossing_faces(mesh: &TriMesh) -> Vec<u32> {
-    let mut faces: Vec<u32> = intersecting_pairs(&mesh.positions, &mesh.triangles)
-        .into_iter()
-        .flatten()
-        .collect();
-    faces.sort_unstable();
-    faces.dedup();
-    faces
-}
-
-/// Puts the corners of every face that crosses another after the fit and did not before back
-/// where they started (a fit on both sides of a thin part can bring its sheets together), until
-/// no new crossing is left.
-fn undo_new_crossings(mesh: &mut TriMesh, start: &[DVec3], crossing_before: &[u32]) {
-    loop {
-        let new: Vec<u32> = crossing_faces(mesh)
-            .into_iter()
-            .filter(|f| crossing_before.binary_search(f).is_err())
-            .collect();
-        let mut undone = false;
-        for f in new {
-            for v in mesh.triangles[f as usize] {
-                let v = v as usize;
-                if mesh.positions[v] != start[v] {
-                    mesh.positions[v] = start[v];
-                    undone = true;
-                }
-            }
-        }
-        if !undone {
-            return;
-        }
     }
 }
 

@@ -10,7 +10,7 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 
 use super::flip::max_min_flips;
-use crate::geometry::triangle::{triangle_angles_deg, triangle_min_angle_deg, triangle_q};
+use crate::geometry::triangle::{triangle_min_angle_deg, triangle_q, AngleBounds};
 use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::mesh_projection::MeshSurface;
@@ -183,9 +183,11 @@ pub(super) fn q(m: &Mesh, t: [u32; 3]) -> f64 {
 
 /// The last pass's angle score of `t` (see [`OptimizeParams::final_theta_max_deg`]), degrees.
 pub(super) fn angle_score(m: &Mesh, t: [u32; 3], params: &Limits) -> f64 {
-    let a = triangle_angles_deg(m.corners(t));
-    let (lo, hi) = (a[0].min(a[1]).min(a[2]), a[0].max(a[1]).max(a[2]));
-    lo.min(params.final_theta_deg + params.final_theta_max_deg - hi)
+    AngleBounds {
+        min_deg: params.final_theta_deg,
+        max_deg: params.final_theta_max_deg,
+    }
+    .score(m.corners(t))
 }
 
 /// The shape score the operations maximize at their worst face: Q and the smallest angle, each

@@ -16,7 +16,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::geometry::self_intersection::intersecting_pairs;
+use crate::geometry::self_intersection::{crossing_faces, undo_new_crossings};
 
 use super::*;
 
@@ -201,12 +201,19 @@ pub(super) fn smooth(
         })
         .collect();
     let pins: Vec<DVec3> = m.positions().to_vec();
-    let crossing_before = crossing_faces(m);
+    let crossing_before = crossing_faces(m.positions(), &m.live_faces().0);
     for _ in 0..iterations {
         stats.valence_flips += valence_flips(m, surface, params, VALENCE_FLIP_MIN_ANGLE_DEG);
         stats.moves += relax(m, surface, &movable, &pins, params);
     }
-    undo_new_crossings(m, &pins, &crossing_before);
+    let mut positions = m.positions().to_vec();
+    undo_new_crossings(&mut positions, &m.live_faces().0, &pins, &crossing_before);
+    for (v, &p) in positions.iter().enumerate() {
+        if p != m.position(v as u32) {
+            // A position the mesh had: finite.
+            let _ = m.relocate_vertex(v as u32, p);
+        }
+    }
     let mut edges: Vec<(u32, u32)> = m.directed_edges().filter(|&(a, b)| a < b).collect();
     edges.sort_unstable();
     for _ in 0..3 {
@@ -219,45 +226,4 @@ pub(super) fn smooth(
         edges.sort_unstable();
     }
     stats
-}
-
-/// The faces of `m` that cross another, each as its sorted corners (slots change with flips).
-fn crossing_faces(m: &Mesh) -> Vec<[u32; 3]> {
-    let (live, _) = m.live_faces();
-    let mut faces: Vec<[u32; 3]> = intersecting_pairs(m.positions(), &live)
-        .into_iter()
-        .flatten()
-        .map(|i| {
-            let mut t = live[i as usize];
-            t.sort_unstable();
-            t
-        })
-        .collect();
-    faces.sort_unstable();
-    faces.dedup();
-    faces
-}
-
-/// Puts the corners of every face that crosses another and did not before the relaxation back
-/// at their `pins` (where they were before it: a relaxation on both sides of a thin part can
-/// bring its sheets together), until no new crossing is left.
-fn undo_new_crossings(m: &mut Mesh, pins: &[DVec3], crossing_before: &[[u32; 3]]) {
-    loop {
-        let mut undone = false;
-        for t in crossing_faces(m) {
-            if crossing_before.binary_search(&t).is_ok() {
-                continue;
-            }
-            for v in t {
-                if m.position(v) != pins[v as usize]
-                    && m.relocate_vertex(v, pins[v as usize]).is_ok()
-                {
-                    undone = true;
-                }
-            }
-        }
-        if !undone {
-            return;
-        }
-    }
 }
