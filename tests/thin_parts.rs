@@ -118,8 +118,14 @@ fn a_tube_too_thin_for_the_count_is_named_with_a_count_that_resolves_it() {
         .iter()
         .find(|r| r.unresolved > 0)
         .expect("a region");
-    // The region is on the tube (model units: the tube as given).
-    assert!(region.min.x >= -0.11 && region.max.x <= 0.11, "{region:?}");
+    // The region is on the tube (model units: the tube as given), up to what the separation of
+    // crossing faces moved a vertex off it.
+    let off = 0.11 + out.untangle.max_displacement;
+    assert!(
+        region.min.x >= -off && region.max.x <= off,
+        "{region:?} {:?}",
+        out.untangle
+    );
     let count = g.resolving_count.expect("a resolving count");
     assert!(count > 2000.0 && count < 100_000.0, "{count}");
     // At that count the tube comes out whole.

@@ -67,7 +67,7 @@ pub struct OptimizeParams {
     /// `final_theta_max_deg` − θmax), which is below `final_theta_deg` exactly when an angle is
     /// out of bounds.
     pub final_theta_max_deg: f64,
-    /// Rounds of the last pass at most (default 4).
+    /// Rounds of the last pass at most (default 8).
     pub final_rounds: usize,
     /// Iterations of the tangential relaxation with valence flips before covering (`smooth.rs`;
     /// default [`SMOOTH_ITERATIONS`], 0 turns it off).
@@ -88,7 +88,7 @@ impl Default for OptimizeParams {
             collapse_offset_sigma_p: 0.25,
             final_theta_deg: 35.0,
             final_theta_max_deg: 100.0,
-            final_rounds: 4,
+            final_rounds: 8,
             smooth_iterations: SMOOTH_ITERATIONS,
         }
     }
