@@ -44,14 +44,14 @@ DEFAULT_MODELS = [
     ("bracket.obj", 4000),
     ("flange.obj", 6000),
 ]
-# The feature angle of the feature-preserving settings (ours_features, cgal_features,
-# botsch_features): the library's CAD_FEATURE_ANGLE_DEG.
+# The feature angle of the feature-preserving settings (cgal_features, botsch_features): the
+# library's CAD_FEATURE_ANGLE_DEG, at which ours finds creases by default.
 CAD_FEATURE_ANGLE = 20
-# The CAD parts: where `ours_features` (remesh --feature-angle 20) runs in a full run.
+# The CAD parts: where the feature settings (and `ours_no_features`) run in a full run.
 CAD_MODELS = {"fandisk.obj", "bracket.obj", "flange.obj"}
 # The feature-preserving settings, run on the CAD parts only in a full run (on any model when
 # asked for with --methods).
-FEATURE_METHODS = {"ours_features", "cgal_features", "botsch_features"}
+FEATURE_METHODS = {"ours_no_features", "cgal_features", "botsch_features"}
 COUNT_TOLERANCE = 0.02
 TIMING_RUNS = 3
 
@@ -370,7 +370,7 @@ def run_poisson_bpa(V, F, n, work, input_path):
 METHODS = {
     "ours": ("remesh (spectral sampling)", "count", run_ours),
     "ours_sigma_n": ("remesh --sigma-n 0.75", "count", None),
-    "ours_features": ("remesh --feature-angle 20", "count", None),
+    "ours_no_features": ("remesh --no-features (creases not detected)", "count", None),
     "ours_paper": ("remesh --smooth 0 --no-fit (the paper's pipeline)", "count", None),
     "meshlab_isotropic": ("MeshLab isotropic explicit remeshing (10 it.)", "length", run_meshlab_isotropic),
     "cgal_isotropic": ("CGAL PMP isotropic_remeshing (10 it.)", "length", run_cgal_isotropic),
@@ -405,7 +405,7 @@ SHORT_NAMES = {
 # The settings of remesh besides `ours`: the extra arguments of each.
 OURS_VARIANTS = {
     "ours_sigma_n": ("--sigma-n", "0.75"),
-    "ours_features": ("--feature-angle", str(CAD_FEATURE_ANGLE)),
+    "ours_no_features": ("--no-features",),
     "ours_paper": ("--smooth", "0", "--no-fit"),
 }
 

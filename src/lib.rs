@@ -163,8 +163,8 @@ pub use surface::curvature::{
     CURVATURE_MAX_BEND_DEG,
 };
 pub use surface::features::{
-    detect_features, FeatureCurve, FeatureParams, Features, CAD_FEATURE_ANGLE_DEG,
-    DEFAULT_FEATURE_ANGLE_DEG,
+    detect_features, long_curve_share, FeatureCurve, FeatureDetection, FeatureParams, Features,
+    AUTO_FEATURE_MIN_SHARE, CAD_FEATURE_ANGLE_DEG, LONG_CURVE_SPACINGS,
 };
 pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceSample};
 

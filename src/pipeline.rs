@@ -29,7 +29,10 @@ use crate::sampling::linear_scan::{
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::sampling::WidthField;
 use crate::surface::curvature::{Curvature, CurvatureParams, CurvatureWidths};
-use crate::surface::features::{detect_features, FeatureParams, DEFAULT_FEATURE_ANGLE_DEG};
+use crate::surface::features::{
+    detect_features, long_curve_share, FeatureDetection, FeatureParams, Features,
+    AUTO_FEATURE_MIN_SHARE,
+};
 use crate::surface::winding::BuriedTest;
 use crate::surface::MeshSurface;
 use crate::surface::SurfaceSample;
@@ -161,12 +164,13 @@ pub struct RemeshParams {
     /// normals ([`fit_to_surface`](crate::fit_to_surface); default [`FIT_ITERATIONS`]; 0: the
     /// vertices stay on the input, as in the paper, and the command line's `--no-fit`).
     pub fit_iterations: usize,
-    /// The feature angle (degrees) of the sharp-feature detection ([`detect_features`], at the
-    /// sample spacing of the first sigma_p): the creases found are sampled evenly along with the
-    /// boundary (`sampling::features::feature_pieces`), kept fixed, and their consecutive samples reported as
-    /// output edges. Default [`DEFAULT_FEATURE_ANGLE_DEG`] (180: off);
-    /// [`CAD_FEATURE_ANGLE_DEG`](crate::CAD_FEATURE_ANGLE_DEG) for CAD parts.
-    pub feature_angle_deg: f64,
+    /// The sharp-feature detection ([`detect_features`], at the sample spacing of the first
+    /// sigma_p): the creases found are sampled evenly along with the boundary
+    /// (`sampling::features::feature_pieces`), kept fixed, and their consecutive samples
+    /// reported as output edges. Default [`FeatureDetection::Auto`]: at
+    /// [`CAD_FEATURE_ANGLE_DEG`](crate::CAD_FEATURE_ANGLE_DEG), kept when the creases are a
+    /// part's (long curves), left out on a scan.
+    pub features: FeatureDetection,
     /// Relative tolerance of the count search (default 0.005).
     pub count_tolerance: f64,
     /// Seed of every random choice.
@@ -188,7 +192,7 @@ impl Default for RemeshParams {
             grading: None,
             curvature: None,
             fit_iterations: FIT_ITERATIONS,
-            feature_angle_deg: DEFAULT_FEATURE_ANGLE_DEG,
+            features: FeatureDetection::Auto,
             count_tolerance: 0.005,
             seed: 1,
         }
@@ -226,6 +230,13 @@ fn edges_present(mesh: &TriMesh, edges: &[[u32; 2]]) -> usize {
 pub struct FeatureStats {
     /// The feature angle, degrees.
     pub angle_deg: f64,
+    /// With automatic detection ([`FeatureDetection::Auto`]): whether the creases found were
+    /// kept (`false`: a scan's folds, left out; the counts below are what was found).
+    pub automatic: Option<bool>,
+    /// The share of the creases' length in curves at least
+    /// [`LONG_CURVE_SPACINGS`](crate::LONG_CURVE_SPACINGS) spacings long
+    /// ([`long_curve_share`]).
+    pub long_curve_share: f64,
     /// The scale the creases were tested at (the sample spacing of the first sigma_p).
     pub scale: f64,
     /// Feature edges of the input.
@@ -315,7 +326,7 @@ pub struct RemeshOutput {
     pub buried_samples: usize,
     /// What the grading by the local feature size did (`None` when it was off).
     pub grading: Option<GradingStats>,
-    /// The sharp features detected on the input (see [`RemeshParams::feature_angle_deg`]).
+    /// The sharp features detected on the input (see [`RemeshParams::features`]).
     pub features: FeatureStats,
     /// Tiny closed shells at unresolved tips removed (bbox-100 units).
     pub stray_shells: StrayShells,
@@ -502,21 +513,37 @@ pub fn remesh(
     // Sharp features: creases that stay sharp at the sample spacing.
     on_stage("features");
     let feature_scale = first_sigma_p / SAMPLES_PER_SIGMA2.sqrt();
-    let features = detect_features(
+    let mut features = detect_features(
         &surface,
         &FeatureParams {
-            angle_deg: params.feature_angle_deg,
+            angle_deg: params.features.angle_deg(),
             scale: feature_scale,
         },
     );
+    let long_share = long_curve_share(&features, &normalized.positions, feature_scale);
+    // Automatic detection keeps a part's creases and leaves a scan's folds out.
+    let auto_kept =
+        (params.features == FeatureDetection::Auto).then_some(long_share >= AUTO_FEATURE_MIN_SHARE);
+    let found = (
+        features.edges.len(),
+        features.curves.len(),
+        features.corners.len(),
+    );
+    let found_closed = features.curves.iter().filter(|c| c.closed).count();
+    let found_length = features.length(&normalized.positions);
+    if auto_kept == Some(false) {
+        features = Features::default();
+    }
     let feature_stats = FeatureStats {
-        angle_deg: params.feature_angle_deg,
+        angle_deg: params.features.angle_deg(),
+        automatic: auto_kept,
+        long_curve_share: long_share,
         scale: feature_scale,
-        edges: features.edges.len(),
-        curves: features.curves.len(),
-        closed_curves: features.curves.iter().filter(|c| c.closed).count(),
-        corners: features.corners.len(),
-        length: features.length(&normalized.positions),
+        edges: found.0,
+        curves: found.1,
+        closed_curves: found_closed,
+        corners: found.2,
+        length: found_length,
         sampled_edges: 0,
         triangulated_edges: 0,
         recovered_edges: 0,

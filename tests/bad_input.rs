@@ -630,8 +630,11 @@ fn gltf_with_several_meshes_and_nested_transforms_equals_its_flattened_obj() {
     );
     let o = write(dir.path(), "scene.obj", obj(&p, &faces, false));
     let (og, oo) = (dir.path().join("g.obj"), dir.path().join("o.obj"));
-    let rg = assert_result(&g, &og, &["--points", "600"]);
-    let ro = assert_result(&o, &oo, &["--points", "600"]);
+    // Without crease detection: the solids' edges are creases a part keeps (automatic detection
+    // keeps them), and a crease's sample count, its length over the spacing rounded, can be
+    // tipped by one by the float32 rounding of the glTF positions.
+    let rg = assert_result(&g, &og, &["--points", "600", "--no-features"]);
+    let ro = assert_result(&o, &oo, &["--points", "600", "--no-features"]);
     assert_eq!(topo(&rg, "components"), 2);
     assert_eq!(rg["topology"], ro["topology"]);
     let (a, b) = (

@@ -6,15 +6,15 @@ mod common;
 use common::grid_box_counts;
 use glam::DVec3;
 use spectral_remesh::{
-    remesh, CurvatureParams, Density, FeatureStats, RemeshParams, TriMesh, CAD_FEATURE_ANGLE_DEG,
-    FIT_ITERATIONS,
+    remesh, CurvatureParams, Density, FeatureDetection, FeatureStats, RemeshParams, TriMesh,
+    CAD_FEATURE_ANGLE_DEG, FIT_ITERATIONS,
 };
 
 /// A remesh at `points` with the CAD feature angle, at `seed`.
 fn cad(points: usize, seed: u64) -> RemeshParams {
     RemeshParams {
         density: Density::Points(points),
-        feature_angle_deg: CAD_FEATURE_ANGLE_DEG,
+        features: FeatureDetection::Angle(CAD_FEATURE_ANGLE_DEG),
         seed,
         // The samples on the input (the fit is measured against this by its own test).
         fit_iterations: 0,
@@ -96,6 +96,7 @@ fn a_boxs_edges_are_output_edges_at_every_seed_with_the_feature_angle() {
         &input,
         &RemeshParams {
             density: Density::Points(2000),
+            features: FeatureDetection::Off,
             ..Default::default()
         },
         &|_| {},

@@ -765,12 +765,28 @@ fn round_up_2(n: f64) -> u64 {
     ((n / scale).ceil() * scale) as u64
 }
 
-/// The report's line on the sharp features of a remesh with `--feature-angle`: what was found,
-/// what the output keeps and how far the creases are from its edges. None when detection was
-/// off.
+/// The report's line on the sharp features of a remesh: what was found, what the output keeps
+/// and how far the creases are from its edges, or why automatic detection left them out. None
+/// when detection was off or found nothing to leave out.
 fn features_note(f: &crate::pipeline::FeatureStats) -> Option<String> {
     if !(f.angle_deg < 180.0) {
         return None;
+    }
+    if f.automatic == Some(false) {
+        if f.edges == 0 {
+            return None;
+        }
+        return Some(format!(
+            "sharp features (automatic, at {}°): {} crease edges in {} curves, {:.0}% of their \
+             length in curves of {} spacings or more: a scan's folds, not a part's creases, so \
+             they are sampled like the rest (--feature-angle {} keeps them)",
+            f.angle_deg,
+            f.edges,
+            f.curves,
+            100.0 * f.long_curve_share,
+            crate::LONG_CURVE_SPACINGS,
+            f.angle_deg
+        ));
     }
     if f.edges == 0 {
         return Some(format!(

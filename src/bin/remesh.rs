@@ -10,8 +10,8 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
     catch_panics, parse_bytes, physical_memory, remove_temporaries, run_points, run_quality,
-    run_remesh, run_simplify, write_report, CurvatureParams, Density, Error, GradingParams,
-    MeshFormat, PointsJob, RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob,
+    run_remesh, run_simplify, write_report, CurvatureParams, Density, Error, FeatureDetection,
+    GradingParams, MeshFormat, PointsJob, RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob,
     TriangulationMethod, FIT_ITERATIONS, STDOUT,
 };
 
@@ -110,10 +110,16 @@ struct Cli {
     /// Sharp features: an input edge is a crease when the surface either side of it turns by
     /// at least DEG degrees, between its two faces and still at the sample spacing (so a scan's
     /// folds are not creases); creases are sampled evenly like the boundary and kept as output
-    /// edges. 20 is the measured choice for CAD parts. 180, the default, turns it off (a scan's
-    /// folds pass it everywhere: horse at 20 comes out with θmin 9°)
-    #[arg(long, default_value_t = spectral_remesh::DEFAULT_FEATURE_ANGLE_DEG, value_name = "DEG")]
-    feature_angle: f64,
+    /// edges, every one found. Without it (the default) creases are found at 20° and kept when
+    /// they are a part's: at least 90% of their length in curves of 3 sample spacings or more
+    /// (a scan's folds come in short pieces and are sampled like the rest). 180 turns detection
+    /// off, as does --no-features.
+    #[arg(long, value_name = "DEG", conflicts_with = "no_features")]
+    feature_angle: Option<f64>,
+
+    /// No sharp-feature detection: every part of the input is sampled alike.
+    #[arg(long)]
+    no_features: bool,
 
     /// How the samples are connected: `restricted`, the default (the restricted Delaunay
     /// triangulation on the input mesh: the dual of the samples' Voronoi cells grown over the
@@ -361,16 +367,17 @@ fn config(cli: Cli) -> Result<Config, Error> {
                     message: format!("must be a number >= 0, got {}", cli.lfs_factor),
                 });
             }
-            if !(cli.feature_angle >= 0.0 && cli.feature_angle <= 180.0) {
-                return Err(Error::InvalidParameter {
-                    name: "--feature-angle",
-                    message: format!(
-                        "must be an angle from 0 to 180 degrees, got {}",
-                        cli.feature_angle
-                    ),
-                });
-            }
-            params.feature_angle_deg = cli.feature_angle;
+            params.features = match cli.feature_angle {
+                _ if cli.no_features => FeatureDetection::Off,
+                None => FeatureDetection::Auto,
+                Some(a) if (0.0..=180.0).contains(&a) => FeatureDetection::Angle(a),
+                Some(a) => {
+                    return Err(Error::InvalidParameter {
+                        name: "--feature-angle",
+                        message: format!("must be an angle from 0 to 180 degrees, got {a}"),
+                    })
+                }
+            };
             params.triangulation = match cli.triangulation.as_str() {
                 "umbrellas" => TriangulationMethod::Umbrellas,
                 "restricted" => TriangulationMethod::RestrictedDelaunay(Default::default()),
