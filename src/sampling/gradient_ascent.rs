@@ -122,20 +122,8 @@ pub fn gradient_ascent_graded<S: Projection + ?Sized>(
     let fixed = fixed.min(n);
     let sigma_p = kernel.sigma_p();
     let r_pos = params.support_radius * sigma_p;
-    let positions: Vec<_> = samples.iter().map(|s| s.position).collect();
-    let tree = StaticTree::new(&positions);
-    // Neighbour lists, fixed for all sweeps (CSR layout).
-    let lists: Vec<Vec<u32>> = (fixed..n)
-        .into_par_iter()
-        .map_init(Vec::new, |found, i| {
-            tree.within(positions[i], r_pos * r_pos, found);
-            found
-                .iter()
-                .map(|x| x.0)
-                .filter(|&j| j as usize != i)
-                .collect()
-        })
-        .collect();
+    // Neighbour lists, fixed for all sweeps.
+    let lists = neighbour_lists(samples, fixed, r_pos);
 
     let mut result = GradientAscentResult {
         mean_move: Vec::with_capacity(params.iterations),
@@ -258,6 +246,24 @@ pub fn gradient_ascent_graded<S: Projection + ?Sized>(
     result
 }
 
+/// For each sample of `samples[from..]`, the indices of the other samples within `radius` of it
+/// (bbox-100 units). Parallel; each list in the tree's order, so deterministic.
+fn neighbour_lists(samples: &[SurfaceSample], from: usize, radius: f64) -> Vec<Vec<u32>> {
+    let positions: Vec<_> = samples.iter().map(|s| s.position).collect();
+    let tree = StaticTree::new(&positions);
+    (from..samples.len())
+        .into_par_iter()
+        .map_init(Vec::new, |found, i| {
+            tree.within(positions[i], radius * radius, found);
+            found
+                .iter()
+                .map(|x| x.0)
+                .filter(|&j| j as usize != i)
+                .collect()
+        })
+        .collect()
+}
+
 /// One step of eq. 11 for sample `i`: the gradient of s at x_i over its neighbours `list`, a
 /// bounded step along it, and the projection onto the surface. Returns the moved sample, the
 /// distance moved and s before the move.
@@ -335,20 +341,7 @@ mod tests {
         seed: u64,
     ) {
         let n = samples.len();
-        let positions: Vec<_> = samples.iter().map(|s| s.position).collect();
-        let tree = StaticTree::new(&positions);
-        let r = params.support_radius * kernel.sigma_p();
-        let mut found = Vec::new();
-        let lists: Vec<Vec<u32>> = (0..n)
-            .map(|i| {
-                tree.within(positions[i], r * r, &mut found);
-                found
-                    .iter()
-                    .map(|x| x.0)
-                    .filter(|&j| j as usize != i)
-                    .collect()
-            })
-            .collect();
+        let lists = neighbour_lists(samples, 0, params.support_radius * kernel.sigma_p());
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let mut order: Vec<usize> = (0..n).collect();
         let mut embedded: Vec<KernelPoint> = samples
