@@ -9,7 +9,6 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
-use crate::geometry::triangle::AngleBounds;
 use crate::kernel::Kernel;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
@@ -475,23 +474,7 @@ pub fn remesh(
     let mut input_points: Vec<DVec3> = normalized.positions.clone();
     if let Some(test) = &buried_test {
         buried_candidates = test.remove_buried(&mut pool, |c| (c.position, c.normal, Some(c.face)));
-        // Each vertex with a face it is a corner of (its first).
-        let mut vertex_face = vec![None; normalized.positions.len()];
-        for (f, t) in normalized.triangles.iter().enumerate().rev() {
-            for &v in t {
-                if let Some(slot) = vertex_face.get_mut(v as usize) {
-                    *slot = Some(f as u32);
-                }
-            }
-        }
-        let mut vertices: Vec<(DVec3, DVec3, Option<u32>)> = normalized
-            .positions
-            .iter()
-            .copied()
-            .zip(normalized.vertex_normals())
-            .zip(vertex_face)
-            .map(|((p, n), f)| (p, n, f))
-            .collect();
+        let mut vertices = BuriedTest::vertex_points(&normalized);
         test.remove_buried(&mut vertices, |&v| v);
         input_points = vertices.into_iter().map(|(p, _, _)| p).collect();
     }
@@ -897,10 +880,7 @@ pub fn remesh(
                 &fixed,
                 params.fit_iterations,
                 // The fit keeps the angles the last pass of optimize reached.
-                params.optimize.as_ref().map(|op| AngleBounds {
-                    min_deg: op.final_theta_deg,
-                    max_deg: op.final_theta_max_deg,
-                }),
+                params.optimize.as_ref().map(OptimizeParams::angle_bounds),
             )
         });
         let untangle_stats = untangle(&mut mesh_normalized, &fixed, sigma_p, &params.untangle);

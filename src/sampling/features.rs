@@ -326,7 +326,7 @@ pub fn feature_pieces(
                 faces: c.faces.clone(),
                 closed: c.closed,
             };
-            (curve_length(mesh, &piece), piece)
+            (c.length(&mesh.positions), piece)
         })
         .collect();
     let ends = |c: &BoundaryCurve| [c.vertices[0], c.vertices[c.vertices.len() - 1]];

@@ -34,9 +34,10 @@ pub struct GradientAscentParams {
     pub support_radius: f64,
     /// Move samples one at a time in a seeded random order, each seeing the moves before it
     /// (Sec. 6.2; default true). Runs of consecutive samples in that order of which no two are
-    /// neighbours are moved in parallel, with the same result. When false, all samples move at once from the positions at
-    /// the start of the sweep, in parallel; that form needs a smaller step (0.25) to converge and
-    /// converges more slowly (horse at 8600, 10 sweeps: θmin,ave 50.5 against 52.6).
+    /// neighbours are moved in parallel, with the same result. When false, all samples move at
+    /// once from the positions at the start of the sweep, in parallel; that form needs a smaller
+    /// step (0.25) to converge and converges more slowly (horse at 8600, 10 sweeps: θmin,ave
+    /// 50.5 against 52.6).
     pub sequential: bool,
     /// Halvings of a step that would lower s (with the neighbours held fixed) before it is taken
     /// anyway (default 0: every step is taken, as in eq. 11). Measured on horse at 8600: no

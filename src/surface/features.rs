@@ -61,16 +61,7 @@ pub fn long_curve_share(features: &Features, positions: &[DVec3], spacing: f64) 
     let lengths: Vec<f64> = features
         .curves
         .iter()
-        .map(|c| {
-            let k = c.vertices.len();
-            let edges = if c.closed { k } else { k.saturating_sub(1) };
-            (0..edges)
-                .map(|i| {
-                    positions[c.vertices[i] as usize]
-                        .distance(positions[c.vertices[(i + 1) % k] as usize])
-                })
-                .sum::<f64>()
-        })
+        .map(|c| c.length(positions))
         .collect();
     let total: f64 = lengths.iter().sum();
     if !(total > 0.0) {
@@ -128,6 +119,18 @@ pub struct Features {
     pub curves: Vec<FeatureCurve>,
     /// The corners, ascending: the ends of the open curves.
     pub corners: Vec<u32>,
+}
+
+impl FeatureCurve {
+    /// The curve's length: the sum of its edges, `vertices[k] → vertices[k+1]` and, closed,
+    /// the last back to the first (units of `positions`).
+    pub fn length(&self, positions: &[DVec3]) -> f64 {
+        let nv = self.vertices.len();
+        let pos = |k: usize| positions[self.vertices[k % nv] as usize];
+        (0..self.faces.len())
+            .map(|k| pos(k).distance(pos(k + 1)))
+            .sum()
+    }
 }
 
 impl Features {

@@ -314,6 +314,26 @@ impl<'a> BuriedTest<'a> {
         }
     }
 
+    /// The vertices of `mesh` as points for [`BuriedTest::buried`]: each with its normal
+    /// ([`TriMesh::vertex_normals`]) and the first face it is a corner of (`None` for an
+    /// unreferenced vertex).
+    pub(crate) fn vertex_points(mesh: &TriMesh) -> Vec<(DVec3, DVec3, Option<u32>)> {
+        let mut vertex_face = vec![None; mesh.positions.len()];
+        for (f, t) in mesh.triangles.iter().enumerate().rev() {
+            for &v in t {
+                if let Some(slot) = vertex_face.get_mut(v as usize) {
+                    *slot = Some(f as u32);
+                }
+            }
+        }
+        mesh.positions
+            .iter()
+            .zip(mesh.vertex_normals())
+            .zip(vertex_face)
+            .map(|((&p, n), f)| (p, n, f))
+            .collect()
+    }
+
     /// Removes the buried items of `items` (keeping the order of the others), each seen as the
     /// surface point, normal and face `point` gives (see [`BuriedTest::buried`]); returns how
     /// many were removed. In parallel.
@@ -464,37 +484,30 @@ mod tests {
     /// The candidates on `m` (area-uniform, with their faces and face normals) and its vertices
     /// (with their normals and a face they are a corner of).
     fn test_points(m: &TriMesh, count: usize, seed: u64) -> Vec<(DVec3, DVec3, Option<u32>)> {
-        let mut vertex_face = vec![None; m.positions.len()];
-        for (f, t) in m.triangles.iter().enumerate().rev() {
-            for &v in t {
-                vertex_face[v as usize] = Some(f as u32);
-            }
-        }
         surface_candidates(m, count, seed)
             .iter()
             .map(|c| (c.position, c.normal, Some(c.face)))
-            .chain(
-                m.positions
-                    .iter()
-                    .zip(m.vertex_normals())
-                    .zip(vertex_face)
-                    .map(|((&p, n), f)| (p, n, f)),
-            )
+            .chain(BuriedTest::vertex_points(m))
             .collect()
     }
 
-    #[test]
-    fn the_regions_give_every_point_the_per_point_answer() {
-        // Two spheres of radius 10 whose centres are 12 apart, each with a cap inside the other;
-        // as given (outward) and turned inside out (the test follows the orientation).
+    /// Two spheres of radius 10 whose centres are 12 apart along z, each with a cap inside the
+    /// other (crossing on the circle at z = 6), as one mesh, oriented outward.
+    fn two_crossing_spheres() -> TriMesh {
         let a = uv_sphere(10.0, 24, 48);
         let b = TriMesh::new(
             a.positions.iter().map(|&p| p + DVec3::Z * 12.0).collect(),
             a.triangles.clone(),
         );
-        let mut inward = union_of(&a, &b);
+        union_of(&a, &b)
+    }
+
+    #[test]
+    fn the_regions_give_every_point_the_per_point_answer() {
+        // As given (outward) and turned inside out (the test follows the orientation).
+        let mut inward = two_crossing_spheres();
         inward.flip_orientation();
-        for m in [union_of(&a, &b), inward] {
+        for m in [two_crossing_spheres(), inward] {
             let points = test_points(&m, 20_000, 3);
             let test = BuriedTest::new(&m, points.len()).expect("the spheres cross");
             let (Some(winding), Some(regions)) = (&test.winding, &test.regions) else {
@@ -531,12 +544,7 @@ mod tests {
 
     #[test]
     fn points_without_a_face_or_off_their_face_are_tested_on_their_own() {
-        let a = uv_sphere(10.0, 24, 48);
-        let b = TriMesh::new(
-            a.positions.iter().map(|&p| p + DVec3::Z * 12.0).collect(),
-            a.triangles.clone(),
-        );
-        let m = union_of(&a, &b);
+        let m = two_crossing_spheres();
         let mut points = test_points(&m, 5_000, 1);
         // No face, a face far away, a face index out of range.
         let n = points.len();

@@ -30,8 +30,9 @@ enum Op {
 /// midpoint), and the move of each corner that may move (towards the centroid of its neighbours
 /// or the apex of the equilateral triangle on a small-angled face's far edge, all, half or a
 /// quarter of the way, projected onto the surface; and to the surface point of best angle score
-/// for its faces that a compass search finds, [`best_angle_position`]). Vertices on the boundary never move; fixed
-/// vertices (boundary samples, covering vertices) move only to undo a crossing.
+/// for its faces that a compass search finds, [`best_angle_position`]). Vertices on the boundary
+/// never move; fixed vertices (boundary samples, covering vertices) move only to undo a
+/// crossing.
 ///
 /// Of the candidates that pass every guard, the one whose new faces have the largest smallest
 /// angle is taken: for a face with a small angle, when that angle is larger than the smallest
@@ -314,16 +315,8 @@ fn best_angle_position(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits)
     if faces.is_empty() || n == DVec3::ZERO {
         return None;
     }
-    let bounds = AngleBounds {
-        min_deg: params.final_theta_deg,
-        max_deg: params.final_theta_max_deg,
-    };
-    let score = |p: DVec3| {
-        faces
-            .iter()
-            .map(|t| bounds.score([p, m.position(t[1]), m.position(t[2])]))
-            .fold(f64::INFINITY, f64::min)
-    };
+    let bounds = params.angle_bounds();
+    let score = |p: DVec3| ring_score(m, &faces, p, &bounds);
     let mean_edge = faces
         .iter()
         .map(|t| old.distance(m.position(t[1])))
@@ -355,6 +348,15 @@ fn best_angle_position(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits)
         }
     }
     (best_p != old).then_some(best_p)
+}
+
+/// The smallest angle score (`bounds`) of the faces `faces` around a vertex (each starting at
+/// it, as [`starting_at`] gives them) with the vertex at `p`.
+fn ring_score(m: &Mesh, faces: &[[u32; 3]], p: DVec3, bounds: &AngleBounds) -> f64 {
+    faces
+        .iter()
+        .map(|t| bounds.score([p, m.position(t[1]), m.position(t[2])]))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The smallest angle of the faces around `v` once it is at `q`, when the move passes the
@@ -621,19 +623,12 @@ mod tests {
         let m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
         let params = limits();
         let v = 3 * 7 + 3;
-        let ring_score = |p: DVec3| {
-            m.faces_around(v)
-                .iter()
-                .map(|&f| {
-                    let t = starting_at(face(&m, f), v);
-                    AngleBounds {
-                        min_deg: params.final_theta_deg,
-                        max_deg: params.final_theta_max_deg,
-                    }
-                    .score([p, m.position(t[1]), m.position(t[2])])
-                })
-                .fold(f64::INFINITY, f64::min)
-        };
+        let faces: Vec<[u32; 3]> = m
+            .faces_around(v)
+            .iter()
+            .map(|&f| starting_at(face(&m, f), v))
+            .collect();
+        let ring_score = |p: DVec3| ring_score(&m, &faces, p, &params.angle_bounds());
         // The best score by brute force over a fine grid of positions around the vertex.
         let old = m.position(v);
         let mut brute = f64::NEG_INFINITY;

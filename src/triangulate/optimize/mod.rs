@@ -60,7 +60,7 @@ pub struct OptimizeParams {
     /// units of sigma_p (default 0.25).
     pub collapse_offset_sigma_p: f64,
     /// The last pass mends the faces whose smallest angle is still below this, degrees
-    /// (default 30), and the faces that cross another.
+    /// (default 35), and the faces that cross another.
     pub final_theta_deg: f64,
     /// The last pass also mends the faces whose largest angle is above this, degrees
     /// (default 100): it works on the angle score min(θmin, `final_theta_deg` +
@@ -72,6 +72,17 @@ pub struct OptimizeParams {
     /// Iterations of the tangential relaxation with valence flips before covering (`smooth.rs`;
     /// default [`SMOOTH_ITERATIONS`], 0 turns it off).
     pub smooth_iterations: usize,
+}
+
+impl OptimizeParams {
+    /// The angle bounds the last pass works towards ([`OptimizeParams::final_theta_deg`],
+    /// [`OptimizeParams::final_theta_max_deg`]).
+    pub fn angle_bounds(&self) -> AngleBounds {
+        AngleBounds {
+            min_deg: self.final_theta_deg,
+            max_deg: self.final_theta_max_deg,
+        }
+    }
 }
 
 impl Default for OptimizeParams {
@@ -127,6 +138,14 @@ pub(super) struct Limits {
 }
 
 impl Limits {
+    /// The last pass's angle bounds ([`OptimizeParams::angle_bounds`]).
+    pub(super) fn angle_bounds(&self) -> AngleBounds {
+        AngleBounds {
+            min_deg: self.final_theta_deg,
+            max_deg: self.final_theta_max_deg,
+        }
+    }
+
     fn new(params: &OptimizeParams, sigma_p: f64) -> Self {
         Limits {
             q_below: params.q_below,
@@ -183,11 +202,7 @@ pub(super) fn q(m: &Mesh, t: [u32; 3]) -> f64 {
 
 /// The last pass's angle score of `t` (see [`OptimizeParams::final_theta_max_deg`]), degrees.
 pub(super) fn angle_score(m: &Mesh, t: [u32; 3], params: &Limits) -> f64 {
-    AngleBounds {
-        min_deg: params.final_theta_deg,
-        max_deg: params.final_theta_max_deg,
-    }
-    .score(m.corners(t))
+    params.angle_bounds().score(m.corners(t))
 }
 
 /// The shape score the operations maximize at their worst face: Q and the smallest angle, each

@@ -2,8 +2,6 @@
 //! surface.
 
 use glam::DVec3;
-use parry3d_f64::query::PointQuery;
-use parry3d_f64::shape::Triangle;
 
 use super::*;
 
@@ -56,11 +54,7 @@ pub(super) fn flip_all(
         let Some(old_mid) = surface.closest_point(0.5 * (px + py)) else {
             return false;
         };
-        let tri_dist = |t: [u32; 3], p: DVec3| {
-            let [a, b, c] = m.corners(t);
-            Triangle::new(a, b, c).distance_to_local_point(p, true)
-        };
-        tri_dist(new1, old_mid.position).min(tri_dist(new2, old_mid.position)) <= params.max_offset
+        distance_to(m, [new1, new2], old_mid.position) <= params.max_offset
     })
 }
 
