@@ -1,6 +1,8 @@
-//! Wall-clock times of a run's stages, as the report lists them.
+//! Wall-clock and processor times of a run's stages, as the report lists them.
 
 use std::time::Instant;
+
+use cpu_time::ProcessTime;
 
 /// One timed stage.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -9,6 +11,37 @@ pub struct Stage {
     pub name: &'static str,
     /// Wall-clock seconds.
     pub seconds: f64,
+    /// Processor seconds of the whole process (every thread, user and system) over the stage:
+    /// `cpu_seconds / seconds` is how many cores it kept busy on average.
+    pub cpu_seconds: f64,
+}
+
+/// A start point for one interval of wall-clock and processor time.
+#[derive(Debug, Clone, Copy)]
+pub struct Clock {
+    wall: Instant,
+    cpu: Option<ProcessTime>,
+}
+
+impl Clock {
+    /// Starts now.
+    pub fn start() -> Self {
+        Clock {
+            wall: Instant::now(),
+            // The process clock (clock_gettime's CLOCK_PROCESS_CPUTIME_ID on Unix) exists on
+            // every platform cpu-time supports; without it the processor time reads 0.
+            cpu: ProcessTime::try_now().ok(),
+        }
+    }
+
+    /// The wall-clock and processor seconds since the start.
+    pub fn elapsed(&self) -> (f64, f64) {
+        let cpu = self
+            .cpu
+            .and_then(|c| c.try_elapsed().ok())
+            .map_or(0.0, |d| d.as_secs_f64());
+        (self.wall.elapsed().as_secs_f64(), cpu)
+    }
 }
 
 /// A stopwatch over consecutive stages: each [`StageTimer::lap`] ends the current stage, which
@@ -16,7 +49,7 @@ pub struct Stage {
 #[derive(Debug, Clone)]
 pub struct StageTimer {
     stages: Vec<Stage>,
-    last: Instant,
+    last: Clock,
 }
 
 impl StageTimer {
@@ -24,20 +57,27 @@ impl StageTimer {
     pub fn new() -> Self {
         StageTimer {
             stages: Vec::new(),
-            last: Instant::now(),
+            last: Clock::start(),
         }
     }
 
     /// Ends the current stage as `name` and starts the next one; a stage run again (a count
-    /// correction) adds to its time and keeps its first place in the list.
+    /// correction) adds to its times and keeps its first place in the list.
     pub fn lap(&mut self, name: &'static str) {
-        let now = Instant::now();
-        let seconds = (now - self.last).as_secs_f64();
+        let next = Clock::start();
+        let (seconds, cpu_seconds) = self.last.elapsed();
         match self.stages.iter_mut().find(|s| s.name == name) {
-            Some(s) => s.seconds += seconds,
-            None => self.stages.push(Stage { name, seconds }),
+            Some(s) => {
+                s.seconds += seconds;
+                s.cpu_seconds += cpu_seconds;
+            }
+            None => self.stages.push(Stage {
+                name,
+                seconds,
+                cpu_seconds,
+            }),
         }
-        self.last = now;
+        self.last = next;
     }
 
     /// The stages so far, in the order they first ended; the timer starts an empty list.
@@ -67,7 +107,20 @@ mod tests {
         let names: Vec<_> = stages.iter().map(|s| s.name).collect();
         assert_eq!(names, ["a", "b"]);
         assert!(stages[1].seconds >= 0.005, "{stages:?}");
-        assert!(stages.iter().all(|s| s.seconds >= 0.0));
+        assert!(stages
+            .iter()
+            .all(|s| s.seconds >= 0.0 && s.cpu_seconds >= 0.0));
         assert!(t.take_stages().is_empty());
+    }
+
+    #[test]
+    fn busy_work_takes_processor_time() {
+        let clock = Clock::start();
+        let mut x = 0u64;
+        while clock.elapsed().0 < 0.02 {
+            x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+        }
+        let (wall, cpu) = clock.elapsed();
+        assert!(cpu > 0.5 * wall, "wall {wall}, cpu {cpu}");
     }
 }

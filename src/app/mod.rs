@@ -8,8 +8,8 @@ mod simplify;
 pub use memory::{estimate_remesh_bytes, parse_bytes, physical_memory};
 pub use simplify::{run_simplify, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary};
 
+use crate::timing::Clock;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use crate::error::{Error, Result};
 use crate::io::{as_written, encode_mesh, read_mesh, write_atomically, MeshFormat};
@@ -105,7 +105,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         memory::check_input_size(&job.input, limit)?;
     }
     on_stage("read");
-    let t = Instant::now();
+    let t = Clock::start();
     let (input, stats) = read_mesh(&job.input)?;
     let input_side = input.bbox().map_or(0.0, |b| b.longest_side());
     let (input, up) = into_normal_range(input);
@@ -125,7 +125,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             ),
         });
     }
-    let read_seconds = t.elapsed().as_secs_f64();
+    let read_seconds = t.elapsed();
     let params = job.params;
     if let Some(limit) = job.max_memory {
         let points = match params.density {
@@ -152,7 +152,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     }
     let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
     on_stage("check");
-    let t = Instant::now();
+    let t = Clock::start();
     // The report and `--strict` describe the file: the mesh as the format stores it (OBJ and
     // PLY exactly; glTF in f32 relative to the node's translation), normalized like the input.
     // A model scaled up by 2^up is written scaled back (rounded to its subnormal numbers), and
@@ -189,7 +189,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             ));
         }
     }
-    let check_seconds = t.elapsed().as_secs_f64();
+    let check_seconds = t.elapsed();
     let mut refusals = Vec::new();
     if !report.invariant_violations.is_empty() {
         let list = report
@@ -220,7 +220,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         });
     }
     on_stage("write");
-    let t = Instant::now();
+    let t = Clock::start();
     // Every check has passed: standard output gets the complete bytes, or nothing.
     let bytes = encode_mesh(&job.output, mesh_out, format)?;
     if to_stdout {
@@ -236,17 +236,17 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     } else {
         write_atomically(&job.output, |w| w.write_all(&bytes))?;
     }
-    let write_seconds = t.elapsed().as_secs_f64();
+    let write_seconds = t.elapsed();
 
-    report.push_stage("read", read_seconds);
+    report.push_stage("read", read_seconds.0, read_seconds.1);
     for s in &out.stages {
-        report.push_stage(s.name, s.seconds);
+        report.push_stage(s.name, s.seconds, s.cpu_seconds);
     }
-    report.push_stage("check (report)", check_seconds);
-    report.push_stage("write", write_seconds);
+    report.push_stage("check (report)", check_seconds.0, check_seconds.1);
+    report.push_stage("write", write_seconds.0, write_seconds.1);
     if job.measure_distance {
         on_stage("distance");
-        let t = Instant::now();
+        let t = Clock::start();
         let a = MeshSurface::new(checked)?;
         let b = MeshSurface::new(&out.input_normalized)?;
         report.distance = Some(surface_distance_with(
@@ -257,7 +257,8 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             DISTANCE_SAMPLES,
             params.seed,
         ));
-        report.push_stage("distance (report)", t.elapsed().as_secs_f64());
+        let (wall, cpu) = t.elapsed();
+        report.push_stage("distance (report)", wall, cpu);
     }
     let extra = &mut report.extra;
     extra.insert("sigma_p".into(), out.sigma_p.into());
@@ -456,7 +457,7 @@ fn orientation_notes(input: &OrientStats, output: &OrientStats, input_faces: usi
 /// # Errors
 /// Reading errors naming the file; [`Error::InvalidMesh`] for a mesh without area.
 pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<QualityReport> {
-    let t = Instant::now();
+    let t = Clock::start();
     let (mesh, _) = read_mesh(path)?;
     let reference = reference
         .map(|r| read_mesh(r).map(|(m, _)| (m, r)))
@@ -477,9 +478,10 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
         .ok_or_else(|| Error::invalid_mesh(path, Normalization::refusal(&bbox)))?;
     let m = normalization.apply_mesh(&mesh);
     let mut report = QualityReport::new(&m);
-    report.push_stage("read and measure", t.elapsed().as_secs_f64());
+    let (wall, cpu) = t.elapsed();
+    report.push_stage("read and measure", wall, cpu);
     if let Some((r, reference_path)) = &reference {
-        let t = Instant::now();
+        let t = Clock::start();
         let rn = normalization.apply_mesh(r);
         report.set_input(&rn);
         // Each side's error names its own file.
@@ -493,7 +495,8 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
             DISTANCE_SAMPLES,
             seed,
         ));
-        report.push_stage("distance", t.elapsed().as_secs_f64());
+        let (wall, cpu) = t.elapsed();
+        report.push_stage("distance", wall, cpu);
     }
     Ok(report)
 }

@@ -23,6 +23,9 @@ pub struct StageTime {
     pub stage: String,
     /// Wall-clock seconds.
     pub seconds: f64,
+    /// Processor seconds (all threads, user and system) over the stage; divided by `seconds`, the
+    /// cores it kept busy on average.
+    pub cpu_seconds: f64,
 }
 
 /// Everything the pipeline reports about an output mesh: the Table 1 triangle measures, its
@@ -149,17 +152,23 @@ impl QualityReport {
             .join("; ")
     }
 
-    /// Appends a stage time (seconds of wall-clock time).
-    pub fn push_stage(&mut self, stage: impl Into<String>, seconds: f64) {
+    /// Appends a stage's wall-clock and processor seconds.
+    pub fn push_stage(&mut self, stage: impl Into<String>, seconds: f64, cpu_seconds: f64) {
         self.stages.push(StageTime {
             stage: stage.into(),
             seconds,
+            cpu_seconds,
         });
     }
 
-    /// The sum of the stage times, in seconds.
+    /// The sum of the stages' wall-clock times, in seconds.
     pub fn total_seconds(&self) -> f64 {
         self.stages.iter().map(|s| s.seconds).sum()
+    }
+
+    /// The sum of the stages' processor times, in seconds.
+    pub fn total_cpu_seconds(&self) -> f64 {
+        self.stages.iter().map(|s| s.cpu_seconds).sum()
     }
 
     /// The report as pretty-printed JSON (field names as in the structs; `genus: null` where
@@ -297,11 +306,21 @@ impl fmt::Display for QualityReport {
         }
 
         writeln!(f)?;
-        writeln!(f, "Time (s)")?;
+        writeln!(
+            f,
+            "{:<w$}{:>VALUE$}{:>VALUE$}",
+            "Time (s)",
+            "wall",
+            "cpu",
+            w = LABEL + 2
+        )?;
+        let times = |f: &mut fmt::Formatter<'_>, label: &str, wall: f64, cpu: f64| {
+            writeln!(f, "  {label:<LABEL$}{wall:>VALUE$.3}{cpu:>VALUE$.3}")
+        };
         for s in &self.stages {
-            row(f, &s.stage, format!("{:.3}", s.seconds))?;
+            times(f, &s.stage, s.seconds, s.cpu_seconds)?;
         }
-        row(f, "total", format!("{:.3}", self.total_seconds()))?;
+        times(f, "total", self.total_seconds(), self.total_cpu_seconds())?;
 
         if !self.extra.is_empty() {
             writeln!(f)?;
@@ -336,7 +355,7 @@ mod tests {
         let m = TriMesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]);
         let mut r = QualityReport::new(&m);
         r.input_topology = Some(topology(&m));
-        r.push_stage("triangulate", 0.25);
+        r.push_stage("triangulate", 0.25, 0.5);
         r.notes.push("a note".into());
         r.extra.insert("sigma_p".into(), serde_json::json!(1.5));
         let s = r.to_string();
@@ -348,7 +367,10 @@ mod tests {
             "Distance to input (bbox-100 units)",
             "(not measured)",
             "Time (s)",
+            "wall",
+            "cpu",
             "total",
+            "0.500",
             "sigma_p",
             "- a note",
         ] {
