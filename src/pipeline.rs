@@ -8,7 +8,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
+use crate::geometry::tolerance::{DEGENERATE_AREA_TOLERANCE, ON_SURFACE_RELATIVE};
 use crate::kernel::Kernel;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
@@ -794,7 +794,12 @@ pub fn remesh(
         let normals: Vec<DVec3> = samples
             .par_iter()
             .map(
-                |s: &SurfaceSample| match surface.closest_point(s.position) {
+                // A sample lies on the surface (up to rounding).
+                |s: &SurfaceSample| match surface.closest_point_hinted(
+                    s.position,
+                    ON_SURFACE_RELATIVE * sigma_p,
+                    f64::MAX,
+                ) {
                     Some(sp) => surface.smooth_normal(&sp),
                     None => s.normal,
                 },

@@ -7,6 +7,7 @@ use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::{TriMesh as ParryTriMesh, TrianglePointLocation};
 
 use crate::error::{Error, Result};
+use crate::geometry::tolerance::SEARCH_BOUND_SLACK;
 use crate::mesh::TriMesh;
 
 /// A point on the surface: where it is, on which triangle, with which barycentric coordinates.
@@ -92,6 +93,27 @@ impl MeshSurface {
             barycentric,
             distance: (proj.point - p).length(),
         })
+    }
+
+    /// [`MeshSurface::closest_point_within`] with a hint: `hint` is the distance from `p` to a
+    /// point known to lie on the surface, so the closest point is no farther. The search is made
+    /// within the hint first (a hair more, for rounding), which prunes most of the hierarchy,
+    /// and within `max_dist` only when that finds nothing (a hint that was not a surface point's
+    /// distance): the same answer as without the hint.
+    pub fn closest_point_hinted(&self, p: DVec3, hint: f64, max_dist: f64) -> Option<SurfacePoint> {
+        let near = hint * (1.0 + SEARCH_BOUND_SLACK) + f64::MIN_POSITIVE;
+        if near < max_dist {
+            if let Some(sp) = self.closest_point_within(p, near) {
+                return Some(sp);
+            }
+        }
+        self.closest_point_within(p, max_dist)
+    }
+
+    /// The closest point to the midpoint of `a` and `b`, hinted by the distance to `a` (a mesh
+    /// edge whose ends lie on the surface: the usual case, and the search is then short).
+    pub fn closest_point_to_midpoint(&self, a: DVec3, b: DVec3) -> Option<SurfacePoint> {
+        self.closest_point_hinted(0.5 * (a + b), 0.5 * a.distance(b), f64::MAX)
     }
 
     /// Unit normal of face `f` of the source mesh.

@@ -99,7 +99,8 @@ pub fn restricted_delaunay(
             }
         };
     for (s, &x) in positions.iter().enumerate() {
-        let Some(sp) = surface.closest_point(x) else {
+        // A sample lies on the surface (up to rounding).
+        let Some(sp) = surface.closest_point_hinted(x, tolerance, f64::MAX) else {
             continue;
         };
         tree.within_unsorted(sp.position, radius * radius, &mut near);

@@ -124,7 +124,7 @@ pub(super) fn mend_faces(
                     let (pk, pr) = (m.position(kept), m.position(removed));
                     let mut aims = vec![pk];
                     if !stays(m, kept) {
-                        if let Some(sp) = surface.closest_point(0.5 * (pk + pr)) {
+                        if let Some(sp) = surface.closest_point_to_midpoint(pk, pr) {
                             aims.push(sp.position);
                         }
                     }
@@ -203,8 +203,8 @@ fn try_flip(
     // How far each pair of faces is from the surface: at the surface points nearest the two
     // diagonals' midpoints.
     let (px, py, pc, pd) = (m.position(x), m.position(y), m.position(c), m.position(d));
-    let old_mid = surface.closest_point(0.5 * (px + py))?;
-    let new_mid = surface.closest_point(0.5 * (pc + pd))?;
+    let old_mid = surface.closest_point_to_midpoint(px, py)?;
+    let new_mid = surface.closest_point_to_midpoint(pc, pd)?;
     let old_off = old_mid
         .distance
         .max(distance_to(m, flip.old, new_mid.position));

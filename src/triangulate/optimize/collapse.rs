@@ -59,7 +59,7 @@ pub(super) fn collapse_short(
             (false, false) => {
                 options.push((b, a, pa));
                 options.push((a, b, pb));
-                if let Some(sp) = surface.closest_point(0.5 * (pa + pb)) {
+                if let Some(sp) = surface.closest_point_to_midpoint(pa, pb) {
                     options.push((b, a, sp.position));
                 }
             }

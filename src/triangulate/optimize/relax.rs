@@ -45,13 +45,13 @@ pub(super) fn flip_all(
             return false;
         }
         let (px, py, pc, pd) = (m.position(x), m.position(y), m.position(c), m.position(d));
-        let Some(new_mid) = surface.closest_point(0.5 * (pc + pd)) else {
+        let Some(new_mid) = surface.closest_point_to_midpoint(pc, pd) else {
             return false;
         };
         if new_mid.distance > params.max_offset {
             return false;
         }
-        let Some(old_mid) = surface.closest_point(0.5 * (px + py)) else {
+        let Some(old_mid) = surface.closest_point_to_midpoint(px, py) else {
             return false;
         };
         distance_to(m, [new1, new2], old_mid.position) <= params.max_offset
@@ -115,7 +115,11 @@ pub(super) fn relax_poor(
             .iter()
             .flat_map(|&c| [1.0, 0.5, 0.25].map(|t| (c, t)))
         {
-            let Some(sp) = surface.closest_point(old.lerp(target, t)) else {
+            let Some(sp) = surface.closest_point_hinted(
+                old.lerp(target, t),
+                t * old.distance(target),
+                f64::MAX,
+            ) else {
                 continue;
             };
             if m.relocate_vertex(v, sp.position).is_err() {

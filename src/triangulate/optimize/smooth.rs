@@ -92,8 +92,7 @@ fn valence_flips(
         if n1.dot(mean_old) <= 0.0 || n2.dot(mean_old) <= 0.0 || n1.dot(n2) < 0.5 {
             continue;
         }
-        let mid = 0.5 * (m.position(c) + m.position(d));
-        match surface.closest_point(mid) {
+        match surface.closest_point_to_midpoint(m.position(c), m.position(d)) {
             Some(sp) if sp.distance <= params.max_offset => {}
             _ => continue,
         }
@@ -149,7 +148,8 @@ fn relax(
             }
             let mut d = weighted / area - old;
             d -= n * n.dot(d);
-            let sp = surface.closest_point_within(old + d, 4.0 * params.max_offset)?;
+            // The vertex lies on the surface: the target is within the move's length of it.
+            let sp = surface.closest_point_hinted(old + d, d.length(), 4.0 * params.max_offset)?;
             (surface.smooth_normal(&sp).dot(n) >= 0.5).then_some((v, sp.position))
         })
         .collect();
