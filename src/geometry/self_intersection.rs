@@ -10,9 +10,24 @@ use rayon::prelude::*;
 use super::triangle::is_degenerate_face;
 use super::triangle_intersection::triangles_intersect;
 
-/// Faces per sequential run of the search (fixed, so the result does not depend on the number
-/// of threads).
-const CHUNK: usize = 1024;
+/// The pairs of `boxes` (items of [`face_boxes`]: a face index and its bounding box) whose
+/// closed boxes overlap, each once as `[f, g]` with f < g (face indices), sorted. The boxes go
+/// into a BVH that is traversed against itself (parry's parallel traversal, whose pairs come in
+/// the order of the sequential one): O(F + pairs) for boxes small against the model, and the
+/// same result for any number of threads.
+pub(crate) fn overlapping_box_pairs(boxes: &[(usize, Aabb)]) -> Vec<[u32; 2]> {
+    if boxes.len() < 2 {
+        return Vec::new();
+    }
+    let bvh = Bvh::from_iter(BvhBuildStrategy::Binned, boxes.iter().copied());
+    let mut pairs: Vec<[u32; 2]> = bvh
+        .traverse_bvtt_single_tree_parallel::<false>()
+        .into_par_iter()
+        .map(|(a, b)| [a.min(b), a.max(b)])
+        .collect();
+    pairs.par_sort_unstable();
+    pairs
+}
 
 /// The pairs of non-adjacent triangles of `triangles` (indices into `positions`) whose closed
 /// triangles share at least one point (they cross, or touch at a point, along an edge or in a
@@ -24,52 +39,42 @@ const CHUNK: usize = 1024;
 /// are pairs that share a vertex index, since adjacent triangles meet by construction.
 ///
 /// # Runtime
-/// The bounding boxes go into a BVH; each triangle queries it with its own box, and every
-/// overlapping pair is decided by [`triangles_intersect`], which is exact. O(F log F) for a mesh
-/// whose triangles are small against the model; parallel (rayon) in fixed chunks, so the result
-/// is deterministic.
+/// The pairs of overlapping bounding boxes come from a BVH traversed against itself
+/// ([`overlapping_box_pairs`]), and every non-adjacent one is decided by
+/// [`triangles_intersect`], which is exact. O(F + pairs) for a mesh whose triangles are small
+/// against the model; parallel (rayon), and deterministic.
 pub fn intersecting_pairs_counted(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
 ) -> (Vec<[u32; 2]>, usize) {
-    let corners = |f: usize| triangles[f].map(|i| positions[i as usize]);
-    let boxes = face_boxes(positions, triangles);
-    if boxes.len() < 2 {
-        return (Vec::new(), 0);
-    }
-    let bvh = Bvh::from_iter(BvhBuildStrategy::Binned, boxes.iter().copied());
-    let per_chunk: Vec<(Vec<[u32; 2]>, usize)> = boxes
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            let (mut pairs, mut candidates) = (Vec::new(), 0);
-            let mut found = Vec::new();
-            for &(f, aabb) in chunk {
-                let tf = triangles[f];
-                found.clear();
-                found.extend(
-                    bvh.intersect_aabb(&aabb)
-                        .map(|g| g as usize)
-                        .filter(|&g| g > f && !tf.iter().any(|i| triangles[g].contains(i))),
-                );
-                found.sort_unstable();
-                for &g in &found {
-                    candidates += 1;
-                    if triangles_intersect(corners(f), corners(g)) {
-                        pairs.push([f as u32, g as u32]);
-                    }
-                }
-            }
-            (pairs, candidates)
+    let candidates = non_adjacent_pairs(positions, triangles);
+    let pairs: Vec<[u32; 2]> = candidates
+        .par_iter()
+        .copied()
+        .filter(|&[f, g]| {
+            triangles_intersect(
+                corners(positions, triangles, f),
+                corners(positions, triangles, g),
+            )
         })
         .collect();
-    let mut pairs = Vec::new();
-    let mut candidates = 0;
-    for (p, c) in per_chunk {
-        pairs.extend(p);
-        candidates += c;
-    }
-    pairs.sort_unstable();
-    (pairs, candidates)
+    (pairs, candidates.len())
+}
+
+/// The corners of face `f`.
+fn corners(positions: &[DVec3], triangles: &[[u32; 3]], f: u32) -> [DVec3; 3] {
+    triangles[f as usize].map(|i| positions[i as usize])
+}
+
+/// The pairs of faces of [`face_boxes`] whose bounding boxes overlap and that share no vertex
+/// index, as [`overlapping_box_pairs`] gives them.
+fn non_adjacent_pairs(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut pairs = overlapping_box_pairs(&face_boxes(positions, triangles));
+    pairs.retain(|&[f, g]| {
+        let tf = triangles[f as usize];
+        !tf.iter().any(|i| triangles[g as usize].contains(i))
+    });
+    pairs
 }
 
 /// The faces the search of [`intersecting_pairs_counted`] takes (every index in range, every
@@ -89,6 +94,10 @@ pub(crate) fn face_boxes(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<(us
         })
         .collect()
 }
+
+/// Faces per sequential run of [`has_intersecting_pair`]'s search (fixed, so the result does
+/// not depend on the number of threads).
+const CHUNK: usize = 1024;
 
 /// Whether [`intersecting_pairs_counted`] would find at least one pair, given `boxes`
 /// ([`face_boxes`] of the same faces) and a BVH over them (leaf data: the face index): the same

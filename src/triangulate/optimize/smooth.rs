@@ -43,13 +43,10 @@ pub struct SmoothStats {
 fn valence_flips(
     m: &mut Mesh,
     surface: &MeshSurface,
+    boundary: &[bool],
     params: &Limits,
     min_angle_deg: f64,
 ) -> usize {
-    // Interior flips do not change which vertices are on the boundary.
-    let boundary: Vec<bool> = (0..m.vertex_count() as u32)
-        .map(|v| m.is_boundary_vertex(v))
-        .collect();
     let mut edges: Vec<(u32, u32)> = m
         .directed_edges()
         .filter(|&(a, b)| a < b && m.face_on(b, a).is_some())
@@ -202,8 +199,13 @@ pub(super) fn smooth(
         .collect();
     let pins: Vec<DVec3> = m.positions().to_vec();
     let crossing_before = crossing_faces(m.positions(), &m.live_faces().0);
+    // Interior flips do not change which vertices are on the boundary.
+    let boundary: Vec<bool> = (0..m.vertex_count() as u32)
+        .map(|v| m.is_boundary_vertex(v))
+        .collect();
     for _ in 0..iterations {
-        stats.valence_flips += valence_flips(m, surface, params, VALENCE_FLIP_MIN_ANGLE_DEG);
+        stats.valence_flips +=
+            valence_flips(m, surface, &boundary, params, VALENCE_FLIP_MIN_ANGLE_DEG);
         stats.moves += relax(m, surface, &movable, &pins, params);
     }
     let mut positions = m.positions().to_vec();
