@@ -16,6 +16,15 @@ use crate::surface::SurfaceSample;
 /// The most samples moved in parallel at once by the sequential sweep.
 const MAX_BATCH: usize = 64;
 
+/// Type of one thread's buffers for [`move_one`].
+type Scratch = (MeasureWorkspace, Vec<(f64, KernelPoint)>, Vec<KernelPoint>);
+
+thread_local! {
+    /// Each thread's buffers for [`move_one`], kept from one batch to the next (a batch is a few
+    /// dozen moves: fresh buffers each time would be allocated and grown thousands of times).
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Default::default());
+}
+
 /// Parameters of the gradient ascent.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GradientAscentParams {
@@ -164,9 +173,8 @@ pub fn gradient_ascent_graded<S: Projection + ?Sized>(
                 let members = &order[start..end];
                 let moves: Vec<(SurfaceSample, f64, f64)> = members
                     .par_iter()
-                    .map_init(
-                        || (MeasureWorkspace::new(), Vec::new(), Vec::new()),
-                        |(ws, near, sorted), &i| {
+                    .map(|&i| {
+                        SCRATCH.with_borrow_mut(|(ws, near, sorted)| {
                             move_one(
                                 kernel,
                                 surface,
@@ -180,8 +188,8 @@ pub fn gradient_ascent_graded<S: Projection + ?Sized>(
                                 near,
                                 sorted,
                             )
-                        },
-                    )
+                        })
+                    })
                     .collect();
                 for (&i, (moved, dist, s)) in members.iter().zip(moves) {
                     samples[i] = moved;
