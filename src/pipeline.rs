@@ -422,10 +422,6 @@ pub fn remesh(
             ),
         ));
     }
-    let surface = MeshSurface::new(&normalized)?;
-    timer.lap("normalize");
-
-    on_stage("candidates");
     // Candidates are drawn for the samples expected inside the surface.
     let expected = match density {
         Target::Points(n) => n as f64,
@@ -453,6 +449,17 @@ pub fn remesh(
     let pool_size = (params.candidates_per_sample * expected)
         .ceil()
         .clamp(16.0, 2e8) as usize;
+    // The search structure of the surface, and beside it (for an input that passes through
+    // itself) the test for the points buried inside the input's own solid: each builds a BVH of
+    // the input's faces on one thread.
+    let (surface, buried_test) = rayon::join(
+        || MeshSurface::new(&normalized),
+        || BuriedTest::new(&normalized, 2 * pool_size + normalized.positions.len()),
+    );
+    let surface = surface?;
+    timer.lap("normalize");
+
+    on_stage("candidates");
     // The candidates are drawn on the faces as read, and a reversed face's candidates take its
     // reversed normal: orienting the input changes the sign of normals, not where points land
     // (the draw depends on a face's corner order), so it changes the output's orientation and
@@ -469,7 +476,6 @@ pub fn remesh(
     // Where the input passes through itself, the candidates inside its own solid are left out
     // (and samples the gradient ascent moves there are put back): the output follows the outer
     // surface and does not cross itself there.
-    let buried_test = BuriedTest::new(&normalized, 2 * pool_size + normalized.positions.len());
     let mut buried_candidates = 0;
     let mut input_points: Vec<DVec3> = normalized.positions.clone();
     if let Some(test) = &buried_test {

@@ -13,6 +13,7 @@
 //! (`CGAL::Polygon_mesh_processing::detect_sharp_edges`); the scale test is ours.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
@@ -183,7 +184,7 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     // candidates too).
     let none = FxHashSet::default();
     let mut sharp: Vec<bool> = candidates
-        .iter()
+        .par_iter()
         .map(|(e, faces)| {
             sharp_at_scale(surface, &uses, &none, *e, *faces, params.scale, cos_bound)
         })
