@@ -17,6 +17,7 @@
 use glam::DVec3;
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
+use rayon::prelude::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
@@ -88,7 +89,6 @@ pub fn restricted_delaunay(
     let mut dist = vec![f64::INFINITY; n];
     let mut label = vec![u32::MAX; n];
     let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
-    let mut near = Vec::new();
     let offer =
         |v: u32, s: u32, d: f64, dist: &mut [f64], label: &mut [u32], heap: &mut BinaryHeap<_>| {
             let i = v as usize;
@@ -98,25 +98,31 @@ pub fn restricted_delaunay(
                 heap.push(Reverse((d.to_bits(), s, v)));
             }
         };
-    for (s, &x) in positions.iter().enumerate() {
-        // A sample lies on the surface (up to rounding).
-        let Some(sp) = surface.closest_point_hinted(x, tolerance, f64::MAX) else {
-            continue;
-        };
-        tree.within_unsorted(sp.position, radius * radius, &mut near);
-        if near.is_empty() {
-            tree.nearest_n(sp.position, 1, &mut near);
-        }
-        let on_face: Vec<u32> = near
-            .iter()
-            .map(|q| q.0)
-            .filter(|&v| lies_in(surface, sp.face, refined.positions[v as usize], tolerance))
-            .collect();
-        let seeds = if on_face.is_empty() {
-            near.iter().map(|q| q.0).take(1).collect()
-        } else {
-            on_face
-        };
+    // Each sample's seeds, found in parallel and offered in sample order.
+    let seeds: Vec<Vec<u32>> = positions
+        .par_iter()
+        .map_init(Vec::new, |near, &x| {
+            // A sample lies on the surface (up to rounding).
+            let Some(sp) = surface.closest_point_hinted(x, tolerance, f64::MAX) else {
+                return Vec::new();
+            };
+            tree.within_unsorted(sp.position, radius * radius, near);
+            if near.is_empty() {
+                tree.nearest_n(sp.position, 1, near);
+            }
+            let on_face: Vec<u32> = near
+                .iter()
+                .map(|q| q.0)
+                .filter(|&v| lies_in(surface, sp.face, refined.positions[v as usize], tolerance))
+                .collect();
+            if on_face.is_empty() {
+                near.iter().map(|q| q.0).take(1).collect()
+            } else {
+                on_face
+            }
+        })
+        .collect();
+    for (s, (seeds, &x)) in seeds.into_iter().zip(positions).enumerate() {
         for v in seeds {
             let d = refined.positions[v as usize].distance(x);
             offer(v, s as u32, d, &mut dist, &mut label, &mut heap);
