@@ -28,6 +28,7 @@ use crate::sampling::linear_scan::{
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::sampling::WidthField;
 use crate::surface::curvature::{Curvature, CurvatureParams, CurvatureWidths};
+use crate::surface::feature_lines::FeatureLines;
 use crate::surface::features::{
     detect_features, long_curve_share, FeatureDetection, FeatureParams, Features,
     AUTO_FEATURE_MIN_SHARE,
@@ -409,6 +410,16 @@ pub fn remesh(
         .map(|c| curve_length(&normalized, c))
         .collect();
     let boundary_length: f64 = curve_lengths.iter().sum();
+    // The boundary curves as segments, which the last pass of the optimization slides boundary
+    // vertices along.
+    let boundary_lines = FeatureLines::new(
+        &normalized.positions,
+        curves.iter().flat_map(|c| {
+            let n = c.vertices.len();
+            let edges = if c.closed { n } else { n.saturating_sub(1) };
+            (0..edges).map(move |k| [c.vertices[k], c.vertices[(k + 1) % n]])
+        }),
+    );
     // A surface thinner everywhere than the zero-area test's tolerance of its own length (a
     // strip of colinear faces, a needle): every triangle on it would be degenerate, and sampling
     // its boundary curves at a spacing its area suggests would take without bound.
@@ -865,6 +876,7 @@ pub fn remesh(
                     &cover_points,
                     &fixed,
                     &feature_edges,
+                    boundary_lines.as_ref(),
                     sigma_p,
                     op,
                 );

@@ -1,6 +1,7 @@
 //! The input surface the samples live on, and projection onto it.
 
 pub mod curvature;
+pub mod feature_lines;
 pub mod features;
 pub(crate) mod front_regions;
 pub mod local_feature_size;

@@ -57,6 +57,12 @@ const POINTS: [([f64; 3], f64); 6] = {
     ]
 };
 
+/// A face's sums for its three corners: Σ b · residual and Σ b over its points.
+type Contribution = [(f64, f64); 3];
+
+/// A face's points' closest points on the surface (`None` where none was found).
+type Closest = [Option<DVec3>; 6];
+
 /// What [`fit_to_surface`] did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct FitStats {
@@ -104,59 +110,58 @@ pub fn fit_to_surface(
     let mut offset = vec![0.0f64; n];
     // Each face's points' closest points of the last iteration: points of the surface, whose
     // distance to a point bounds its distance to the surface (the search prunes by it).
-    let mut found: Vec<[Option<DVec3>; 6]> = vec![[None; 6]; mesh.triangles.len()];
+    let mut found: Vec<Closest> = vec![[None; 6]; mesh.triangles.len()];
     for _ in 0..iterations {
         // Per face: for each corner, Σ b · residual and Σ b over the face's points.
-        let (contributions, closest): (Vec<[(f64, f64); 3]>, Vec<[Option<DVec3>; 6]>) =
-            (0..mesh.triangles.len())
-                .into_par_iter()
-                .map(|f| {
-                    let t = mesh.triangles[f];
-                    let p = mesh.corners(f);
-                    let normal = mesh.face_normal(f);
-                    let mut out = [(0.0, 0.0); 3];
-                    let mut closest = [None; 6];
-                    if normal == DVec3::ZERO {
-                        return (out, closest);
+        let (contributions, closest): (Vec<Contribution>, Vec<Closest>) = (0..mesh.triangles.len())
+            .into_par_iter()
+            .map(|f| {
+                let t = mesh.triangles[f];
+                let p = mesh.corners(f);
+                let normal = mesh.face_normal(f);
+                let mut out = [(0.0, 0.0); 3];
+                let mut closest = [None; 6];
+                if normal == DVec3::ZERO {
+                    return (out, closest);
+                }
+                let reach = p[0]
+                    .distance(p[1])
+                    .max(p[1].distance(p[2]))
+                    .max(p[2].distance(p[0]));
+                for (k, (b, weight)) in POINTS.into_iter().enumerate() {
+                    let x = b[0] * p[0] + b[1] * p[1] + b[2] * p[2];
+                    // The point's closest point within half the face's longest edge; searched
+                    // first within its distance to a point known to be on the surface (the last
+                    // iteration's answer, or the nearest corner where it started), which gives
+                    // the same answer when one lies within that and prunes most of the search.
+                    let near = found[f][k].map_or_else(
+                        || {
+                            t.iter()
+                                .map(|&v| x.distance(start[v as usize]))
+                                .fold(f64::INFINITY, f64::min)
+                        },
+                        |q| x.distance(q),
+                    );
+                    let Some(q) = surface.closest_point_hinted(x, near, 0.5 * reach) else {
+                        continue;
+                    };
+                    closest[k] = Some(q.position);
+                    // A point on another sheet (facing away: a thin part's other side) is not
+                    // this face's sag.
+                    if surface.face_normal(q.face).dot(normal) < FIT_MIN_NORMAL_COS {
+                        continue;
                     }
-                    let reach = p[0]
-                        .distance(p[1])
-                        .max(p[1].distance(p[2]))
-                        .max(p[2].distance(p[0]));
-                    for (k, (b, weight)) in POINTS.into_iter().enumerate() {
-                        let x = b[0] * p[0] + b[1] * p[1] + b[2] * p[2];
-                        // The point's closest point within half the face's longest edge; searched
-                        // first within its distance to a point known to be on the surface (the last
-                        // iteration's answer, or the nearest corner where it started), which gives
-                        // the same answer when one lies within that and prunes most of the search.
-                        let near = found[f][k].map_or_else(
-                            || {
-                                t.iter()
-                                    .map(|&v| x.distance(start[v as usize]))
-                                    .fold(f64::INFINITY, f64::min)
-                            },
-                            |q| x.distance(q),
-                        );
-                        let Some(q) = surface.closest_point_hinted(x, near, 0.5 * reach) else {
-                            continue;
-                        };
-                        closest[k] = Some(q.position);
-                        // A point on another sheet (facing away: a thin part's other side) is not
-                        // this face's sag.
-                        if surface.face_normal(q.face).dot(normal) < FIT_MIN_NORMAL_COS {
-                            continue;
-                        }
-                        let residual = (q.position - x).dot(normal);
-                        for c in 0..3 {
-                            if !fixed[t[c] as usize] {
-                                out[c].0 += weight * b[c] * residual;
-                                out[c].1 += weight * b[c];
-                            }
+                    let residual = (q.position - x).dot(normal);
+                    for c in 0..3 {
+                        if !fixed[t[c] as usize] {
+                            out[c].0 += weight * b[c] * residual;
+                            out[c].1 += weight * b[c];
                         }
                     }
-                    (out, closest)
-                })
-                .unzip();
+                }
+                (out, closest)
+            })
+            .unzip();
         found = closest;
         let mut sum = vec![(0.0f64, 0.0f64); n];
         for (t, c) in mesh.triangles.iter().zip(&contributions) {

@@ -9,6 +9,7 @@ use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use super::*;
 use crate::geometry::self_intersection::intersecting_pairs;
 use crate::geometry::triangle_intersection::triangles_intersect;
+use crate::surface::feature_lines::FeatureLines;
 use crate::triangulate::flip::max_min_candidate;
 
 /// One local operation on the mesh.
@@ -20,6 +21,8 @@ enum Op {
     Collapse(u32, u32, DVec3),
     /// Move the vertex to the position.
     Move(u32, DVec3),
+    /// Split the edge `a`–`b` at a new vertex at the position.
+    Split(u32, u32, DVec3),
 }
 
 /// Mends the faces of `m` whose smallest angle is below `params.final_theta_deg` (worst first),
@@ -30,9 +33,12 @@ enum Op {
 /// midpoint), and the move of each corner that may move (towards the centroid of its neighbours
 /// or the apex of the equilateral triangle on a small-angled face's far edge, all, half or a
 /// quarter of the way, projected onto the surface; and to the surface point of best angle score
-/// for its faces that a compass search finds, [`best_angle_position`]). Vertices on the boundary
-/// never move; fixed vertices (boundary samples, covering vertices) move only to undo a
-/// crossing.
+/// for its faces that a compass search finds, [`best_angle_position`]). A vertex on the boundary
+/// moves only along the input's boundary curves `boundary` (none without them: [`slide_targets`]);
+/// other fixed vertices (covering vertices) move only to undo a crossing. Where none of these
+/// mends the face, each of its interior edges may be split at a new vertex placed by the same
+/// compass search ([`try_split`]; Hu et al.'s edge split): a boundary vertex where the
+/// boundary turns by more than 180° and only two faces share the angle gets a third.
 ///
 /// Of the candidates that pass every guard, the one whose new faces have the largest smallest
 /// angle is taken: for a face with a small angle, when that angle is larger than the smallest
@@ -53,6 +59,7 @@ enum Op {
 pub(super) fn mend_faces(
     m: &mut Mesh,
     surface: &MeshSurface,
+    boundary: Option<&FeatureLines>,
     fixed: &[bool],
     params: &Limits,
 ) -> usize {
@@ -101,7 +108,7 @@ pub(super) fn mend_faces(
             }
             let stays = |m: &Mesh, v: u32| (is_fixed(v) && !crossing) || m.is_boundary_vertex(v);
             let mut best: Option<(f64, Op)> = None;
-            let mut offer = |value: Option<(f64, f64)>, op: Op| {
+            let offer = |best: &mut Option<(f64, Op)>, value: Option<(f64, f64)>, op: Op| {
                 let Some((old, new)) = value else {
                     return;
                 };
@@ -111,12 +118,16 @@ pub(super) fn mend_faces(
                     new > old + IMPROVEMENT_TOLERANCE
                 };
                 if good && best.is_none_or(|b| new > b.0) {
-                    best = Some((new, op));
+                    *best = Some((new, op));
                 }
             };
             for k in 0..3 {
                 let (x, y) = (t[k], t[(k + 1) % 3]);
-                offer(try_flip(m, surface, &guard, x, y, params), Op::Flip(x, y));
+                offer(
+                    &mut best,
+                    try_flip(m, surface, &guard, x, y, params),
+                    Op::Flip(x, y),
+                );
                 for (removed, kept) in [(x, y), (y, x)] {
                     if stays(m, removed) {
                         continue;
@@ -130,6 +141,7 @@ pub(super) fn mend_faces(
                     }
                     for q in aims {
                         offer(
+                            &mut best,
                             try_collapse(m, &guard, removed, kept, q, params),
                             Op::Collapse(removed, kept, q),
                         );
@@ -137,11 +149,29 @@ pub(super) fn mend_faces(
                 }
             }
             for &v in &t {
+                if let (Some(lines), true) = (boundary, m.is_boundary_vertex(v)) {
+                    // A boundary vertex moves along the input's boundary only.
+                    for q in slide_targets(m, lines, v) {
+                        offer(&mut best, try_move(m, &guard, v, q, params), Op::Move(v, q));
+                    }
+                    continue;
+                }
                 if stays(m, v) {
                     continue;
                 }
                 for q in move_targets(m, surface, v, params) {
-                    offer(try_move(m, &guard, v, q, params), Op::Move(v, q));
+                    offer(&mut best, try_move(m, &guard, v, q, params), Op::Move(v, q));
+                }
+            }
+            // Only where nothing else mends the face, one of its edges is split at the surface
+            // point nearest its middle (a vertex with too few faces for the angle around it,
+            // such as a boundary vertex where the boundary turns, gets one more).
+            if best.is_none() {
+                for k in 0..3 {
+                    let (x, y) = (t[k], t[(k + 1) % 3]);
+                    if let Some((value, q)) = try_split(m, surface, &guard, x, y, params) {
+                        offer(&mut best, Some(value), Op::Split(x, y, q));
+                    }
                 }
             }
             let Some((_, op)) = best else {
@@ -153,6 +183,14 @@ pub(super) fn mend_faces(
                     .collapse_edge(removed, kept, q, None)
                     .map(|_| m.faces_around(kept).to_vec()),
                 Op::Move(v, q) => m.relocate_vertex(v, q).map(|_| m.faces_around(v).to_vec()),
+                Op::Split(x, y, q) => {
+                    let v = m.add_vertex(q);
+                    let split = m.split_edge(x, y, v, None).map(|s| s.to_vec());
+                    if split.is_err() {
+                        m.pop_vertex();
+                    }
+                    split
+                }
             };
             if let Ok(slots) = applied {
                 guard.changed(&slots);
@@ -294,6 +332,39 @@ fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits) -> Vec
     targets
 }
 
+/// How far along each of its boundary edges a boundary vertex is tried, as fractions of the edge
+/// (less than half: the vertex stays between its neighbours on the boundary).
+const SLIDE_FRACTIONS: [f64; 4] = [0.1, 0.2, 0.3, 0.4];
+
+/// Where a move of the boundary vertex `v` is tried: along each of its two boundary edges by
+/// [`SLIDE_FRACTIONS`] of the edge, projected onto the input's boundary curves `lines`; a
+/// projection that lands farther from the edge's point than a quarter of the way there (onto
+/// another stretch of boundary) is left out. None for a vertex on more or fewer than two boundary
+/// edges or on a crease (a corner of the boundary, or the end of a crease on it).
+fn slide_targets(m: &Mesh, lines: &FeatureLines, v: u32) -> Vec<DVec3> {
+    let ring = m.ring(v);
+    if ring.iter().any(|&u| m.is_protected(v, u)) {
+        return Vec::new();
+    }
+    let along: Vec<u32> = ring
+        .into_iter()
+        .filter(|&u| m.face_on(v, u).is_none() || m.face_on(u, v).is_none())
+        .collect();
+    let [a, b] = along[..] else {
+        return Vec::new();
+    };
+    let p = m.position(v);
+    [a, b]
+        .into_iter()
+        .flat_map(|u| SLIDE_FRACTIONS.map(|s| (u, s)))
+        .filter_map(|(u, s)| {
+            let aim = p.lerp(m.position(u), s);
+            let q = lines.closest_point(aim);
+            (q.distance(aim) <= 0.25 * aim.distance(p)).then_some(q)
+        })
+        .collect()
+}
+
 /// The position of `v` on the surface that raises the smallest angle score of its faces most,
 /// by a compass search in its tangent plane (8 directions, the step halved when none helps,
 /// from a quarter of its mean edge down to 1/64 of it; each point projected onto the surface):
@@ -301,27 +372,41 @@ fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits) -> Vec
 /// with minimal angle improvement", TVCG 2017, Sec. 5), which raises the worst angle of a ring
 /// that neither the centroid nor an equilateral apex does. `None` when no step helps.
 fn best_angle_position(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits) -> Option<DVec3> {
-    let old = m.position(v);
-    let faces: Vec<[u32; 3]> = m
+    let ring: Vec<[DVec3; 2]> = m
         .faces_around(v)
         .iter()
-        .map(|&f| starting_at(face(m, f), v))
+        .map(|&f| {
+            let t = starting_at(face(m, f), v);
+            [m.position(t[1]), m.position(t[2])]
+        })
         .collect();
-    let n = faces
+    let old = m.position(v);
+    let best = compass_search(surface, &ring, old, params);
+    (best != old).then_some(best)
+}
+
+/// The position on the surface, from `start`, of the largest smallest angle score of the faces
+/// `[p, ring[i][0], ring[i][1]]` around a vertex at p: a compass search in the plane of their
+/// mean normal, 8 directions, the step halved when none helps, from a quarter of the mean edge
+/// down to 1/64 of it, each point projected onto the surface. `start` when no step helps.
+fn compass_search(
+    surface: &MeshSurface,
+    ring: &[[DVec3; 2]],
+    start: DVec3,
+    params: &Limits,
+) -> DVec3 {
+    let old = start;
+    let n = ring
         .iter()
-        .map(|&t| normal(m, t))
+        .map(|&[b, c]| (b - old).cross(c - old).normalize_or_zero())
         .fold(DVec3::ZERO, |a, b| a + b)
         .normalize_or_zero();
-    if faces.is_empty() || n == DVec3::ZERO {
-        return None;
+    if ring.is_empty() || n == DVec3::ZERO {
+        return start;
     }
     let bounds = params.angle_bounds();
-    let score = |p: DVec3| ring_score(m, &faces, p, &bounds);
-    let mean_edge = faces
-        .iter()
-        .map(|t| old.distance(m.position(t[1])))
-        .sum::<f64>()
-        / faces.len() as f64;
+    let score = |p: DVec3| ring_score(ring, p, &bounds);
+    let mean_edge = ring.iter().map(|&[b, _]| old.distance(b)).sum::<f64>() / ring.len() as f64;
     let (u, w) = n.any_orthonormal_pair();
     let (mut best_p, mut best) = (old, score(old));
     let mut step = 0.25 * mean_edge;
@@ -347,15 +432,14 @@ fn best_angle_position(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits)
             step *= 0.5;
         }
     }
-    (best_p != old).then_some(best_p)
+    best_p
 }
 
-/// The smallest angle score (`bounds`) of the faces `faces` around a vertex (each starting at
-/// it, as [`starting_at`] gives them) with the vertex at `p`.
-fn ring_score(m: &Mesh, faces: &[[u32; 3]], p: DVec3, bounds: &AngleBounds) -> f64 {
-    faces
-        .iter()
-        .map(|t| bounds.score([p, m.position(t[1]), m.position(t[2])]))
+/// The smallest angle score (`bounds`) of the faces `[p, ring[i][0], ring[i][1]]` around a vertex
+/// at `p` (each face's other corners in order, as [`starting_at`] gives them).
+fn ring_score(ring: &[[DVec3; 2]], p: DVec3, bounds: &AngleBounds) -> f64 {
+    ring.iter()
+        .map(|&[b, c]| bounds.score([p, b, c]))
         .fold(f64::INFINITY, f64::min)
 }
 
@@ -382,6 +466,52 @@ fn try_move(
         && !guard.crosses(m, &faces, &slots);
     let _ = m.relocate_vertex(v, p);
     ok.then_some((old, new))
+}
+
+/// The smallest angle scores before and after splitting the interior edge `a`–`b` at the surface
+/// point nearest its middle, and that point, when the split passes the guards of
+/// [`mend_faces`]: no new face turns by more than `max_normal_turn_deg` from the face it is cut
+/// from, the new vertex is within `collapse_offset` of the edge's middle (not on a sheet across
+/// a thin part), and no new face crosses another. `None` for a boundary or protected edge.
+fn try_split(
+    m: &mut Mesh,
+    surface: &MeshSurface,
+    guard: &CrossingGuard,
+    a: u32,
+    b: u32,
+    params: &Limits,
+) -> Option<((f64, f64), DVec3)> {
+    if m.is_protected(a, b) {
+        return None;
+    }
+    let (f1, f2, c, d) = m.edge_faces(a, b).ok()?;
+    let (pa, pb) = (m.position(a), m.position(b));
+    let mid = surface.closest_point_to_midpoint(pa, pb)?.position;
+    // The new vertex's ring, and its best position from the edge's middle.
+    let [qa, qb, qc, qd] = [a, b, c, d].map(|v| m.position(v));
+    let q = compass_search(
+        surface,
+        &[[qc, qa], [qb, qc], [qd, qb], [qa, qd]],
+        mid,
+        params,
+    );
+    if q.distance(0.5 * (pa + pb)) > params.collapse_offset {
+        return None;
+    }
+    let old_faces = [face(m, f1), face(m, f2)];
+    let old = worst_angle(m, old_faces, params);
+    let old_normals = old_faces.map(|t| normal(m, t));
+    let v = m.add_vertex(q);
+    let new = [[a, v, c], [v, b, c], [b, v, d], [v, a, d]];
+    let cos_turn = params.max_normal_turn_deg.to_radians().cos();
+    let ok = new
+        .iter()
+        .enumerate()
+        .all(|(k, &t)| normal(m, t).dot(old_normals[k / 2]) >= cos_turn)
+        && !guard.crosses(m, &new, &[f1, f2]);
+    let value = worst_angle(m, new, params);
+    m.pop_vertex();
+    ok.then_some(((old, value), q))
 }
 
 /// Finds the faces a new face would cross: a BVH over the faces as they were when the pass
@@ -485,7 +615,7 @@ mod tests {
         let before = theta_min(&m);
         assert!(before < 20.0, "{before}");
         let fixed = vec![false; m.vertex_count()];
-        let made = mend_faces(&mut m, &surface, &fixed, &limits());
+        let made = mend_faces(&mut m, &surface, None, &fixed, &limits());
         assert!(made >= 1);
         assert_eq!(m.degree(v), 0, "the vertex is gone");
         assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
@@ -509,7 +639,7 @@ mod tests {
             .filter(|&v| fixed[v])
             .map(|v| m.position(v as u32))
             .collect();
-        mend_faces(&mut m, &surface, &fixed, &limits());
+        mend_faces(&mut m, &surface, None, &fixed, &limits());
         assert!(theta_min(&m) >= 25.0, "{before} -> {}", theta_min(&m));
         let after: Vec<DVec3> = (0..m.vertex_count())
             .filter(|&v| fixed[v])
@@ -525,7 +655,7 @@ mod tests {
         let (g, surface) = flat(4);
         let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
         let fixed = vec![false; m.vertex_count()];
-        assert_eq!(mend_faces(&mut m, &surface, &fixed, &limits()), 0);
+        assert_eq!(mend_faces(&mut m, &surface, None, &fixed, &limits()), 0);
         assert_eq!(m.to_trimesh(), g);
     }
 
@@ -553,7 +683,7 @@ mod tests {
         let fixed = vec![false; m.vertex_count()];
         // sigma_p 4: the pass may move the mesh by up to 1 off the surface, more than the poke.
         let wide = Limits::new(&OptimizeParams::default(), 4.0);
-        let made = mend_faces(&mut m, &surface, &fixed, &wide);
+        let made = mend_faces(&mut m, &surface, None, &fixed, &wide);
         assert!(made >= 1);
         let out = m.to_trimesh();
         let pairs = intersecting_pairs(&out.positions, &out.triangles);
@@ -567,7 +697,7 @@ mod tests {
         assert_eq!(m.sanity_check(), Ok(()));
         // Without moves that far (sigma_p 1: 0.25), nothing is made that would cross.
         let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
-        mend_faces(&mut m, &surface, &fixed, &limits());
+        mend_faces(&mut m, &surface, None, &fixed, &limits());
         let out = m.to_trimesh();
         assert!(
             intersecting_pairs(&out.positions, &out.triangles).len()
@@ -605,6 +735,88 @@ mod tests {
         assert!(!guard.crosses(&m, &lower_faces, &[lower.clone(), slots.clone()].concat()));
     }
 
+    /// The largest angle of the live faces, degrees.
+    fn theta_max(m: &Mesh) -> f64 {
+        m.live_faces()
+            .0
+            .into_iter()
+            .map(|t| {
+                let [a, b, c] = m.corners(t);
+                let angle =
+                    |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p).to_degrees();
+                angle(a, b, c).max(angle(b, c, a)).max(angle(c, a, b))
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// A fan of six faces round a fixed vertex c at the origin, its ring a unit hexagon with one
+    /// corner v pulled in to `inset` of the way: the boundary turns by more than 180° at v, whose
+    /// two faces share that angle (103° each at 0.3).
+    fn fan_with_a_reflex_corner(inset: f64) -> (TriMesh, u32) {
+        let mut positions = vec![DVec3::ZERO];
+        for k in 0..6 {
+            let a = k as f64 * std::f64::consts::FRAC_PI_3;
+            let r = if k == 0 { inset } else { 1.0 };
+            positions.push(DVec3::new(r * a.cos(), r * a.sin(), 0.0));
+        }
+        let triangles = (0..6).map(|k| [0, 1 + k, 1 + (k + 1) % 6]).collect();
+        (TriMesh::new(positions, triangles), 1)
+    }
+
+    #[test]
+    fn a_reflex_boundary_corner_with_two_faces_gets_its_edge_split() {
+        let (g, v) = fan_with_a_reflex_corner(0.3);
+        let surface = MeshSurface::new(&g).unwrap();
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        assert!(theta_max(&m) > 102.0, "{}", theta_max(&m));
+        // The corner is on the boundary, the centre fixed (a covering vertex), and the corner's
+        // neighbours on the boundary have two faces each (no collapse): no flip, collapse or move
+        // mends the corner's faces, whose angles at it add up to 206°.
+        let fixed = vec![true; m.vertex_count()];
+        let made = mend_faces(&mut m, &surface, None, &fixed, &limits());
+        assert!(made >= 1);
+        assert!(m.vertex_count() > 7, "no vertex added");
+        assert!(m.degree(v) >= 3, "the corner has {} faces", m.degree(v));
+        assert!(theta_max(&m) <= 100.0, "{}", theta_max(&m));
+        assert!(theta_min(&m) >= 35.0, "{}", theta_min(&m));
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    #[test]
+    fn a_boundary_vertex_slides_along_the_boundary_to_mend_its_face() {
+        // A strip along a straight boundary (y = 0): boundary vertices at x = 0, 0.12 and 1, and
+        // above them two fixed vertices; the face on the short boundary edge has a small angle.
+        let positions = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.12, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 0.9, 0.0),
+            DVec3::new(1.0, 0.9, 0.0),
+        ];
+        let triangles = vec![[0, 1, 3], [1, 4, 3], [1, 2, 4]];
+        let g = TriMesh::new(positions, triangles);
+        let surface = MeshSurface::new(&g).unwrap();
+        let boundary =
+            FeatureLines::new(&g.positions, [[0, 1], [1, 2], [2, 4], [4, 3], [3, 0]]).unwrap();
+        let fixed = vec![true; 5];
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        let before = theta_min(&m);
+        assert!(before < 10.0, "{before}");
+        // Without the boundary's lines, vertex 1 stays and nothing mends the face.
+        mend_faces(&mut m, &surface, None, &fixed, &limits());
+        assert_eq!(m.position(1), DVec3::new(0.12, 0.0, 0.0));
+        let made = mend_faces(&mut m, &surface, Some(&boundary), &fixed, &limits());
+        assert!(made >= 1);
+        let p = m.position(1);
+        assert!(p.y.abs() < 1e-12 && p.x > 0.12 && p.x < 1.0, "{p}");
+        assert!(
+            theta_min(&m) > before + 10.0,
+            "{before} -> {}",
+            theta_min(&m)
+        );
+        assert_eq!(m.sanity_check(), Ok(()));
+    }
+
     #[test]
     fn the_compass_search_finds_the_best_angle_position_of_a_ring() {
         // An interior vertex of a flat grid whose ring is distorted: the centroid of the ring
@@ -623,12 +835,15 @@ mod tests {
         let m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
         let params = limits();
         let v = 3 * 7 + 3;
-        let faces: Vec<[u32; 3]> = m
+        let ring: Vec<[DVec3; 2]> = m
             .faces_around(v)
             .iter()
-            .map(|&f| starting_at(face(&m, f), v))
+            .map(|&f| {
+                let t = starting_at(face(&m, f), v);
+                [m.position(t[1]), m.position(t[2])]
+            })
             .collect();
-        let ring_score = |p: DVec3| ring_score(&m, &faces, p, &params.angle_bounds());
+        let ring_score = |p: DVec3| ring_score(&ring, p, &params.angle_bounds());
         // The best score by brute force over a fine grid of positions around the vertex.
         let old = m.position(v);
         let mut brute = f64::NEG_INFINITY;

@@ -13,6 +13,7 @@ use super::flip::max_min_flips;
 use crate::geometry::triangle::{triangle_min_angle_deg, triangle_q, AngleBounds};
 use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
+use crate::surface::feature_lines::FeatureLines;
 use crate::surface::mesh_projection::MeshSurface;
 
 mod angles;
@@ -291,8 +292,10 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// (the input, same units): covers the input points of `cover_points` that are farther than
 /// `params.cover_distance_sigma_p` · `sigma_p` from it, then flips edges and relaxes vertices
 /// around the triangles with Q below `params.q_below`. Vertices with `fixed[v]` (boundary
-/// samples) do not move; boundary edges are not flipped, and the `protected` edges (the creases
-/// kept as edges) are neither flipped nor collapsed. New vertices are appended, so
+/// samples) do not move, except that the last pass slides boundary vertices along `boundary`
+/// (the input's boundary curves, same units; with `None` they stay); boundary edges are not
+/// flipped, and the `protected` edges (the creases kept as edges) are neither flipped nor
+/// collapsed. New vertices are appended, so
 /// existing indices stay valid; vertices merged away by a collapse are left unreferenced.
 /// Returns what was done and, for each face of the result, the index of the face of `mesh` it
 /// still is (`None` for a new or changed face). Deterministic.
@@ -325,12 +328,14 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// Everything else stays as the sampler and the tangent-plane Delaunay left it. On horse at 8600
 /// about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
 /// spacing).
+#[allow(clippy::too_many_arguments)] // the mesh, the input and its creases and boundary, the limits
 pub fn optimize(
     mesh: &mut TriMesh,
     surface: &MeshSurface,
     cover_points: &[DVec3],
     fixed: &[bool],
     protected: &[[u32; 2]],
+    boundary: Option<&FeatureLines>,
     sigma_p: f64,
     params: &OptimizeParams,
 ) -> (OptimizeStats, Vec<Option<u32>>) {
@@ -370,7 +375,7 @@ pub fn optimize(
             break;
         }
     }
-    stats.mends = mend_faces(&mut m, surface, &fixed, params);
+    stats.mends = mend_faces(&mut m, surface, boundary, &fixed, params);
     let (positions, faces, origin) = m.into_parts();
     *mesh = TriMesh::new(positions, faces);
     (stats, origin)
@@ -450,7 +455,16 @@ mod tests {
         mesh.positions[v] += DVec3::new(0.8, 0.1, 0.0);
         let before = triangle_quality(&mesh);
         let fixed: Vec<bool> = vec![false; mesh.vertex_count()];
-        let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, &[], 1.0, &no_cover());
+        let (stats, _) = optimize(
+            &mut mesh,
+            &surface,
+            &[],
+            &fixed,
+            &[],
+            None,
+            1.0,
+            &no_cover(),
+        );
         let after = triangle_quality(&mesh);
         assert!(stats.moves + stats.flips + stats.collapses + stats.smooth.moves > 0);
         assert!(
@@ -473,7 +487,16 @@ mod tests {
         let original = mesh.positions.clone();
         let mut fixed = vec![false; mesh.vertex_count()];
         fixed[3 * 7 + 3] = true;
-        let (_, origin) = optimize(&mut mesh, &surface, &[], &fixed, &[], 1.0, &no_cover());
+        let (_, origin) = optimize(
+            &mut mesh,
+            &surface,
+            &[],
+            &fixed,
+            &[],
+            None,
+            1.0,
+            &no_cover(),
+        );
         assert_eq!(origin.len(), mesh.face_count());
         assert!(origin.iter().any(|o| o.is_none()) && origin.iter().any(|o| o.is_some()));
         assert_eq!(mesh.positions[3], original[3]);
@@ -515,7 +538,16 @@ mod tests {
         let t0 = topology(&mesh);
         assert!(t0.is_manifold() && t0.euler_characteristic == 1);
         let fixed = vec![false; mesh.vertex_count()];
-        let (stats, _) = optimize(&mut mesh, &surface, &[], &fixed, &[], 1.0, &no_cover());
+        let (stats, _) = optimize(
+            &mut mesh,
+            &surface,
+            &[],
+            &fixed,
+            &[],
+            None,
+            1.0,
+            &no_cover(),
+        );
         assert!(stats.collapses >= 1, "{stats:?}");
         assert_manifold_disk(&mut mesh);
         assert!(triangle_quality(&mesh).theta_min > 30.0);
@@ -563,6 +595,7 @@ mod tests {
             &input.positions,
             &fixed,
             &[],
+            None,
             1.0,
             &OptimizeParams::default(),
         );
