@@ -35,7 +35,9 @@ enum Op {
 /// quarter of the way, projected onto the surface; and to the surface point of best angle score
 /// for its faces that a compass search finds, [`best_angle_position`]). A vertex on the boundary
 /// moves only along the input's boundary curves `boundary` (none without them: [`slide_targets`]);
-/// other fixed vertices (covering vertices) move only to undo a crossing. Where none of these
+/// a fixed vertex on a crease moves only to undo a crossing; other fixed vertices (covering
+/// vertices, at the tips of the input) move like the rest, their old position kept within the
+/// collapse offset of their faces. Where none of these
 /// mends the face, each of its interior edges may be split at a new vertex placed by the same
 /// compass search ([`try_split`]; Hu et al.'s edge split): a boundary vertex where the
 /// boundary turns by more than 180° and only two faces share the angle gets a third.
@@ -106,7 +108,10 @@ pub(super) fn mend_faces(
             if !crossing && angle_score(m, t, params) >= bound {
                 continue;
             }
-            let stays = |m: &Mesh, v: u32| (is_fixed(v) && !crossing) || m.is_boundary_vertex(v);
+            let stays = |m: &Mesh, v: u32| {
+                (is_fixed(v) && !crossing && m.ring(v).iter().any(|&u| m.is_protected(v, u)))
+                    || m.is_boundary_vertex(v)
+            };
             let mut best: Option<(f64, Op)> = None;
             let offer = |best: &mut Option<(f64, Op)>, value: Option<(f64, f64)>, op: Op| {
                 let Some((old, new)) = value else {
