@@ -156,7 +156,7 @@ pub(super) fn mend_faces(
             for &v in &t {
                 if let (Some(lines), true) = (boundary, m.is_boundary_vertex(v)) {
                     // A boundary vertex moves along the input's boundary only.
-                    for q in slide_targets(m, lines, v) {
+                    if let Some(q) = slide_targets(m, lines, v, params) {
                         offer(&mut best, try_move(m, &guard, v, q, params), Op::Move(v, q));
                     }
                     continue;
@@ -172,8 +172,7 @@ pub(super) fn mend_faces(
             // point nearest its middle (a vertex with too few faces for the angle around it,
             // such as a boundary vertex where the boundary turns, gets one more).
             if best.is_none() {
-                for k in 0..3 {
-                    let (x, y) = (t[k], t[(k + 1) % 3]);
+                if let Some((x, y)) = opposite_largest_angle(m, t, params) {
                     if let Some((value, q)) = try_split(m, surface, &guard, x, y, params) {
                         offer(&mut best, Some(value), Op::Split(x, y, q));
                     }
@@ -341,25 +340,36 @@ fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits) -> Vec
 /// (less than half: the vertex stays between its neighbours on the boundary).
 const SLIDE_FRACTIONS: [f64; 4] = [0.1, 0.2, 0.3, 0.4];
 
-/// Where a move of the boundary vertex `v` is tried: along each of its two boundary edges by
-/// [`SLIDE_FRACTIONS`] of the edge, projected onto the input's boundary curves `lines`; a
-/// projection that lands farther from the edge's point than a quarter of the way there (onto
-/// another stretch of boundary) is left out. None for a vertex on more or fewer than two boundary
-/// edges or on a crease (a corner of the boundary, or the end of a crease on it).
-fn slide_targets(m: &Mesh, lines: &FeatureLines, v: u32) -> Vec<DVec3> {
+/// Where a move of the boundary vertex `v` is tried: of the points along each of its two
+/// boundary edges by [`SLIDE_FRACTIONS`] of the edge, projected onto the input's boundary curves
+/// `lines`, the one of best angle score for its faces ([`ring_score`]), when that is better than
+/// where `v` is (a projection that lands farther from the edge's point than a quarter of the way
+/// there, onto another stretch of boundary, is left out). None for a vertex on more or fewer
+/// than two boundary edges or on a crease (a corner of the boundary, or the end of a crease on
+/// it).
+fn slide_targets(m: &Mesh, lines: &FeatureLines, v: u32, params: &Limits) -> Option<DVec3> {
     let ring = m.ring(v);
     if ring.iter().any(|&u| m.is_protected(v, u)) {
-        return Vec::new();
+        return None;
     }
     let along: Vec<u32> = ring
         .into_iter()
         .filter(|&u| m.face_on(v, u).is_none() || m.face_on(u, v).is_none())
         .collect();
     let [a, b] = along[..] else {
-        return Vec::new();
+        return None;
     };
+    let faces: Vec<[DVec3; 2]> = m
+        .faces_around(v)
+        .iter()
+        .map(|&f| {
+            let t = starting_at(face(m, f), v);
+            [m.position(t[1]), m.position(t[2])]
+        })
+        .collect();
+    let bounds = params.angle_bounds();
     let p = m.position(v);
-    [a, b]
+    let (best, _) = [a, b]
         .into_iter()
         .flat_map(|u| SLIDE_FRACTIONS.map(|s| (u, s)))
         .filter_map(|(u, s)| {
@@ -367,7 +377,15 @@ fn slide_targets(m: &Mesh, lines: &FeatureLines, v: u32) -> Vec<DVec3> {
             let q = lines.closest_point(aim);
             (q.distance(aim) <= 0.25 * aim.distance(p)).then_some(q)
         })
-        .collect()
+        .map(|q| (q, ring_score(&faces, q, &bounds)))
+        .fold((p, ring_score(&faces, p, &bounds)), |best, c| {
+            if c.1 > best.1 + IMPROVEMENT_TOLERANCE {
+                c
+            } else {
+                best
+            }
+        });
+    (best != p).then_some(best)
 }
 
 /// The position of `v` on the surface that raises the smallest angle score of its faces most,
@@ -471,6 +489,19 @@ fn try_move(
         && !guard.crosses(m, &faces, &slots);
     let _ = m.relocate_vertex(v, p);
     ok.then_some((old, new))
+}
+
+/// The edge of `t` opposite its largest angle, when that angle is above the bound
+/// (`final_theta_max_deg`): the edge a split mends it by (the new edge to the split point cuts
+/// the angle in two).
+fn opposite_largest_angle(m: &Mesh, t: [u32; 3], params: &Limits) -> Option<(u32, u32)> {
+    let p = m.corners(t);
+    let angle = |k: usize| {
+        let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+        (b - a).angle_between(c - a).to_degrees()
+    };
+    let k = (0..3).max_by(|&i, &j| angle(i).total_cmp(&angle(j)))?;
+    (angle(k) > params.final_theta_max_deg).then_some((t[(k + 1) % 3], t[(k + 2) % 3]))
 }
 
 /// The smallest angle scores before and after splitting the interior edge `a`–`b` at the surface
