@@ -40,7 +40,7 @@ pub(crate) fn overlapping_box_pairs(boxes: &[(usize, Aabb)]) -> Vec<[u32; 2]> {
 ///
 /// # Runtime
 /// The pairs of overlapping bounding boxes come from a BVH traversed against itself
-/// ([`overlapping_box_pairs`]), and every non-adjacent one is decided by
+/// (parry's parallel BVTT), and every non-adjacent one is decided by
 /// [`triangles_intersect`], which is exact. O(F + pairs) for a mesh whose triangles are small
 /// against the model; parallel (rayon), and deterministic.
 pub fn intersecting_pairs_counted(
