@@ -6,7 +6,6 @@
 //! edges.
 
 use glam::DVec3;
-use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
 
 use super::TriMesh;
@@ -28,59 +27,96 @@ fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
-/// Undirected edge -> the faces on it: two inline (`NONE` when empty), more (a non-manifold
-/// edge) in `more`.
-#[derive(Default)]
-struct EdgeFaces {
-    two: FxHashMap<(u32, u32), [u32; 2]>,
-    more: FxHashMap<(u32, u32), Vec<u32>>,
+/// The faces on each edge, as cycles of face sides: side `3 f + k` is the edge from corner `k`
+/// to corner `k + 1` of face `f`; `next` links the sides on one undirected edge in a cycle, in
+/// the order the faces came onto the edge (a side alone on its edge links to itself), and the
+/// first of them carries [`HEAD`]. The order is what makes the refinement deterministic.
+struct Sides {
+    next: Vec<u32>,
 }
 
-const NONE: u32 = u32::MAX;
+/// The flag of the first side of a cycle, in the high bit of `next`.
+const HEAD: u32 = 1 << 31;
 
-impl EdgeFaces {
-    fn with_capacity(n: usize) -> Self {
-        EdgeFaces {
-            two: FxHashMap::with_capacity_and_hasher(n, Default::default()),
-            more: FxHashMap::default(),
+impl Sides {
+    fn new(triangles: &[[u32; 3]], capacity: usize) -> Self {
+        let mut next: Vec<u32> = Vec::with_capacity(3 * capacity);
+        next.extend((0..3 * triangles.len() as u32).map(|s| s | HEAD));
+        // Sides on one edge, in face order; a face that repeats a corner has zero area and is
+        // never split, and its sides stay alone.
+        let mut sides: Vec<((u32, u32), u32)> = triangles
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
+            .flat_map(|(f, t)| {
+                (0..3).map(move |k| (key(t[k], t[(k + 1) % 3]), 3 * f as u32 + k as u32))
+            })
+            .collect();
+        sides.sort_unstable();
+        for run in sides.chunk_by(|x, y| x.0 == y.0) {
+            let ring: Vec<u32> = run.iter().map(|&(_, s)| s).collect();
+            link(&mut next, &ring);
         }
+        Sides { next }
     }
 
-    fn push(&mut self, e: (u32, u32), f: u32) {
-        let slot = self.two.entry(e).or_insert([NONE; 2]);
-        if slot[0] == NONE {
-            slot[0] = f;
-        } else if slot[1] == NONE {
-            slot[1] = f;
-        } else {
-            self.more.entry(e).or_default().push(f);
-        }
+    fn next(&self, s: u32) -> u32 {
+        self.next[s as usize] & !HEAD
     }
 
-    /// Removes the edge; returns its faces.
-    fn take(&mut self, e: (u32, u32), out: &mut Vec<u32>) {
+    /// The sides on the edge of side `s`, the first to come onto it first.
+    fn around(&self, s: u32, out: &mut Vec<u32>) {
         out.clear();
-        if let Some(slot) = self.two.remove(&e) {
-            out.extend(slot.into_iter().filter(|&f| f != NONE));
-            if let Some(m) = self.more.remove(&e) {
-                out.extend(m);
+        let mut head = s;
+        while self.next[head as usize] & HEAD == 0 {
+            head = self.next(head);
+        }
+        let mut x = head;
+        loop {
+            out.push(x);
+            x = self.next(x);
+            if x == head {
+                break;
             }
         }
     }
 
-    /// Face `g` on edge `e` becomes face `h`.
-    fn replace(&mut self, e: (u32, u32), g: u32, h: u32) {
-        if let Some(slot) = self.two.get_mut(&e) {
-            if let Some(s) = slot.iter_mut().find(|s| **s == g) {
-                *s = h;
-                return;
-            }
+    /// Side `new` takes the place of side `old` in its cycle.
+    fn replace(&mut self, old: u32, new: u32) {
+        let after = self.next(old);
+        let flag = self.next[old as usize] & HEAD;
+        if after == old {
+            self.set(new, new, flag);
+            return;
         }
-        if let Some(m) = self.more.get_mut(&e) {
-            if let Some(s) = m.iter_mut().find(|s| **s == g) {
-                *s = h;
-            }
+        let mut before = after;
+        while self.next(before) != old {
+            before = self.next(before);
         }
+        let before_flag = self.next[before as usize] & HEAD;
+        self.set(before, new, before_flag);
+        self.set(new, after, flag);
+    }
+
+    fn set(&mut self, s: u32, next: u32, flag: u32) {
+        let s = s as usize;
+        if s >= self.next.len() {
+            self.next.resize(s + 1, 0);
+        }
+        self.next[s] = next | flag;
+    }
+
+    fn push_face(&mut self) {
+        let n = self.next.len() as u32;
+        self.next.extend([n | HEAD, (n + 1) | HEAD, (n + 2) | HEAD]);
+    }
+}
+
+/// Links `ring` (sides of one edge, in order) into a cycle, its first side the head.
+fn link(next: &mut [u32], ring: &[u32]) {
+    for (i, &s) in ring.iter().enumerate() {
+        let flag = if i == 0 { HEAD } else { 0 };
+        next[s as usize] = ring[(i + 1) % ring.len()] | flag;
     }
 }
 
@@ -99,12 +135,7 @@ pub fn bisect_to_length(mesh: &TriMesh, max_length: f64, max_splits: usize) -> O
     positions.reserve(expected / 2);
     triangles.reserve(expected);
     parent.reserve(expected);
-    let mut edge_faces = EdgeFaces::with_capacity(3 * expected / 2);
-    for (f, t) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            edge_faces.push(key(t[k], t[(k + 1) % 3]), f as u32);
-        }
-    }
+    let mut sides = Sides::new(&triangles, expected);
     // The longest edge; edges equal in length up to LENGTH_TIE (the same mesh read from float32
     // and from text) are told apart by their vertex indices, so both refine alike.
     let longest = |positions: &[DVec3], t: [u32; 3]| -> (usize, f64) {
@@ -125,39 +156,53 @@ pub fn bisect_to_length(mesh: &TriMesh, max_length: f64, max_splits: usize) -> O
     };
     let mut queue: VecDeque<u32> = (0..triangles.len() as u32).collect();
     let mut splits = 0;
-    let mut faces = Vec::new();
+    let (mut around, mut at_a, mut at_b) = (Vec::new(), Vec::new(), Vec::new());
     while let Some(f) = queue.pop_front() {
         let t = triangles[f as usize];
+        if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+            continue;
+        }
         let (k, d2) = longest(&positions, t);
         if d2 <= limit2 || !d2.is_finite() {
             continue;
         }
-        if splits >= max_splits {
+        sides.around(3 * f + k as u32, &mut around);
+        // (the cycles index sides by 31 bits: a refinement that big does not fit in memory)
+        if splits >= max_splits || 3 * (triangles.len() + around.len()) >= HEAD as usize {
             return None;
         }
         let (a, b) = (t[k], t[(k + 1) % 3]);
         let m = positions.len() as u32;
         positions.push(0.5 * (positions[a as usize] + positions[b as usize]));
         splits += 1;
-        edge_faces.take(key(a, b), &mut faces);
-        for &g in &faces {
+        at_a.clear();
+        at_b.clear();
+        for &s in &around {
+            let (g, j) = (s / 3, (s % 3) as usize);
             let tg = triangles[g as usize];
-            let Some(j) = (0..3).find(|&j| key(tg[j], tg[(j + 1) % 3]) == key(a, b)) else {
-                continue;
-            };
             let (x, y, c) = (tg[j], tg[(j + 1) % 3], tg[(j + 2) % 3]);
+            // g keeps x-m-c (its side j + 1 turns from y-c into m-c); h is m-y-c.
             let h = triangles.len() as u32;
-            triangles[g as usize] = [x, m, c];
+            triangles[g as usize][(j + 1) % 3] = m;
             triangles.push([m, y, c]);
             parent.push(parent[g as usize]);
-            edge_faces.push(key(x, m), g);
-            edge_faces.push(key(m, y), h);
-            edge_faces.push(key(m, c), g);
-            edge_faces.push(key(m, c), h);
-            edge_faces.replace(key(y, c), g, h);
+            sides.push_face();
+            let yc = 3 * g + ((j + 1) % 3) as u32;
+            sides.replace(yc, 3 * h + 1);
+            link(&mut sides.next, &[yc, 3 * h + 2]);
+            let (xm, my) = (3 * g + j as u32, 3 * h);
+            if x == a {
+                at_a.push(xm);
+                at_b.push(my);
+            } else {
+                at_a.push(my);
+                at_b.push(xm);
+            }
             queue.push_back(g);
             queue.push_back(h);
         }
+        link(&mut sides.next, &at_a);
+        link(&mut sides.next, &at_b);
     }
     Some(Refined {
         positions,
