@@ -152,6 +152,7 @@ pub use timing::Stage;
 
 // The input surface: closest points, projection, and the test for its self-buried parts.
 pub use surface::winding::BuriedTest;
+
 // The local feature size of the input (shrinking medial balls), for a graded kernel width.
 pub use surface::local_feature_size::{
     local_feature_size, LfsParams, LocalFeatureSize, MAX_LFS_SAMPLES,
@@ -166,7 +167,7 @@ pub use surface::features::{
     detect_features, long_curve_share, FeatureCurve, FeatureDetection, FeatureParams, Features,
     AUTO_FEATURE_MIN_SHARE, CAD_FEATURE_ANGLE_DEG, LONG_CURVE_SPACINGS,
 };
-pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceSample};
+pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 
 // Sampling stages: candidates and boundary samples, the linear scan (and the sigma_p search for
 // a count), the gradient ascent.

@@ -55,6 +55,7 @@
 //! One evaluation of f costs one fixed-radius kd-tree query and `1 + max_refit` passes over the
 //! neighbours; a projection a few evaluations.
 
+use crate::surface::SurfacePoint;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -513,6 +514,36 @@ impl crate::surface::Projection for Rimls {
     }
 }
 
+/// The RIMLS surface answering the closest-point queries of the stages after the triangulation
+/// (so they can fit a mesh to a point set's surface). The "closest point" is the Newton foot
+/// point of [`Rimls::project`]: on the surface, along the gradient from `p`, which is the
+/// closest point up to the surface's curvature over the distance (not a global search: a point
+/// nearer another sheet than σ_p may go to that sheet). `face` is 0 and `barycentric` a third
+/// each; `None` where the projection fails (no input point within 3 σ_p, a vanishing
+/// gradient).
+impl crate::surface::SurfaceQuery for Rimls {
+    fn closest_point_within(&self, p: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        if !p.is_finite() {
+            return None;
+        }
+        let (position, _) = Rimls::project(self, p)?;
+        let distance = position.distance(p);
+        (distance <= max_dist).then_some(SurfacePoint {
+            position,
+            face: 0,
+            barycentric: [1.0 / 3.0; 3],
+            distance,
+        })
+    }
+
+    /// ∇f / |∇f| at the point (zero where the gradient vanishes or the point is outside the
+    /// support).
+    fn smooth_normal(&self, sp: &SurfacePoint) -> DVec3 {
+        self.value_and_gradient(sp.position)
+            .map_or(DVec3::ZERO, |(_, g)| g.normalize_or_zero())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -839,6 +870,40 @@ mod tests {
                 "sigma_n {sigma_n}: max normal error {max_angle} deg"
             );
         }
+    }
+
+    #[test]
+    fn closest_point_queries_on_a_sphere_go_to_the_sphere() {
+        use crate::surface::SurfaceQuery;
+        const R: f64 = 20.0;
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let normals: Vec<DVec3> = (0..40_000).map(|_| random_unit(&mut rng)).collect();
+        let positions: Vec<DVec3> = normals.iter().map(|n| R * *n).collect();
+        let rimls = Rimls::new(positions, normals, RimlsParams::new(1.0, f64::INFINITY)).unwrap();
+        // RIMLS lies off a sphere by about sigma_p^2 (k1 + k2) / 4 = 0.025 (the module's bias).
+        let within = 2.0 * 0.025;
+        for _ in 0..200 {
+            let u = random_unit(&mut rng);
+            let p = (R + rng.random_range(-1.0..=1.0)) * u;
+            let sp = SurfaceQuery::closest_point(&rimls, p).unwrap();
+            assert!(
+                (sp.position.length() - R).abs() < within,
+                "{}",
+                sp.position.length()
+            );
+            assert!(sp.position.normalize().angle_between(u) < 1e-3);
+            assert!((sp.distance - sp.position.distance(p)).abs() < 1e-12);
+            assert!(rimls.smooth_normal(&sp).angle_between(u).to_degrees() < 1.0);
+            // Farther than max_dist: none; and the midpoint of two surface points about 2 apart
+            // goes back.
+            assert!(rimls.closest_point_within(p, 0.5 * sp.distance).is_none());
+            let q = R * (u + 0.1 * random_unit(&mut rng)).normalize();
+            let mid = rimls.closest_point_to_midpoint(sp.position, q);
+            assert!((mid.unwrap().position.length() - R).abs() < within);
+        }
+        // Outside the support (no point within 3 sigma_p): none, not a far-off guess.
+        assert!(SurfaceQuery::closest_point(&rimls, DVec3::splat(1000.0)).is_none());
+        assert!(SurfaceQuery::closest_point(&rimls, DVec3::NAN).is_none());
     }
 
     #[test]

@@ -52,6 +52,70 @@ impl Projection for MeshSurface {
     }
 }
 
+/// Closest-point queries on the surface a mesh is fitted to, as the stages after the
+/// triangulation ask them (the last pass's moves, flips, collapses and splits, the fit): on the
+/// input mesh ([`MeshSurface`], exact closest points through a BVH), or on another surface that
+/// answers the same questions. Positions and distances in the units of the surface (bbox-100 in
+/// the pipeline).
+pub trait SurfaceQuery: Sync {
+    /// The closest point of the surface to `p` if it is within `max_dist` of `p`; `None` also
+    /// when `p` is not finite.
+    fn closest_point_within(&self, p: DVec3, max_dist: f64) -> Option<SurfacePoint>;
+
+    /// The unit normal of the surface at `sp` (a point this surface returned), smooth across
+    /// the pieces of the surface.
+    fn smooth_normal(&self, sp: &SurfacePoint) -> DVec3;
+
+    /// The unit normal of the piece of the surface `sp` lies on (on a mesh, its triangle's);
+    /// [`SurfaceQuery::smooth_normal`] on a smooth surface.
+    fn piece_normal(&self, sp: &SurfacePoint) -> DVec3 {
+        self.smooth_normal(sp)
+    }
+
+    /// The closest point of the surface to `p`. `None` only when `p` is not finite.
+    fn closest_point(&self, p: DVec3) -> Option<SurfacePoint> {
+        self.closest_point_within(p, f64::MAX)
+    }
+
+    /// [`SurfaceQuery::closest_point_within`], where `hint` is the distance from `p` to a point
+    /// known to lie on the surface: the same answer, possibly found faster.
+    fn closest_point_hinted(&self, p: DVec3, hint: f64, max_dist: f64) -> Option<SurfacePoint> {
+        let _ = hint;
+        self.closest_point_within(p, max_dist)
+    }
+
+    /// The closest point to the midpoint of `a` and `b`, two points on the surface.
+    fn closest_point_to_midpoint(&self, a: DVec3, b: DVec3) -> Option<SurfacePoint> {
+        self.closest_point_hinted(0.5 * (a + b), 0.5 * a.distance(b), f64::MAX)
+    }
+}
+
+impl SurfaceQuery for MeshSurface {
+    fn closest_point_within(&self, p: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        MeshSurface::closest_point_within(self, p, max_dist)
+    }
+
+    fn smooth_normal(&self, sp: &SurfacePoint) -> DVec3 {
+        MeshSurface::smooth_normal(self, sp)
+    }
+
+    fn piece_normal(&self, sp: &SurfacePoint) -> DVec3 {
+        self.face_normal(sp.face)
+    }
+
+    fn closest_point(&self, p: DVec3) -> Option<SurfacePoint> {
+        MeshSurface::closest_point(self, p)
+    }
+
+    fn closest_point_hinted(&self, p: DVec3, hint: f64, max_dist: f64) -> Option<SurfacePoint> {
+        MeshSurface::closest_point_hinted(self, p, hint, max_dist)
+    }
+
+    fn closest_point_to_midpoint(&self, a: DVec3, b: DVec3) -> Option<SurfacePoint> {
+        MeshSurface::closest_point_to_midpoint(self, a, b)
+    }
+}
+
 impl MeshSurface {
     /// The sample at a surface point: its position, face and the face's normal.
     fn sample_at(&self, sp: &SurfacePoint) -> SurfaceSample {

@@ -58,9 +58,9 @@ enum Op {
 ///   crossing face is replaced only by faces that cross nothing.
 ///
 /// Returns the number of operations made. Deterministic.
-pub(super) fn mend_faces(
+pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     boundary: Option<&FeatureLines>,
     fixed: &[bool],
     params: &Limits,
@@ -223,9 +223,9 @@ fn worst_angle(m: &Mesh, faces: impl IntoIterator<Item = [u32; 3]>, params: &Lim
 
 /// The smallest angle of the two faces the max-min flip of `x`–`y` makes, when it passes the
 /// guards of [`mend_faces`].
-fn try_flip(
+fn try_flip<S: SurfaceQuery + ?Sized>(
     m: &Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     guard: &CrossingGuard,
     x: u32,
     y: u32,
@@ -308,7 +308,12 @@ fn try_collapse(
 /// Where a move of `v` is tried: towards the centroid of its neighbours and towards the apex of
 /// the equilateral triangle on the far edge of each of its faces with an angle below `bound`
 /// (all the way, half and a quarter of the way), projected onto the surface.
-fn move_targets(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits) -> Vec<DVec3> {
+fn move_targets<S: SurfaceQuery + ?Sized>(
+    m: &Mesh,
+    surface: &S,
+    v: u32,
+    params: &Limits,
+) -> Vec<DVec3> {
     let old = m.position(v);
     let ring = m.ring(v);
     if ring.is_empty() {
@@ -394,7 +399,12 @@ fn slide_targets(m: &Mesh, lines: &FeatureLines, v: u32, params: &Limits) -> Opt
 /// the vertex relocation of Hu et al. ("Error-bounded and feature preserving surface remeshing
 /// with minimal angle improvement", TVCG 2017, Sec. 5), which raises the worst angle of a ring
 /// that neither the centroid nor an equilateral apex does. `None` when no step helps.
-fn best_angle_position(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits) -> Option<DVec3> {
+fn best_angle_position<S: SurfaceQuery + ?Sized>(
+    m: &Mesh,
+    surface: &S,
+    v: u32,
+    params: &Limits,
+) -> Option<DVec3> {
     let ring: Vec<[DVec3; 2]> = m
         .faces_around(v)
         .iter()
@@ -412,8 +422,8 @@ fn best_angle_position(m: &Mesh, surface: &MeshSurface, v: u32, params: &Limits)
 /// `[p, ring[i][0], ring[i][1]]` around a vertex at p: a compass search in the plane of their
 /// mean normal, 8 directions, the step halved when none helps, from a quarter of the mean edge
 /// down to 1/64 of it, each point projected onto the surface. `start` when no step helps.
-fn compass_search(
-    surface: &MeshSurface,
+fn compass_search<S: SurfaceQuery + ?Sized>(
+    surface: &S,
     ring: &[[DVec3; 2]],
     start: DVec3,
     params: &Limits,
@@ -509,9 +519,9 @@ fn opposite_largest_angle(m: &Mesh, t: [u32; 3], params: &Limits) -> Option<(u32
 /// [`mend_faces`]: no new face turns by more than `max_normal_turn_deg` from the face it is cut
 /// from, the new vertex is within `collapse_offset` of the edge's middle (not on a sheet across
 /// a thin part), and no new face crosses another. `None` for a boundary or protected edge.
-fn try_split(
+fn try_split<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     guard: &CrossingGuard,
     a: u32,
     b: u32,

@@ -12,9 +12,9 @@ use super::*;
 /// exactly the two opposite vertices), raises the smallest Q of the faces involved, turns no face
 /// by more than `max_normal_turn_deg`, and leaves both old positions within `collapse_offset` of
 /// the new faces. Returns the number of collapses.
-pub(super) fn collapse_short(
+pub(super) fn collapse_short<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     fixed: &[bool],
     short: f64,
     params: &Limits,

@@ -15,6 +15,7 @@ use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::mesh_projection::MeshSurface;
+use crate::surface::SurfaceQuery;
 
 mod angles;
 mod collapse;
@@ -329,9 +330,9 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
 /// spacing).
 #[allow(clippy::too_many_arguments)] // the mesh, the input and its creases and boundary, the limits
-pub fn optimize(
+pub fn optimize<S: SurfaceQuery + ?Sized>(
     mesh: &mut TriMesh,
-    surface: &MeshSurface,
+    surface: &S,
     cover_points: &[DVec3],
     fixed: &[bool],
     protected: &[[u32; 2]],

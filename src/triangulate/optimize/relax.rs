@@ -8,7 +8,11 @@ use super::*;
 /// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around poor triangles'
 /// vertices, where the new faces face the way the old ones did and stay within `max_offset` of
 /// the surface. Returns the number of flips.
-pub(super) fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &Limits) -> usize {
+pub(super) fn flip_poor<S: SurfaceQuery + ?Sized>(
+    m: &mut Mesh,
+    surface: &S,
+    params: &Limits,
+) -> usize {
     let mut edges: Vec<(u32, u32)> = Vec::new();
     for v in poor_vertices(m, params) {
         for &f in m.faces_around(v) {
@@ -27,9 +31,9 @@ pub(super) fn flip_poor(m: &mut Mesh, surface: &MeshSurface, params: &Limits) ->
 /// Max-min angle flips ([`max_min_flips`]) of `edges`, in order, where the new faces face the
 /// way the old ones did and stay within `max_offset` of the surface. Returns the number of
 /// flips.
-pub(super) fn flip_all(
+pub(super) fn flip_all<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     params: &Limits,
     edges: &[(u32, u32)],
 ) -> usize {
@@ -60,9 +64,9 @@ pub(super) fn flip_all(
 
 /// One sweep of relaxation over the vertices of poor triangles (see [`optimize`]).
 /// Returns the number of moves.
-pub(super) fn relax_poor(
+pub(super) fn relax_poor<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     fixed: &[bool],
     params: &Limits,
 ) -> usize {

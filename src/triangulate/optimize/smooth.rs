@@ -40,9 +40,9 @@ pub struct SmoothStats {
 /// valences from their targets, when the new faces face the way the old ones did, their smallest
 /// angle is at least `min_angle_deg` (or no worse than before), and the new edge's midpoint is
 /// within `max_offset` of the surface. Returns the number of flips.
-fn valence_flips(
+fn valence_flips<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     boundary: &[bool],
     params: &Limits,
     min_angle_deg: f64,
@@ -111,9 +111,9 @@ fn valence_flips(
 /// than `max_normal_turn_deg`, and when the surface point is within 4 `max_offset` of the target
 /// and faces the way the vertex does (not another sheet of a thin part). Returns the number of
 /// moves.
-fn relax(
+fn relax<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     movable: &[bool],
     pins: &[DVec3],
     params: &Limits,
@@ -179,9 +179,9 @@ fn relax(
 /// Tangential relaxation with valence flips (see the module), `iterations` times, then max-min
 /// flips to a Delaunay mesh. Vertices with `fixed[v]`, on a boundary or at a protected edge do
 /// not move; protected and boundary edges are not flipped.
-pub(super) fn smooth(
+pub(super) fn smooth<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
-    surface: &MeshSurface,
+    surface: &S,
     fixed: &[bool],
     params: &Limits,
     iterations: usize,
