@@ -17,7 +17,6 @@ size) and memory.png (peak memory against output size).
 import argparse
 import json
 import os
-import re
 import shutil
 import statistics
 import subprocess
@@ -26,6 +25,8 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from scaling import timed  # GNU time's wall seconds and peak RSS
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -56,24 +57,11 @@ def subdivide(src: Path, dst: Path):
     return len(v)
 
 
-def timed(cmd):
-    """Runs cmd under GNU time -v; returns (wall seconds, peak RSS in MiB)."""
-    r = subprocess.run(["/usr/bin/time", "-v"] + cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit(f"scale: {' '.join(cmd)} failed:\n{r.stderr}")
-    wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", r.stderr).group(1)
-    seconds = 0.0
-    for part in wall.split(":"):
-        seconds = seconds * 60 + float(part)
-    rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", r.stderr).group(1))
-    return seconds, rss_kb / 1024
-
-
 def run(path: Path, n: int, repeats: int, seed: int, work: Path):
     walls, rss, reports = [], [], []
     for _ in range(repeats):
         out, rep = work / "out.obj", work / "report.json"
-        wall, peak = timed([REMESH, str(path), str(out), "--points", str(n), "--seed", str(seed),
+        wall, peak, _ = timed([REMESH, str(path), str(out), "--points", str(n), "--seed", str(seed),
                             "--report", str(rep), "-q"])
         walls.append(wall)
         rss.append(peak)

@@ -47,7 +47,7 @@ def timed(cmd):
     """Runs cmd under GNU time -v; returns (wall seconds, peak RSS in MiB, stdout)."""
     r = subprocess.run(["/usr/bin/time", "-v"] + cmd, capture_output=True, text=True)
     if r.returncode != 0:
-        sys.exit(f"scaling: {' '.join(cmd)} failed:\n{r.stderr}")
+        sys.exit(f"{Path(sys.argv[0]).stem}: {' '.join(cmd)} failed:\n{r.stderr}")
     wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", r.stderr).group(1)
     seconds = 0.0
     for part in wall.split(":"):

@@ -364,14 +364,7 @@ fn slide_targets(m: &Mesh, lines: &FeatureLines, v: u32, params: &Limits) -> Opt
     let [a, b] = along[..] else {
         return None;
     };
-    let faces: Vec<[DVec3; 2]> = m
-        .faces_around(v)
-        .iter()
-        .map(|&f| {
-            let t = starting_at(face(m, f), v);
-            [m.position(t[1]), m.position(t[2])]
-        })
-        .collect();
+    let faces = ring_of(m, v);
     let bounds = params.angle_bounds();
     let p = m.position(v);
     let (best, _) = [a, b]
@@ -393,6 +386,17 @@ fn slide_targets(m: &Mesh, lines: &FeatureLines, v: u32, params: &Limits) -> Opt
     (best != p).then_some(best)
 }
 
+/// The faces around `v` as their two other corners, in order (the ring [`ring_score`] scores).
+fn ring_of(m: &Mesh, v: u32) -> Vec<[DVec3; 2]> {
+    m.faces_around(v)
+        .iter()
+        .map(|&f| {
+            let t = starting_at(face(m, f), v);
+            [m.position(t[1]), m.position(t[2])]
+        })
+        .collect()
+}
+
 /// The position of `v` on the surface that raises the smallest angle score of its faces most,
 /// by a compass search in its tangent plane (8 directions, the step halved when none helps,
 /// from a quarter of its mean edge down to 1/64 of it; each point projected onto the surface):
@@ -405,14 +409,7 @@ fn best_angle_position<S: SurfaceQuery + ?Sized>(
     v: u32,
     params: &Limits,
 ) -> Option<DVec3> {
-    let ring: Vec<[DVec3; 2]> = m
-        .faces_around(v)
-        .iter()
-        .map(|&f| {
-            let t = starting_at(face(m, f), v);
-            [m.position(t[1]), m.position(t[2])]
-        })
-        .collect();
+    let ring = ring_of(m, v);
     let old = m.position(v);
     let best = compass_search(surface, &ring, old, params);
     (best != old).then_some(best)
