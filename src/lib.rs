@@ -216,8 +216,8 @@ pub use check::{
 
 // The quality report: Table 1's triangle measures, Metro-style distances, stage times.
 pub use report::{
-    surface_distance, surface_distance_with, surface_samples, triangle_quality, QualityReport,
-    StageTime, SurfaceDistance, TriangleQuality,
+    surface_distance, surface_distance_with, surface_samples, triangle_quality, PointSetDistance,
+    QualityReport, StageTime, SurfaceDistance, TriangleQuality,
 };
 
 // Point sets: streaming reading and writing, points drawn from a mesh, normal estimation, the

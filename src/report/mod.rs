@@ -8,6 +8,8 @@ mod distance;
 mod quality_report;
 mod triangle_quality;
 
-pub use distance::{surface_distance, surface_distance_with, surface_samples, SurfaceDistance};
+pub use distance::{
+    surface_distance, surface_distance_with, surface_samples, PointSetDistance, SurfaceDistance,
+};
 pub use quality_report::{QualityReport, StageTime};
 pub use triangle_quality::{triangle_quality, TriangleQuality};
