@@ -219,6 +219,16 @@ pub fn surface_distance_with(
         || surface_samples(b, samples_per_side, seed ^ SECOND_SIDE_SEED),
     );
     let (fwd, bwd) = rayon::join(|| one_side(&pa, b_surface), || one_side(&pb, a_surface));
+    combine(fwd, bwd, samples_per_side)
+}
+
+/// The two sides' (max, sum of squares, sum, count) of distances as a [`SurfaceDistance`] (a
+/// side with no distance reads 0).
+fn combine(
+    fwd: (f64, f64, f64, usize),
+    bwd: (f64, f64, f64, usize),
+    samples_per_side: usize,
+) -> SurfaceDistance {
     let rms = |(_, sum_sq, _, n): (f64, f64, f64, usize)| {
         if n == 0 {
             0.0
@@ -317,30 +327,7 @@ impl<'a> PointSetDistance<'a> {
             let d = d2.sqrt();
             fwd = (fwd.0.max(d), fwd.1 + d2, fwd.2 + d, fwd.3 + 1);
         }
-        let bwd = self.backward;
-        let rms = |sum_sq: f64, n: usize| {
-            if n == 0 {
-                0.0
-            } else {
-                (sum_sq / n as f64).sqrt()
-            }
-        };
-        let (forward_rms, backward_rms) = (rms(fwd.1, fwd.3), rms(bwd.1, bwd.3));
-        let total = fwd.3 + bwd.3;
-        SurfaceDistance {
-            hausdorff: fwd.0.max(bwd.0),
-            rms: forward_rms.max(backward_rms),
-            mean: if total == 0 {
-                0.0
-            } else {
-                (fwd.2 + bwd.2) / total as f64
-            },
-            forward_hausdorff: fwd.0,
-            backward_hausdorff: bwd.0,
-            forward_rms,
-            backward_rms,
-            samples_per_side: self.samples_per_side,
-        }
+        combine(fwd, self.backward, self.samples_per_side)
     }
 }
 
@@ -348,17 +335,10 @@ impl<'a> PointSetDistance<'a> {
 mod tests {
     use super::*;
 
-    /// Points on the sphere of radius `r` (a Fibonacci spiral: even spacing), `n` of them.
+    /// `n` points evenly spread on the sphere of radius `r`.
     fn sphere_points(r: f64, n: usize) -> Vec<DVec3> {
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        (0..n)
-            .map(|i| {
-                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-                let s = (1.0 - z * z).sqrt();
-                let a = golden * i as f64;
-                r * DVec3::new(s * a.cos(), s * a.sin(), z)
-            })
-            .collect()
+        let unit = crate::mesh::test_meshes::fibonacci_sphere(n);
+        unit.into_iter().map(|u| r * u).collect()
     }
 
     #[test]
