@@ -440,6 +440,15 @@ mod tests {
         assert_eq!(m.sanity_check(), Ok(()));
     }
 
+    /// [`optimize`] with no cover points, creases or boundary lines, sigma_p 1 and no cover.
+    fn optimize_plain(
+        mesh: &mut TriMesh,
+        surface: &MeshSurface,
+        fixed: &[bool],
+    ) -> (OptimizeStats, Vec<Option<u32>>) {
+        optimize(mesh, surface, &[], fixed, &[], None, 1.0, &no_cover())
+    }
+
     fn no_cover() -> OptimizeParams {
         OptimizeParams {
             cover_distance_sigma_p: f64::INFINITY,
@@ -456,16 +465,7 @@ mod tests {
         mesh.positions[v] += DVec3::new(0.8, 0.1, 0.0);
         let before = triangle_quality(&mesh);
         let fixed: Vec<bool> = vec![false; mesh.vertex_count()];
-        let (stats, _) = optimize(
-            &mut mesh,
-            &surface,
-            &[],
-            &fixed,
-            &[],
-            None,
-            1.0,
-            &no_cover(),
-        );
+        let (stats, _) = optimize_plain(&mut mesh, &surface, &fixed);
         let after = triangle_quality(&mesh);
         assert!(stats.moves + stats.flips + stats.collapses + stats.smooth.moves > 0);
         assert!(
@@ -488,16 +488,7 @@ mod tests {
         let original = mesh.positions.clone();
         let mut fixed = vec![false; mesh.vertex_count()];
         fixed[3 * 7 + 3] = true;
-        let (_, origin) = optimize(
-            &mut mesh,
-            &surface,
-            &[],
-            &fixed,
-            &[],
-            None,
-            1.0,
-            &no_cover(),
-        );
+        let (_, origin) = optimize_plain(&mut mesh, &surface, &fixed);
         assert_eq!(origin.len(), mesh.face_count());
         assert!(origin.iter().any(|o| o.is_none()) && origin.iter().any(|o| o.is_some()));
         assert_eq!(mesh.positions[3], original[3]);
@@ -539,16 +530,7 @@ mod tests {
         let t0 = topology(&mesh);
         assert!(t0.is_manifold() && t0.euler_characteristic == 1);
         let fixed = vec![false; mesh.vertex_count()];
-        let (stats, _) = optimize(
-            &mut mesh,
-            &surface,
-            &[],
-            &fixed,
-            &[],
-            None,
-            1.0,
-            &no_cover(),
-        );
+        let (stats, _) = optimize_plain(&mut mesh, &surface, &fixed);
         assert!(stats.collapses >= 1, "{stats:?}");
         assert_manifold_disk(&mut mesh);
         assert!(triangle_quality(&mesh).theta_min > 30.0);
