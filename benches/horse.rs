@@ -47,6 +47,7 @@ fn remesh_job(c: &mut Criterion) {
         strict: false,
         measure_distance: false,
         max_memory: None,
+        as_points: false,
     };
     // The split per stage of one run, which criterion's total does not show.
     let report = run_remesh(&job, &|_| {}).expect("remesh");

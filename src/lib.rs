@@ -122,6 +122,7 @@ mod kernel;
 mod measure;
 mod mesh;
 mod pipeline;
+mod point_pipeline;
 mod points;
 mod report;
 mod sampling;
@@ -229,7 +230,13 @@ pub use points::normals::{estimate_normals, NormalOrientation};
 pub use points::out_of_core::{
     simplify_out_of_core, simplify_progressive, OutOfCoreParams, OutOfCoreResult, ProgressiveResult,
 };
+pub use points::outliers::OutlierFilter;
 pub use points::rimls::{Rimls, RimlsParams, RimlsProjection};
+
+// Point sets in, meshes out (issue 19).
+pub use point_pipeline::{
+    is_point_set, remesh_points, PointRemeshOutput, PointRemeshParams, RIMLS_POINTS_PER_SAMPLE,
+};
 pub use points::{PlyPointWriter, Point, PointReader};
 
 // The jobs of the `remesh` command line: files in, files and report out.

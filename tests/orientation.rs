@@ -37,6 +37,7 @@ fn remesh(
         strict: false,
         format: None,
         max_memory: None,
+        as_points: false,
     };
     let report = run_remesh(&job, &|_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
     let (out, _) = read_mesh(&output).unwrap();

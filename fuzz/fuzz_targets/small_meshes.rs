@@ -285,6 +285,7 @@ pub fn assert_remesh_is_sound(data: &[u8], dir: &Path) {
         measure_distance: false,
         strict: false,
         max_memory: None,
+        as_points: false,
         format: None,
     };
     match run_remesh(&job, &|_| {}) {

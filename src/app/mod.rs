@@ -3,6 +3,7 @@
 //! from a mesh; writing the JSON report, and turning a panic into an error.
 
 mod memory;
+mod remesh_points;
 mod simplify;
 
 pub use memory::{estimate_remesh_bytes, parse_bytes, physical_memory};
@@ -51,6 +52,10 @@ pub struct RemeshJob {
     /// ([`estimate_remesh_bytes`]) is larger is refused before it starts (and an input file too
     /// large to fit is refused before it is read). `None`: no limit.
     pub max_memory: Option<u64>,
+    /// Whether the input is read as a point set (its faces ignored) even when it has faces:
+    /// `--as-points` (a PLY file). A text point file or a PLY file without faces is read as a
+    /// point set either way ([`is_point_set`](crate::is_point_set)).
+    pub as_points: bool,
 }
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
@@ -100,6 +105,9 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
                 job.output.display()
             ),
         });
+    }
+    if job.as_points || crate::is_point_set(&job.input)? {
+        return remesh_points::run(job, format, on_stage);
     }
     if let Some(limit) = job.max_memory {
         memory::check_input_size(&job.input, limit)?;
@@ -190,52 +198,10 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         }
     }
     let check_seconds = t.elapsed();
-    let mut refusals = Vec::new();
-    if !report.invariant_violations.is_empty() {
-        let list = report
-            .invariant_violations
-            .iter()
-            .map(|v| v.to_string())
-            .collect::<Vec<_>>()
-            .join("; ");
-        refusals.push(format!("the output mesh breaks its invariants ({list})"));
-        report
-            .notes
-            .push(format!("the output mesh breaks its invariants: {list}"));
-    }
-    if !report.topology_changes.is_empty() {
-        refusals.push(format!(
-            "the output's topology differs from the input's ({})",
-            report.topology_changes_text()
-        ));
-    }
-    if job.strict && !refusals.is_empty() {
-        return Err(Error::Internal {
-            stage: "invariant check",
-            message: format!(
-                "{}; {} was not written (--strict)",
-                refusals.join("; "),
-                job.output.display()
-            ),
-        });
-    }
+    refuse_if_strict(job, &mut report)?;
     on_stage("write");
     let t = Clock::start();
-    // Every check has passed: standard output gets the complete bytes, or nothing.
-    let bytes = encode_mesh(&job.output, mesh_out, format)?;
-    if to_stdout {
-        use std::io::Write;
-        let mut stdout = std::io::stdout().lock();
-        stdout
-            .write_all(&bytes)
-            .and_then(|()| stdout.flush())
-            .map_err(|e| Error::Write {
-                path: job.output.clone(),
-                message: format!("cannot write to standard output: {e}"),
-            })?;
-    } else {
-        write_atomically(&job.output, |w| w.write_all(&bytes))?;
-    }
+    write_output(job, format, mesh_out)?;
     let write_seconds = t.elapsed();
 
     report.push_stage("read", read_seconds.0, read_seconds.1);
@@ -408,6 +374,60 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         ));
     }
     Ok(report)
+}
+
+/// Notes the output's invariant violations in `report`; with `job.strict`, an error when it
+/// breaks an invariant or its topology differs from the input's.
+fn refuse_if_strict(job: &RemeshJob, report: &mut QualityReport) -> Result<()> {
+    let mut refusals = Vec::new();
+    if !report.invariant_violations.is_empty() {
+        let list = report
+            .invariant_violations
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join("; ");
+        refusals.push(format!("the output mesh breaks its invariants ({list})"));
+        report
+            .notes
+            .push(format!("the output mesh breaks its invariants: {list}"));
+    }
+    if !report.topology_changes.is_empty() {
+        refusals.push(format!(
+            "the output's topology differs from the input's ({})",
+            report.topology_changes_text()
+        ));
+    }
+    if job.strict && !refusals.is_empty() {
+        return Err(Error::Internal {
+            stage: "invariant check",
+            message: format!(
+                "{}; {} was not written (--strict)",
+                refusals.join("; "),
+                job.output.display()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Writes `mesh` to `job.output` in `format`, atomically, or to standard output: the complete
+/// bytes or nothing.
+fn write_output(job: &RemeshJob, format: MeshFormat, mesh: &TriMesh) -> Result<()> {
+    let bytes = encode_mesh(&job.output, mesh, format)?;
+    if is_stdout(&job.output) {
+        use std::io::Write;
+        let mut stdout = std::io::stdout().lock();
+        stdout
+            .write_all(&bytes)
+            .and_then(|()| stdout.flush())
+            .map_err(|e| Error::Write {
+                path: job.output.clone(),
+                message: format!("cannot write to standard output: {e}"),
+            })
+    } else {
+        write_atomically(&job.output, |w| w.write_all(&bytes))
+    }
 }
 
 /// The report's notes on orienting the input and the output ([`OrientStats`]): how many input

@@ -24,6 +24,8 @@ Examples:
   remesh cow.obj - --format glb --points 3000 -q > cow-3k.glb
   remesh quality out.obj --ref in.obj
   remesh points horse.obj horse-14M.ply --count 14000000
+  remesh horse-14M.ply horse-300k.obj --points 300000
+  remesh scan.xyz scan-20k.ply --points 20000
   remesh simplify horse-14M.ply horse-300k.ply --points 300000
   remesh simplify scan.xyz levels.ply --levels 4,2,1";
 
@@ -37,7 +39,9 @@ struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
 
-    /// Input mesh: .obj, .ply, .gltf, .glb, .stl (binary or ascii) or .off.
+    /// Input mesh: .obj, .ply, .gltf, .glb, .stl (binary or ascii) or .off; or a point set (a
+    /// scan): a .ply without faces, or text .xyz .xyzn .csv .txt .pts .asc (x y z [nx ny nz] per
+    /// line), with or without normals, read out of core; it needs --points or --sigma-p.
     #[arg(required = true)]
     input: Option<PathBuf>,
 
@@ -155,6 +159,11 @@ struct Cli {
     /// Default: the machine's physical memory.
     #[arg(long, value_name = "SIZE", value_parser = parse_bytes)]
     max_memory: Option<u64>,
+
+    /// Read a .ply input as a point set, ignoring its faces (a range map, a mesh whose
+    /// connectivity is not to be trusted).
+    #[arg(long)]
+    as_points: bool,
 
     /// Print nothing but errors.
     #[arg(short, long)]
@@ -437,6 +446,7 @@ fn config(cli: Cli) -> Result<Config, Error> {
                 measure_distance: !cli.no_distance,
                 strict: cli.strict,
                 max_memory: cli.max_memory.or_else(physical_memory),
+                as_points: cli.as_points,
             };
             Ok(Config::Remesh {
                 job: Box::new(job),

@@ -5,6 +5,7 @@
 pub mod generate;
 pub mod normals;
 pub mod out_of_core;
+pub mod outliers;
 pub mod rimls;
 pub mod stream;
 

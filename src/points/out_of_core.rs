@@ -14,6 +14,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::normals::{estimate_normals, NormalOrientation};
+use super::outliers::OutlierFilter;
 use super::rimls::{Rimls, RimlsParams};
 use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -114,6 +115,85 @@ pub struct OutOfCoreResult {
 /// whose bounding box has no extent; [`Error::Io`] when the temporary files fail.
 pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<OutOfCoreResult> {
     let t0 = Instant::now();
+    let scan = scan_out_of_core(input, params, false, params.resample > 0)?;
+    let t3 = Instant::now();
+    let ScanOutput {
+        mut samples,
+        support,
+        input_points,
+        had_normals,
+        sigma_p,
+        normalization,
+        rejected_by_nearest,
+        measured,
+        seconds: [read, search, _],
+        ..
+    } = scan;
+    let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+    if params.resample > 0 {
+        resample_on_rimls(&kernel, &mut samples, support, had_normals, params)?;
+    } else if !had_normals {
+        estimate_sample_normals(&mut samples, params.orientation);
+    }
+    for p in &mut samples {
+        p.position = normalization.invert(p.position);
+    }
+    let t4 = Instant::now();
+    Ok(OutOfCoreResult {
+        samples,
+        input_points,
+        had_normals,
+        sigma_p,
+        normalization,
+        rejected_by_nearest,
+        measured,
+        seconds: [
+            read,
+            search,
+            (t3 - t0).as_secs_f64() - read - search,
+            (t4 - t3).as_secs_f64(),
+        ],
+    })
+}
+
+/// The out-of-core linear scan of [`simplify_out_of_core`] (its passes 1 and 2), before normals
+/// and resampling, in bbox-100 units.
+pub(crate) struct ScanOutput {
+    /// The output set O, bbox-100 units, in the order the scan accepted it; normals as read
+    /// (zero without them).
+    pub samples: Vec<Point>,
+    /// The first bucket's points, shuffled (a uniformly random subset of the input of up to
+    /// `bucket_points`), bbox-100 units; empty unless asked for.
+    pub support: Vec<Point>,
+    /// Points read.
+    pub input_points: u64,
+    /// Whether the input had normals.
+    pub had_normals: bool,
+    /// The sigma_p used, bbox-100 units.
+    pub sigma_p: f64,
+    /// Model units ↔ bbox-100 units.
+    pub normalization: Normalization,
+    /// Candidates rejected by their nearest output sample alone, and measured with eq. 10.
+    pub rejected_by_nearest: usize,
+    /// Candidates whose measure was evaluated.
+    pub measured: usize,
+    /// Outliers ([`OutlierFilter`]) dropped from the samples and the support.
+    pub outliers_removed: usize,
+    /// Seconds: reading and bucketing, the sigma_p search (and the outlier filter), the scan.
+    pub seconds: [f64; 3],
+}
+
+/// Passes 1 and 2 of [`simplify_out_of_core`]. With `drop_outliers`, an [`OutlierFilter`] of
+/// the first bucket's points removes outliers from the sigma_p search's subset, from the
+/// samples after the scan, and from the support (so isolated points neither raise the count the
+/// search sees nor become samples). With `keep_support`, the first bucket is returned.
+pub(crate) fn scan_out_of_core(
+    input: &Path,
+    params: &OutOfCoreParams,
+    drop_outliers: bool,
+    keep_support: bool,
+) -> Result<ScanOutput> {
+    let t0 = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let bucket_set = Buckets::write(input, params, &mut rng)?;
     let (total, had_normals, normalization) = (
@@ -124,53 +204,59 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
     let t1 = Instant::now();
 
     // sigma_p: given, or searched on a scaled-down problem (see `search_sigma_p`).
-    let sigma_p = match params.target {
-        None => params.sigma_p,
-        Some(n) => {
-            let first = bucket_set.load(0, &mut rng)?;
-            search_sigma_p(&first, total, n, params)?
+    let mut outliers_removed = 0;
+    let mut filter = None;
+    let sigma_p = if params.target.is_none() && !drop_outliers {
+        params.sigma_p
+    } else {
+        let mut first = bucket_set.load(0, &mut rng)?;
+        if drop_outliers {
+            let positions: Vec<DVec3> = first.iter().map(|p| p.position).collect();
+            let f = OutlierFilter::new(&positions);
+            f.retain(&mut first, |p| p.position);
+            filter = Some(f);
+        }
+        match params.target {
+            None => params.sigma_p,
+            Some(n) => search_sigma_p(&first, total, n, params)?,
         }
     };
     let t2 = Instant::now();
 
     let kernel = Kernel::new(sigma_p, params.sigma_n)?;
     let mut scanner = LinearScanner::new(&kernel, &params.scan);
-    // The samples in bbox-100 units, and the first bucket when resampling needs it.
+    // The samples in bbox-100 units, and the first bucket when asked for.
     let mut samples: Vec<Point> = Vec::new();
-    let mut first_bucket: Vec<Point> = Vec::new();
+    let mut support: Vec<Point> = Vec::new();
     let mut accepted = Vec::new();
     bucket_set.for_each(&mut rng, |pts| {
         let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
         accepted.clear();
         scanner.offer_batch(&batch, &mut accepted);
         samples.extend(accepted.iter().map(|&i| pts[i]));
-        if params.resample > 0 && first_bucket.is_empty() {
-            first_bucket = pts;
+        if keep_support && support.is_empty() {
+            support = pts;
         }
     })?;
+    if let Some(f) = &filter {
+        outliers_removed += f.retain(&mut samples, |p| p.position);
+        outliers_removed += f.retain(&mut support, |p| p.position);
+    }
     let t3 = Instant::now();
-    if params.resample > 0 {
-        resample_on_rimls(&kernel, &mut samples, first_bucket, had_normals, params)?;
-    } else if !had_normals {
-        estimate_sample_normals(&mut samples, params.orientation);
-    }
-    for p in &mut samples {
-        p.position = normalization.invert(p.position);
-    }
-    let t4 = Instant::now();
-    Ok(OutOfCoreResult {
+    Ok(ScanOutput {
         samples,
+        support,
         input_points: total,
         had_normals,
         sigma_p,
         normalization,
         rejected_by_nearest: scanner.rejected_by_nearest,
         measured: scanner.measured,
+        outliers_removed,
         seconds: [
             (t1 - t0).as_secs_f64(),
             (t2 - t1).as_secs_f64(),
             (t3 - t2).as_secs_f64(),
-            (t4 - t3).as_secs_f64(),
         ],
     })
 }
@@ -202,20 +288,13 @@ fn resample_on_rimls(
     had_normals: bool,
     params: &OutOfCoreParams,
 ) -> Result<()> {
-    let mut support = support;
-    support.truncate(RIMLS_POINTS_PER_SAMPLE.saturating_sub(1) * samples.len());
-    support.extend_from_slice(samples);
-    if !had_normals {
-        estimate_sample_normals(&mut support, params.orientation);
-        let from = support.len() - samples.len();
-        samples.copy_from_slice(&support[from..]);
-    }
-    let (positions, normals) = support.iter().map(|p| (p.position, p.normal)).unzip();
-    drop(support);
-    let rimls = Rimls::new(
-        positions,
-        normals,
+    let rimls = rimls_of(
         RimlsParams::new(kernel.sigma_p(), kernel.sigma_n()),
+        samples,
+        support,
+        RIMLS_POINTS_PER_SAMPLE,
+        had_normals,
+        params.orientation,
     )?;
     let mut moving: Vec<SurfaceSample> = samples
         .iter()
@@ -237,6 +316,35 @@ fn resample_on_rimls(
         p.normal = m.normal;
     }
     Ok(())
+}
+
+/// The RIMLS surface (`params`) of `samples` and the first
+/// `(points_per_sample - 1) · samples.len()` points of `support` (a uniformly random subset of
+/// the input), bbox-100 units. Without input normals (`had_normals` false), normals are
+/// estimated on that set (PCA over 10 neighbours, oriented by `orientation`) and given to the
+/// samples as well.
+///
+/// # Errors
+/// Those of [`Rimls::new`] (no points, a non-finite position or a zero normal).
+pub(crate) fn rimls_of(
+    params: RimlsParams,
+    samples: &mut [Point],
+    support: Vec<Point>,
+    points_per_sample: usize,
+    had_normals: bool,
+    orientation: NormalOrientation,
+) -> Result<Rimls> {
+    let mut support = support;
+    support.truncate(points_per_sample.saturating_sub(1) * samples.len());
+    support.extend_from_slice(samples);
+    if !had_normals {
+        estimate_sample_normals(&mut support, orientation);
+        let from = support.len() - samples.len();
+        samples.copy_from_slice(&support[from..]);
+    }
+    let (positions, normals) = support.iter().map(|p| (p.position, p.normal)).unzip();
+    drop(support);
+    Rimls::new(positions, normals, params)
 }
 
 /// The result of [`simplify_progressive`].

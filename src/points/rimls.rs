@@ -327,6 +327,11 @@ impl Rimls {
         &self.params
     }
 
+    /// The points (`N`, position units), in the order given.
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.positions.len()

@@ -456,6 +456,44 @@ fn fill(input: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
 }
 
 /// Whether `path`'s extension names an XYZ/CSV text point set.
+/// Whether `path` holds a point set rather than a mesh: a text point format by its extension,
+/// or a PLY file whose header declares no faces (no `face` or `tristrips` element with entries).
+/// A file that cannot be read or is not PLY is not a point set (reading it as a mesh then says
+/// what is wrong); this never fails.
+pub(crate) fn is_point_set(path: &Path) -> Result<bool> {
+    if is_text_extension(path) {
+        return Ok(true);
+    }
+    let is_ply = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
+    if !is_ply {
+        return Ok(false);
+    }
+    let Ok(file) = File::open(path) else {
+        return Ok(false);
+    };
+    let mut input = BufReader::new(file);
+    match input.fill_buf() {
+        Ok(head) if head.starts_with(b"ply\n") || head.starts_with(b"ply\r\n") => {}
+        _ => return Ok(false),
+    }
+    let mut reader = ply_rs_bw::parser::Reader::new(input);
+    let Ok(header) = read_header(path, &mut reader) else {
+        return Ok(false);
+    };
+    let has_vertices = header
+        .elements
+        .first()
+        .is_some_and(|(name, e)| name == "vertex" && e.count > 0);
+    let has_faces = header
+        .elements
+        .iter()
+        .any(|(name, e)| (name == "face" || name == "tristrips") && e.count > 0);
+    Ok(has_vertices && !has_faces)
+}
+
 fn is_text_extension(path: &Path) -> bool {
     path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
         ["xyz", "csv", "txt", "pts", "asc", "xyzn"]

@@ -1,0 +1,159 @@
+//! `remesh IN OUT --points N` where IN is a point set: [`remesh_points`], the checks and the
+//! report as for a mesh, and the distances measured against the input points themselves.
+
+use glam::DVec3;
+
+use super::{memory, refuse_if_strict, write_output, RemeshJob, DISTANCE_SAMPLES};
+use crate::error::Result;
+use crate::io::{as_written, MeshFormat};
+use crate::pipeline::{Density, MAX_POINTS};
+use crate::point_pipeline::{remesh_points, PointRemeshParams};
+use crate::points::PointReader;
+use crate::report::{PointSetDistance, QualityReport};
+use crate::surface::MeshSurface;
+use crate::timing::Clock;
+
+/// Points per chunk of the distance measurement's pass over the input.
+const DISTANCE_CHUNK: usize = 1 << 20;
+
+/// The point-set branch of [`run_remesh`](super::run_remesh), after its usage checks.
+pub(super) fn run(
+    job: &RemeshJob,
+    format: MeshFormat,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<QualityReport> {
+    let params = PointRemeshParams {
+        remesh: job.params,
+        ..PointRemeshParams::default()
+    };
+    if let (Some(limit), Density::Points(n)) = (job.max_memory, job.params.density) {
+        if n <= MAX_POINTS {
+            memory::check_remesh_budget(0, n as f64, job.measure_distance, limit)?;
+        }
+    }
+    let out = remesh_points(&job.input, &params, on_stage)?;
+
+    on_stage("check");
+    let t = Clock::start();
+    let written;
+    let checked = match format {
+        MeshFormat::Obj | MeshFormat::Ply | MeshFormat::Off => &out.mesh_normalized,
+        MeshFormat::Gltf | MeshFormat::Glb | MeshFormat::Stl => {
+            written = out.normalization.apply_mesh(&as_written(&out.mesh, format));
+            &written
+        }
+    };
+    let mut report = QualityReport::new(checked);
+    let check_seconds = t.elapsed();
+    refuse_if_strict(job, &mut report)?;
+    on_stage("write");
+    let t = Clock::start();
+    write_output(job, format, &out.mesh)?;
+    let write_seconds = t.elapsed();
+    for s in &out.stages {
+        report.push_stage(s.name, s.seconds, s.cpu_seconds);
+    }
+    report.push_stage("check (report)", check_seconds.0, check_seconds.1);
+    report.push_stage("write", write_seconds.0, write_seconds.1);
+
+    if job.measure_distance {
+        on_stage("distance");
+        let t = Clock::start();
+        let surface = MeshSurface::new(checked)?;
+        let mut distance =
+            PointSetDistance::new(checked, &surface, DISTANCE_SAMPLES, job.params.seed);
+        let mut reader = PointReader::open(&job.input)?;
+        let mut chunk = Vec::new();
+        let mut positions: Vec<DVec3> = Vec::new();
+        while reader.read_chunk(&mut chunk, DISTANCE_CHUNK)? > 0 {
+            positions.clear();
+            positions.extend(chunk.iter().map(|p| out.normalization.apply(p.position)));
+            distance.add_points(&positions);
+        }
+        report.distance = Some(distance.finish());
+        let (wall, cpu) = t.elapsed();
+        report.push_stage("distance (report)", wall, cpu);
+        report.notes.push(
+            "Hausdorff and RMS are to the input points (output to its nearest point, each \
+             point to the output), outliers included"
+                .into(),
+        );
+    }
+
+    let extra = &mut report.extra;
+    extra.insert("sigma_p".into(), out.sigma_p.into());
+    extra.insert(
+        "sigma_n".into(),
+        if job.params.sigma_n.is_finite() {
+            job.params.sigma_n.into()
+        } else {
+            "infinity".into()
+        },
+    );
+    if let Some(n) = out.target {
+        extra.insert("target_points".into(), n.into());
+    }
+    extra.insert("input_points".into(), out.input_points.into());
+    extra.insert("had_normals".into(), out.had_normals.into());
+    extra.insert("outliers_removed".into(), out.outliers_removed.into());
+    extra.insert("samples".into(), out.samples.into());
+    extra.insert("unprojected_samples".into(), out.unprojected_samples.into());
+    extra.insert("rimls_points".into(), out.rimls_points.into());
+    extra.insert("seed".into(), job.params.seed.into());
+    extra.insert(
+        "assembly".into(),
+        serde_json::to_value(&out.assembly).unwrap_or_default(),
+    );
+    extra.insert(
+        "optimize".into(),
+        serde_json::to_value(out.optimize).unwrap_or_default(),
+    );
+    extra.insert(
+        "untangle".into(),
+        serde_json::to_value(out.untangle).unwrap_or_default(),
+    );
+    if let Some(fit) = out.fit {
+        extra.insert("fit".into(), serde_json::to_value(fit).unwrap_or_default());
+    }
+    extra.insert(
+        "output_orientation".into(),
+        serde_json::to_value(out.output_orientation).unwrap_or_default(),
+    );
+    report.notes.push(format!(
+        "the input is a point set ({} points, {}): the samples lie on the RIMLS surface of the \
+         points and were connected by tangent-plane umbrellas",
+        out.input_points,
+        if out.had_normals {
+            "with normals"
+        } else {
+            "normals estimated"
+        }
+    ));
+    if out.outliers_removed > 0 {
+        report.notes.push(format!(
+            "{} isolated points (outliers) were left out of the samples and the surface",
+            out.outliers_removed
+        ));
+    }
+    if let Some(n) = out.target {
+        let v = out.mesh.vertex_count();
+        if (v as f64 - n as f64).abs() > 0.01 * n as f64 {
+            report.notes.push(format!(
+                "target not reached: {v} vertices for --points {n} (more than 1% off)"
+            ));
+        }
+    }
+    if out.dropped_samples > 0 {
+        report.notes.push(format!(
+            "{} samples ended in no triangle and were left out",
+            out.dropped_samples
+        ));
+    }
+    if out.assembly.holes_left > 0 {
+        report.notes.push(format!(
+            "{} holes of the triangulation could not be closed",
+            out.assembly.holes_left
+        ));
+    }
+    Ok(report)
+}

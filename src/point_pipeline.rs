@@ -1,0 +1,344 @@
+//! The remeshing pipeline for a point set (a scan): out-of-core linear scan of the points →
+//! outlier filter → RIMLS surface of the points → samples projected onto it → gradient ascent on
+//! it → tangent-plane umbrellas → local optimization and fit against it → untangle → outward
+//! orientation → model units. The paper's Figure 1 path (Sec. 6.1, 6.2 and 7).
+//!
+//! The mesh pipeline ([`crate::pipeline`]) has an input surface to project onto, measure
+//! against and take boundaries, creases and local feature size from; here the surface is the
+//! RIMLS surface ([`Rimls`](crate::Rimls), Öztireli, Guennebaud, Gross 2009) of a uniformly random subset of
+//! the points (the first bucket of the out-of-core scan) and the samples, with the sampling's
+//! sigma_p and sigma_n, so memory stays bounded by the output and one bucket, not by the input.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::kernel::Kernel;
+use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
+use crate::pipeline::{Density, RemeshParams};
+use crate::points::normals::NormalOrientation;
+use crate::points::out_of_core::{rimls_of, scan_out_of_core, OutOfCoreParams};
+use crate::points::rimls::RimlsParams;
+use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
+use crate::surface::features::FeatureDetection;
+use crate::surface::SurfaceSample;
+pub use crate::timing::Stage;
+use crate::timing::StageTimer;
+use crate::triangulate::fit::FitStats;
+use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
+use crate::triangulate::untangle::{untangle, UntangleStats};
+use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
+
+/// Points of the RIMLS surface per output sample: the samples and `RIMLS_POINTS_PER_SAMPLE - 1`
+/// random input points per sample (the first bucket's). More average noise better at a
+/// proportional cost per projection.
+pub const RIMLS_POINTS_PER_SAMPLE: usize = 4;
+
+/// The RIMLS surface's parameters for a sampling at `sigma_p` and `sigma_n`: the same widths,
+/// but where the sampling is by position alone (sigma_n infinite) the surface keeps the normal
+/// term at the RIMLS default (0.75): without it the two sides of a part thinner than the
+/// support (3 sigma_p), whose normals point apart, average into one sheet between them.
+pub fn rimls_params(sigma_p: f64, sigma_n: f64) -> RimlsParams {
+    if sigma_n.is_finite() {
+        RimlsParams::new(sigma_p, sigma_n)
+    } else {
+        RimlsParams {
+            sigma_p,
+            ..RimlsParams::default()
+        }
+    }
+}
+
+/// Parameters of [`remesh_points`].
+#[derive(Debug, Clone)]
+pub struct PointRemeshParams {
+    /// The pipeline's parameters as for a mesh. `density` must be `Points` or `SigmaP`; a point
+    /// set has no local feature size or curvature estimate yet (`grading` and `curvature` must
+    /// be `None`) and no detected creases (`features` `Angle` is refused); `triangulation` is
+    /// always the umbrellas (the restricted Delaunay triangulation needs an input mesh).
+    pub remesh: RemeshParams,
+    /// Points per bucket of the out-of-core scan (the fixed buffer; default 2^20).
+    pub bucket_points: usize,
+    /// Where the bucket files go (default: the system's temporary folder).
+    pub temp_dir: Option<PathBuf>,
+    /// How normals are oriented for a point set without them.
+    pub orientation: NormalOrientation,
+    /// Whether isolated points are dropped ([`OutlierFilter`](crate::points::outliers::OutlierFilter);
+    /// default true).
+    pub drop_outliers: bool,
+}
+
+impl Default for PointRemeshParams {
+    fn default() -> Self {
+        PointRemeshParams {
+            remesh: RemeshParams::default(),
+            bucket_points: 1 << 20,
+            temp_dir: None,
+            orientation: NormalOrientation::SpanningTree,
+            drop_outliers: true,
+        }
+    }
+}
+
+/// The result of [`remesh_points`].
+#[derive(Debug, Clone)]
+pub struct PointRemeshOutput {
+    /// The output mesh, model units (the input points' units).
+    pub mesh: TriMesh,
+    /// The same mesh in bbox-100 units.
+    pub mesh_normalized: TriMesh,
+    /// Model units ↔ bbox-100 units (the points' bounding box).
+    pub normalization: Normalization,
+    /// The sigma_p used, bbox-100 units.
+    pub sigma_p: f64,
+    /// The target count, if one was given.
+    pub target: Option<usize>,
+    /// Points read.
+    pub input_points: u64,
+    /// Whether the input had normals (else they were estimated).
+    pub had_normals: bool,
+    /// Isolated points dropped from the samples and the RIMLS support.
+    pub outliers_removed: usize,
+    /// Samples after the scan and the outlier filter.
+    pub samples: usize,
+    /// Samples the RIMLS projection did not reach (left out).
+    pub unprojected_samples: usize,
+    /// Points of the RIMLS surface.
+    pub rimls_points: usize,
+    /// The gradient ascent on the RIMLS surface.
+    pub gradient_ascent: GradientAscentResult,
+    /// The umbrellas' assembly.
+    pub assembly: AssemblyStats,
+    /// The local optimization against the RIMLS surface.
+    pub optimize: OptimizeStats,
+    /// The least-squares fit to the RIMLS surface, if run.
+    pub fit: Option<FitStats>,
+    /// The separation of crossing faces.
+    pub untangle: UntangleStats,
+    /// Samples that ended in no triangle.
+    pub dropped_samples: usize,
+    /// The output's orientation (closed parts turned outward).
+    pub output_orientation: OrientStats,
+    /// Wall-clock and processor seconds per stage.
+    pub stages: Vec<Stage>,
+}
+
+/// Remeshes the point set in the file `input` (PLY without faces, or XYZ/CSV text; see
+/// [`PointReader`](crate::points::PointReader)), with or without normals, out of core.
+/// `on_stage` is called with each stage name as it starts.
+///
+/// Memory: the output, the first bucket of the input (`params.bucket_points` points), and the
+/// RIMLS surface of `RIMLS_POINTS_PER_SAMPLE` points per sample; not the input.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the option for a density other than a count or sigma_p
+/// (`--points`), grading (`--lfs-factor`), curvature (`--chord-error`), a crease angle
+/// (`--feature-angle`) or a finite sigma_n (`--sigma-n`) on points without normals; the
+/// errors of reading the points ([`PointReader`](crate::points::PointReader)), naming the
+/// file; [`Error::InvalidMesh`] for an empty set, one with no extent, or one of which nothing
+/// could be triangulated.
+pub fn remesh_points(
+    input: &Path,
+    params: &PointRemeshParams,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<PointRemeshOutput> {
+    let rp = &params.remesh;
+    let refuse = |name: &'static str, what: &str| Error::InvalidParameter {
+        name,
+        message: format!(
+            "{what} is not available for a point set ({})",
+            input.display()
+        ),
+    };
+    let (target, sigma_p) = match rp.density {
+        Density::Points(n) => (Some(n), 1.0),
+        Density::SigmaP(s) => (None, s),
+        Density::InputVertices => {
+            return Err(Error::InvalidParameter {
+                name: "--points",
+                message: format!(
+                    "{} is a point set: give the output's vertex count with --points N (or \
+                     its sigma_p with --sigma-p)",
+                    input.display()
+                ),
+            })
+        }
+    };
+    if rp.grading.is_some() {
+        return Err(refuse("--lfs-factor", "grading by local feature size"));
+    }
+    if rp.curvature.is_some() {
+        return Err(refuse("--chord-error", "grading by curvature"));
+    }
+    if matches!(rp.features, FeatureDetection::Angle(_)) {
+        return Err(refuse("--feature-angle", "sharp-feature detection"));
+    }
+    let had_normals = crate::points::PointReader::open(input)?.has_normals();
+    if rp.sigma_n.is_finite() && !had_normals {
+        return Err(Error::InvalidParameter {
+            name: "--sigma-n",
+            message: format!("{} has no normals; sigma_n needs them", input.display()),
+        });
+    }
+    let mut timer = StageTimer::new();
+
+    on_stage("scan");
+    let scan_params = OutOfCoreParams {
+        target,
+        sigma_p,
+        sigma_n: rp.sigma_n,
+        scan: rp.linear_scan,
+        bucket_points: params.bucket_points,
+        seed: rp.seed,
+        temp_dir: params.temp_dir.clone(),
+        resample: 0,
+        orientation: params.orientation,
+    };
+    let scan = scan_out_of_core(input, &scan_params, params.drop_outliers, true)?;
+    let sigma_p = scan.sigma_p;
+    let normalization = scan.normalization;
+    let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
+    let mut samples = scan.samples;
+    timer.lap("scan");
+
+    on_stage("RIMLS surface");
+    let rimls = rimls_of(
+        rimls_params(sigma_p, rp.sigma_n),
+        &mut samples,
+        scan.support,
+        RIMLS_POINTS_PER_SAMPLE,
+        scan.had_normals,
+        params.orientation,
+    )?;
+    // The samples are input points, noisy: they start on the surface.
+    let positions: Vec<DVec3> = samples.iter().map(|p| p.position).collect();
+    let projected = rimls.project_all(&positions);
+    drop(positions);
+    let mut moving: Vec<SurfaceSample> = projected
+        .into_iter()
+        .flatten()
+        .map(|(position, normal)| SurfaceSample {
+            position,
+            normal,
+            face: 0,
+        })
+        .collect();
+    let unprojected_samples = samples.len() - moving.len();
+    // The RIMLS points on their own surface: the points the optimization keeps covered.
+    let cover_points: Vec<DVec3> = rimls
+        .project_all(rimls.positions())
+        .into_iter()
+        .flatten()
+        .map(|(p, _)| p)
+        .collect();
+    timer.lap("RIMLS surface");
+
+    on_stage("gradient ascent");
+    let ga = gradient_ascent(
+        &kernel,
+        &rimls,
+        &mut moving,
+        0,
+        &rp.gradient_ascent,
+        rp.seed,
+    );
+    timer.lap("gradient ascent");
+
+    on_stage("triangulate");
+    let positions: Vec<DVec3> = moving.iter().map(|s| s.position).collect();
+    let normals: Vec<DVec3> = moving
+        .par_iter()
+        .map(|s| {
+            rimls
+                .value_and_gradient(s.position)
+                .and_then(|(_, g)| g.try_normalize())
+                .unwrap_or(s.normal)
+        })
+        .collect();
+    let set = SampleSet {
+        positions: &positions,
+        normals: &normals,
+        boundary_edges: &[],
+    };
+    let (faces, _sources, assembly) = triangulate(&set, &rp.triangulate);
+    if faces.is_empty() {
+        return Err(Error::invalid_mesh(
+            input,
+            "the points gave no triangle (too few, or not on a surface)",
+        ));
+    }
+    let mut mesh = TriMesh::new(positions, faces);
+    timer.lap("triangulate");
+
+    on_stage("optimize");
+    let optimize_stats = match &rp.optimize {
+        Some(op) => {
+            let fixed = vec![false; mesh.positions.len()];
+            optimize(
+                &mut mesh,
+                &rimls,
+                &cover_points,
+                &fixed,
+                &[],
+                None,
+                sigma_p,
+                op,
+            )
+            .0
+        }
+        None => OptimizeStats::default(),
+    };
+    let dropped_samples = mesh.remove_unreferenced_vertices();
+    timer.lap("optimize");
+    let fixed = vec![false; mesh.positions.len()];
+    let fit = (rp.fit_iterations > 0).then(|| {
+        on_stage("fit");
+        let f = crate::triangulate::fit::fit_to_surface(
+            &mut mesh,
+            &rimls,
+            &fixed,
+            rp.fit_iterations,
+            rp.optimize.as_ref().map(OptimizeParams::angle_bounds),
+        );
+        timer.lap("fit");
+        f
+    });
+    on_stage("untangle");
+    let untangle_stats = untangle(&mut mesh, &fixed, sigma_p, &rp.untangle);
+    // The points' normals point outward (given, or oriented so): so does the output.
+    let output_orientation = orient_consistently(&mut mesh, true);
+    timer.lap("untangle");
+    Ok(PointRemeshOutput {
+        mesh: normalization.invert_mesh(&mesh),
+        mesh_normalized: mesh,
+        normalization,
+        sigma_p,
+        target,
+        input_points: scan.input_points,
+        had_normals: scan.had_normals,
+        outliers_removed: scan.outliers_removed,
+        samples: samples.len(),
+        unprojected_samples,
+        rimls_points: rimls.len(),
+        gradient_ascent: ga,
+        assembly,
+        optimize: optimize_stats,
+        fit,
+        untangle: untangle_stats,
+        dropped_samples,
+        output_orientation,
+        stages: timer.take_stages(),
+    })
+}
+
+/// Whether the file `path` is a point set for [`remesh_points`] rather than a mesh: a text
+/// point format by its extension (`.xyz .xyzn .csv .txt .pts .asc`), or a PLY file without
+/// faces (no `face` element, or one with no entries).
+///
+/// # Errors
+/// Reading a PLY header, naming the file.
+pub fn is_point_set(path: &Path) -> Result<bool> {
+    crate::points::stream::is_point_set(path)
+}

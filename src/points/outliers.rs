@@ -1,0 +1,197 @@
+//! Outlier removal for point sets: a point is dropped when the distance to its k-th nearest
+//! neighbour is far above the set's typical one (globally) or its neighbours' (locally).
+//!
+//! Source: statistical outlier removal (Rusu, Marton, Blodow, Dolha, Beetz 2008, "Towards 3D
+//! point cloud based object maps for household environments", Sec. 4) for the global test, and
+//! the local outlier factor (Breunig, Kriegel, Ng, Sander 2000) simplified to one ratio of
+//! k-distances for the local one.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::spatial::StaticTree;
+
+/// Neighbours whose distance measures a point's isolation.
+pub const OUTLIER_NEIGHBORS: usize = 8;
+
+/// A point is an outlier when its k-distance is more than this many times the median
+/// k-distance of the reference set: a far outlier, wherever it is.
+pub const GLOBAL_FACTOR: f64 = 6.0;
+
+/// A point is an outlier when its k-distance is more than this many times the median
+/// k-distance of its own k neighbours: a point off a surface that is denser than it. A surface
+/// point where the sampling thins out (a grazing scan) has neighbours about as sparse as
+/// itself; Gaussian noise of the order of the spacing moves the ratio by well under 2.
+pub const LOCAL_FACTOR: f64 = 3.0;
+
+/// Outlier tests against a fixed reference set (any units; the tests are scale-free).
+pub struct OutlierFilter {
+    tree: StaticTree,
+    /// Each reference point's k-distance (to its k-th nearest other point).
+    k_distance: Vec<f64>,
+    /// `GLOBAL_FACTOR` times the median k-distance.
+    global_cutoff: f64,
+}
+
+impl OutlierFilter {
+    /// The filter of `reference`, a uniformly random subset of the point set (or all of it).
+    /// With fewer than `OUTLIER_NEIGHBORS + 2` points nothing is an outlier.
+    pub fn new(reference: &[DVec3]) -> Self {
+        let tree = StaticTree::new(reference);
+        let k_distance: Vec<f64> = reference
+            .par_iter()
+            .map_init(Vec::new, |found, &p| k_distance(&tree, p, found))
+            .collect();
+        let mut sorted: Vec<f64> = k_distance
+            .iter()
+            .copied()
+            .filter(|d| d.is_finite())
+            .collect();
+        let global_cutoff = if reference.len() < OUTLIER_NEIGHBORS + 2 || sorted.is_empty() {
+            f64::INFINITY
+        } else {
+            let mid = sorted.len() / 2;
+            GLOBAL_FACTOR * *sorted.select_nth_unstable_by(mid, f64::total_cmp).1
+        };
+        OutlierFilter {
+            tree,
+            k_distance,
+            global_cutoff,
+        }
+    }
+
+    /// Whether `p` is an outlier of the reference set (a point of the set itself is compared
+    /// with the others).
+    pub fn is_outlier(&self, p: DVec3, found: &mut Vec<(u32, f64)>) -> bool {
+        if !self.global_cutoff.is_finite() {
+            return false;
+        }
+        let d = k_distance(&self.tree, p, found);
+        if d > self.global_cutoff {
+            return true;
+        }
+        let mut near: Vec<f64> = found
+            .iter()
+            .filter(|&&(_, d2)| d2 > 0.0)
+            .map(|&(j, _)| self.k_distance[j as usize])
+            .collect();
+        if near.is_empty() {
+            return false;
+        }
+        let mid = near.len() / 2;
+        let local = *near.select_nth_unstable_by(mid, f64::total_cmp).1;
+        d > LOCAL_FACTOR * local
+    }
+
+    /// Keeps the items of `items` (positions by `position`) that are not outliers, in order;
+    /// returns how many were dropped. Deterministic.
+    pub fn retain<T: Send + Sync>(
+        &self,
+        items: &mut Vec<T>,
+        position: impl Fn(&T) -> DVec3 + Sync,
+    ) -> usize {
+        let keep: Vec<bool> = items
+            .par_iter()
+            .map_init(Vec::new, |found, t| !self.is_outlier(position(t), found))
+            .collect();
+        let before = items.len();
+        let mut i = 0;
+        items.retain(|_| {
+            i += 1;
+            keep[i - 1]
+        });
+        before - items.len()
+    }
+}
+
+/// The distance from `p` to its `OUTLIER_NEIGHBORS`-th nearest point of `tree` other than
+/// itself (points at distance 0 are skipped); infinity when there are not that many. `found`
+/// is left holding the neighbours.
+fn k_distance(tree: &StaticTree, p: DVec3, found: &mut Vec<(u32, f64)>) -> f64 {
+    tree.nearest_n(p, OUTLIER_NEIGHBORS + 1, found);
+    if found.first().is_some_and(|&(_, d2)| d2 == 0.0) {
+        found.remove(0);
+    } else {
+        found.truncate(OUTLIER_NEIGHBORS);
+    }
+    if found.len() < OUTLIER_NEIGHBORS {
+        return f64::INFINITY;
+    }
+    found[OUTLIER_NEIGHBORS - 1].1.sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Points on the unit sphere, with `noise` Gaussian-ish jitter (sum of uniforms).
+    fn sphere(n: usize, noise: f64, rng: &mut ChaCha8Rng) -> Vec<DVec3> {
+        (0..n)
+            .map(|_| {
+                let z: f64 = rng.random_range(-1.0..=1.0);
+                let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+                let s = (1.0 - z * z).sqrt();
+                let r = 1.0 + noise * (0..4).map(|_| rng.random_range(-1.0..1.0)).sum::<f64>();
+                DVec3::new(s * phi.cos(), s * phi.sin(), z) * r
+            })
+            .collect()
+    }
+
+    #[test]
+    fn far_points_go_and_the_surface_stays() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut points = sphere(20_000, 0.005, &mut rng);
+        let surface = points.len();
+        // 1% outliers uniform in the cube around the sphere, at least 0.2 off it (10 spacings).
+        let mut outliers = 0;
+        while outliers < 200 {
+            let p = DVec3::new(
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+            );
+            if (p.length() - 1.0).abs() > 0.2 {
+                points.push(p);
+                outliers += 1;
+            }
+        }
+        let filter = OutlierFilter::new(&points);
+        let mut kept: Vec<(usize, DVec3)> = points.iter().copied().enumerate().collect();
+        let dropped = filter.retain(&mut kept, |&(_, p)| p);
+        let surface_dropped = surface - kept.iter().filter(|(i, _)| *i < surface).count();
+        let outliers_kept = kept.iter().filter(|(i, _)| *i >= surface).count();
+        assert_eq!(outliers_kept, 0, "outliers kept");
+        assert!(
+            surface_dropped <= surface / 1000,
+            "{surface_dropped} surface points dropped"
+        );
+        assert_eq!(dropped, surface_dropped + 200);
+    }
+
+    #[test]
+    fn a_sparser_part_of_the_surface_is_not_an_outlier() {
+        // Half the sphere sampled 16 times sparser (spacing 4x): the local test compares with
+        // neighbours as sparse, the global one allows up to GLOBAL_FACTOR.
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let points: Vec<DVec3> = sphere(40_000, 0.0, &mut rng)
+            .into_iter()
+            .enumerate()
+            .filter(|(i, p)| p.z > 0.0 || i % 16 == 0)
+            .map(|(_, p)| p)
+            .collect();
+        let filter = OutlierFilter::new(&points);
+        let mut kept = points.clone();
+        let dropped = filter.retain(&mut kept, |&p| p);
+        assert!(dropped <= points.len() / 500, "{dropped} dropped");
+    }
+
+    #[test]
+    fn tiny_sets_have_no_outliers() {
+        let points = vec![DVec3::ZERO, DVec3::X, DVec3::splat(100.0)];
+        let filter = OutlierFilter::new(&points);
+        let mut found = Vec::new();
+        assert!(!filter.is_outlier(DVec3::splat(1e6), &mut found));
+    }
+}
