@@ -98,7 +98,12 @@ pub(super) fn run(
     extra.insert("outliers_removed".into(), out.outliers_removed.into());
     extra.insert("samples".into(), out.samples.into());
     extra.insert("unprojected_samples".into(), out.unprojected_samples.into());
+    extra.insert("rescan_rejected".into(), out.rescan_rejected.into());
     extra.insert("rimls_points".into(), out.rimls_points.into());
+    extra.insert(
+        "scan_seconds".into(),
+        serde_json::to_value(out.scan_seconds).unwrap_or_default(),
+    );
     extra.insert("seed".into(), job.params.seed.into());
     extra.insert(
         "assembly".into(),
@@ -112,9 +117,6 @@ pub(super) fn run(
         "untangle".into(),
         serde_json::to_value(out.untangle).unwrap_or_default(),
     );
-    if let Some(fit) = out.fit {
-        extra.insert("fit".into(), serde_json::to_value(fit).unwrap_or_default());
-    }
     extra.insert(
         "output_orientation".into(),
         serde_json::to_value(out.output_orientation).unwrap_or_default(),

@@ -115,7 +115,12 @@ pub struct OutOfCoreResult {
 /// whose bounding box has no extent; [`Error::Io`] when the temporary files fail.
 pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<OutOfCoreResult> {
     let t0 = Instant::now();
-    let scan = scan_out_of_core(input, params, false, params.resample > 0)?;
+    let support_per_sample = if params.resample > 0 {
+        RIMLS_POINTS_PER_SAMPLE - 1
+    } else {
+        0
+    };
+    let scan = scan_out_of_core(input, params, false, support_per_sample)?;
     let t3 = Instant::now();
     let ScanOutput {
         mut samples,
@@ -162,8 +167,8 @@ pub(crate) struct ScanOutput {
     /// The output set O, bbox-100 units, in the order the scan accepted it; normals as read
     /// (zero without them).
     pub samples: Vec<Point>,
-    /// The first bucket's points, shuffled (a uniformly random subset of the input of up to
-    /// `bucket_points`), bbox-100 units; empty unless asked for.
+    /// The first bucket's points, shuffled (a uniformly random subset of the input), up to
+    /// `support_per_sample` per sample, bbox-100 units.
     pub support: Vec<Point>,
     /// Points read.
     pub input_points: u64,
@@ -183,82 +188,124 @@ pub(crate) struct ScanOutput {
     pub seconds: [f64; 3],
 }
 
-/// Passes 1 and 2 of [`simplify_out_of_core`]. With `drop_outliers`, an [`OutlierFilter`] of
-/// the first bucket's points removes outliers from the sigma_p search's subset, from the
-/// samples after the scan, and from the support (so isolated points neither raise the count the
-/// search sees nor become samples). With `keep_support`, the first bucket is returned.
+/// Passes 1 and 2 of [`simplify_out_of_core`] ([`ScannedInput::open`] and
+/// [`ScannedInput::scan`] at the sigma_p found or given).
 pub(crate) fn scan_out_of_core(
     input: &Path,
     params: &OutOfCoreParams,
     drop_outliers: bool,
-    keep_support: bool,
+    support_per_sample: usize,
 ) -> Result<ScanOutput> {
-    let t0 = Instant::now();
-    let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-    let bucket_set = Buckets::write(input, params, &mut rng)?;
-    let (total, had_normals, normalization) = (
-        bucket_set.total,
-        bucket_set.had_normals,
-        bucket_set.normalization,
-    );
-    let t1 = Instant::now();
+    let mut source = ScannedInput::open(input, params, drop_outliers)?;
+    let sigma_p = source.sigma_p;
+    source.scan(sigma_p, support_per_sample)
+}
 
-    // sigma_p: given, or searched on a scaled-down problem (see `search_sigma_p`).
-    let mut outliers_removed = 0;
-    let mut filter = None;
-    let sigma_p = if params.target.is_none() && !drop_outliers {
-        params.sigma_p
-    } else {
-        let mut first = bucket_set.load(0, &mut rng)?;
-        if drop_outliers {
-            let positions: Vec<DVec3> = first.iter().map(|p| p.position).collect();
-            let f = OutlierFilter::new(&positions);
-            f.retain(&mut first, |p| p.position);
-            filter = Some(f);
-        }
-        match params.target {
-            None => params.sigma_p,
-            Some(n) => search_sigma_p(&first, total, n, params)?,
-        }
-    };
-    let t2 = Instant::now();
+/// A point set bucketed for out-of-core linear scans (pass 1 of [`simplify_out_of_core`]), with
+/// its sigma_p for the target count, ready to be scanned (pass 2) at any sigma_p, more than once.
+pub(crate) struct ScannedInput {
+    buckets: Buckets,
+    rng: ChaCha8Rng,
+    params: OutOfCoreParams,
+    filter: Option<OutlierFilter>,
+    /// The sigma_p for `params.target` (bbox-100 units), or `params.sigma_p`.
+    pub sigma_p: f64,
+    /// Seconds: reading and bucketing; the sigma_p search and the outlier filter.
+    seconds: [f64; 2],
+}
 
-    let kernel = Kernel::new(sigma_p, params.sigma_n)?;
-    let mut scanner = LinearScanner::new(&kernel, &params.scan);
-    // The samples in bbox-100 units, and the first bucket when asked for.
-    let mut samples: Vec<Point> = Vec::new();
-    let mut support: Vec<Point> = Vec::new();
-    let mut accepted = Vec::new();
-    bucket_set.for_each(&mut rng, |pts| {
-        let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
-        accepted.clear();
-        scanner.offer_batch(&batch, &mut accepted);
-        samples.extend(accepted.iter().map(|&i| pts[i]));
-        if keep_support && support.is_empty() {
-            support = pts;
-        }
-    })?;
-    if let Some(f) = &filter {
-        outliers_removed += f.retain(&mut samples, |p| p.position);
-        outliers_removed += f.retain(&mut support, |p| p.position);
+impl ScannedInput {
+    /// Pass 1 and the sigma_p search. With `drop_outliers`, an [`OutlierFilter`] of the first
+    /// bucket's points removes outliers from the sigma_p search's subset, and later from each
+    /// scan's samples and support (so isolated points neither raise the count the search sees
+    /// nor become samples).
+    pub(crate) fn open(
+        input: &Path,
+        params: &OutOfCoreParams,
+        drop_outliers: bool,
+    ) -> Result<Self> {
+        let t0 = Instant::now();
+        let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+        let buckets = Buckets::write(input, params, &mut rng)?;
+        let t1 = Instant::now();
+        // sigma_p: given, or searched on a scaled-down problem (see `search_sigma_p`).
+        let mut filter = None;
+        let sigma_p = if params.target.is_none() && !drop_outliers {
+            params.sigma_p
+        } else {
+            let mut first = buckets.load(0, &mut rng)?;
+            if drop_outliers {
+                // The filter's reference: a random subset of the first bucket (already shuffled).
+                let reference: Vec<DVec3> = first
+                    .iter()
+                    .take(FILTER_REFERENCE_POINTS)
+                    .map(|p| p.position)
+                    .collect();
+                let f = OutlierFilter::new(&reference);
+                if let Some(n) = params.target {
+                    first.truncate(search_subset_len(first.len(), buckets.total, n));
+                }
+                f.retain(&mut first, |p| p.position);
+                filter = Some(f);
+            }
+            match params.target {
+                None => params.sigma_p,
+                Some(n) => search_sigma_p(&first, buckets.total, n, params)?,
+            }
+        };
+        let t2 = Instant::now();
+        Ok(ScannedInput {
+            buckets,
+            rng,
+            params: params.clone(),
+            filter,
+            sigma_p,
+            seconds: [(t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64()],
+        })
     }
-    let t3 = Instant::now();
-    Ok(ScanOutput {
-        samples,
-        support,
-        input_points: total,
-        had_normals,
-        sigma_p,
-        normalization,
-        rejected_by_nearest: scanner.rejected_by_nearest,
-        measured: scanner.measured,
-        outliers_removed,
-        seconds: [
-            (t1 - t0).as_secs_f64(),
-            (t2 - t1).as_secs_f64(),
-            (t3 - t2).as_secs_f64(),
-        ],
-    })
+
+    /// Pass 2 at `sigma_p` (bbox-100 units), keeping up to `support_per_sample` points of the
+    /// first bucket per sample as the support. A scan after the first draws other shuffles.
+    pub(crate) fn scan(&mut self, sigma_p: f64, support_per_sample: usize) -> Result<ScanOutput> {
+        let t2 = Instant::now();
+        let params = &self.params;
+        let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+        let mut scanner = LinearScanner::new(&kernel, &params.scan);
+        // The samples in bbox-100 units, and the first bucket when asked for.
+        let mut samples: Vec<Point> = Vec::new();
+        let mut support: Vec<Point> = Vec::new();
+        let mut accepted = Vec::new();
+        self.buckets.for_each(&mut self.rng, |pts| {
+            let batch: Vec<(DVec3, DVec3)> = pts.iter().map(|p| (p.position, p.normal)).collect();
+            accepted.clear();
+            scanner.offer_batch(&batch, &mut accepted);
+            samples.extend(accepted.iter().map(|&i| pts[i]));
+            if support_per_sample > 0 && support.is_empty() {
+                support = pts;
+            }
+        })?;
+        let mut outliers_removed = 0;
+        if let Some(f) = &self.filter {
+            outliers_removed += f.retain(&mut samples, |p| p.position);
+        }
+        support.truncate(support_per_sample.saturating_mul(samples.len()));
+        if let Some(f) = &self.filter {
+            outliers_removed += f.retain(&mut support, |p| p.position);
+        }
+        let t3 = Instant::now();
+        Ok(ScanOutput {
+            samples,
+            support,
+            input_points: self.buckets.total,
+            had_normals: self.buckets.had_normals,
+            sigma_p,
+            normalization: self.buckets.normalization,
+            rejected_by_nearest: scanner.rejected_by_nearest,
+            measured: scanner.measured,
+            outliers_removed,
+            seconds: [self.seconds[0], self.seconds[1], (t3 - t2).as_secs_f64()],
+        })
+    }
 }
 
 /// PCA normals for points without them (10 neighbours), oriented by `orientation`.
@@ -577,6 +624,19 @@ impl Buckets {
     }
 }
 
+/// Points of the first bucket the outlier filter compares with (a random subset: the tests are
+/// scale-free, so a sparser reference only coarsens them).
+const FILTER_REFERENCE_POINTS: usize = 1 << 18;
+
+/// The length of the prefix of a bucket of `available` points that [`search_sigma_p`] scans
+/// for `target` samples from `total` input points.
+fn search_subset_len(available: usize, total: u64, target: usize) -> usize {
+    let target = target.max(1);
+    let density = (total as f64 / target as f64).min(SEARCH_MAX_DENSITY);
+    let small_target = target.min(SEARCH_SAMPLES);
+    ((density * small_target as f64).ceil() as usize).min(available)
+}
+
 /// Most samples the scaled-down search problem aims at.
 const SEARCH_SAMPLES: usize = 10_000;
 
@@ -595,10 +655,8 @@ fn search_sigma_p(
     params: &OutOfCoreParams,
 ) -> Result<f64> {
     let target = target.max(1);
-    let density = (total as f64 / target as f64).min(SEARCH_MAX_DENSITY);
-    let small_target = target.min(SEARCH_SAMPLES);
-    let subset = ((density * small_target as f64).ceil() as usize).min(sample.len());
-    let small_target = small_target.min(subset);
+    let subset = search_subset_len(sample.len(), total, target);
+    let small_target = target.min(SEARCH_SAMPLES).min(subset);
     let batch: Vec<(DVec3, DVec3)> = sample[..subset]
         .iter()
         .map(|p| (p.position, p.normal))
