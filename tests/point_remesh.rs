@@ -1,0 +1,292 @@
+//! Issue 19: point sets in, meshes out. A point set sampled from a closed surface (with or
+//! without normals, clean or with noise and outliers, in one bucket or many) becomes a closed,
+//! manifold, consistently oriented mesh of the surface's genus whose vertices lie on it; the
+//! command line's jobs take PLY files without faces and XYZ text as point sets.
+
+mod common;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use spectral_remesh::{
+    check_invariants, is_point_set, remesh_points, run_remesh, topology, write_mesh,
+    write_surface_points, Density, Error, PointRemeshOutput, PointRemeshParams, RemeshJob,
+    RemeshParams, TriMesh,
+};
+
+/// A torus around the z axis (radii `big` and `small`), `n` × `m` quads split in two, outward.
+fn torus(big: f64, small: f64, n: usize, m: usize) -> TriMesh {
+    let mut positions = Vec::new();
+    for i in 0..n {
+        let u = i as f64 / n as f64 * std::f64::consts::TAU;
+        for j in 0..m {
+            let v = j as f64 / m as f64 * std::f64::consts::TAU;
+            let r = big + small * v.cos();
+            positions.push(DVec3::new(r * u.cos(), r * u.sin(), small * v.sin()));
+        }
+    }
+    let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+/// Writes `points` (and `normals` if given) as XYZ text, one point per line.
+fn write_xyz(path: &Path, points: &[DVec3], normals: Option<&[DVec3]>) {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    for (i, p) in points.iter().enumerate() {
+        match normals {
+            Some(n) => writeln!(
+                f,
+                "{} {} {} {} {} {}",
+                p.x, p.y, p.z, n[i].x, n[i].y, n[i].z
+            ),
+            None => writeln!(f, "{} {} {}", p.x, p.y, p.z),
+        }
+        .unwrap();
+    }
+}
+
+/// `count` points uniformly on the unit sphere (Archimedes), with their normals.
+fn sphere_points(count: usize, rng: &mut ChaCha8Rng) -> (Vec<DVec3>, Vec<DVec3>) {
+    let points: Vec<DVec3> = (0..count)
+        .map(|_| {
+            let z: f64 = rng.random_range(-1.0..=1.0);
+            let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+            let s = (1.0 - z * z).sqrt();
+            DVec3::new(s * phi.cos(), s * phi.sin(), z)
+        })
+        .collect();
+    (points.clone(), points)
+}
+
+fn params(points: usize, seed: u64) -> PointRemeshParams {
+    PointRemeshParams {
+        remesh: RemeshParams {
+            density: Density::Points(points),
+            seed,
+            ..RemeshParams::default()
+        },
+        ..PointRemeshParams::default()
+    }
+}
+
+/// Asserts the output is closed, manifold, oriented, one part, of genus `genus`, with about
+/// `points` vertices (within 2%).
+fn assert_closed(out: &PointRemeshOutput, genus: i64, points: usize) {
+    let t = topology(&out.mesh);
+    assert!(t.is_closed_manifold(), "{t:?}");
+    assert_eq!(t.components, 1, "{t:?}");
+    assert_eq!(t.genus, Some(genus), "{t:?}");
+    let violations = check_invariants(&out.mesh);
+    assert!(violations.is_empty(), "{violations:?}");
+    let v = out.mesh.vertex_count() as f64;
+    assert!(
+        (v - points as f64).abs() <= 0.02 * points as f64,
+        "{v} vertices for {points}"
+    );
+}
+
+/// The largest |distance(v) - 1| over the vertices (for a unit sphere: distance to the origin).
+fn worst_off(mesh: &TriMesh, distance: impl Fn(DVec3) -> f64) -> f64 {
+    mesh.positions
+        .iter()
+        .map(|&p| (distance(p)).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn sphere_points_with_normals_become_a_closed_sphere() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere.ply");
+    write_surface_points(&common::icosphere(5), 60_000, 3, &input).unwrap();
+    let out = remesh_points(&input, &params(1500, 1), &|_| {}).unwrap();
+    assert!(out.had_normals);
+    assert_closed(&out, 0, 1500);
+    // On the sphere: the RIMLS bias sigma_p^2 / (2R) is 0.2% of R at this count.
+    let off = worst_off(&out.mesh, |p| p.length() - 1.0);
+    assert!(off < 0.01, "a vertex {off} off the unit sphere");
+    // Facing outward.
+    assert!(out.mesh.signed_volume() > 0.0);
+}
+
+#[test]
+fn torus_points_without_normals_keep_the_genus() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = torus(1.0, 0.4, 120, 48);
+    let (big, small) = (1.0, 0.4);
+    let input = dir.path().join("torus.ply");
+    write_surface_points(&mesh, 80_000, 5, &input).unwrap();
+    // The same points as XYZ text without normals.
+    let mut reader = spectral_remesh::PointReader::open(&input).unwrap();
+    let mut pts = Vec::new();
+    reader.read_chunk(&mut pts, 1 << 20).unwrap();
+    let xyz = dir.path().join("torus.xyz");
+    let positions: Vec<DVec3> = pts.iter().map(|p| p.position).collect();
+    write_xyz(&xyz, &positions, None);
+    for seed in 1..=2 {
+        let out = remesh_points(&xyz, &params(2000, seed), &|_| {}).unwrap();
+        assert!(!out.had_normals);
+        assert_closed(&out, 1, 2000);
+        let off = worst_off(&out.mesh, |p| {
+            let ring = DVec3::new(p.x, p.y, 0.0).normalize_or_zero() * big;
+            (p - ring).length() - small
+        });
+        assert!(off < 0.02, "seed {seed}: a vertex {off} off the torus");
+        assert!(out.mesh.signed_volume() > 0.0);
+    }
+}
+
+#[test]
+fn noise_and_outliers_still_give_the_closed_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (mut points, _) = sphere_points(100_000, &mut rng);
+    // Gaussian noise of 0.1% of the diagonal (2 sqrt 3), by Box-Muller.
+    let sigma = 0.001 * 2.0 * 3f64.sqrt();
+    for p in &mut points {
+        let (u, v): (f64, f64) = (rng.random_range(1e-12..1.0), rng.random_range(0.0..1.0));
+        let g = (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos();
+        *p *= 1.0 + sigma * g;
+    }
+    // 1% outliers uniform in the bounding box, at least 0.1 off the sphere.
+    let mut outliers = 0;
+    while outliers < 1000 {
+        let p = DVec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        if (p.length() - 1.0).abs() > 0.1 {
+            points.push(p);
+            outliers += 1;
+        }
+    }
+    let input = dir.path().join("noisy.xyz");
+    write_xyz(&input, &points, None);
+    let out = remesh_points(&input, &params(1500, 1), &|_| {}).unwrap();
+    assert!(
+        out.outliers_removed >= 900,
+        "{} outliers removed",
+        out.outliers_removed
+    );
+    assert_closed(&out, 0, 1500);
+    let off = worst_off(&out.mesh, |p| p.length() - 1.0);
+    assert!(off < 0.02, "a vertex {off} off the unit sphere");
+}
+
+#[test]
+fn many_buckets_give_the_same_guarantees_as_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere.ply");
+    write_surface_points(&common::icosphere(5), 60_000, 9, &input).unwrap();
+    for bucket_points in [1 << 20, 7_000] {
+        let out = remesh_points(
+            &input,
+            &PointRemeshParams {
+                bucket_points,
+                temp_dir: Some(dir.path().to_path_buf()),
+                ..params(1500, 2)
+            },
+            &|_| {},
+        )
+        .unwrap();
+        assert_closed(&out, 0, 1500);
+        let off = worst_off(&out.mesh, |p| p.length() - 1.0);
+        assert!(off < 0.01, "{bucket_points}: a vertex {off} off the sphere");
+    }
+    // The buckets are gone.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn a_point_set_needs_a_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere.ply");
+    write_surface_points(&common::icosphere(3), 5_000, 1, &input).unwrap();
+    let p = PointRemeshParams {
+        remesh: RemeshParams {
+            density: Density::InputVertices,
+            ..RemeshParams::default()
+        },
+        ..PointRemeshParams::default()
+    };
+    match remesh_points(&input, &p, &|_| {}) {
+        Err(Error::InvalidParameter { name, message }) => {
+            assert_eq!(name, "--points");
+            assert!(message.contains("sphere.ply"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+fn job(input: PathBuf, output: PathBuf, as_points: bool) -> RemeshJob {
+    RemeshJob {
+        input,
+        output,
+        format: None,
+        params: RemeshParams {
+            density: Density::Points(800),
+            ..RemeshParams::default()
+        },
+        measure_distance: true,
+        strict: true,
+        max_memory: None,
+        as_points,
+    }
+}
+
+#[test]
+fn the_remesh_job_takes_point_files_and_keeps_meshes_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = common::icosphere(4);
+    // A PLY without faces and XYZ text are point sets; a PLY mesh and an OBJ are not.
+    let points = dir.path().join("points.ply");
+    write_surface_points(&sphere, 30_000, 2, &points).unwrap();
+    let mesh_ply = dir.path().join("mesh.ply");
+    write_mesh(&mesh_ply, &sphere).unwrap();
+    let mesh_obj = dir.path().join("mesh.obj");
+    write_mesh(&mesh_obj, &sphere).unwrap();
+    let xyz = dir.path().join("points.xyz");
+    let (p, n) = sphere_points(30_000, &mut ChaCha8Rng::seed_from_u64(4));
+    write_xyz(&xyz, &p, Some(&n));
+    assert!(is_point_set(&points).unwrap());
+    assert!(is_point_set(&xyz).unwrap());
+    assert!(!is_point_set(&mesh_ply).unwrap());
+    assert!(!is_point_set(&mesh_obj).unwrap());
+
+    for input in [&points, &xyz] {
+        let output = dir.path().join("out.obj");
+        let report = run_remesh(&job(input.clone(), output.clone(), false), &|_| {}).unwrap();
+        assert_eq!(report.extra["input_points"], 30_000, "{input:?}");
+        assert!(report.topology.is_closed_manifold());
+        assert_eq!(report.topology.genus, Some(0));
+        // Distances to the points (the unit sphere is radius 50 in bbox-100 units): each
+        // point's exact distance to the output is the chords' sag, well under 1 at 800
+        // vertices; the output's distance to the nearest point adds up to about the points'
+        // spacing (1 here).
+        let d = report.distance.expect("distance");
+        assert!(d.backward_hausdorff < 1.0, "{input:?}: {d:?}");
+        assert!(d.forward_hausdorff < 3.0, "{input:?}: {d:?}");
+        let (written, _) = spectral_remesh::read_mesh(&output).unwrap();
+        assert_eq!(written.vertex_count(), report.topology.vertices);
+    }
+    // The mesh PLY is remeshed as a mesh; with --as-points its faces are ignored.
+    let output = dir.path().join("out2.obj");
+    let as_mesh = run_remesh(&job(mesh_ply.clone(), output.clone(), false), &|_| {}).unwrap();
+    assert!(as_mesh.extra.get("input_points").is_none());
+    assert!(as_mesh.input_topology.is_some());
+    let as_points = run_remesh(&job(mesh_ply, output, true), &|_| {}).unwrap();
+    assert_eq!(
+        as_points.extra["input_points"],
+        sphere.vertex_count() as u64
+    );
+}
