@@ -235,7 +235,8 @@ pub use points::rimls::{Rimls, RimlsParams, RimlsProjection};
 
 // Point sets in, meshes out (issue 19).
 pub use point_pipeline::{
-    is_point_set, remesh_points, PointRemeshOutput, PointRemeshParams, RIMLS_POINTS_PER_SAMPLE,
+    is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams, MAX_SCANS,
+    RIMLS_POINTS_PER_SAMPLE,
 };
 pub use points::{PlyPointWriter, Point, PointReader};
 
