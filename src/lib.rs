@@ -191,6 +191,7 @@ pub use triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
 pub use triangulate::optimize::{
     optimize, OptimizeParams, OptimizeStats, SmoothStats, SMOOTH_ITERATIONS,
 };
+pub use triangulate::stray_shells::StrayShells;
 pub use triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 pub use triangulate::{
     assemble, triangulate, triangulate_restricted, vote_triangles, AssemblyParams, AssemblyStats,

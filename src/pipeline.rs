@@ -121,7 +121,7 @@ const MAX_GRADING_POINTS: f64 = 200_000.0;
 
 /// The most vertices of a shell [`remove_stray_shells`] removes: a few samples closing on
 /// themselves at a tip (4 make a tetrahedron), not a part of the surface.
-const STRAY_SHELL_VERTICES: usize = 8;
+pub(crate) const STRAY_SHELL_VERTICES: usize = 8;
 
 /// The iterations of the least-squares fit, by default: the RMS distance is within 2% of its
 /// limit after 3 (flange at 6000 with --feature-angle 20: 0.0158 unfitted, 0.0090 after 1, 0.0089

@@ -151,6 +151,14 @@ pub(super) fn run(
             out.dropped_samples
         ));
     }
+    let st = &out.stray_shells;
+    if st.shells > 0 {
+        report.notes.push(format!(
+            "{} tiny closed pieces ({} vertices) that split off where the surface is too thin \
+             for this count were left out",
+            st.shells, st.vertices
+        ));
+    }
     if out.assembly.holes_left > 0 {
         report.notes.push(format!(
             "{} holes of the triangulation could not be closed",
