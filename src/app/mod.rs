@@ -227,22 +227,10 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         report.push_stage("distance (report)", wall, cpu);
     }
     let extra = &mut report.extra;
-    extra.insert("sigma_p".into(), out.sigma_p.into());
-    extra.insert(
-        "sigma_n".into(),
-        if params.sigma_n.is_finite() {
-            params.sigma_n.into()
-        } else {
-            "infinity".into()
-        },
-    );
-    if let Some(n) = out.target {
-        extra.insert("target_points".into(), n.into());
-    }
+    insert_kernel_extras(extra, out.sigma_p, &params, out.target);
     extra.insert("samples".into(), out.samples.into());
     extra.insert("boundary_samples".into(), out.boundary_samples.into());
     extra.insert("candidates".into(), out.candidates.into());
-    extra.insert("seed".into(), params.seed.into());
     extra.insert(
         "sigma_p_search".into(),
         serde_json::to_value(&out.search_history).unwrap_or_default(),
@@ -374,6 +362,28 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         ));
     }
     Ok(report)
+}
+
+/// The report's `sigma_p`, `sigma_n`, `target_points` and `seed` entries.
+fn insert_kernel_extras(
+    extra: &mut serde_json::Map<String, serde_json::Value>,
+    sigma_p: f64,
+    params: &RemeshParams,
+    target: Option<usize>,
+) {
+    extra.insert("sigma_p".into(), sigma_p.into());
+    extra.insert(
+        "sigma_n".into(),
+        if params.sigma_n.is_finite() {
+            params.sigma_n.into()
+        } else {
+            "infinity".into()
+        },
+    );
+    if let Some(n) = target {
+        extra.insert("target_points".into(), n.into());
+    }
+    extra.insert("seed".into(), params.seed.into());
 }
 
 /// Notes the output's invariant violations in `report`; with `job.strict`, an error when it

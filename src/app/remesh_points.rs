@@ -3,7 +3,9 @@
 
 use glam::DVec3;
 
-use super::{memory, refuse_if_strict, write_output, RemeshJob, DISTANCE_SAMPLES};
+use super::{
+    insert_kernel_extras, memory, refuse_if_strict, write_output, RemeshJob, DISTANCE_SAMPLES,
+};
 use crate::error::Result;
 use crate::io::{as_written, MeshFormat};
 use crate::pipeline::{Density, MAX_POINTS};
@@ -81,18 +83,7 @@ pub(super) fn run(
     }
 
     let extra = &mut report.extra;
-    extra.insert("sigma_p".into(), out.sigma_p.into());
-    extra.insert(
-        "sigma_n".into(),
-        if job.params.sigma_n.is_finite() {
-            job.params.sigma_n.into()
-        } else {
-            "infinity".into()
-        },
-    );
-    if let Some(n) = out.target {
-        extra.insert("target_points".into(), n.into());
-    }
+    insert_kernel_extras(extra, out.sigma_p, &job.params, out.target);
     extra.insert("input_points".into(), out.input_points.into());
     extra.insert("had_normals".into(), out.had_normals.into());
     extra.insert("outliers_removed".into(), out.outliers_removed.into());
@@ -104,7 +95,6 @@ pub(super) fn run(
         "scan_seconds".into(),
         serde_json::to_value(out.scan_seconds).unwrap_or_default(),
     );
-    extra.insert("seed".into(), job.params.seed.into());
     extra.insert(
         "assembly".into(),
         serde_json::to_value(&out.assembly).unwrap_or_default(),

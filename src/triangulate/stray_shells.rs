@@ -12,7 +12,7 @@ use crate::disjoint_sets::Dsu;
 use crate::mesh::TriMesh;
 use crate::triangulate::FaceSource;
 
-/// What [`remove_stray_shells`] removed.
+/// What `remove_stray_shells` removed: the tiny closed shells the pipelines leave out.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StrayShells {
     /// Shells removed.
