@@ -192,6 +192,7 @@ pub use triangulate::optimize::{
     optimize, OptimizeParams, OptimizeStats, SmoothStats, SMOOTH_ITERATIONS,
 };
 pub use triangulate::stray_shells::StrayShells;
+pub use triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
 pub use triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 pub use triangulate::{
     assemble, triangulate, triangulate_restricted, vote_triangles, AssemblyParams, AssemblyStats,
@@ -236,8 +237,8 @@ pub use points::rimls::{Rimls, RimlsParams, RimlsProjection};
 
 // Point sets in, meshes out (issue 19).
 pub use point_pipeline::{
-    is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams, MAX_SCANS,
-    RIMLS_POINTS_PER_SAMPLE,
+    is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams,
+    DOMAIN_GAP_SIGMA_P, MAX_SCANS, OPEN_GAP_SIGMA_P, RIMLS_POINTS_PER_SAMPLE,
 };
 pub use points::{PlyPointWriter, Point, PointReader};
 

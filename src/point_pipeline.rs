@@ -20,15 +20,18 @@ use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::pipeline::{Density, RemeshParams, STRAY_SHELL_VERTICES};
 use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{rimls_of, OutOfCoreParams, ScannedInput};
+use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::linear_scan::LinearScanner;
+use crate::spatial::StaticTree;
 use crate::surface::features::FeatureDetection;
-use crate::surface::SurfaceSample;
+use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
+use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
 use crate::triangulate::untangle::{untangle, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
 
@@ -49,6 +52,59 @@ pub fn rimls_params(sigma_p: f64, sigma_n: f64) -> RimlsParams {
             sigma_p,
             ..RimlsParams::default()
         }
+    }
+}
+
+/// Gap in the data, in units of sigma_p, beyond which the surface is taken to be absent (an open
+/// scan's boundary or hole): a face with its centroid or an edge midpoint farther than this
+/// from every point of the RIMLS surface's support is removed (with the hole fill it is part
+/// of). The support holds about `RIMLS_POINTS_PER_SAMPLE` points per sigma_p², uniformly
+/// random: an empty disc of radius 1.5 sigma_p in it has probability exp(-4π 2.25) ≈ 5e-13
+/// where the data goes on.
+pub const OPEN_GAP_SIGMA_P: f64 = 1.5;
+
+/// Distance, in units of sigma_p, from the nearest support point beyond which a projection onto
+/// the RIMLS surface is refused: the samples and the mesh stay on the data rather than on the
+/// surface's extrapolation past an open scan's boundary. An empty disc of this radius among the
+/// support points (about 4 per sigma_p²) has probability exp(-4π 0.5625) ≈ 1e-3 where the data
+/// goes on: a move refused there is only a move not made.
+pub const DOMAIN_GAP_SIGMA_P: f64 = 0.75;
+
+/// The RIMLS surface restricted to where there is data: within `max_gap` of a support point.
+struct Domain<'a> {
+    rimls: &'a Rimls,
+    tree: StaticTree,
+    max_gap_2: f64,
+}
+
+impl Domain<'_> {
+    /// Whether a support point lies within `r` of `p`.
+    fn within(&self, p: DVec3, r: f64) -> bool {
+        let mut found = Vec::with_capacity(1);
+        self.tree.nearest_n(p, 1, &mut found);
+        found.first().is_some_and(|&(_, d2)| d2 <= r * r)
+    }
+
+    fn covers_one(&self, p: DVec3) -> bool {
+        self.within(p, self.max_gap_2.sqrt())
+    }
+}
+
+impl Projection for Domain<'_> {
+    fn project(&self, p: DVec3) -> Option<SurfaceSample> {
+        let s = Projection::project(self.rimls, p)?;
+        self.covers_one(s.position).then_some(s)
+    }
+}
+
+impl SurfaceQuery for Domain<'_> {
+    fn closest_point_within(&self, p: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        let sp = self.rimls.closest_point_within(p, max_dist)?;
+        self.covers_one(sp.position).then_some(sp)
+    }
+
+    fn smooth_normal(&self, sp: &SurfacePoint) -> DVec3 {
+        self.rimls.smooth_normal(sp)
     }
 }
 
@@ -119,6 +175,8 @@ pub struct PointRemeshOutput {
     pub gradient_ascent: GradientAscentResult,
     /// The umbrellas' assembly.
     pub assembly: AssemblyStats,
+    /// Faces removed for spanning a gap in the data (open scans).
+    pub unsupported: UnsupportedFaces,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,
     /// The separation of crossing faces.
@@ -277,6 +335,11 @@ pub fn remesh_points(
         }
     };
     let normalization = scan.normalization;
+    let domain = Domain {
+        rimls: &rimls,
+        tree: StaticTree::new(rimls.positions()),
+        max_gap_2: (DOMAIN_GAP_SIGMA_P * sigma_p).powi(2),
+    };
     // The RIMLS points on their own surface: the points the optimization keeps covered.
     let cover_points: Vec<DVec3> = rimls
         .project_all(rimls.positions())
@@ -289,7 +352,7 @@ pub fn remesh_points(
     on_stage("gradient ascent");
     let ga = gradient_ascent(
         &kernel,
-        &rimls,
+        &domain,
         &mut moving,
         0,
         &rp.gradient_ascent,
@@ -313,7 +376,7 @@ pub fn remesh_points(
         normals: &normals,
         boundary_edges: &[],
     };
-    let (faces, _sources, assembly) = triangulate(&set, &rp.triangulate);
+    let (faces, mut sources, assembly) = triangulate(&set, &rp.triangulate);
     if faces.is_empty() {
         return Err(Error::invalid_mesh(
             input,
@@ -321,6 +384,10 @@ pub fn remesh_points(
         ));
     }
     let mut mesh = TriMesh::new(positions, faces);
+    // Faces the assembly closed across a gap in the data (an open scan's holes) go.
+    let unsupported = remove_unsupported_faces(&mut mesh, &mut sources, |p| {
+        domain.within(p, OPEN_GAP_SIGMA_P * sigma_p)
+    });
     timer.lap("triangulate");
 
     on_stage("optimize");
@@ -329,7 +396,7 @@ pub fn remesh_points(
             let fixed = vec![false; mesh.positions.len()];
             optimize(
                 &mut mesh,
-                &rimls,
+                &domain,
                 &cover_points,
                 &fixed,
                 &[],
@@ -382,6 +449,7 @@ pub fn remesh_points(
         rimls_points: rimls.len(),
         gradient_ascent: ga,
         assembly,
+        unsupported,
         optimize: optimize_stats,
         untangle: untangle_stats,
         dropped_samples,

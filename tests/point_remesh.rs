@@ -184,6 +184,54 @@ fn noise_and_outliers_still_give_the_closed_surface() {
 }
 
 #[test]
+fn an_open_patch_keeps_its_boundary_and_its_hole() {
+    // A wavy square patch 2 × 2 with a round hole of radius 0.3 in the middle, 60,000 points
+    // with normals: at 1500 vertices the spacing is about 0.05, the hole 12 spacings wide.
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let height = |x: f64, y: f64| 0.1 * (2.0 * x).sin() * (1.5 * y).cos();
+    let (mut points, mut normals) = (Vec::new(), Vec::new());
+    while points.len() < 60_000 {
+        let (x, y): (f64, f64) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        if x.hypot(y) < 0.3 {
+            continue;
+        }
+        points.push(DVec3::new(x, y, height(x, y)));
+        let (hx, hy) = (
+            0.2 * (2.0 * x).cos() * (1.5 * y).cos(),
+            -0.15 * (2.0 * x).sin() * (1.5 * y).sin(),
+        );
+        normals.push(DVec3::new(-hx, -hy, 1.0).normalize());
+    }
+    let input = dir.path().join("patch.xyz");
+    write_xyz(&input, &points, Some(&normals));
+    for seed in 1..=2 {
+        let out = remesh_points(&input, &params(1500, seed), &|_| {}).unwrap();
+        let t = topology(&out.mesh);
+        assert!(t.is_manifold(), "seed {seed}: {t:?}");
+        assert_eq!(t.components, 1, "seed {seed}: {t:?}");
+        assert_eq!(t.boundary_loops, 2, "seed {seed}: {t:?}");
+        assert!(check_invariants(&out.mesh).is_empty());
+        // No face over the hole, none beyond the square (up to a spacing).
+        for tri in &out.mesh.triangles {
+            let c = tri
+                .iter()
+                .map(|&i| out.mesh.positions[i as usize])
+                .sum::<DVec3>()
+                / 3.0;
+            assert!(c.x.hypot(c.y) > 0.25, "seed {seed}: a face at {c}");
+            assert!(
+                c.x.abs().max(c.y.abs()) < 1.05,
+                "seed {seed}: a face at {c}"
+            );
+        }
+        // On the surface.
+        let off = worst_off(&out.mesh, |p| p.z - height(p.x, p.y));
+        assert!(off < 0.01, "seed {seed}: a vertex {off} off the patch");
+    }
+}
+
+#[test]
 fn many_buckets_give_the_same_guarantees_as_one() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("sphere.ply");

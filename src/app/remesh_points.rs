@@ -100,6 +100,10 @@ pub(super) fn run(
         serde_json::to_value(&out.assembly).unwrap_or_default(),
     );
     extra.insert(
+        "unsupported_faces".into(),
+        serde_json::to_value(out.unsupported).unwrap_or_default(),
+    );
+    extra.insert(
         "optimize".into(),
         serde_json::to_value(out.optimize).unwrap_or_default(),
     );
@@ -139,6 +143,15 @@ pub(super) fn run(
         report.notes.push(format!(
             "{} samples ended in no triangle and were left out",
             out.dropped_samples
+        ));
+    }
+    if report.topology.boundary_loops > 0 {
+        report.notes.push(format!(
+            "the points leave {} boundary loops open (gaps in the data wider than {} sigma_p: \
+             {} faces across them were removed)",
+            report.topology.boundary_loops,
+            crate::point_pipeline::OPEN_GAP_SIGMA_P,
+            out.unsupported.faces + out.unsupported.pinched_faces
         ));
     }
     let st = &out.stray_shells;

@@ -95,8 +95,9 @@ impl Scalar {
 }
 
 /// Reads a point set in chunks, from
-/// - PLY (ascii or binary of either byte order): the `vertex` element, which must be the first
-///   element of the file; its properties must be scalars; `x y z` are required, `nx ny nz` are
+/// - PLY (ascii or binary of either byte order): the `vertex` element (elements before it, such
+///   as a range map's `camera`, are skipped; in binary they must hold scalars only); its
+///   properties must be scalars; `x y z` are required, `nx ny nz` are
 ///   used when all three are present, everything else is skipped;
 /// - XYZ/CSV text (`.xyz .csv .txt .pts .asc .xyzn`): one point per line, `x y z` or
 ///   `x y z nx ny nz` (further columns skipped), separated by commas, semicolons or blanks. A
@@ -124,7 +125,7 @@ impl PointReader {
     ///
     /// # Errors
     /// [`Error::Io`] when the file cannot be opened; [`Error::Parse`] naming the file for a
-    /// header that is not PLY, lacks `x y z`, or has no leading `vertex` element, or for a text
+    /// header that is not PLY, lacks `x y z`, or has no `vertex` element or one before it that cannot be skipped (a list property in binary), or for a text
     /// file whose first point has fewer than three numbers.
     pub fn open(path: &Path) -> Result<Self> {
         if is_text_extension(path) {
@@ -155,15 +156,50 @@ impl PointReader {
             ply_rs_bw::ply::Encoding::BinaryLittleEndian => Encoding::BinaryLittle,
             ply_rs_bw::ply::Encoding::BinaryBigEndian => Encoding::BinaryBig,
         };
-        let vertex = match header.elements.first() {
-            Some((name, vertex)) if name == "vertex" => vertex,
-            Some((name, _)) => {
-                return Err(parse(format!(
-                    "the first element is `{name}`; point sets need `vertex` first"
-                )))
-            }
-            None => return Err(parse("no `vertex` element".into())),
+        // Elements before `vertex` (a range map's `camera`) are skipped: their records have a
+        // fixed size (scalars only) or, in ascii, one line each.
+        let Some(at) = header.elements.keys().position(|name| name == "vertex") else {
+            return Err(parse("no `vertex` element".into()));
         };
+        let mut input = input;
+        let mut line_number = line_number;
+        for (name, element) in header.elements.iter().take(at) {
+            match encoding {
+                Encoding::Ascii => {
+                    let mut line = String::new();
+                    for _ in 0..element.count {
+                        line.clear();
+                        if input.read_line(&mut line).map_err(|e| Error::io(path, e))? == 0 {
+                            return Err(parse(format!("the file ends inside `{name}`")));
+                        }
+                        line_number += 1;
+                    }
+                }
+                _ => {
+                    let mut size = 0u64;
+                    for property in element.properties.values() {
+                        match &property.data_type {
+                            PropertyType::Scalar(ty) => {
+                                size += Scalar::from(ty.clone()).size() as u64
+                            }
+                            PropertyType::List(..) => {
+                                return Err(parse(format!(
+                                    "`{name}` comes before `vertex` and has a list property; \
+                                     it cannot be skipped"
+                                )))
+                            }
+                        }
+                    }
+                    let skip = size * element.count as u64;
+                    let copied = std::io::copy(&mut (&mut input).take(skip), &mut std::io::sink())
+                        .map_err(|e| Error::io(path, e))?;
+                    if copied < skip {
+                        return Err(parse(format!("the file ends inside `{name}`")));
+                    }
+                }
+            }
+        }
+        let vertex = &header.elements[at];
         let count = vertex.count as u64;
         let mut properties: Vec<(Scalar, Option<usize>)> = Vec::new();
         let mut names: Vec<&str> = Vec::new();
@@ -485,8 +521,8 @@ pub(crate) fn is_point_set(path: &Path) -> Result<bool> {
     };
     let has_vertices = header
         .elements
-        .first()
-        .is_some_and(|(name, e)| name == "vertex" && e.count > 0);
+        .iter()
+        .any(|(name, e)| name == "vertex" && e.count > 0);
     let has_faces = header
         .elements
         .iter()
@@ -750,15 +786,55 @@ mod tests {
     }
 
     #[test]
+    fn elements_before_the_vertices_are_skipped() {
+        // A range map's header: a `camera` element (scalars) before `vertex`, faces after.
+        let dir = tempfile::tempdir().unwrap();
+        let head = "ply\nformat binary_little_endian 1.0\nelement camera 2\nproperty float a\n\
+                    property int b\nproperty uchar c\nelement vertex 2\nproperty float x\n\
+                    property float y\nproperty float z\nelement face 1\n\
+                    property list uchar int vertex_indices\nend_header\n";
+        let mut bytes = head.as_bytes().to_vec();
+        bytes.extend(std::iter::repeat_n(0xAB, 2 * 9));
+        for v in [1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0] {
+            bytes.extend(v.to_le_bytes());
+        }
+        bytes.push(3);
+        for i in [0i32, 1, 1] {
+            bytes.extend(i.to_le_bytes());
+        }
+        let path = dir.path().join("range.ply");
+        std::fs::write(&path, &bytes).unwrap();
+        let mut r = PointReader::open(&path).unwrap();
+        let mut out = Vec::new();
+        assert_eq!(r.read_chunk(&mut out, 10).unwrap(), 2);
+        assert_eq!(out[1].position, DVec3::new(4.0, 5.0, 6.0));
+        // It has faces: a mesh, unless asked for as points.
+        assert!(!is_point_set(&path).unwrap());
+        // In ascii, one line per entry.
+        let ascii = "ply\nformat ascii 1.0\nelement camera 1\nproperty float a\n\
+                     element vertex 1\nproperty float x\nproperty float y\nproperty float z\n\
+                     end_header\n9 9 9 9\n1 2 3\n";
+        let path = dir.path().join("ascii.ply");
+        std::fs::write(&path, ascii).unwrap();
+        let mut r = PointReader::open(&path).unwrap();
+        assert_eq!(r.read_chunk(&mut out, 10).unwrap(), 1);
+        assert_eq!(out[0].position, DVec3::new(1.0, 2.0, 3.0));
+        assert!(is_point_set(&path).unwrap());
+    }
+
+    #[test]
     fn bad_ply_headers_are_one_line_errors_naming_the_file() {
         let dir = tempfile::tempdir().unwrap();
         let vertex = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
         let cases = [
             ("not ply", "v 0 0 0\n".to_string(), "not a PLY file"),
             (
-                "face first",
-                format!("ply\nformat ascii 1.0\nelement face 0\n{vertex}end_header\n"),
-                "`vertex` first",
+                "list first",
+                format!(
+                    "ply\nformat binary_little_endian 1.0\nelement face 1\n\
+                     property list uchar int vertex_indices\n{vertex}end_header\n"
+                ),
+                "cannot be skipped",
             ),
             (
                 "list",

@@ -10,6 +10,7 @@ pub mod refine;
 pub mod restricted_delaunay;
 pub mod stray_shells;
 pub mod tangent_delaunay;
+pub mod unsupported;
 pub mod untangle;
 
 pub use cleanup::{assemble, AssemblyParams, AssemblyStats, FaceSource};
