@@ -48,6 +48,7 @@ fn remesh_job(c: &mut Criterion) {
         measure_distance: false,
         max_memory: None,
         as_points: false,
+        viewpoint: None,
     };
     // The split per stage of one run, which criterion's total does not show.
     let report = run_remesh(&job, &|_| {}).expect("remesh");

@@ -125,7 +125,7 @@ pub struct PointRemeshParams {
     pub bucket_points: usize,
     /// Where the bucket files go (default: the system's temporary folder).
     pub temp_dir: Option<PathBuf>,
-    /// How normals are oriented for a point set without them.
+    /// How normals are oriented for a point set without them (a viewpoint in model units).
     pub orientation: NormalOrientation,
     /// Whether isolated points are dropped ([`OutlierFilter`](crate::points::outliers::OutlierFilter);
     /// default true).
@@ -288,7 +288,8 @@ pub fn remesh_points(
             std::mem::take(&mut scan.support),
             RIMLS_POINTS_PER_SAMPLE,
             scan.had_normals,
-            params.orientation,
+            // The points are in the bbox-100 frame, a viewpoint in model units.
+            params.orientation.in_frame(&scan.normalization),
         )?;
         // The samples are input points, noisy: they start on the surface.
         let positions: Vec<DVec3> = samples.iter().map(|p| p.position).collect();

@@ -38,6 +38,7 @@ fn remesh(
         format: None,
         max_memory: None,
         as_points: false,
+        viewpoint: None,
     };
     let report = run_remesh(&job, &|_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
     let (out, _) = read_mesh(&output).unwrap();

@@ -362,3 +362,67 @@ fn resampling_on_rimls_evens_the_spacing_and_stays_on_the_surface() {
     assert!(angles[angles.len() / 2] < 5.0);
     assert!(angles[angles.len() - 1] < 90.0, "a flipped normal");
 }
+
+/// A viewpoint is given in the input's units: the estimated normals of a cap of a unit sphere
+/// far from the origin face a sensor above it, in `simplify` and in the point-set remeshing.
+/// (Issue 19: the viewpoint was used as if in the bbox-100 frame; a point 5 units above the
+/// cap lay below most of the cap's points there, and their normals pointed down.)
+#[test]
+fn a_viewpoint_in_model_units_orients_the_normals_towards_it() {
+    use glam::DVec3;
+    use rand::RngExt;
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("cap.xyz");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let offset = DVec3::new(1000.0, -500.0, 20.0);
+    let mut f = std::io::BufWriter::new(std::fs::File::create(&input).unwrap());
+    for _ in 0..20_000 {
+        // The cap z > 0.5 of the unit sphere (Archimedes: z uniform).
+        let z: f64 = rng.random_range(0.5..1.0);
+        let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+        let s = (1.0 - z * z).sqrt();
+        let p = DVec3::new(s * phi.cos(), s * phi.sin(), z) + offset;
+        writeln!(f, "{} {} {}", p.x, p.y, p.z).unwrap();
+    }
+    drop(f);
+    let eye = offset + DVec3::new(0.0, 0.0, 5.0);
+    let params = OutOfCoreParams {
+        target: Some(500),
+        orientation: spectral_remesh::NormalOrientation::Viewpoint(eye),
+        temp_dir: Some(dir.path().to_path_buf()),
+        ..Default::default()
+    };
+    let out = simplify_out_of_core(&input, &params).unwrap();
+    let wrong = out
+        .samples
+        .iter()
+        .filter(|p| p.normal.dot(eye - p.position) <= 0.0)
+        .count();
+    assert_eq!(wrong, 0, "{wrong} of {} normals face away", out.samples.len());
+    let remeshed = spectral_remesh::remesh_points(
+        &input,
+        &spectral_remesh::PointRemeshParams {
+            remesh: spectral_remesh::RemeshParams {
+                density: spectral_remesh::Density::Points(500),
+                ..Default::default()
+            },
+            orientation: spectral_remesh::NormalOrientation::Viewpoint(eye),
+            temp_dir: Some(dir.path().to_path_buf()),
+            ..Default::default()
+        },
+        &|_| {},
+    )
+    .unwrap();
+    // The output is oriented like the normals: its faces face the sensor.
+    let m = &remeshed.mesh;
+    let facing = m
+        .triangles
+        .iter()
+        .filter(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            (b - a).cross(c - a).dot(eye - (a + b + c) / 3.0) > 0.0
+        })
+        .count();
+    assert_eq!(facing, m.triangles.len());
+}

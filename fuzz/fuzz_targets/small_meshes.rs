@@ -286,6 +286,7 @@ pub fn assert_remesh_is_sound(data: &[u8], dir: &Path) {
         strict: false,
         max_memory: None,
         as_points: false,
+        viewpoint: None,
         format: None,
     };
     match run_remesh(&job, &|_| {}) {

@@ -56,6 +56,10 @@ pub struct RemeshJob {
     /// `--as-points` (a PLY file). A text point file or a PLY file without faces is read as a
     /// point set either way ([`is_point_set`](crate::is_point_set)).
     pub as_points: bool,
+    /// For a point set without normals: the estimated normals face this point (model units; a
+    /// single scan's sensor) instead of being oriented outward by a spanning tree. Not used for
+    /// meshes.
+    pub viewpoint: Option<glam::DVec3>,
 }
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.

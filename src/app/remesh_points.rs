@@ -10,6 +10,7 @@ use crate::error::Result;
 use crate::io::{as_written, MeshFormat};
 use crate::pipeline::{Density, MAX_POINTS};
 use crate::point_pipeline::{remesh_points, PointRemeshParams};
+use crate::points::normals::NormalOrientation;
 use crate::points::PointReader;
 use crate::report::{PointSetDistance, QualityReport};
 use crate::surface::MeshSurface;
@@ -26,6 +27,10 @@ pub(super) fn run(
 ) -> Result<QualityReport> {
     let params = PointRemeshParams {
         remesh: job.params,
+        orientation: match job.viewpoint {
+            Some(v) => NormalOrientation::Viewpoint(v),
+            None => NormalOrientation::SpanningTree,
+        },
         ..PointRemeshParams::default()
     };
     if let (Some(limit), Density::Points(n)) = (job.max_memory, job.params.density) {

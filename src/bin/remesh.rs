@@ -165,6 +165,11 @@ struct Cli {
     #[arg(long)]
     as_points: bool,
 
+    /// For a point set without normals: orient the estimated normals towards this point
+    /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
+    viewpoint: Option<[f64; 3]>,
+
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
@@ -447,6 +452,7 @@ fn config(cli: Cli) -> Result<Config, Error> {
                 strict: cli.strict,
                 max_memory: cli.max_memory.or_else(physical_memory),
                 as_points: cli.as_points,
+                viewpoint: cli.viewpoint.map(glam::DVec3::from),
             };
             Ok(Config::Remesh {
                 job: Box::new(job),

@@ -24,6 +24,17 @@ pub enum NormalOrientation {
     Viewpoint(DVec3),
 }
 
+impl NormalOrientation {
+    /// The same orientation for points in `normalization`'s bbox-100 frame: a viewpoint is
+    /// given in model units and moves with the points.
+    pub fn in_frame(self, normalization: &crate::mesh::Normalization) -> Self {
+        match self {
+            NormalOrientation::Viewpoint(v) => NormalOrientation::Viewpoint(normalization.apply(v)),
+            o => o,
+        }
+    }
+}
+
 /// Unit normals of `points` (any units): the least-variance direction of each point's `k`
 /// nearest neighbours (itself included), oriented as `orientation` says. `k` below 3 is taken
 /// as 3. Deterministic.

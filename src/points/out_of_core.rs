@@ -135,6 +135,11 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         ..
     } = scan;
     let kernel = Kernel::new(sigma_p, params.sigma_n)?;
+    // The samples are in the bbox-100 frame here, a viewpoint in model units.
+    let params = &OutOfCoreParams {
+        orientation: params.orientation.in_frame(&normalization),
+        ..params.clone()
+    };
     if params.resample > 0 {
         resample_on_rimls(&kernel, &mut samples, support, had_normals, params)?;
     } else if !had_normals {
