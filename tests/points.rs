@@ -399,7 +399,12 @@ fn a_viewpoint_in_model_units_orients_the_normals_towards_it() {
         .iter()
         .filter(|p| p.normal.dot(eye - p.position) <= 0.0)
         .count();
-    assert_eq!(wrong, 0, "{wrong} of {} normals face away", out.samples.len());
+    assert_eq!(
+        wrong,
+        0,
+        "{wrong} of {} normals face away",
+        out.samples.len()
+    );
     let remeshed = spectral_remesh::remesh_points(
         &input,
         &spectral_remesh::PointRemeshParams {

@@ -284,14 +284,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             stats.welded_vertices
         ));
     }
-    if let Some(n) = out.target {
-        let v = out.mesh.vertex_count();
-        if (v as f64 - n as f64).abs() > 0.01 * n as f64 {
-            report.notes.push(format!(
-                "target not reached: {v} vertices for --points {n} (more than 1% off)"
-            ));
-        }
-    }
+    count_note(&mut report.notes, out.target, out.mesh.vertex_count());
     if out.buried_candidates + out.buried_samples > 0 {
         report.notes.push(format!(
             "the input passes through itself: {} candidate points inside its own solid were left \
@@ -351,21 +344,36 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         input.face_count(),
     ));
     if out.dropped_samples > 0 {
-        report.notes.push(format!(
-            "{} samples ended in no triangle and were left out",
-            out.dropped_samples
-        ));
+        report.notes.push(dropped_note(out.dropped_samples));
     }
     if let Some(note) = features_note(&out.features) {
         report.notes.push(note);
     }
     if out.assembly.holes_left > 0 {
-        report.notes.push(format!(
-            "{} holes of the triangulation could not be closed",
-            out.assembly.holes_left
-        ));
+        report.notes.push(holes_note(out.assembly.holes_left));
     }
     Ok(report)
+}
+
+/// The report's note when the output's vertex count is more than 1% off the target.
+fn count_note(notes: &mut Vec<String>, target: Option<usize>, vertices: usize) {
+    if let Some(n) = target {
+        if (vertices as f64 - n as f64).abs() > 0.01 * n as f64 {
+            notes.push(format!(
+                "target not reached: {vertices} vertices for --points {n} (more than 1% off)"
+            ));
+        }
+    }
+}
+
+/// The report's note on samples that ended in no triangle.
+fn dropped_note(dropped: usize) -> String {
+    format!("{dropped} samples ended in no triangle and were left out")
+}
+
+/// The report's note on holes of the triangulation left open.
+fn holes_note(holes: usize) -> String {
+    format!("{holes} holes of the triangulation could not be closed")
 }
 
 /// The report's `sigma_p`, `sigma_n`, `target_points` and `seed` entries.

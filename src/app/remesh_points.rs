@@ -4,7 +4,8 @@
 use glam::DVec3;
 
 use super::{
-    insert_kernel_extras, memory, refuse_if_strict, write_output, RemeshJob, DISTANCE_SAMPLES,
+    count_note, dropped_note, holes_note, insert_kernel_extras, memory, refuse_if_strict,
+    write_output, RemeshJob, DISTANCE_SAMPLES,
 };
 use crate::error::Result;
 use crate::io::{as_written, MeshFormat};
@@ -136,19 +137,9 @@ pub(super) fn run(
             out.outliers_removed
         ));
     }
-    if let Some(n) = out.target {
-        let v = out.mesh.vertex_count();
-        if (v as f64 - n as f64).abs() > 0.01 * n as f64 {
-            report.notes.push(format!(
-                "target not reached: {v} vertices for --points {n} (more than 1% off)"
-            ));
-        }
-    }
+    count_note(&mut report.notes, out.target, out.mesh.vertex_count());
     if out.dropped_samples > 0 {
-        report.notes.push(format!(
-            "{} samples ended in no triangle and were left out",
-            out.dropped_samples
-        ));
+        report.notes.push(dropped_note(out.dropped_samples));
     }
     if report.topology.boundary_loops > 0 {
         report.notes.push(format!(
@@ -168,10 +159,7 @@ pub(super) fn run(
         ));
     }
     if out.assembly.holes_left > 0 {
-        report.notes.push(format!(
-            "{} holes of the triangulation could not be closed",
-            out.assembly.holes_left
-        ));
+        report.notes.push(holes_note(out.assembly.holes_left));
     }
     Ok(report)
 }
