@@ -289,6 +289,7 @@ fn job(input: PathBuf, output: PathBuf, as_points: bool) -> RemeshJob {
         strict: true,
         max_memory: None,
         as_points,
+        viewpoint: None,
     }
 }
 
