@@ -202,18 +202,16 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         }
     }
     let check_seconds = t.elapsed();
-    refuse_if_strict(job, &mut report)?;
-    on_stage("write");
-    let t = Clock::start();
-    write_output(job, format, mesh_out)?;
-    let write_seconds = t.elapsed();
-
     report.push_stage("read", read_seconds.0, read_seconds.1);
-    for s in &out.stages {
-        report.push_stage(s.name, s.seconds, s.cpu_seconds);
-    }
-    report.push_stage("check (report)", check_seconds.0, check_seconds.1);
-    report.push_stage("write", write_seconds.0, write_seconds.1);
+    check_and_write(
+        job,
+        format,
+        mesh_out,
+        &mut report,
+        &out.stages,
+        check_seconds,
+        on_stage,
+    )?;
     if job.measure_distance {
         on_stage("distance");
         let t = Clock::start();
@@ -396,6 +394,31 @@ fn insert_kernel_extras(
         extra.insert("target_points".into(), n.into());
     }
     extra.insert("seed".into(), params.seed.into());
+}
+
+/// The end of a remeshing job: `--strict` ([`refuse_if_strict`]), then `mesh` written, and the
+/// report's stages: the pipeline's `stages`, the check (`check_seconds`, wall and processor)
+/// and the write.
+fn check_and_write(
+    job: &RemeshJob,
+    format: MeshFormat,
+    mesh: &TriMesh,
+    report: &mut QualityReport,
+    stages: &[crate::timing::Stage],
+    check_seconds: (f64, f64),
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<()> {
+    refuse_if_strict(job, report)?;
+    on_stage("write");
+    let t = Clock::start();
+    write_output(job, format, mesh)?;
+    let write_seconds = t.elapsed();
+    for s in stages {
+        report.push_stage(s.name, s.seconds, s.cpu_seconds);
+    }
+    report.push_stage("check (report)", check_seconds.0, check_seconds.1);
+    report.push_stage("write", write_seconds.0, write_seconds.1);
+    Ok(())
 }
 
 /// Notes the output's invariant violations in `report`; with `job.strict`, an error when it

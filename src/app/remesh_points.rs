@@ -4,8 +4,8 @@
 use glam::DVec3;
 
 use super::{
-    count_note, dropped_note, holes_note, insert_kernel_extras, memory, refuse_if_strict,
-    write_output, RemeshJob, DISTANCE_SAMPLES,
+    check_and_write, count_note, dropped_note, holes_note, insert_kernel_extras, memory, RemeshJob,
+    DISTANCE_SAMPLES,
 };
 use crate::error::Result;
 use crate::io::{as_written, MeshFormat};
@@ -53,16 +53,15 @@ pub(super) fn run(
     };
     let mut report = QualityReport::new(checked);
     let check_seconds = t.elapsed();
-    refuse_if_strict(job, &mut report)?;
-    on_stage("write");
-    let t = Clock::start();
-    write_output(job, format, &out.mesh)?;
-    let write_seconds = t.elapsed();
-    for s in &out.stages {
-        report.push_stage(s.name, s.seconds, s.cpu_seconds);
-    }
-    report.push_stage("check (report)", check_seconds.0, check_seconds.1);
-    report.push_stage("write", write_seconds.0, write_seconds.1);
+    check_and_write(
+        job,
+        format,
+        &out.mesh,
+        &mut report,
+        &out.stages,
+        check_seconds,
+        on_stage,
+    )?;
 
     if job.measure_distance {
         on_stage("distance");
