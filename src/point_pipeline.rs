@@ -74,19 +74,18 @@ pub const DOMAIN_GAP_SIGMA_P: f64 = 0.75;
 struct Domain<'a> {
     rimls: &'a Rimls,
     tree: StaticTree,
-    max_gap_2: f64,
+    /// The projections' reach past the data (`DOMAIN_GAP_SIGMA_P` sigma_p).
+    max_gap: f64,
 }
 
 impl Domain<'_> {
     /// Whether a support point lies within `r` of `p`.
     fn within(&self, p: DVec3, r: f64) -> bool {
-        let mut found = Vec::with_capacity(1);
-        self.tree.nearest_n(p, 1, &mut found);
-        found.first().is_some_and(|&(_, d2)| d2 <= r * r)
+        self.tree.nearest(p).is_some_and(|(_, d2)| d2 <= r * r)
     }
 
     fn covers_one(&self, p: DVec3) -> bool {
-        self.within(p, self.max_gap_2.sqrt())
+        self.within(p, self.max_gap)
     }
 }
 
@@ -250,8 +249,8 @@ pub fn remesh_points(
     if matches!(rp.features, FeatureDetection::Angle(_)) {
         return Err(refuse("--feature-angle", "sharp-feature detection"));
     }
-    let had_normals = crate::points::PointReader::open(input)?.has_normals();
-    if rp.sigma_n.is_finite() && !had_normals {
+    // (Opening a text file counts its points: only when sigma_n needs the answer.)
+    if rp.sigma_n.is_finite() && !crate::points::PointReader::open(input)?.has_normals() {
         return Err(Error::InvalidParameter {
             name: "--sigma-n",
             message: format!("{} has no normals; sigma_n needs them", input.display()),
@@ -339,7 +338,7 @@ pub fn remesh_points(
     let domain = Domain {
         rimls: &rimls,
         tree: StaticTree::new(rimls.positions()),
-        max_gap_2: (DOMAIN_GAP_SIGMA_P * sigma_p).powi(2),
+        max_gap: DOMAIN_GAP_SIGMA_P * sigma_p,
     };
     // The RIMLS points on their own surface: the points the optimization keeps covered.
     let cover_points: Vec<DVec3> = rimls

@@ -207,6 +207,17 @@ impl StaticTree {
         }
     }
 
+    /// The nearest point to `p` as `(index, squared distance)`; `None` when the tree is empty.
+    pub fn nearest(&self, p: DVec3) -> Option<(u32, f64)> {
+        let r = self
+            .tree
+            .as_ref()?
+            .query(&arr(p))
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        Some((r.item, r.distance))
+    }
+
     /// The `k` nearest points to `p`, nearest first, as `(index, squared distance)`.
     pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
         out.clear();
