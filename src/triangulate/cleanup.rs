@@ -471,7 +471,7 @@ fn triangulate_polygon(
 /// Finds vertices whose faces form more than one edge-connected fan and removes the faces of
 /// all fans but the largest, so that hole filling can rebuild them as one. Returns how many faces
 /// were removed.
-fn repair_pinched_vertices(b: &mut Assembly) -> usize {
+pub(crate) fn repair_pinched_vertices(b: &mut Assembly) -> usize {
     let mut around: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     let (faces, slots) = b.live_faces();
     for (t, f) in faces.into_iter().zip(slots) {

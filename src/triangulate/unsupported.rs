@@ -3,12 +3,15 @@
 //! face whose centroid or an edge midpoint lies farther than a distance from every input point
 //! spans such a hole; it is removed with the whole patch of hole-filling faces it belongs to
 //! (the assembly's fill of that loop), and the vertices the removal pinches (two fans meeting
-//! at one vertex) keep their largest fan, so the output stays manifold.
+//! at one vertex) keep their largest fan (the assembly's own repair), so the output stays
+//! manifold.
 
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
+use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
+use crate::triangulate::cleanup::repair_pinched_vertices;
 use crate::triangulate::FaceSource;
 
 /// What [`remove_unsupported_faces`] removed.
@@ -72,99 +75,43 @@ pub fn remove_unsupported_faces(
             }
         }
     }
-    let faces = retain_faces(mesh, sources, &drop);
+    let faces = drop.iter().filter(|&&d| d).count();
+    if faces == 0 {
+        return UnsupportedFaces::default();
+    }
+    // The removal and the pinched fans (the assembly's repair) on the edit mesh.
+    let mut m: EditMesh<FaceSource> = EditMesh::from_trimesh(
+        mesh,
+        |f| {
+            sources
+                .get(f as usize)
+                .copied()
+                .unwrap_or(FaceSource::Refined)
+        },
+        SlotPolicy::Reuse,
+    );
+    for (f, _) in drop.iter().enumerate().filter(|(_, &d)| d) {
+        // Every face of the mesh is live in `m`.
+        let _ = m.remove_face(f as u32);
+    }
     let mut pinched_faces = 0;
-    if faces > 0 {
-        // Removing a fan can pinch another vertex of it: repeat until none is left.
-        loop {
-            let n = remove_smaller_fans(mesh, sources);
-            if n == 0 {
-                break;
-            }
-            pinched_faces += n;
+    // Removing a fan can pinch another vertex of it: repeat until none is left.
+    loop {
+        let n = repair_pinched_vertices(&mut m);
+        if n == 0 {
+            break;
         }
+        pinched_faces += n;
+    }
+    let (_, triangles, labels) = m.into_parts();
+    mesh.triangles = triangles;
+    if !sources.is_empty() {
+        *sources = labels;
     }
     UnsupportedFaces {
         faces,
         pinched_faces,
     }
-}
-
-/// At each vertex whose faces form more than one fan (faces joined through the edges at the
-/// vertex), removes the faces of all fans but the largest. Returns how many were removed.
-fn remove_smaller_fans(mesh: &mut TriMesh, sources: &mut Vec<FaceSource>) -> usize {
-    let mut around: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        for &v in t {
-            around.entry(v).or_default().push(f);
-        }
-    }
-    let mut vertices: Vec<u32> = around.keys().copied().collect();
-    vertices.sort_unstable();
-    let mut drop = vec![false; mesh.triangles.len()];
-    for v in vertices {
-        let faces: Vec<usize> = around[&v].iter().copied().filter(|&f| !drop[f]).collect();
-        // Fans: union of faces sharing an edge (v, w).
-        let mut fan: Vec<usize> = (0..faces.len()).collect();
-        fn root(fan: &mut [usize], mut i: usize) -> usize {
-            while fan[i] != i {
-                fan[i] = fan[fan[i]];
-                i = fan[i];
-            }
-            i
-        }
-        let mut by_edge: FxHashMap<u32, usize> = FxHashMap::default();
-        for (k, &f) in faces.iter().enumerate() {
-            for &w in mesh.triangles[f].iter().filter(|&&w| w != v) {
-                match by_edge.get(&w) {
-                    Some(&j) => {
-                        let (a, b) = (root(&mut fan, j), root(&mut fan, k));
-                        fan[a.max(b)] = a.min(b);
-                    }
-                    None => {
-                        by_edge.insert(w, k);
-                    }
-                }
-            }
-        }
-        let mut size: FxHashMap<usize, usize> = FxHashMap::default();
-        for k in 0..faces.len() {
-            *size.entry(root(&mut fan, k)).or_default() += 1;
-        }
-        if size.len() < 2 {
-            continue;
-        }
-        // The largest fan, the first one on a tie.
-        let keep = *size
-            .iter()
-            .max_by_key(|&(&r, &n)| (n, usize::MAX - r))
-            .map(|(r, _)| r)
-            .unwrap_or(&0);
-        for (k, &f) in faces.iter().enumerate() {
-            if root(&mut fan, k) != keep {
-                drop[f] = true;
-            }
-        }
-    }
-    retain_faces(mesh, sources, &drop)
-}
-
-/// Removes the faces `drop` marks (and their sources, where there are any); returns how many.
-fn retain_faces(mesh: &mut TriMesh, sources: &mut Vec<FaceSource>, drop: &[bool]) -> usize {
-    let before = mesh.triangles.len();
-    let mut i = 0;
-    mesh.triangles.retain(|_| {
-        i += 1;
-        !drop[i - 1]
-    });
-    if sources.len() == drop.len() {
-        let mut i = 0;
-        sources.retain(|_| {
-            i += 1;
-            !drop[i - 1]
-        });
-    }
-    before - mesh.triangles.len()
 }
 
 #[cfg(test)]
