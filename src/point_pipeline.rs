@@ -273,7 +273,16 @@ pub fn remesh_points(
     let mut source = ScannedInput::open(input, &scan_params, params.drop_outliers)?;
     let mut sigma_p = source.sigma_p;
     let mut scans = 0;
-    let (scan, kernel, rimls, samples, mut moving, unprojected_samples, rescan_rejected) = loop {
+    let (
+        scan,
+        kernel,
+        rimls,
+        support_tree,
+        samples,
+        mut moving,
+        unprojected_samples,
+        rescan_rejected,
+    ) = loop {
         scans += 1;
         let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE - 1)?;
         let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
@@ -289,14 +298,23 @@ pub fn remesh_points(
             scan.had_normals,
             // The points are in the bbox-100 frame, a viewpoint in model units.
             params.orientation.in_frame(&scan.normalization),
+            // Points on no sheet of the density the open-gap rule bridges carry no surface.
+            Some(2.0 * OPEN_GAP_SIGMA_P * sigma_p),
         )?;
+        let support_tree = StaticTree::new(rimls.positions());
         // The samples are input points, noisy: they start on the surface.
         let positions: Vec<DVec3> = samples.iter().map(|p| p.position).collect();
         let projected = rimls.project_all(&positions);
         drop(positions);
+        let reach2 = (DOMAIN_GAP_SIGMA_P * sigma_p).powi(2);
         let mut moving: Vec<SurfaceSample> = projected
             .into_iter()
             .flatten()
+            .filter(|&(position, _)| {
+                support_tree
+                    .nearest(position)
+                    .is_some_and(|(_, d2)| d2 <= reach2)
+            })
             .map(|(position, normal)| SurfaceSample {
                 position,
                 normal,
@@ -331,13 +349,24 @@ pub fn remesh_points(
                 sigma_p *= (v / n as f64).sqrt();
                 on_stage("scan");
             }
-            _ => break (scan, kernel, rimls, samples, moving, unprojected, rejected),
+            _ => {
+                break (
+                    scan,
+                    kernel,
+                    rimls,
+                    support_tree,
+                    samples,
+                    moving,
+                    unprojected,
+                    rejected,
+                )
+            }
         }
     };
     let normalization = scan.normalization;
     let domain = Domain {
         rimls: &rimls,
-        tree: StaticTree::new(rimls.positions()),
+        tree: support_tree,
         max_gap: DOMAIN_GAP_SIGMA_P * sigma_p,
     };
     // The RIMLS points on their own surface: the points the optimization keeps covered.

@@ -14,7 +14,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::normals::{estimate_normals, NormalOrientation};
-use super::outliers::OutlierFilter;
+use super::outliers::{off_sheet, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
 use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -347,6 +347,7 @@ fn resample_on_rimls(
         RIMLS_POINTS_PER_SAMPLE,
         had_normals,
         params.orientation,
+        None,
     )?;
     let mut moving: Vec<SurfaceSample> = samples
         .iter()
@@ -374,7 +375,8 @@ fn resample_on_rimls(
 /// `(points_per_sample - 1) · samples.len()` points of `support` (a uniformly random subset of
 /// the input), bbox-100 units. Without input normals (`had_normals` false), normals are
 /// estimated on that set (PCA over 10 neighbours, oriented by `orientation`) and given to the
-/// samples as well.
+/// samples as well. With `sheet_radius` the points on no sheet at that radius
+/// ([`off_sheet`]) are left out of the surface (the samples keep their entries).
 ///
 /// # Errors
 /// Those of [`Rimls::new`] (no points, a non-finite position or a zero normal).
@@ -385,6 +387,7 @@ pub(crate) fn rimls_of(
     points_per_sample: usize,
     had_normals: bool,
     orientation: NormalOrientation,
+    sheet_radius: Option<f64>,
 ) -> Result<Rimls> {
     let mut support = support;
     support.truncate(points_per_sample.saturating_sub(1) * samples.len());
@@ -394,8 +397,16 @@ pub(crate) fn rimls_of(
         let from = support.len() - samples.len();
         samples.copy_from_slice(&support[from..]);
     }
-    let (positions, normals) = support.iter().map(|p| (p.position, p.normal)).unzip();
+    let (mut positions, mut normals): (Vec<DVec3>, Vec<DVec3>) =
+        support.iter().map(|p| (p.position, p.normal)).unzip();
     drop(support);
+    if let Some(radius) = sheet_radius {
+        let off = off_sheet(&positions, radius);
+        let mut keep = off.iter().map(|&o| !o);
+        positions.retain(|_| keep.next().unwrap_or(true));
+        let mut keep = off.iter().map(|&o| !o);
+        normals.retain(|_| keep.next().unwrap_or(true));
+    }
     Rimls::new(positions, normals, params)
 }
 

@@ -4,7 +4,8 @@
 //! Source: statistical outlier removal (Rusu, Marton, Blodow, Dolha, Beetz 2008, "Towards 3D
 //! point cloud based object maps for household environments", Sec. 4) for the global test, and
 //! the local outlier factor (Breunig, Kriegel, Ng, Sander 2000) simplified to one ratio of
-//! k-distances for the local one.
+//! k-distances for the local one. A second test, [`off_sheet`], finds the points on no sheet of
+//! data at a given scale (strands of flying pixels).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -104,6 +105,29 @@ impl OutlierFilter {
     }
 }
 
+/// Neighbours within the radius that put a point on a sheet (see [`off_sheet`]).
+pub const SHEET_NEIGHBORS: usize = 6;
+
+/// For each of `positions`, whether fewer than `SHEET_NEIGHBORS` other points lie within
+/// `radius` of it: the point is on no two-dimensional sheet of data at that scale. A point
+/// inside a hexagonal lattice of spacing up to `radius` has six neighbours within it; a point
+/// with fewer lies on a strand or alone, as the flying pixels a range scanner leaves along depth
+/// discontinuities (strands along the view rays, a few spacings apart), which a surface through
+/// them would bridge. Any units; deterministic (parallel).
+pub fn off_sheet(positions: &[DVec3], radius: f64) -> Vec<bool> {
+    let tree = StaticTree::new(positions);
+    let r2 = radius * radius;
+    positions
+        .par_iter()
+        .map_init(Vec::new, |found, &p| {
+            tree.nearest_n(p, SHEET_NEIGHBORS + 1, found);
+            // The point itself is among them (distance 0), and so are exact duplicates.
+            let near = found.iter().filter(|&&(_, d2)| d2 <= r2).count();
+            near < SHEET_NEIGHBORS + 1
+        })
+        .collect()
+}
+
 /// The distance from `p` to its `OUTLIER_NEIGHBORS`-th nearest point of `tree` other than
 /// itself (points at distance 0 are skipped); infinity when there are not that many. `found`
 /// is left holding the neighbours.
@@ -193,5 +217,30 @@ mod tests {
         let filter = OutlierFilter::new(&points);
         let mut found = Vec::new();
         assert!(!filter.is_outlier(DVec3::splat(1e6), &mut found));
+    }
+
+    #[test]
+    fn a_strand_off_a_plane_is_off_sheet_and_the_plane_is_not() {
+        // A 30 x 30 grid of spacing 1 (corners and edges included) and a strand of points 2
+        // apart leaving it along its normal, as flying pixels do.
+        let mut points: Vec<DVec3> = (0..900)
+            .map(|i| DVec3::new((i % 30) as f64, (i / 30) as f64, 0.0))
+            .collect();
+        let strand: Vec<DVec3> = (1..=10)
+            .map(|k| DVec3::new(15.0, 15.0, 2.0 * k as f64))
+            .collect();
+        points.extend_from_slice(&strand);
+        let off = off_sheet(&points, 3.0);
+        assert!(off[..900].iter().all(|&o| !o), "a grid point is off the sheet");
+        // The strand's points farther than the radius from the plane see at most two others.
+        for (k, &o) in off[900..].iter().enumerate() {
+            if strand[k].z > 3.0 {
+                assert!(o, "strand point {k} is on a sheet");
+            }
+        }
+        // Duplicates are neighbours: a point repeated seven times is on a sheet of itself.
+        let dup = vec![DVec3::ONE; 7];
+        assert!(off_sheet(&dup, 0.5).iter().all(|&o| !o));
+        assert!(off_sheet(&dup[..6], 0.5).iter().all(|&o| o));
     }
 }
