@@ -3,17 +3,21 @@
 //! from a mesh; writing the JSON report, and turning a panic into an error.
 
 mod memory;
+mod options;
 mod remesh_points;
 mod simplify;
 
 pub use memory::{estimate_remesh_bytes, parse_bytes, physical_memory};
+pub use options::RemeshOptions;
 pub use simplify::{run_simplify, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary};
 
 use crate::timing::Clock;
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
-use crate::io::{as_written, encode_mesh, read_mesh, write_atomically, MeshFormat};
+use crate::io::{
+    as_written, check_and_clean, encode_mesh, read_mesh, write_atomically, MeshFormat,
+};
 use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::pipeline::{
     expected_samples, remesh, validate_input, Density, RemeshParams, MAX_POINTS,
@@ -119,6 +123,32 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     on_stage("read");
     let t = Clock::start();
     let (input, stats) = read_mesh(&job.input)?;
+    let write = |mesh: &TriMesh| write_output(job, format, mesh);
+    let (_, report) = remesh_read(
+        job,
+        format,
+        input,
+        stats.welded_vertices,
+        t,
+        &write,
+        on_stage,
+    )?;
+    Ok(report)
+}
+
+/// [`run_remesh`] from the mesh read on (shared with [`remesh_mesh`]): the pipeline, the check,
+/// `write` (called with the output mesh in model units once `--strict` has passed), the report.
+/// `input` is the mesh as read, `welded_vertices` what reading welded, `t` the clock started
+/// before reading (the report's `read` stage). Returns the output mesh as written and the report.
+fn remesh_read(
+    job: &RemeshJob,
+    format: MeshFormat,
+    input: TriMesh,
+    welded_vertices: usize,
+    t: Clock,
+    write: &dyn Fn(&TriMesh) -> Result<()>,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<(TriMesh, QualityReport)> {
     let input_side = input.bbox().map_or(0.0, |b| b.longest_side());
     let (input, up) = into_normal_range(input);
     if up != 0 && matches!(format, MeshFormat::Gltf | MeshFormat::Glb | MeshFormat::Stl) {
@@ -205,7 +235,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     report.push_stage("read", read_seconds.0, read_seconds.1);
     check_and_write(
         job,
-        format,
+        write,
         mesh_out,
         &mut report,
         &out.stages,
@@ -276,10 +306,9 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             input_side
         ));
     }
-    if stats.welded_vertices > 0 {
+    if welded_vertices > 0 {
         report.notes.push(format!(
-            "{} input vertices at identical positions were merged",
-            stats.welded_vertices
+            "{welded_vertices} input vertices at identical positions were merged"
         ));
     }
     count_note(&mut report.notes, out.target, out.mesh.vertex_count());
@@ -350,7 +379,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     if out.assembly.holes_left > 0 {
         report.notes.push(holes_note(out.assembly.holes_left));
     }
-    Ok(report)
+    Ok((scaled_back.unwrap_or(out.mesh), report))
 }
 
 /// The report's note when the output's vertex count is more than 1% off the target.
@@ -396,12 +425,12 @@ fn insert_kernel_extras(
     extra.insert("seed".into(), params.seed.into());
 }
 
-/// The end of a remeshing job: `--strict` ([`refuse_if_strict`]), then `mesh` written, and the
-/// report's stages: the pipeline's `stages`, the check (`check_seconds`, wall and processor)
-/// and the write.
+/// The end of a remeshing job: `--strict` ([`refuse_if_strict`]), then `mesh` written by
+/// `write`, and the report's stages: the pipeline's `stages`, the check (`check_seconds`, wall
+/// and processor) and the write.
 fn check_and_write(
     job: &RemeshJob,
-    format: MeshFormat,
+    write: &dyn Fn(&TriMesh) -> Result<()>,
     mesh: &TriMesh,
     report: &mut QualityReport,
     stages: &[crate::timing::Stage],
@@ -411,7 +440,7 @@ fn check_and_write(
     refuse_if_strict(job, report)?;
     on_stage("write");
     let t = Clock::start();
-    write_output(job, format, mesh)?;
+    write(mesh)?;
     let write_seconds = t.elapsed();
     for s in stages {
         report.push_stage(s.name, s.seconds, s.cpu_seconds);
@@ -527,6 +556,40 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
     let reference = reference
         .map(|r| read_mesh(r).map(|(m, _)| (m, r)))
         .transpose()?;
+    quality_read(mesh, path, reference, seed, t)
+}
+
+/// Reports on a mesh held in memory as [`run_quality`] reports on a file holding it: `mesh`
+/// and `reference` get the checks and clean-up reading gives a file's mesh (faces present,
+/// indices in range, finite coordinates; identical positions welded, unreferenced vertices
+/// removed), then the same measures; with `reference`, the distance to it too (both in the
+/// reference's bbox-100 frame, or the mesh's own without one; the distance's random points
+/// from `seed`). The report equals `run_quality`'s for files holding the same meshes, but for
+/// its stage times.
+///
+/// # Errors
+/// [`Error::InvalidMesh`] naming `mesh` or `reference` for a mesh that fails those checks or
+/// has no area.
+pub fn quality_mesh(mesh: TriMesh, reference: Option<TriMesh>, seed: u64) -> Result<QualityReport> {
+    let t = Clock::start();
+    let (mesh, _) = check_and_clean(Path::new("mesh"), mesh)?;
+    let reference = reference
+        .map(|r| {
+            check_and_clean(Path::new("reference"), r).map(|(m, _)| (m, Path::new("reference")))
+        })
+        .transpose()?;
+    quality_read(mesh, Path::new("mesh"), reference, seed, t)
+}
+
+/// [`run_quality`] from the meshes read on (shared with [`quality_mesh`]): `path` and the
+/// reference's path name them in errors; `t` is the clock started before reading.
+fn quality_read(
+    mesh: TriMesh,
+    path: &Path,
+    reference: Option<(TriMesh, &Path)>,
+    seed: u64,
+    t: Clock,
+) -> Result<QualityReport> {
     // Subnormal coordinates: both meshes scaled up alike (the report is in bbox-100 units).
     let (mesh, reference) = match &reference {
         Some((r, p)) => {
@@ -564,6 +627,68 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
         report.push_stage("distance", wall, cpu);
     }
     Ok(report)
+}
+
+/// The output of [`remesh_mesh`]: the remeshed mesh and its report.
+#[derive(Debug, Clone)]
+pub struct RemeshedMesh {
+    /// The output mesh in the input's (model) units: what [`run_remesh`] writes to a file (as
+    /// PLY, OBJ or OFF, which store it exactly).
+    pub mesh: TriMesh,
+    /// The report, as [`run_remesh`] gives it (its `write` stage is the hand-over of the mesh).
+    pub report: QualityReport,
+}
+
+/// Remeshes a mesh held in memory exactly as [`run_remesh`] remeshes a file holding it (written
+/// as PLY, OBJ or OFF): the checks and clean-up reading gives a file's mesh (faces present,
+/// indices in range, finite coordinates; identical positions welded, unreferenced vertices
+/// removed), the same pipeline, check and report. The same `params` give the same output mesh,
+/// bit for bit, as `remesh` on a file holding `mesh`.
+///
+/// `measure_distance`, `strict` and `max_memory` are [`RemeshJob`]'s fields of those names;
+/// `on_stage` is called with each stage's name as it starts. Errors name the mesh as `input
+/// mesh`.
+///
+/// # Errors
+/// [`Error::InvalidMesh`] for a mesh that fails the reader's checks; whatever the pipeline
+/// returns ([`Error::InvalidParameter`] for parameters out of range); with `strict`, an
+/// [`Error::Internal`] (stage `invariant check`) when the output breaks an invariant or its
+/// topology differs from the input's; [`Error::InvalidParameter`] naming `--max-memory` for a
+/// job whose estimated peak memory is over `max_memory`.
+pub fn remesh_mesh(
+    mesh: TriMesh,
+    params: &RemeshParams,
+    measure_distance: bool,
+    strict: bool,
+    max_memory: Option<u64>,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<RemeshedMesh> {
+    const INPUT: &str = "input mesh";
+    on_stage("read");
+    let t = Clock::start();
+    let (input, welded_vertices) = check_and_clean(Path::new(INPUT), mesh)?;
+    let job = RemeshJob {
+        input: PathBuf::from(INPUT),
+        output: PathBuf::from("the output mesh"),
+        format: None,
+        params: *params,
+        measure_distance,
+        strict,
+        max_memory,
+        as_points: false,
+        viewpoint: None,
+    };
+    // PLY: the output is handed over in f64, exactly as PLY, OBJ and OFF store it.
+    let (mesh, report) = remesh_read(
+        &job,
+        MeshFormat::Ply,
+        input,
+        welded_vertices,
+        t,
+        &|_| Ok(()),
+        on_stage,
+    )?;
+    Ok(RemeshedMesh { mesh, report })
 }
 
 /// The output path that means standard output: `-`.

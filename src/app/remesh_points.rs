@@ -4,8 +4,8 @@
 use glam::DVec3;
 
 use super::{
-    check_and_write, count_note, dropped_note, holes_note, insert_kernel_extras, memory, RemeshJob,
-    DISTANCE_SAMPLES,
+    check_and_write, count_note, dropped_note, holes_note, insert_kernel_extras, memory,
+    write_output, RemeshJob, DISTANCE_SAMPLES,
 };
 use crate::error::Result;
 use crate::io::{as_written, MeshFormat};
@@ -55,7 +55,7 @@ pub(super) fn run(
     let check_seconds = t.elapsed();
     check_and_write(
         job,
-        format,
+        &|mesh| write_output(job, format, mesh),
         &out.mesh,
         &mut report,
         &out.stages,

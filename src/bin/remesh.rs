@@ -10,9 +10,8 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
     catch_panics, parse_bytes, physical_memory, remove_temporaries, run_points, run_quality,
-    run_remesh, run_simplify, write_report, CurvatureParams, Density, Error, FeatureDetection,
-    GradingParams, MeshFormat, PointsJob, RemeshJob, RemeshParams, SimplifyDensity, SimplifyJob,
-    TriangulationMethod, FIT_ITERATIONS, STDOUT,
+    run_remesh, run_simplify, write_report, Error, MeshFormat, PointsJob, RemeshJob, RemeshOptions,
+    SimplifyDensity, SimplifyJob, STDOUT,
 };
 
 const EXAMPLES: &str = "\
@@ -297,8 +296,8 @@ enum Config {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for flags that clap's own checks let through but that make no job.
-fn config(cli: Cli) -> Result<Config, Error> {
-    match cli.command {
+fn config(mut cli: Cli) -> Result<Config, Error> {
+    match cli.command.take() {
         Some(Command::Quality {
             mesh,
             reference,
@@ -358,91 +357,13 @@ fn config(cli: Cli) -> Result<Config, Error> {
             seed,
         })),
         None => {
-            let (Some(input), Some(output)) = (cli.input, cli.output) else {
+            let (Some(input), Some(output)) = (cli.input.take(), cli.output.take()) else {
                 return Err(Error::InvalidParameter {
                     name: "INPUT OUTPUT",
                     message: "both are required (see --help)".into(),
                 });
             };
-            let density = match (cli.points, cli.sigma_p) {
-                (Some(n), None) => Density::Points(n),
-                (None, Some(s)) => Density::SigmaP(s),
-                _ => Density::InputVertices,
-            };
-            let mut params = RemeshParams {
-                density,
-                seed: cli.seed,
-                ..Default::default()
-            };
-            params.gradient_ascent.iterations = cli.iterations;
-            if !(cli.lfs_factor.is_finite() && cli.lfs_factor >= 0.0) {
-                return Err(Error::InvalidParameter {
-                    name: "--lfs-factor",
-                    message: format!("must be a number >= 0, got {}", cli.lfs_factor),
-                });
-            }
-            params.features = match cli.feature_angle {
-                _ if cli.no_features => FeatureDetection::Off,
-                None => FeatureDetection::Auto,
-                Some(a) if (0.0..=180.0).contains(&a) => FeatureDetection::Angle(a),
-                Some(a) => {
-                    return Err(Error::InvalidParameter {
-                        name: "--feature-angle",
-                        message: format!("must be an angle from 0 to 180 degrees, got {a}"),
-                    })
-                }
-            };
-            params.triangulation = match cli.triangulation.as_str() {
-                "umbrellas" => TriangulationMethod::Umbrellas,
-                "restricted" => TriangulationMethod::RestrictedDelaunay(Default::default()),
-                other => {
-                    return Err(Error::InvalidParameter {
-                        name: "--triangulation",
-                        message: format!("must be umbrellas or restricted, got {other}"),
-                    })
-                }
-            };
-            params.grading = (cli.lfs_factor > 0.0).then(|| GradingParams {
-                lfs_factor: cli.lfs_factor,
-                ..GradingParams::default()
-            });
-            if !(cli.chord_error.is_finite() && cli.chord_error >= 0.0) {
-                return Err(Error::InvalidParameter {
-                    name: "--chord-error",
-                    message: format!("must be a number >= 0, got {}", cli.chord_error),
-                });
-            }
-            params.fit_iterations = if cli.no_fit { 0 } else { FIT_ITERATIONS };
-            if !(cli.min_angle >= 0.0 && cli.min_angle < 60.0) {
-                return Err(Error::InvalidParameter {
-                    name: "--min-angle",
-                    message: format!(
-                        "must be an angle from 0 to 60 degrees, got {}",
-                        cli.min_angle
-                    ),
-                });
-            }
-            if !(cli.max_angle > 60.0 && cli.max_angle <= 180.0) {
-                return Err(Error::InvalidParameter {
-                    name: "--max-angle",
-                    message: format!(
-                        "must be an angle above 60 and up to 180 degrees, got {}",
-                        cli.max_angle
-                    ),
-                });
-            }
-            if let Some(op) = params.optimize.as_mut() {
-                op.smooth_iterations = cli.smooth;
-                op.final_theta_deg = cli.min_angle;
-                op.final_theta_max_deg = cli.max_angle;
-            }
-            params.curvature = (cli.chord_error > 0.0).then(|| CurvatureParams {
-                chord_error: cli.chord_error,
-                ..CurvatureParams::default()
-            });
-            if let Some(s) = cli.sigma_n {
-                params.sigma_n = s;
-            }
+            let params = remesh_options(&cli).params()?;
             let job = RemeshJob {
                 input,
                 output,
@@ -460,6 +381,26 @@ fn config(cli: Cli) -> Result<Config, Error> {
                 quiet: cli.quiet,
             })
         }
+    }
+}
+
+/// The pipeline options of `remesh INPUT OUTPUT` (checked by [`RemeshOptions::params`]).
+fn remesh_options(cli: &Cli) -> RemeshOptions {
+    RemeshOptions {
+        points: cli.points,
+        sigma_p: cli.sigma_p,
+        sigma_n: cli.sigma_n,
+        lfs_factor: cli.lfs_factor,
+        chord_error: cli.chord_error,
+        no_fit: cli.no_fit,
+        smooth: cli.smooth,
+        min_angle: cli.min_angle,
+        max_angle: cli.max_angle,
+        feature_angle: cli.feature_angle,
+        no_features: cli.no_features,
+        triangulation: cli.triangulation.clone(),
+        iterations: cli.iterations,
+        seed: cli.seed,
     }
 }
 
@@ -566,5 +507,73 @@ fn main() -> ExitCode {
             eprintln!("remesh: error: {e}");
             ExitCode::from(e.exit_code() as u8)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The library's [`RemeshOptions::default`] (which the Python bindings use) is the command
+    /// line's defaults, and every flag reaches its field.
+    #[test]
+    fn option_defaults_are_the_command_lines() {
+        let cli = Cli::parse_from(["remesh", "in.obj", "out.obj"]);
+        assert_eq!(remesh_options(&cli), RemeshOptions::default());
+        let cli = Cli::parse_from([
+            "remesh",
+            "in.obj",
+            "out.obj",
+            "--points",
+            "123",
+            "--sigma-n",
+            "0.5",
+            "--lfs-factor",
+            "0.75",
+            "--chord-error",
+            "0.003",
+            "--no-fit",
+            "--smooth",
+            "3",
+            "--min-angle",
+            "30",
+            "--max-angle",
+            "120",
+            "--feature-angle",
+            "25",
+            "--triangulation",
+            "umbrellas",
+            "--iterations",
+            "4",
+            "--seed",
+            "9",
+        ]);
+        let given = RemeshOptions {
+            points: Some(123),
+            sigma_p: None,
+            sigma_n: Some(0.5),
+            lfs_factor: 0.75,
+            chord_error: 0.003,
+            no_fit: true,
+            smooth: 3,
+            min_angle: 30.0,
+            max_angle: 120.0,
+            feature_angle: Some(25.0),
+            no_features: false,
+            triangulation: "umbrellas".into(),
+            iterations: 4,
+            seed: 9,
+        };
+        assert_eq!(remesh_options(&cli), given);
+        let cli = Cli::parse_from([
+            "remesh",
+            "in.obj",
+            "out.obj",
+            "--sigma-p",
+            "2",
+            "--no-features",
+        ]);
+        let o = remesh_options(&cli);
+        assert_eq!((o.sigma_p, o.no_features), (Some(2.0), true));
     }
 }

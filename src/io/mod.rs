@@ -392,6 +392,16 @@ fn finish(path: &Path, mut mesh: TriMesh, stats: &mut ReadStats) -> Result<TriMe
     Ok(mesh)
 }
 
+/// The checks and clean-up [`read_mesh`] gives a file's mesh after parsing it (faces present,
+/// indices in range, finite coordinates; identical positions welded, unreferenced vertices
+/// removed), for a mesh made in memory; `label` names it in errors where a file's path would.
+/// Returns the mesh and how many vertices were welded.
+pub(crate) fn check_and_clean(label: &Path, mesh: TriMesh) -> Result<(TriMesh, usize)> {
+    let mut stats = ReadStats::new(MeshFormat::Ply);
+    let mesh = finish(label, mesh, &mut stats)?;
+    Ok((mesh, stats.welded_vertices))
+}
+
 /// Reads a whole file, mapping failure to [`Error::Io`] naming `path`.
 fn read_file(path: &Path) -> Result<Vec<u8>> {
     fs::read(path).map_err(|e| Error::io(path, e))

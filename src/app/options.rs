@@ -1,0 +1,216 @@
+//! The `remesh` command line's pipeline options as plain values, and the one translation of them
+//! into [`RemeshParams`]: the binary and the Python bindings both go through
+//! [`RemeshOptions::params`], so the same options give the same pipeline, byte for byte.
+
+use crate::error::{Error, Result};
+use crate::pipeline::{Density, RemeshParams, FIT_ITERATIONS};
+use crate::sampling::grading::GradingParams;
+use crate::surface::curvature::CurvatureParams;
+use crate::surface::features::FeatureDetection;
+use crate::triangulate::optimize::SMOOTH_ITERATIONS;
+use crate::triangulate::TriangulationMethod;
+
+/// The pipeline options of `remesh INPUT OUTPUT`, one field per flag, as given (unchecked);
+/// [`RemeshOptions::default`] holds the command line's defaults. Lengths are in bbox-100 units
+/// (the input scaled so its bounding box's longest side is 100), angles in degrees.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RemeshOptions {
+    /// `--points N`: about N output vertices (sigma_p searched for). `None` with `sigma_p`
+    /// `None` too: as many as the input has vertices.
+    pub points: Option<usize>,
+    /// `--sigma-p S`: the kernel width, instead of `points` (giving both is an error).
+    pub sigma_p: Option<f64>,
+    /// `--sigma-n S`: the normal width; `None` is infinity (isotropic sampling).
+    pub sigma_n: Option<f64>,
+    /// `--lfs-factor C`: the kernel width follows the local thickness; 0 turns it off.
+    pub lfs_factor: f64,
+    /// `--chord-error E`: the spacing follows the curvature; 0 turns it off.
+    pub chord_error: f64,
+    /// `--no-fit`: no least-squares vertex placement (the vertices stay on the input).
+    pub no_fit: bool,
+    /// `--smooth N`: iterations of the finishing relaxation.
+    pub smooth: usize,
+    /// `--min-angle DEG`: the smallest angle the last optimization pass works towards, in
+    /// [0, 60).
+    pub min_angle: f64,
+    /// `--max-angle DEG`: the largest angle it works towards, in (60, 180].
+    pub max_angle: f64,
+    /// `--feature-angle DEG`: keep every crease found at DEG (0 to 180); `None`: automatic at
+    /// 20°.
+    pub feature_angle: Option<f64>,
+    /// `--no-features`: no crease detection (giving `feature_angle` too is an error).
+    pub no_features: bool,
+    /// `--triangulation METHOD`: `restricted` (restricted Delaunay) or `umbrellas`.
+    pub triangulation: String,
+    /// `--iterations K`: gradient-ascent sweeps.
+    pub iterations: usize,
+    /// `--seed S`: the seed of every random choice.
+    pub seed: u64,
+}
+
+impl Default for RemeshOptions {
+    /// The command line's defaults (a test of the binary checks that they agree).
+    fn default() -> Self {
+        RemeshOptions {
+            points: None,
+            sigma_p: None,
+            sigma_n: None,
+            lfs_factor: 0.0,
+            chord_error: 0.0,
+            no_fit: false,
+            smooth: SMOOTH_ITERATIONS,
+            min_angle: 35.0,
+            max_angle: 100.0,
+            feature_angle: None,
+            no_features: false,
+            triangulation: "restricted".to_string(),
+            iterations: 10,
+            seed: 1,
+        }
+    }
+}
+
+impl RemeshOptions {
+    /// The pipeline parameters these options give.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`], naming the flag as the command line spells it, for a
+    /// negative or non-finite `lfs_factor` or `chord_error`, a `feature_angle` outside 0–180,
+    /// an unknown `triangulation`, angle bounds outside their ranges, or options that exclude
+    /// each other (`points` with `sigma_p`, `feature_angle` with `no_features`). The other
+    /// ranges (`points`, `sigma_p`, `sigma_n`) are checked by the pipeline itself.
+    pub fn params(&self) -> Result<RemeshParams> {
+        let density = match (self.points, self.sigma_p) {
+            (Some(_), Some(_)) => {
+                return Err(Error::InvalidParameter {
+                    name: "--points",
+                    message: "give --points or --sigma-p, not both".into(),
+                })
+            }
+            (Some(n), None) => Density::Points(n),
+            (None, Some(s)) => Density::SigmaP(s),
+            (None, None) => Density::InputVertices,
+        };
+        let mut params = RemeshParams {
+            density,
+            seed: self.seed,
+            ..Default::default()
+        };
+        params.gradient_ascent.iterations = self.iterations;
+        if !(self.lfs_factor.is_finite() && self.lfs_factor >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "--lfs-factor",
+                message: format!("must be a number >= 0, got {}", self.lfs_factor),
+            });
+        }
+        params.features = match self.feature_angle {
+            Some(_) if self.no_features => {
+                return Err(Error::InvalidParameter {
+                    name: "--feature-angle",
+                    message: "give --feature-angle or --no-features, not both".into(),
+                })
+            }
+            _ if self.no_features => FeatureDetection::Off,
+            None => FeatureDetection::Auto,
+            Some(a) if (0.0..=180.0).contains(&a) => FeatureDetection::Angle(a),
+            Some(a) => {
+                return Err(Error::InvalidParameter {
+                    name: "--feature-angle",
+                    message: format!("must be an angle from 0 to 180 degrees, got {a}"),
+                })
+            }
+        };
+        params.triangulation = match self.triangulation.as_str() {
+            "umbrellas" => TriangulationMethod::Umbrellas,
+            "restricted" => TriangulationMethod::RestrictedDelaunay(Default::default()),
+            other => {
+                return Err(Error::InvalidParameter {
+                    name: "--triangulation",
+                    message: format!("must be umbrellas or restricted, got {other}"),
+                })
+            }
+        };
+        params.grading = (self.lfs_factor > 0.0).then(|| GradingParams {
+            lfs_factor: self.lfs_factor,
+            ..GradingParams::default()
+        });
+        if !(self.chord_error.is_finite() && self.chord_error >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "--chord-error",
+                message: format!("must be a number >= 0, got {}", self.chord_error),
+            });
+        }
+        params.fit_iterations = if self.no_fit { 0 } else { FIT_ITERATIONS };
+        if !(self.min_angle >= 0.0 && self.min_angle < 60.0) {
+            return Err(Error::InvalidParameter {
+                name: "--min-angle",
+                message: format!(
+                    "must be an angle from 0 to 60 degrees, got {}",
+                    self.min_angle
+                ),
+            });
+        }
+        if !(self.max_angle > 60.0 && self.max_angle <= 180.0) {
+            return Err(Error::InvalidParameter {
+                name: "--max-angle",
+                message: format!(
+                    "must be an angle above 60 and up to 180 degrees, got {}",
+                    self.max_angle
+                ),
+            });
+        }
+        if let Some(op) = params.optimize.as_mut() {
+            op.smooth_iterations = self.smooth;
+            op.final_theta_deg = self.min_angle;
+            op.final_theta_max_deg = self.max_angle;
+        }
+        params.curvature = (self.chord_error > 0.0).then(|| CurvatureParams {
+            chord_error: self.chord_error,
+            ..CurvatureParams::default()
+        });
+        if let Some(s) = self.sigma_n {
+            params.sigma_n = s;
+        }
+        Ok(params)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Options that exclude each other are refused here (clap refuses them earlier for the
+    /// binary); the defaults give the pipeline's defaults but for the density.
+    #[test]
+    fn exclusive_options_are_refused_and_defaults_pass() {
+        let both = RemeshOptions {
+            points: Some(100),
+            sigma_p: Some(2.0),
+            ..Default::default()
+        };
+        assert!(matches!(
+            both.params(),
+            Err(Error::InvalidParameter {
+                name: "--points",
+                ..
+            })
+        ));
+        let features = RemeshOptions {
+            feature_angle: Some(30.0),
+            no_features: true,
+            ..Default::default()
+        };
+        assert!(matches!(
+            features.params(),
+            Err(Error::InvalidParameter {
+                name: "--feature-angle",
+                ..
+            })
+        ));
+        let p = RemeshOptions::default().params().unwrap();
+        assert_eq!(p.density, Density::InputVertices);
+        assert_eq!(p.seed, 1);
+        assert_eq!(p.fit_iterations, FIT_ITERATIONS);
+        assert_eq!(p.features, FeatureDetection::Auto);
+    }
+}
