@@ -231,7 +231,10 @@ mod tests {
             .collect();
         points.extend_from_slice(&strand);
         let off = off_sheet(&points, 3.0);
-        assert!(off[..900].iter().all(|&o| !o), "a grid point is off the sheet");
+        assert!(
+            off[..900].iter().all(|&o| !o),
+            "a grid point is off the sheet"
+        );
         // The strand's points farther than the radius from the plane see at most two others.
         for (k, &o) in off[900..].iter().enumerate() {
             if strand[k].z > 3.0 {
