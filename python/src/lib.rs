@@ -1,0 +1,390 @@
+//! The `spectral_remesh` Python module: the library's reading, remeshing and quality report on
+//! numpy arrays (`python/spectral_remesh.pyi` documents it for Python users).
+//!
+//! Every function copies its arrays into the library's types with the GIL held, then releases
+//! the GIL (`Python::detach`) for the work. Errors become Python exceptions carrying the
+//! library's one-line message ([`to_py_err`]); a panic (a bug) is caught before it reaches the
+//! interpreter and raised as `RuntimeError`.
+//!
+//! Arrays in: any array-like numpy can read (`numpy.asarray`). Positions of any real dtype are
+//! converted to `float64`, face indices of any integer dtype checked against the vertex count;
+//! non-contiguous arrays (slices, transposes) are read through their strides. Wrong shapes,
+//! non-numeric dtypes, non-finite coordinates and indices out of range are `ValueError`s.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+
+use glam::DVec3;
+use numpy::ndarray::Array2;
+use numpy::{
+    IntoPyArray, PyArray2, PyArrayDescrMethods, PyReadonlyArray2,
+    PyUntypedArray, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyRuntimeError,
+    PyValueError,
+};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use spectral::{Error, QualityReport, RemeshOptions, TriMesh};
+
+/// A library error as the Python exception a caller expects, with the library's one-line
+/// message: `OSError` (or its `FileNotFoundError`, `PermissionError`, `IsADirectoryError`) when
+/// the operating system refused a file, `ValueError` for input that cannot be used (an
+/// unsupported format, a file that does not parse, a mesh that fails the checks, a parameter
+/// out of range), `RuntimeError` for an internal failure (and `strict=True` refusing an
+/// output).
+fn to_py_err(e: Error) -> PyErr {
+    let message = e.to_string();
+    match &e {
+        Error::Io { source, .. } => match source.kind() {
+            std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
+            std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
+            std::io::ErrorKind::IsADirectory => PyIsADirectoryError::new_err(message),
+            _ => PyOSError::new_err(message),
+        },
+        Error::Write { .. } => PyOSError::new_err(message),
+        Error::UnsupportedFormat { .. }
+        | Error::Parse { .. }
+        | Error::InvalidMesh { .. }
+        | Error::InvalidParameter { .. } => PyValueError::new_err(message),
+        Error::Internal { .. } => PyRuntimeError::new_err(message),
+    }
+}
+
+/// Runs `work` without the GIL, catching a panic: the library's result, or the panic as a
+/// `RuntimeError` naming it a bug. (The panic's message and place are also on standard error,
+/// from Rust's panic hook, which is left as it is: replacing a process-wide hook from several
+/// Python threads at once would race.)
+fn without_gil<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> spectral::Result<T> + Send,
+) -> PyResult<T> {
+    let result = py.detach(|| catch_unwind(AssertUnwindSafe(work)));
+    match result {
+        Ok(r) => r.map_err(to_py_err),
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown cause".into());
+            Err(PyRuntimeError::new_err(format!(
+                "panic: {} (a bug: please report it)",
+                what.replace('\n', " ")
+            )))
+        }
+    }
+}
+
+/// `value` as a numpy array of shape `(n, 3)`: `numpy.asarray(value)`, its shape checked.
+/// `name` names it in errors.
+fn array_n3<'py>(
+    py: Python<'py>,
+    name: &str,
+    value: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyUntypedArray>> {
+    let array = py
+        .import("numpy")?
+        .call_method1("asarray", (value,))?
+        .cast_into::<PyUntypedArray>()?;
+    let shape = array.shape();
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{name} must be an array of shape (n, 3), got shape {}",
+            shape_text(shape)
+        )));
+    }
+    Ok(array)
+}
+
+/// A shape as Python prints it: `(4,)`, `(4, 2)`.
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [one] => format!("({one},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// Vertex positions from an array-like of shape `(n, 3)` and a real dtype (floating point or
+/// integer; converted to `float64`). Finiteness is checked by the library
+/// ([`spectral::remesh_mesh`], [`spectral::quality_mesh`]) with the vertex named.
+fn positions(py: Python<'_>, name: &str, value: &Bound<'_, PyAny>) -> PyResult<Vec<DVec3>> {
+    let array = array_n3(py, name, value)?;
+    let dtype = array.dtype();
+    if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
+        return Err(PyValueError::new_err(format!(
+            "{name} must hold real numbers (a float or integer dtype), got dtype {}",
+            dtype.str()?
+        )));
+    }
+    let array: PyReadonlyArray2<f64> = py
+        .import("numpy")?
+        .call_method1("asarray", (array, "float64"))?
+        .extract()?;
+    Ok(array
+        .as_array()
+        .rows()
+        .into_iter()
+        .map(|r| DVec3::new(r[0], r[1], r[2]))
+        .collect())
+}
+
+/// Triangles from an array-like of shape `(m, 3)` and an integer dtype, each index checked to
+/// name one of `vertices` vertices (0-based).
+fn triangles(
+    py: Python<'_>,
+    name: &str,
+    value: &Bound<'_, PyAny>,
+    vertices: usize,
+) -> PyResult<Vec<[u32; 3]>> {
+    let array = array_n3(py, name, value)?;
+    let dtype = array.dtype();
+    let (kind, size) = (dtype.kind(), dtype.itemsize());
+    if !matches!(kind, b'i' | b'u') {
+        return Err(PyValueError::new_err(format!(
+            "{name} must hold vertex indices (an integer dtype), got dtype {}",
+            dtype.str()?
+        )));
+    }
+    if u32::try_from(vertices).is_err() {
+        return Err(PyValueError::new_err(format!(
+            "{vertices} vertices are more than 32-bit indices can name"
+        )));
+    }
+    let out_of_range = |row: usize, col: usize, value: String| {
+        PyValueError::new_err(format!(
+            "{name}[{row}, {col}] = {value} is not a vertex index: the vertices are numbered 0 \
+             to {} (0-based)",
+            vertices as i128 - 1
+        ))
+    };
+    let np = py.import("numpy")?;
+    let mut out = Vec::with_capacity(array.shape()[0]);
+    if kind == b'u' && size == 8 {
+        // uint64 does not fit int64: read as it is.
+        let array: PyReadonlyArray2<u64> = np.call_method1("asarray", (array, "uint64"))?.extract()?;
+        for (row, r) in array.as_array().rows().into_iter().enumerate() {
+            let mut t = [0u32; 3];
+            for col in 0..3 {
+                t[col] = match usize::try_from(r[col]) {
+                    Ok(i) if i < vertices => i as u32,
+                    _ => return Err(out_of_range(row, col, r[col].to_string())),
+                };
+            }
+            out.push(t);
+        }
+    } else {
+        let array: PyReadonlyArray2<i64> = np.call_method1("asarray", (array, "int64"))?.extract()?;
+        for (row, r) in array.as_array().rows().into_iter().enumerate() {
+            let mut t = [0u32; 3];
+            for col in 0..3 {
+                t[col] = match usize::try_from(r[col]) {
+                    Ok(i) if i < vertices => i as u32,
+                    _ => return Err(out_of_range(row, col, r[col].to_string())),
+                };
+            }
+            out.push(t);
+        }
+    }
+    Ok(out)
+}
+
+/// A mesh from the arrays `v` and `f` (named `v_name`, `f_name` in errors).
+fn mesh_from(
+    py: Python<'_>,
+    (v_name, v): (&str, &Bound<'_, PyAny>),
+    (f_name, f): (&str, &Bound<'_, PyAny>),
+) -> PyResult<TriMesh> {
+    let positions = positions(py, v_name, v)?;
+    let triangles = triangles(py, f_name, f, positions.len())?;
+    Ok(TriMesh::new(positions, triangles))
+}
+
+/// A mesh as the arrays `(V: float64[n, 3], F: int64[m, 3])`.
+fn mesh_arrays<'py>(
+    py: Python<'py>,
+    mesh: TriMesh,
+) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>) {
+    let n = mesh.positions.len();
+    let m = mesh.triangles.len();
+    let v: Vec<f64> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
+    let f: Vec<i64> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(i64::from))
+        .collect();
+    // The lengths are 3n and 3m by construction.
+    let v = Array2::from_shape_vec((n, 3), v).unwrap_or_else(|_| Array2::zeros((0, 3)));
+    let f = Array2::from_shape_vec((m, 3), f).unwrap_or_else(|_| Array2::zeros((0, 3)));
+    (v.into_pyarray(py), f.into_pyarray(py))
+}
+
+/// A report as the dict `json.loads` makes of the command line's JSON report.
+fn report_dict<'py>(py: Python<'py>, report: &QualityReport) -> PyResult<Bound<'py, PyDict>> {
+    Ok(py
+        .import("json")?
+        .call_method1("loads", (report.to_json(),))?
+        .cast_into::<PyDict>()?)
+}
+
+/// Reads a mesh file through the library's readers, as `remesh` reads its input.
+///
+/// Returns `(V, F)`: `V` float64 (n, 3) positions in the file's units, `F` int64 (m, 3)
+/// 0-based vertex indices, triangulated, identical positions welded, unreferenced vertices
+/// removed. Raises `OSError` when the file cannot be opened, `ValueError` when its format is
+/// not supported or its content cannot be used.
+#[pyfunction]
+#[pyo3(signature = (path, /))]
+fn read<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
+    let (mesh, _) = without_gil(py, move || spectral::read_mesh(&path))?;
+    Ok(mesh_arrays(py, mesh))
+}
+
+/// The quality report of a mesh (Table 1's triangle measures, topology, invariants), and with
+/// `ref=(V0, F0)` the distance to that reference: the dict `remesh quality --json` prints for
+/// the same meshes, but for the stage times. Lengths are in the bbox-100 frame of `ref` (of
+/// the mesh itself without one).
+#[pyfunction]
+#[pyo3(signature = (V, F, r#ref = None, seed = 1))]
+#[allow(non_snake_case)]
+fn quality<'py>(
+    py: Python<'py>,
+    V: &Bound<'py, PyAny>,
+    F: &Bound<'py, PyAny>,
+    r#ref: Option<&Bound<'py, PyAny>>,
+    seed: u64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mesh = mesh_from(py, ("V", V), ("F", F))?;
+    let reference = match r#ref {
+        None => None,
+        Some(r) => {
+            let pair: (Bound<'py, PyAny>, Bound<'py, PyAny>) = r.extract().map_err(|_| {
+                PyValueError::new_err("ref must be a pair (V0, F0) of arrays, or None")
+            })?;
+            Some(mesh_from(py, ("ref[0]", &pair.0), ("ref[1]", &pair.1))?)
+        }
+    };
+    let report = without_gil(py, move || spectral::quality_mesh(mesh, reference, seed))?;
+    report_dict(py, &report)
+}
+
+/// `max_memory` as bytes: an int, a size such as `"8G"`, or `None` for the machine's physical
+/// memory (the command line's default).
+fn memory_limit(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<u64>> {
+    let Some(value) = value else {
+        return Ok(spectral::physical_memory());
+    };
+    if let Ok(text) = value.extract::<String>() {
+        return spectral::parse_bytes(&text)
+            .map(Some)
+            .map_err(|e| PyValueError::new_err(format!("invalid parameter max_memory: {e}")));
+    }
+    match value.extract::<i128>() {
+        Ok(n) if (0..=u64::MAX as i128).contains(&n) => Ok(Some(n as u64)),
+        _ => Err(PyValueError::new_err(
+            "invalid parameter max_memory: give a number of bytes >= 0 or a size such as \"8G\"",
+        )),
+    }
+}
+
+/// A count option: an int >= 0 (named as the command line names it in the error).
+fn count(name: &str, value: i128) -> PyResult<usize> {
+    usize::try_from(value)
+        .map_err(|_| PyValueError::new_err(format!("invalid parameter {name}: must be an integer >= 0, got {value}")))
+}
+
+/// Remeshes the mesh `(V, F)` as `remesh` remeshes a file holding it, with the same options:
+/// the same output, bit for bit, for the same seed. Returns `(V, F, report)`.
+#[pyfunction]
+#[pyo3(signature = (
+    V, F, *, points = None, sigma_p = None, sigma_n = None, seed = 1, iterations = None,
+    lfs_factor = None, chord_error = None, fit = true, smooth = None, min_angle = None,
+    max_angle = None, feature_angle = None, features = true, triangulation = None,
+    distance = true, strict = false, max_memory = None
+))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
+fn remesh<'py>(
+    py: Python<'py>,
+    V: &Bound<'py, PyAny>,
+    F: &Bound<'py, PyAny>,
+    points: Option<i128>,
+    sigma_p: Option<f64>,
+    sigma_n: Option<f64>,
+    seed: i128,
+    iterations: Option<i128>,
+    lfs_factor: Option<f64>,
+    chord_error: Option<f64>,
+    fit: bool,
+    smooth: Option<i128>,
+    min_angle: Option<f64>,
+    max_angle: Option<f64>,
+    feature_angle: Option<f64>,
+    features: bool,
+    triangulation: Option<String>,
+    distance: bool,
+    strict: bool,
+    max_memory: Option<&Bound<'py, PyAny>>,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyDict>,
+)> {
+    let defaults = RemeshOptions::default();
+    let seed = u64::try_from(seed).map_err(|_| {
+        PyValueError::new_err(format!(
+            "invalid parameter --seed: must be an integer from 0 to 2^64 - 1, got {seed}"
+        ))
+    })?;
+    let options = RemeshOptions {
+        points: points.map(|n| count("--points", n)).transpose()?,
+        sigma_p,
+        sigma_n,
+        lfs_factor: lfs_factor.unwrap_or(defaults.lfs_factor),
+        chord_error: chord_error.unwrap_or(defaults.chord_error),
+        no_fit: !fit,
+        smooth: smooth
+            .map(|n| count("--smooth", n))
+            .transpose()?
+            .unwrap_or(defaults.smooth),
+        min_angle: min_angle.unwrap_or(defaults.min_angle),
+        max_angle: max_angle.unwrap_or(defaults.max_angle),
+        feature_angle,
+        no_features: !features,
+        triangulation: triangulation.unwrap_or(defaults.triangulation),
+        iterations: iterations
+            .map(|n| count("--iterations", n))
+            .transpose()?
+            .unwrap_or(defaults.iterations),
+        seed,
+    };
+    let params = options.params().map_err(to_py_err)?;
+    let max_memory = memory_limit(max_memory)?;
+    let mesh = mesh_from(py, ("V", V), ("F", F))?;
+    let out = without_gil(py, move || {
+        spectral::remesh_mesh(mesh, &params, distance, strict, max_memory, &|_| {})
+    })?;
+    let (v, f) = mesh_arrays(py, out.mesh);
+    Ok((v, f, report_dict(py, &out.report)?))
+}
+
+/// Spectral sampling and remeshing of triangle meshes (Öztireli, Alexa, Gross 2010), numpy in,
+/// numpy out.
+#[pymodule]
+fn spectral_remesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(quality, m)?)?;
+    m.add_function(wrap_pyfunction!(remesh, m)?)?;
+    Ok(())
+}
