@@ -17,8 +17,8 @@ use std::path::PathBuf;
 use glam::DVec3;
 use numpy::ndarray::Array2;
 use numpy::{
-    IntoPyArray, PyArray2, PyArrayDescrMethods, PyReadonlyArray2,
-    PyUntypedArray, PyUntypedArrayMethods,
+    IntoPyArray, PyArray2, PyArrayDescrMethods, PyReadonlyArray2, PyUntypedArray,
+    PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{
     PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyRuntimeError,
@@ -77,11 +77,12 @@ fn without_gil<T: Send>(
     }
 }
 
-/// `value` as a numpy array of shape `(n, 3)`: `numpy.asarray(value)`, its shape checked.
-/// `name` names it in errors.
+/// `value` as a numpy array of shape `(rows, 3)`: `numpy.asarray(value)`, its shape checked.
+/// `name` names it in errors, `rows` the number of rows (`n`, `m`).
 fn array_n3<'py>(
     py: Python<'py>,
     name: &str,
+    rows: &str,
     value: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyUntypedArray>> {
     let array = py
@@ -91,7 +92,7 @@ fn array_n3<'py>(
     let shape = array.shape();
     if shape.len() != 2 || shape[1] != 3 {
         return Err(PyValueError::new_err(format!(
-            "{name} must be an array of shape (n, 3), got shape {}",
+            "{name} must be an array of shape ({rows}, 3), got shape {}",
             shape_text(shape)
         )));
     }
@@ -117,7 +118,7 @@ fn shape_text(shape: &[usize]) -> String {
 /// integer; converted to `float64`). Finiteness is checked by the library
 /// ([`spectral::remesh_mesh`], [`spectral::quality_mesh`]) with the vertex named.
 fn positions(py: Python<'_>, name: &str, value: &Bound<'_, PyAny>) -> PyResult<Vec<DVec3>> {
-    let array = array_n3(py, name, value)?;
+    let array = array_n3(py, name, "n", value)?;
     let dtype = array.dtype();
     if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
         return Err(PyValueError::new_err(format!(
@@ -145,7 +146,7 @@ fn triangles(
     value: &Bound<'_, PyAny>,
     vertices: usize,
 ) -> PyResult<Vec<[u32; 3]>> {
-    let array = array_n3(py, name, value)?;
+    let array = array_n3(py, name, "m", value)?;
     let dtype = array.dtype();
     let (kind, size) = (dtype.kind(), dtype.itemsize());
     if !matches!(kind, b'i' | b'u') {
@@ -170,7 +171,8 @@ fn triangles(
     let mut out = Vec::with_capacity(array.shape()[0]);
     if kind == b'u' && size == 8 {
         // uint64 does not fit int64: read as it is.
-        let array: PyReadonlyArray2<u64> = np.call_method1("asarray", (array, "uint64"))?.extract()?;
+        let array: PyReadonlyArray2<u64> =
+            np.call_method1("asarray", (array, "uint64"))?.extract()?;
         for (row, r) in array.as_array().rows().into_iter().enumerate() {
             let mut t = [0u32; 3];
             for col in 0..3 {
@@ -182,7 +184,8 @@ fn triangles(
             out.push(t);
         }
     } else {
-        let array: PyReadonlyArray2<i64> = np.call_method1("asarray", (array, "int64"))?.extract()?;
+        let array: PyReadonlyArray2<i64> =
+            np.call_method1("asarray", (array, "int64"))?.extract()?;
         for (row, r) in array.as_array().rows().into_iter().enumerate() {
             let mut t = [0u32; 3];
             for col in 0..3 {
@@ -208,11 +211,11 @@ fn mesh_from(
     Ok(TriMesh::new(positions, triangles))
 }
 
+/// A mesh as numpy arrays: `V` float64 (n, 3), `F` int64 (m, 3).
+type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
+
 /// A mesh as the arrays `(V: float64[n, 3], F: int64[m, 3])`.
-fn mesh_arrays<'py>(
-    py: Python<'py>,
-    mesh: TriMesh,
-) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>) {
+fn mesh_arrays<'py>(py: Python<'py>, mesh: TriMesh) -> MeshArrays<'py> {
     let n = mesh.positions.len();
     let m = mesh.triangles.len();
     let v: Vec<f64> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
@@ -235,26 +238,71 @@ fn report_dict<'py>(py: Python<'py>, report: &QualityReport) -> PyResult<Bound<'
         .cast_into::<PyDict>()?)
 }
 
-/// Reads a mesh file through the library's readers, as `remesh` reads its input.
+/// Read a mesh file through the library's readers, as `remesh` reads its input.
 ///
-/// Returns `(V, F)`: `V` float64 (n, 3) positions in the file's units, `F` int64 (m, 3)
-/// 0-based vertex indices, triangulated, identical positions welded, unreferenced vertices
-/// removed. Raises `OSError` when the file cannot be opened, `ValueError` when its format is
-/// not supported or its content cannot be used.
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///     A mesh file: .obj, .ply (ascii or binary), .gltf or .glb, .stl or .off, told by its
+///     extension.
+///
+/// Returns
+/// -------
+/// V : numpy.ndarray of float64, shape (n, 3)
+///     Vertex positions in the file's own (model) units.
+/// F : numpy.ndarray of int64, shape (m, 3)
+///     Triangles as 0-based indices into V. Polygons are triangulated, vertices at identical
+///     positions welded and vertices no triangle uses removed, as for `remesh`.
+///
+/// Raises
+/// ------
+/// OSError
+///     The file cannot be opened or read (FileNotFoundError, PermissionError or
+///     IsADirectoryError where that is the cause).
+/// ValueError
+///     The extension names no mesh format, the content does not parse, or the mesh cannot be
+///     used (no triangles, an index out of range, a non-finite coordinate).
 #[pyfunction]
 #[pyo3(signature = (path, /))]
-fn read<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
+fn read<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshArrays<'py>> {
     let (mesh, _) = without_gil(py, move || spectral::read_mesh(&path))?;
     Ok(mesh_arrays(py, mesh))
 }
 
-/// The quality report of a mesh (Table 1's triangle measures, topology, invariants), and with
-/// `ref=(V0, F0)` the distance to that reference: the dict `remesh quality --json` prints for
-/// the same meshes, but for the stage times. Lengths are in the bbox-100 frame of `ref` (of
-/// the mesh itself without one).
+/// The quality report of a triangle mesh, as `remesh quality --json` gives it.
+///
+/// The mesh (and the reference) get the reader's checks and clean-up first (vertices at
+/// identical positions welded, vertices no triangle uses removed), so the report equals the
+/// command line's for files holding the same arrays, but for the stage times.
+///
+/// Parameters
+/// ----------
+/// V : array_like, shape (n, 3)
+///     Vertex positions, any real dtype (converted to float64), in model units.
+/// F : array_like, shape (m, 3)
+///     Triangles as 0-based indices into V, any integer dtype.
+/// ref : tuple (V0, F0) or None
+///     A reference surface (usually a remesher's input) as two such arrays. It sets the
+///     bbox-100 frame of every length, and the report gains the distance between the two.
+/// seed : int
+///     Seed of the distance's random points.
+///
+/// Returns
+/// -------
+/// dict
+///     The JSON report as `json.loads` reads it: `triangles` (Table 1: `theta_min`,
+///     `theta_min_ave`, `theta_max` in degrees, `q_min`, `q_ave`, `pct_theta_below_30` in
+///     percent of the triangles, `p30` in percent of the angles, `faces_measured`), `topology`,
+///     `self_intersections`, `invariant_violations`, `distance` (None without `ref`;
+///     `hausdorff`, `rms`, `mean` and the one-sided values in bbox-100 units, the reference
+///     scaled so its bounding box's longest side is 100), `input_topology` (the reference's),
+///     `topology_changes`, `stages` (wall and processor seconds), `notes`, `extra`.
+///
+/// Raises
+/// ------
+/// ValueError
+///     An array of the wrong shape or dtype, a non-finite coordinate, an index out of range,
+///     no triangles, or a mesh without area.
 #[pyfunction]
 #[pyo3(signature = (V, F, r#ref = None, seed = 1))]
 #[allow(non_snake_case)]
@@ -300,12 +348,94 @@ fn memory_limit(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<u64>> {
 
 /// A count option: an int >= 0 (named as the command line names it in the error).
 fn count(name: &str, value: i128) -> PyResult<usize> {
-    usize::try_from(value)
-        .map_err(|_| PyValueError::new_err(format!("invalid parameter {name}: must be an integer >= 0, got {value}")))
+    usize::try_from(value).map_err(|_| {
+        PyValueError::new_err(format!(
+            "invalid parameter {name}: must be an integer >= 0, got {value}"
+        ))
+    })
 }
 
-/// Remeshes the mesh `(V, F)` as `remesh` remeshes a file holding it, with the same options:
-/// the same output, bit for bit, for the same seed. Returns `(V, F, report)`.
+/// `remesh`'s result: the output's `V` and `F` and the report.
+type Remeshed<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyDict>,
+);
+
+/// Remesh a triangle mesh by spectral sampling, as the `remesh` command line does.
+///
+/// The same arrays and options give the same output, bit for bit, as `remesh IN OUT` on a file
+/// holding the arrays (`remesh` writes .ply, .obj and .off exactly). Each option is the command
+/// line's flag of that name; None takes the command line's default. Lengths are in bbox-100
+/// units: the input scaled so its bounding box's longest side is 100. The GIL is released
+/// during the work.
+///
+/// Parameters
+/// ----------
+/// V : array_like, shape (n, 3)
+///     Vertex positions, any real dtype (converted to float64), in model units.
+/// F : array_like, shape (m, 3)
+///     Triangles as 0-based indices into V, any integer dtype. Vertices at identical positions
+///     are welded and vertices no triangle uses removed first, as the reader does.
+/// points : int or None
+///     About this many output vertices (within 1%); sigma_p is searched for. 4 to 20 million.
+///     With neither points nor sigma_p: as many as the input has vertices.
+/// sigma_p : float or None
+///     The kernel width in bbox-100 units, instead of points.
+/// sigma_n : float or None
+///     The normal width; finite values give feature-adaptive sampling. None: infinity.
+/// seed : int
+///     Seed of every random choice.
+/// iterations : int or None
+///     Gradient-ascent sweeps (10).
+/// lfs_factor : float or None
+///     Thin parts: the kernel width follows the local thickness (0: off, the default; 0.75 is
+///     the measured setting).
+/// chord_error : float or None
+///     Curved parts: the spacing follows the curvature (0: off, the default; 0.003 for CAD
+///     parts).
+/// fit : bool
+///     The least-squares vertex placement (True, the default; False is `--no-fit`).
+/// smooth : int or None
+///     Iterations of the finishing relaxation (10).
+/// min_angle, max_angle : float or None
+///     The angle bounds in degrees the last optimization pass works towards (35, 100).
+/// feature_angle : float or None
+///     Keep every crease found at this angle in degrees (0 to 180). None: automatic at 20°.
+/// features : bool
+///     False: no crease detection (`--no-features`; not with feature_angle).
+/// triangulation : str or None
+///     "restricted" (restricted Delaunay, the default) or "umbrellas".
+/// distance : bool
+///     Measure the Hausdorff and RMS distance to the input (False is `--no-distance`).
+/// strict : bool
+///     Raise RuntimeError instead of returning an output that breaks an invariant or whose
+///     topology differs from the input's.
+/// max_memory : int, str or None
+///     The most memory the job may take, in bytes or as a size ("512M", "8G", "2GiB"); a job
+///     whose estimated peak is larger is refused at once. None: the machine's physical memory.
+///
+/// Returns
+/// -------
+/// V : numpy.ndarray of float64, shape (k, 3)
+///     The output's vertex positions, in the input's units.
+/// F : numpy.ndarray of int64, shape (l, 3)
+///     The output's triangles, 0-based indices into V, oriented consistently (closed parts
+///     outward).
+/// report : dict
+///     The JSON report of `remesh --report` as `json.loads` reads it (see `quality`), with the
+///     input's topology, and in `extra` sigma_p, the sigma_p search, the seed and the stages'
+///     statistics.
+///
+/// Raises
+/// ------
+/// ValueError
+///     An array of the wrong shape or dtype, a non-finite coordinate, an index out of range,
+///     no triangles, an option out of its range or two that exclude each other (named as the
+///     command line names it), or a job over max_memory.
+/// RuntimeError
+///     With strict=True, an output that breaks an invariant or changes the topology; or an
+///     internal failure.
 #[pyfunction]
 #[pyo3(signature = (
     V, F, *, points = None, sigma_p = None, sigma_n = None, seed = 1, iterations = None,
@@ -335,11 +465,7 @@ fn remesh<'py>(
     distance: bool,
     strict: bool,
     max_memory: Option<&Bound<'py, PyAny>>,
-) -> PyResult<(
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<i64>>,
-    Bound<'py, PyDict>,
-)> {
+) -> PyResult<Remeshed<'py>> {
     let defaults = RemeshOptions::default();
     let seed = u64::try_from(seed).map_err(|_| {
         PyValueError::new_err(format!(
@@ -378,8 +504,16 @@ fn remesh<'py>(
     Ok((v, f, report_dict(py, &out.report)?))
 }
 
-/// Spectral sampling and remeshing of triangle meshes (Öztireli, Alexa, Gross 2010), numpy in,
-/// numpy out.
+/// Spectral sampling and remeshing of triangle meshes (Öztireli, Alexa, Gross 2010: Spectral
+/// Sampling of Manifolds), numpy in, numpy out.
+///
+/// Arrays in: anything ``numpy.asarray`` reads. Positions of any real dtype are converted to
+/// float64; face indices of any integer dtype are checked against the vertex count (a float
+/// array of indices is refused); non-contiguous arrays (slices, transposes, negative strides) are
+/// read through their strides, never refused. Errors carry the library's one-line message:
+/// ValueError for input or options that cannot be used, OSError for files the operating system
+/// refuses, RuntimeError for an internal failure (a bug) or a strict refusal. The GIL is released
+/// while the library works.
 #[pymodule]
 fn spectral_remesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -1,0 +1,367 @@
+"""Tests of the spectral_remesh Python module against the `remesh` command line.
+
+Needs the models in ../shared/data beside the repository (fails without them) and the
+`remesh` binary: $REMESH_BIN, or built here with `cargo build --release --bin remesh` (a no-op
+when CI's `cargo test --release --workspace` has built it).
+"""
+
+import ast
+import inspect
+import json
+import os
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import spectral_remesh as sr
+
+REPO = Path(__file__).resolve().parents[2]
+DATA = REPO.parent / "shared" / "data"
+STUBS = REPO / "python" / "spectral_remesh.pyi"
+
+
+@pytest.fixture(scope="session")
+def spot_path():
+    path = DATA / "spot.obj"
+    if not path.is_file():
+        pytest.fail(f"{path} is missing: the tests need ../shared/data beside the repository")
+    return path
+
+
+@pytest.fixture(scope="session")
+def spot(spot_path):
+    return sr.read(spot_path)
+
+
+@pytest.fixture(scope="session")
+def remesh_bin():
+    given = os.environ.get("REMESH_BIN")
+    if given:
+        return Path(given)
+    out = subprocess.run(
+        ["cargo", "build", "--release", "--bin", "remesh", "--message-format=json-render-diagnostics"],
+        cwd=REPO,
+        check=True,
+        stdout=subprocess.PIPE,
+        text=True,
+    ).stdout
+    for line in out.splitlines():
+        message = json.loads(line)
+        if message.get("reason") == "compiler-artifact" and message.get("executable"):
+            if message["target"]["name"] == "remesh":
+                return Path(message["executable"])
+    pytest.fail("cargo build did not report the remesh executable")
+
+
+def read_binary_ply(path):
+    """The vertex positions and faces of a binary PLY as `remesh` writes it (vertex x y z
+    double, nx ny nz float; face list uchar int), parsed here without the library."""
+    data = path.read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode("ascii").splitlines()
+    assert "format binary_little_endian 1.0" in header
+    counts = {}
+    for line in header:
+        if line.startswith("element "):
+            _, name, n = line.split()
+            counts[name] = int(n)
+    props = [line for line in header if line.startswith("property ")]
+    assert props == [
+        "property double x",
+        "property double y",
+        "property double z",
+        "property float nx",
+        "property float ny",
+        "property float nz",
+        "property list uchar int vertex_indices",
+    ], props
+    vertex = np.dtype([("p", "<f8", 3), ("n", "<f4", 3)])
+    face = np.dtype([("k", "u1"), ("i", "<i4", 3)])
+    nv, nf = counts["vertex"], counts["face"]
+    v = np.frombuffer(data, vertex, nv, end)
+    f = np.frombuffer(data, face, nf, end + nv * vertex.itemsize)
+    assert end + nv * vertex.itemsize + nf * face.itemsize == len(data)
+    assert (f["k"] == 3).all()
+    return v["p"].copy(), f["i"].astype(np.int64)
+
+
+def without_times(report):
+    report = dict(report)
+    stages = report.pop("stages")
+    return report, [s["stage"] for s in stages]
+
+
+def test_read_spot(spot):
+    V, F = spot
+    assert V.dtype == np.float64 and V.shape == (2930, 3)
+    assert F.dtype == np.int64 and F.shape == (5856, 3)
+    assert V.flags.c_contiguous and F.flags.c_contiguous
+    assert np.isfinite(V).all()
+    assert F.min() == 0 and F.max() == len(V) - 1
+
+
+@pytest.mark.parametrize("seed", [1, 7])
+def test_remesh_equals_cli(spot, spot_path, remesh_bin, tmp_path, seed):
+    """Byte-identical arrays: the CLI's binary PLY (positions as double) against the arrays."""
+    out, report_path = tmp_path / "out.ply", tmp_path / "report.json"
+    subprocess.run(
+        [remesh_bin, spot_path, out, "--points", "2000", "--seed", str(seed), "-q",
+         "--report", report_path],
+        check=True,
+    )
+    V, F, report = sr.remesh(*spot, points=2000, seed=seed)
+    cli_V, cli_F = read_binary_ply(out)
+    assert V.dtype == np.float64 and F.dtype == np.int64
+    assert V.shape == cli_V.shape and F.shape == cli_F.shape
+    assert V.tobytes() == cli_V.tobytes()
+    assert F.tobytes() == cli_F.tobytes()
+    assert abs(len(V) - 2000) <= 20
+    # The report is the CLI's but for the times.
+    assert without_times(report) == without_times(json.loads(report_path.read_text()))
+    assert report["extra"]["seed"] == seed
+
+
+def test_remesh_seed_changes_output(spot):
+    a = sr.remesh(*spot, points=500, seed=1, distance=False)
+    b = sr.remesh(*spot, points=500, seed=2, distance=False)
+    c = sr.remesh(*spot, points=500, seed=1, distance=False)
+    assert a[0].tobytes() == c[0].tobytes() and a[1].tobytes() == c[1].tobytes()
+    assert a[0].shape != b[0].shape or a[0].tobytes() != b[0].tobytes()
+    assert a[2]["distance"] is None
+
+
+def test_remesh_options_reach_the_pipeline(spot, spot_path, remesh_bin, tmp_path):
+    out = tmp_path / "out.ply"
+    flags = ["--sigma-p", "4", "--sigma-n", "0.8", "--no-fit", "--smooth", "2",
+             "--min-angle", "30", "--max-angle", "120", "--feature-angle", "40",
+             "--iterations", "3", "--seed", "5", "--no-distance", "-q"]
+    subprocess.run([remesh_bin, spot_path, out, *flags], check=True)
+    V, F, report = sr.remesh(
+        *spot, sigma_p=4.0, sigma_n=0.8, fit=False, smooth=2, min_angle=30, max_angle=120,
+        feature_angle=40, iterations=3, seed=5, distance=False,
+    )
+    cli_V, cli_F = read_binary_ply(out)
+    assert V.tobytes() == cli_V.tobytes() and F.tobytes() == cli_F.tobytes()
+    assert report["extra"]["sigma_p"] == 4.0 and report["extra"]["sigma_n"] == 0.8
+    assert "fit" not in report["extra"]
+
+
+QUALITY_KEYS = {
+    "triangles", "topology", "self_intersections", "invariant_violations", "distance",
+    "input_topology", "topology_changes", "stages", "notes", "extra",
+}
+TRIANGLE_KEYS = {
+    "theta_min", "theta_min_ave", "theta_max", "q_min", "q_ave", "pct_theta_below_30", "p30",
+    "faces_measured",
+}
+
+
+def test_quality_equals_cli(spot, spot_path, remesh_bin):
+    q = sr.quality(*spot)
+    assert set(q) == QUALITY_KEYS
+    assert set(q["triangles"]) == TRIANGLE_KEYS
+    assert q["distance"] is None and q["input_topology"] is None
+    assert q["topology"]["vertices"] == 2930 and q["topology"]["genus"] == 0
+    cli = subprocess.run(
+        [remesh_bin, "quality", spot_path, "--json"], check=True, stdout=subprocess.PIPE, text=True
+    ).stdout
+    assert without_times(q) == without_times(json.loads(cli))
+
+
+def test_quality_with_reference_equals_cli(spot, spot_path, remesh_bin, tmp_path):
+    V, F, _ = sr.remesh(*spot, points=1000, distance=False)
+    out = tmp_path / "out.ply"
+    subprocess.run([remesh_bin, spot_path, out, "--points", "1000", "--no-distance", "-q"], check=True)
+    q = sr.quality(V, F, ref=spot)
+    assert q["distance"]["hausdorff"] > 0 and q["distance"]["samples_per_side"] == 200000
+    cli = subprocess.run(
+        [remesh_bin, "quality", out, "--ref", spot_path, "--json"],
+        check=True, stdout=subprocess.PIPE, text=True,
+    ).stdout
+    assert without_times(q) == without_times(json.loads(cli))
+
+
+def test_non_contiguous_and_other_dtypes_are_read_alike(spot):
+    V, F = spot
+    wide = np.zeros((len(V), 6))
+    wide[:, ::2] = V
+    strided = wide[:, ::2]
+    assert not strided.flags.c_contiguous
+    reversed_rows = V[::-1][::-1]
+    fortran = np.asfortranarray(F)
+    expected, _ = without_times(sr.quality(V, F))
+    for v, f in [
+        (strided, F),
+        (reversed_rows, fortran),
+        (V, F.astype(np.int32)),
+        (V, F.astype(np.uint64)),
+        (V, F.astype(np.uint32)),
+        (V.tolist(), F.tolist()),
+    ]:
+        assert without_times(sr.quality(v, f))[0] == expected
+    # float32 positions are converted exactly.
+    v32 = V.astype(np.float32)
+    assert without_times(sr.quality(v32, F))[0] == without_times(sr.quality(v32.astype(np.float64), F))[0]
+
+
+def tetrahedron():
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float64)
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], dtype=np.int64)
+    return V, F
+
+
+@pytest.mark.parametrize(
+    "V, F, pattern",
+    [
+        (np.zeros((4, 2)), tetrahedron()[1], r"V must be an array of shape \(n, 3\), got shape \(4, 2\)"),
+        (np.zeros(12), tetrahedron()[1], r"V must be an array of shape \(n, 3\), got shape \(12,\)"),
+        (tetrahedron()[0], np.zeros((4, 4), dtype=np.int64), r"F must be an array of shape \(m, 3\), got shape \(4, 4\)"),
+        (tetrahedron()[0], tetrahedron()[1][:, :, None], r"F must be an array of shape"),
+        (tetrahedron()[0].astype(str), tetrahedron()[1], r"V must hold real numbers"),
+        (tetrahedron()[0].astype(complex), tetrahedron()[1], r"V must hold real numbers"),
+        (tetrahedron()[0], tetrahedron()[1].astype(np.float64), r"F must hold vertex indices \(an integer dtype\), got dtype"),
+        (tetrahedron()[0], tetrahedron()[1].astype(bool), r"F must hold vertex indices"),
+        (tetrahedron()[0], np.array([[0, 2, 1], [0, 1, 4]]), r"F\[1, 2\] = 4 is not a vertex index: the vertices are numbered 0 to 3"),
+        (tetrahedron()[0], np.array([[0, 2, 1], [0, -1, 3]]), r"F\[1, 1\] = -1 is not a vertex index"),
+        (tetrahedron()[0], np.array([[0, 2, 1], [0, 2**40, 3]], dtype=np.uint64), r"F\[1, 1\] = 1099511627776 is not a vertex index"),
+        (np.array([[0, 0, np.nan], [1, 0, 0], [0, 1, 0], [0, 0, 1]]), tetrahedron()[1], r"mesh: vertex 0 \(0-based\) has a non-finite coordinate"),
+        (np.array([[0, 0, 0], [1, 0, 0], [0, np.inf, 0], [0, 0, 1]]), tetrahedron()[1], r"vertex 2 \(0-based\) has a non-finite coordinate"),
+        (tetrahedron()[0], np.zeros((0, 3), dtype=np.int64), r"no faces"),
+        (tetrahedron()[0], np.array([[0, 0, 1]]), r"no faces \(every triangle is degenerate"),
+        ([[0, 0, 0], [1, 0]], tetrahedron()[1], r"."),
+    ],
+)
+def test_bad_arrays_raise_value_error(V, F, pattern):
+    for call in (lambda: sr.quality(V, F), lambda: sr.remesh(V, F, points=100, distance=False)):
+        with pytest.raises(ValueError, match=pattern):
+            call()
+
+
+def test_bad_reference_raises_value_error():
+    V, F = tetrahedron()
+    with pytest.raises(ValueError, match=r"ref must be a pair \(V0, F0\)"):
+        sr.quality(V, F, ref=V)
+    with pytest.raises(ValueError, match=r"ref\[1\]\[0, 0\] = 9 is not a vertex index"):
+        sr.quality(V, F, ref=(V, F + 9))
+    with pytest.raises(ValueError, match=r"reference: vertex 1 \(0-based\) has a non-finite"):
+        sr.quality(V, F, ref=(np.where(np.arange(12).reshape(4, 3) == 3, np.nan, V), F))
+
+
+@pytest.mark.parametrize(
+    "options, pattern",
+    [
+        ({"points": -5}, r"invalid parameter --points: must be an integer >= 0, got -5"),
+        ({"points": 2}, r"invalid parameter --points"),
+        ({"points": 100, "sigma_p": 2.0}, r"give --points or --sigma-p, not both"),
+        ({"sigma_p": -1.0}, r"invalid parameter --sigma-p"),
+        ({"sigma_p": float("nan")}, r"invalid parameter --sigma-p"),
+        ({"sigma_n": 0.0}, r"invalid parameter --sigma-n"),
+        ({"min_angle": 70}, r"invalid parameter --min-angle"),
+        ({"max_angle": 50}, r"invalid parameter --max-angle"),
+        ({"feature_angle": 200}, r"invalid parameter --feature-angle"),
+        ({"feature_angle": 30, "features": False}, r"give --feature-angle or --no-features"),
+        ({"triangulation": "voronoi"}, r"invalid parameter --triangulation: must be umbrellas or restricted"),
+        ({"lfs_factor": -1.0}, r"invalid parameter --lfs-factor"),
+        ({"chord_error": float("inf")}, r"invalid parameter --chord-error"),
+        ({"seed": -1}, r"invalid parameter --seed"),
+        ({"smooth": -1}, r"invalid parameter --smooth"),
+        ({"max_memory": "1K"}, r"--max-memory"),
+        ({"max_memory": "lots"}, r"invalid parameter max_memory"),
+        ({"max_memory": -3}, r"invalid parameter max_memory"),
+    ],
+)
+def test_bad_options_raise_value_error(spot, options, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        sr.remesh(*spot, distance=False, **options)
+
+
+def test_unknown_option_raises_type_error(spot):
+    with pytest.raises(TypeError):
+        sr.remesh(*spot, point=100)
+
+
+def test_read_errors(tmp_path):
+    missing = tmp_path / "missing.obj"
+    with pytest.raises(FileNotFoundError, match="missing.obj"):
+        sr.read(missing)
+    with pytest.raises(OSError):
+        sr.read(str(missing))
+    text = tmp_path / "mesh.txt"
+    text.write_text("1 2 3\n")
+    with pytest.raises(ValueError, match=r"mesh.txt: unsupported format"):
+        sr.read(text)
+    bad = tmp_path / "bad.ply"
+    bad.write_bytes(b"not a ply file\n")
+    with pytest.raises(ValueError, match=r"bad.ply: not a PLY file"):
+        sr.read(bad)
+    folder = tmp_path / "folder.obj"
+    folder.mkdir()
+    with pytest.raises(OSError, match="folder.obj"):
+        sr.read(folder)
+
+
+def test_gil_is_released(spot):
+    """Another Python thread runs while remesh works: no gap in its clock as long as the call."""
+    done = threading.Event()
+    times = []
+
+    def work():
+        start = time.perf_counter()
+        sr.remesh(*spot, points=2000, distance=False)
+        times.append(time.perf_counter() - start)
+        done.set()
+
+    stamps = [time.perf_counter()]
+    worker = threading.Thread(target=work)
+    worker.start()
+    while not done.is_set():
+        stamps.append(time.perf_counter())
+        time.sleep(0.001)
+    worker.join()
+    stamps.append(time.perf_counter())
+    (duration,) = times
+    gaps = np.diff(stamps)
+    assert duration > 0.3, duration
+    assert gaps.max() < 0.5 * duration, (gaps.max(), duration)
+
+
+def stub_functions():
+    tree = ast.parse(STUBS.read_text())
+    return ast.get_docstring(tree), {
+        node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)
+    }
+
+
+def test_stubs_match_the_module():
+    """The stubs' docstrings and signatures are the module's own (pyo3 takes both from the
+    Rust source), so the two cannot drift apart."""
+    module_doc, functions = stub_functions()
+    assert inspect.cleandoc(sr.__doc__) == module_doc
+    public = {name for name in dir(sr) if not name.startswith("_") and callable(getattr(sr, name))}
+    public.discard("spectral_remesh")
+    assert public == set(functions)
+    for name, node in functions.items():
+        runtime = getattr(sr, name)
+        assert inspect.getdoc(runtime) == ast.get_docstring(node), name
+        signature = inspect.signature(runtime)
+        args = node.args
+        stub = [(a.arg, "POSITIONAL_ONLY") for a in args.posonlyargs]
+        stub += [(a.arg, "POSITIONAL_OR_KEYWORD") for a in args.args]
+        stub += [(a.arg, "KEYWORD_ONLY") for a in args.kwonlyargs]
+        assert [(p.name, p.kind.name) for p in signature.parameters.values()] == stub, name
+        stub_defaults = [ast.literal_eval(d) for d in args.defaults]
+        stub_defaults += [ast.literal_eval(d) for d in args.kw_defaults if d is not None]
+        runtime_defaults = [
+            p.default for p in signature.parameters.values() if p.default is not p.empty
+        ]
+        assert runtime_defaults == stub_defaults, name
+
+
+def test_installed_package_has_stubs():
+    package = Path(sr.__file__).parent
+    assert (package / "py.typed").is_file()
+    assert (package / "__init__.pyi").read_text() == STUBS.read_text()
