@@ -35,9 +35,10 @@ use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces
 use crate::triangulate::untangle::{untangle, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
 
-/// Points of the RIMLS surface per output sample: the samples and `RIMLS_POINTS_PER_SAMPLE - 1`
-/// random input points per sample (the first bucket's). More average noise better at a
-/// proportional cost per projection.
+/// Points of the RIMLS surface per output sample: random input points (the first bucket's), the
+/// samples not among them (a sample is an input point: a near outlier taken as a sample would
+/// hold a bubble of surface around itself). More average noise better at a proportional cost
+/// per projection.
 pub const RIMLS_POINTS_PER_SAMPLE: usize = 4;
 
 /// The RIMLS surface's parameters for a sampling at `sigma_p` and `sigma_n`: the same widths,
@@ -284,7 +285,7 @@ pub fn remesh_points(
         rescan_rejected,
     ) = loop {
         scans += 1;
-        let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE - 1)?;
+        let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE)?;
         let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
         let mut samples = std::mem::take(&mut scan.samples);
         timer.lap("scan");
@@ -300,6 +301,7 @@ pub fn remesh_points(
             params.orientation.in_frame(&scan.normalization),
             // Points on no sheet of the density the open-gap rule bridges carry no surface.
             Some(2.0 * OPEN_GAP_SIGMA_P * sigma_p),
+            false,
         )?;
         let support_tree = StaticTree::new(rimls.positions());
         // The samples are input points, noisy: they start on the surface.
