@@ -169,8 +169,8 @@ pub fn off_plane(positions: &[DVec3]) -> Vec<bool> {
                 if n == DVec3::ZERO {
                     return false;
                 }
-                let ms = near.iter().map(|q| (*q - c).dot(n).powi(2)).sum::<f64>()
-                    / near.len() as f64;
+                let ms =
+                    near.iter().map(|q| (*q - c).dot(n).powi(2)).sum::<f64>() / near.len() as f64;
                 // A floor for neighbours exactly on a plane: a millionth of their reach.
                 let reach = found.last().map_or(0.0, |&(_, d2)| d2.sqrt());
                 let rms = ms.sqrt().max(1e-6 * reach);
@@ -283,7 +283,10 @@ mod tests {
             .collect();
         points.extend_from_slice(&strand);
         let off = off_sheet(&points, 3.0);
-        assert!(off[..900].iter().all(|&o| !o), "a grid point is off the sheet");
+        assert!(
+            off[..900].iter().all(|&o| !o),
+            "a grid point is off the sheet"
+        );
         // The strand's points farther than the radius from the plane see at most two others.
         for (k, &o) in off[900..].iter().enumerate() {
             if strand[k].z > 3.0 {
@@ -318,7 +321,11 @@ mod tests {
         for i in 0..40 {
             for j in 0..40 {
                 let (u, v) = (i as f64 / 39.0, j as f64 / 39.0);
-                cube.extend([DVec3::new(u, v, 0.0), DVec3::new(u, 0.0, v), DVec3::new(0.0, u, v)]);
+                cube.extend([
+                    DVec3::new(u, v, 0.0),
+                    DVec3::new(u, 0.0, v),
+                    DVec3::new(0.0, u, v),
+                ]);
             }
         }
         let off = off_plane(&cube);
