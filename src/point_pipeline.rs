@@ -32,12 +32,13 @@ use crate::timing::StageTimer;
 use crate::triangulate::optimize::{optimize, OptimizeStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
 use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
-use crate::triangulate::untangle::{untangle, UntangleStats};
+use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
 
-/// Points of the RIMLS surface per output sample: the samples and `RIMLS_POINTS_PER_SAMPLE - 1`
-/// random input points per sample (the first bucket's). More average noise better at a
-/// proportional cost per projection.
+/// Points of the RIMLS surface per output sample: random input points (the first bucket's), the
+/// samples not among them (a sample is an input point: a near outlier taken as a sample would
+/// hold a bubble of surface around itself). More average noise better at a proportional cost
+/// per projection.
 pub const RIMLS_POINTS_PER_SAMPLE: usize = 4;
 
 /// The RIMLS surface's parameters for a sampling at `sigma_p` and `sigma_n`: the same widths,
@@ -106,6 +107,10 @@ impl SurfaceQuery for Domain<'_> {
         self.rimls.smooth_normal(sp)
     }
 }
+
+/// Edge collapses at most where untangling by moves leaves crossing faces
+/// ([`UntangleParams::max_collapses`]): each removes one crossing pair or more.
+pub const POINT_UNTANGLE_COLLAPSES: usize = 100;
 
 /// Scans of the input at most: the first at the searched sigma_p, then corrections of sigma_p
 /// for the count on the surface.
@@ -178,9 +183,12 @@ pub struct PointRemeshOutput {
     pub unsupported: UnsupportedFaces,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,
-    /// The separation of crossing faces.
+    /// The separation of crossing faces of the umbrellas (before the optimization).
+    pub untangle_umbrellas: UntangleStats,
+    /// The separation of crossing faces after the optimization.
     pub untangle: UntangleStats,
-    /// Samples that ended in no triangle.
+    /// Samples that ended in no triangle (the optimization's and the untangling's collapses
+    /// included).
     pub dropped_samples: usize,
     /// Tiny closed shells left out (see [`remesh_points`]).
     pub stray_shells: StrayShells,
@@ -284,7 +292,7 @@ pub fn remesh_points(
         rescan_rejected,
     ) = loop {
         scans += 1;
-        let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE - 1)?;
+        let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE)?;
         let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
         let mut samples = std::mem::take(&mut scan.samples);
         timer.lap("scan");
@@ -300,6 +308,7 @@ pub fn remesh_points(
             params.orientation.in_frame(&scan.normalization),
             // Points on no sheet of the density the open-gap rule bridges carry no surface.
             Some(2.0 * OPEN_GAP_SIGMA_P * sigma_p),
+            false,
         )?;
         let support_tree = StaticTree::new(rimls.positions());
         // The samples are input points, noisy: they start on the surface.
@@ -417,6 +426,18 @@ pub fn remesh_points(
     let unsupported = remove_unsupported_faces(&mut mesh, &mut sources, |p| {
         domain.within(p, OPEN_GAP_SIGMA_P * sigma_p)
     });
+
+    // The RIMLS surface is a level set: it never passes through itself, so a crossing of the
+    // umbrellas is a fold of the triangulation (a tip thinner than sigma_p, where the samples
+    // of its two sides see each other), which collapsing its edges removes when moving its
+    // vertices does not. Untangled before the optimization (which then shapes the triangles the
+    // collapses left) and after it.
+    let untangle_params = UntangleParams {
+        max_collapses: POINT_UNTANGLE_COLLAPSES,
+        ..rp.untangle
+    };
+    let no_fixed = vec![false; mesh.positions.len()];
+    let untangle_umbrellas = untangle(&mut mesh, &no_fixed, sigma_p, &untangle_params);
     timer.lap("triangulate");
 
     on_stage("optimize");
@@ -444,7 +465,8 @@ pub fn remesh_points(
     // 0.77, 0.60 without, at 1.8 times the run time (each of its moves is a RIMLS projection).
     let fixed = vec![false; mesh.positions.len()];
     on_stage("untangle");
-    let untangle_stats = untangle(&mut mesh, &fixed, sigma_p, &rp.untangle);
+    let untangle_stats = untangle(&mut mesh, &fixed, sigma_p, &untangle_params);
+    let collapsed = mesh.remove_unreferenced_vertices();
     // A tiny closed shell (a few samples closing into a tetrahedron where a tip is thinner than
     // the spacing) is no part of the surface: a real part 4 sigma_p across would have tens of
     // samples. The largest part always stays.
@@ -480,8 +502,9 @@ pub fn remesh_points(
         assembly,
         unsupported,
         optimize: optimize_stats,
+        untangle_umbrellas,
         untangle: untangle_stats,
-        dropped_samples,
+        dropped_samples: dropped_samples + collapsed,
         stray_shells,
         output_orientation,
         scan_seconds: scan.seconds,

@@ -117,6 +117,10 @@ pub(super) fn run(
         serde_json::to_value(out.untangle).unwrap_or_default(),
     );
     extra.insert(
+        "untangle_umbrellas".into(),
+        serde_json::to_value(out.untangle_umbrellas).unwrap_or_default(),
+    );
+    extra.insert(
         "output_orientation".into(),
         serde_json::to_value(out.output_orientation).unwrap_or_default(),
     );

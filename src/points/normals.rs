@@ -67,7 +67,7 @@ pub fn estimate_normals(points: &[DVec3], k: usize, orientation: NormalOrientati
 }
 
 /// The least-variance direction of `points` (unit; zero when undefined).
-fn plane_normal(points: &[DVec3]) -> DVec3 {
+pub(crate) fn plane_normal(points: &[DVec3]) -> DVec3 {
     let mean = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
     let mut c = Matrix3::<f64>::zeros();
     for p in points {

@@ -14,7 +14,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::normals::{estimate_normals, NormalOrientation};
-use super::outliers::{off_sheet, OutlierFilter};
+use super::outliers::{off_plane, off_sheet, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
 use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -348,6 +348,7 @@ fn resample_on_rimls(
         had_normals,
         params.orientation,
         None,
+        true,
     )?;
     let mut moving: Vec<SurfaceSample> = samples
         .iter()
@@ -373,9 +374,12 @@ fn resample_on_rimls(
 
 /// The RIMLS surface (`params`) of `samples` and the first
 /// `(points_per_sample - 1) · samples.len()` points of `support` (a uniformly random subset of
-/// the input), bbox-100 units. Without input normals (`had_normals` false), normals are
-/// estimated on that set (PCA over 10 neighbours, oriented by `orientation`) and given to the
-/// samples as well. With `sheet_radius` the points on no sheet at that radius
+/// the input), bbox-100 units; with `samples_in_support` false, of the first
+/// `points_per_sample · samples.len()` points of `support` alone (a sample off the surface, a
+/// near outlier, then projects onto the others' surface instead of carrying a bubble of its
+/// own). Without input normals (`had_normals` false), normals are estimated on that set (PCA
+/// over 10 neighbours, oriented by `orientation`) and given to the samples as well when they
+/// are in it. With `sheet_radius` the points on no sheet at that radius
 /// ([`off_sheet`]) are left out of the surface (the samples keep their entries).
 ///
 /// # Errors
@@ -388,20 +392,31 @@ pub(crate) fn rimls_of(
     had_normals: bool,
     orientation: NormalOrientation,
     sheet_radius: Option<f64>,
+    samples_in_support: bool,
 ) -> Result<Rimls> {
     let mut support = support;
-    support.truncate(points_per_sample.saturating_sub(1) * samples.len());
-    support.extend_from_slice(samples);
+    if samples_in_support {
+        support.truncate(points_per_sample.saturating_sub(1) * samples.len());
+        support.extend_from_slice(samples);
+    } else {
+        support.truncate(points_per_sample.saturating_mul(samples.len()));
+    }
     if !had_normals {
         estimate_sample_normals(&mut support, orientation);
-        let from = support.len() - samples.len();
-        samples.copy_from_slice(&support[from..]);
+        if samples_in_support {
+            let from = support.len() - samples.len();
+            samples.copy_from_slice(&support[from..]);
+        }
     }
     let (mut positions, mut normals): (Vec<DVec3>, Vec<DVec3>) =
         support.iter().map(|p| (p.position, p.normal)).unzip();
     drop(support);
     if let Some(radius) = sheet_radius {
-        let off = off_sheet(&positions, radius);
+        let off: Vec<bool> = off_sheet(&positions, radius)
+            .into_iter()
+            .zip(off_plane(&positions))
+            .map(|(a, b)| a || b)
+            .collect();
         let mut keep = off.iter().map(|&o| !o);
         positions.retain(|_| keep.next().unwrap_or(true));
         let mut keep = off.iter().map(|&o| !o);

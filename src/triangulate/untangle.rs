@@ -10,6 +10,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::geometry::self_intersection::intersecting_pairs;
+use crate::geometry::triangle::{is_degenerate_face, triangle_min_angle_deg};
 use crate::geometry::triangle_intersection::triangles_intersect;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
@@ -23,6 +24,11 @@ pub struct UntangleParams {
     pub margin_sigma_p: f64,
     /// The longest move of a vertex in one round (σ_p units). Default 0.25.
     pub max_step_sigma_p: f64,
+    /// Edge collapses at most when moves leave crossing pairs (default 0: none). Only where the
+    /// surface cannot pass through itself (a point set's RIMLS surface is a level set): a
+    /// crossing is then the triangulation's fold, which collapsing its edges removes; on an input
+    /// mesh that passes through itself it is the input's, and collapses would eat the part.
+    pub max_collapses: usize,
 }
 
 impl Default for UntangleParams {
@@ -31,6 +37,7 @@ impl Default for UntangleParams {
             max_rounds: 30,
             margin_sigma_p: 0.01,
             max_step_sigma_p: 0.25,
+            max_collapses: 0,
         }
     }
 }
@@ -48,6 +55,8 @@ pub struct UntangleStats {
     pub vertices_moved: usize,
     /// The largest total displacement of a vertex (σ_p units).
     pub max_displacement: f64,
+    /// Edges collapsed after the moves (see [`UntangleParams::max_collapses`]).
+    pub collapses: usize,
 }
 
 /// Moves vertices of `mesh` (bbox-100 units) until no two non-adjacent faces intersect
@@ -116,6 +125,12 @@ pub fn untangle(
             }
         }
     }
+    if !pairs.is_empty() && params.max_collapses > 0 {
+        let (collapses, left) = collapse_folds(&mut m, fixed, params.max_collapses);
+        stats.collapses = collapses;
+        pairs = left;
+        mesh.triangles = m.live_faces().0;
+    }
     mesh.positions = m.positions().to_vec();
     stats.pairs_after = pairs.len();
     stats.vertices_moved = moved.iter().filter(|&&m| m).count();
@@ -127,6 +142,113 @@ pub fn untangle(
         .fold(0.0, f64::max)
         / sigma_p;
     stats
+}
+
+/// Edges tried per collapse: the shortest edges of the faces still crossing.
+const COLLAPSE_CANDIDATES: usize = 16;
+
+/// Collapses edges of crossing faces, one at a time: of the `COLLAPSE_CANDIDATES` shortest edges
+/// of the faces still crossing (neither end `fixed`), each collapsed to its midpoint or to
+/// either end, the legal collapse ([`EditMesh::collapse_edge`]) that leaves fewer crossings
+/// among the faces it changes than there were among the faces around the edge and the best
+/// smallest angle among them; until none cross, none helps or `max` collapses are made. Returns the collapses made and the pairs left (indices
+/// into the live faces). Deterministic.
+fn collapse_folds(m: &mut EditMesh, fixed: &[bool], max: usize) -> (usize, Vec<[u32; 2]>) {
+    let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
+    let mut made = 0;
+    let mut pairs = intersecting_pairs(m.positions(), &m.live_faces().0);
+    while !pairs.is_empty() && made < max {
+        let triangles = m.live_faces().0;
+        let mut edges: Vec<(f64, u32, u32)> = Vec::new();
+        for &f in pairs.iter().flatten() {
+            let t = triangles[f as usize];
+            for k in 0..3 {
+                let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                if !is_fixed(a) && !is_fixed(b) {
+                    edges.push((m.position(a).distance(m.position(b)), a, b));
+                }
+            }
+        }
+        edges.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+        edges.dedup_by(|x, y| (x.1, x.2) == (y.1, y.2));
+        // Of the collapses that lower the crossings around the edge, the one leaving the best
+        // smallest angle around the kept vertex (either end kept, at either end or midway).
+        let mut better: Option<(f64, EditMesh)> = None;
+        for &(_, a, b) in edges.iter().take(COLLAPSE_CANDIDATES) {
+            let around: Vec<u32> = faces_around_both(m, a, b);
+            let before = crossings_of(m, &around);
+            let (pa, pb) = (m.position(a), m.position(b));
+            for (removed, kept, at) in [(a, b, 0.5 * (pa + pb)), (a, b, pb), (b, a, pa)] {
+                let mut trial = m.clone();
+                if trial.collapse_edge(removed, kept, at, ()).is_err() {
+                    continue;
+                }
+                let fan = trial.faces_around(kept);
+                if crossings_of(&trial, fan) >= before {
+                    continue;
+                }
+                let angle = fan
+                    .iter()
+                    .filter_map(|&f| trial.face(f))
+                    .map(|t| triangle_min_angle_deg(trial.corners(t)))
+                    .fold(f64::INFINITY, f64::min);
+                if better.as_ref().is_none_or(|(best, _)| angle > *best) {
+                    better = Some((angle, trial));
+                }
+            }
+        }
+        let Some((_, trial)) = better else { break };
+        *m = trial;
+        pairs = intersecting_pairs(m.positions(), &m.live_faces().0);
+        made += 1;
+    }
+    (made, pairs)
+}
+
+/// The faces (slots) around `a` or `b`, each once.
+fn faces_around_both(m: &EditMesh, a: u32, b: u32) -> Vec<u32> {
+    let mut faces: Vec<u32> = m.faces_around(a).to_vec();
+    faces.extend_from_slice(m.faces_around(b));
+    faces.sort_unstable();
+    faces.dedup();
+    faces
+}
+
+/// The crossing pairs of live faces with at least one face in `faces` (slots), as
+/// [`intersecting_pairs`] counts them: faces sharing a vertex and degenerate faces left out.
+/// A linear pass over the faces per face of `faces` (a handful).
+fn crossings_of(m: &EditMesh, faces: &[u32]) -> usize {
+    let p = m.positions();
+    let bbox = |t: [u32; 3]| {
+        let c = t.map(|v| p[v as usize]);
+        (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
+    };
+    let mut count = 0;
+    for &f in faces {
+        let Some(t) = m.face(f) else { continue };
+        if is_degenerate_face(p, t) {
+            continue;
+        }
+        let (lo, hi) = bbox(t);
+        for g in 0..m.slots() as u32 {
+            // A pair inside `faces` is counted once, from its smaller slot.
+            if g == f || (g < f && faces.contains(&g)) {
+                continue;
+            }
+            let Some(u) = m.face(g) else { continue };
+            if u.iter().any(|v| t.contains(v)) || is_degenerate_face(p, u) {
+                continue;
+            }
+            let (ulo, uhi) = bbox(u);
+            if ulo.cmpgt(hi).any() || uhi.cmplt(lo).any() {
+                continue;
+            }
+            if triangles_intersect(t.map(|v| p[v as usize]), u.map(|v| p[v as usize])) {
+                count += 1;
+            }
+        }
+    }
+    count
 }
 
 /// One round's moves for the crossing `pairs`: `(vertex, displacement)`. The pairs are taken in
@@ -269,5 +391,45 @@ mod tests {
             s.pairs_after,
             intersecting_pairs(&m.positions, &m.triangles).len()
         );
+    }
+
+    #[test]
+    fn a_fold_is_collapsed_away_when_asked_and_left_when_not() {
+        // A flat 8 x 8 grid with one interior vertex dragged across its neighbours: its fan
+        // folds over faces two columns away (coplanar overlaps share an area).
+        let mut m = grid(8, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let v = 4 * 9 + 4;
+        m.positions[v] = DVec3::new(6.5, 4.4, 0.0);
+        let before = intersecting_pairs(&m.positions, &m.triangles).len();
+        assert!(before > 0);
+        let fixed = vec![false; m.positions.len()];
+        // Collapses only (no move rounds), so the collapses are what is tested.
+        let only_collapses = UntangleParams {
+            max_rounds: 0,
+            max_collapses: 10,
+            ..Default::default()
+        };
+        let mut without = m.clone();
+        let s = untangle(
+            &mut without,
+            &fixed,
+            1.0,
+            &UntangleParams {
+                max_collapses: 0,
+                ..only_collapses
+            },
+        );
+        assert_eq!((s.pairs_after, s.collapses), (before, 0), "{s:?}");
+        let s = untangle(&mut m, &fixed, 1.0, &only_collapses);
+        assert!(s.collapses >= 1 && s.pairs_after == 0, "{s:?}");
+        assert!(intersecting_pairs(&m.positions, &m.triangles).is_empty());
+        m.remove_unreferenced_vertices();
+        assert!(
+            check_invariants(&m).is_empty(),
+            "{:?}",
+            check_invariants(&m)
+        );
+        let edited: EditMesh = EditMesh::from_trimesh(&m, |_| (), SlotPolicy::Reuse);
+        assert_eq!(edited.sanity_check(), Ok(()));
     }
 }
