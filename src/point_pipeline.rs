@@ -19,7 +19,7 @@ use crate::kernel::Kernel;
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::pipeline::{Density, RemeshParams, STRAY_SHELL_VERTICES};
 use crate::points::normals::NormalOrientation;
-use crate::points::out_of_core::{rimls_of, OutOfCoreParams, ScannedInput};
+use crate::points::out_of_core::{rimls_of, OutOfCoreParams, RimlsSupport, ScannedInput};
 use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
@@ -302,13 +302,16 @@ pub fn remesh_points(
             rimls_params(sigma_p, rp.sigma_n),
             &mut samples,
             std::mem::take(&mut scan.support),
-            RIMLS_POINTS_PER_SAMPLE,
+            RimlsSupport {
+                points_per_sample: RIMLS_POINTS_PER_SAMPLE,
+                samples_in_support: false,
+                // Points on no sheet of the density the open-gap rule bridges carry no
+                // surface.
+                sheet_radius: Some(2.0 * OPEN_GAP_SIGMA_P * sigma_p),
+            },
             scan.had_normals,
             // The points are in the bbox-100 frame, a viewpoint in model units.
             params.orientation.in_frame(&scan.normalization),
-            // Points on no sheet of the density the open-gap rule bridges carry no surface.
-            Some(2.0 * OPEN_GAP_SIGMA_P * sigma_p),
-            false,
         )?;
         let support_tree = StaticTree::new(rimls.positions());
         // The samples are input points, noisy: they start on the surface.

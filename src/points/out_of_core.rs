@@ -344,11 +344,13 @@ fn resample_on_rimls(
         RimlsParams::new(kernel.sigma_p(), kernel.sigma_n()),
         samples,
         support,
-        RIMLS_POINTS_PER_SAMPLE,
+        RimlsSupport {
+            points_per_sample: RIMLS_POINTS_PER_SAMPLE,
+            samples_in_support: true,
+            sheet_radius: None,
+        },
         had_normals,
         params.orientation,
-        None,
-        true,
     )?;
     let mut moving: Vec<SurfaceSample> = samples
         .iter()
@@ -372,15 +374,28 @@ fn resample_on_rimls(
     Ok(())
 }
 
+/// Which points carry the RIMLS surface of [`rimls_of`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RimlsSupport {
+    /// Points per sample.
+    pub points_per_sample: usize,
+    /// Whether the samples are among them.
+    pub samples_in_support: bool,
+    /// Whether the points on no sheet at this radius ([`off_sheet`]) and those off their
+    /// neighbours' plane ([`off_plane`]) are left out.
+    pub sheet_radius: Option<f64>,
+}
+
 /// The RIMLS surface (`params`) of `samples` and the first
 /// `(points_per_sample - 1) · samples.len()` points of `support` (a uniformly random subset of
 /// the input), bbox-100 units; with `samples_in_support` false, of the first
 /// `points_per_sample · samples.len()` points of `support` alone (a sample off the surface, a
 /// near outlier, then projects onto the others' surface instead of carrying a bubble of its
-/// own). Without input normals (`had_normals` false), normals are estimated on that set (PCA
-/// over 10 neighbours, oriented by `orientation`) and given to the samples as well when they
-/// are in it. With `sheet_radius` the points on no sheet at that radius
-/// ([`off_sheet`]) are left out of the surface (the samples keep their entries).
+/// own); both from `which`. Without input normals (`had_normals` false), normals are estimated
+/// on that set (PCA over 10 neighbours, oriented by `orientation`) and given to the samples as
+/// well when they are in it. With `sheet_radius` the points on no sheet at that radius
+/// ([`off_sheet`]) and those off their neighbours' plane ([`off_plane`]) are left out of the
+/// surface (the samples keep their entries).
 ///
 /// # Errors
 /// Those of [`Rimls::new`] (no points, a non-finite position or a zero normal).
@@ -388,12 +403,15 @@ pub(crate) fn rimls_of(
     params: RimlsParams,
     samples: &mut [Point],
     support: Vec<Point>,
-    points_per_sample: usize,
+    which: RimlsSupport,
     had_normals: bool,
     orientation: NormalOrientation,
-    sheet_radius: Option<f64>,
-    samples_in_support: bool,
 ) -> Result<Rimls> {
+    let RimlsSupport {
+        points_per_sample,
+        samples_in_support,
+        sheet_radius,
+    } = which;
     let mut support = support;
     if samples_in_support {
         support.truncate(points_per_sample.saturating_sub(1) * samples.len());
