@@ -168,36 +168,38 @@ fn triangles(
         ))
     };
     let np = py.import("numpy")?;
-    let mut out = Vec::with_capacity(array.shape()[0]);
+    // Each index checked against the vertex count, whatever its integer type.
+    fn checked<T: Copy + ToString>(
+        rows: numpy::ndarray::ArrayView2<'_, T>,
+        vertices: usize,
+        out_of_range: impl Fn(usize, usize, String) -> PyErr,
+    ) -> PyResult<Vec<[u32; 3]>>
+    where
+        usize: TryFrom<T>,
+    {
+        let mut out = Vec::with_capacity(rows.nrows());
+        for (row, r) in rows.rows().into_iter().enumerate() {
+            let mut t = [0u32; 3];
+            for col in 0..3 {
+                t[col] = match usize::try_from(r[col]) {
+                    Ok(i) if i < vertices => i as u32,
+                    _ => return Err(out_of_range(row, col, r[col].to_string())),
+                };
+            }
+            out.push(t);
+        }
+        Ok(out)
+    }
     if kind == b'u' && size == 8 {
         // uint64 does not fit int64: read as it is.
         let array: PyReadonlyArray2<u64> =
             np.call_method1("asarray", (array, "uint64"))?.extract()?;
-        for (row, r) in array.as_array().rows().into_iter().enumerate() {
-            let mut t = [0u32; 3];
-            for col in 0..3 {
-                t[col] = match usize::try_from(r[col]) {
-                    Ok(i) if i < vertices => i as u32,
-                    _ => return Err(out_of_range(row, col, r[col].to_string())),
-                };
-            }
-            out.push(t);
-        }
+        checked(array.as_array(), vertices, out_of_range)
     } else {
         let array: PyReadonlyArray2<i64> =
             np.call_method1("asarray", (array, "int64"))?.extract()?;
-        for (row, r) in array.as_array().rows().into_iter().enumerate() {
-            let mut t = [0u32; 3];
-            for col in 0..3 {
-                t[col] = match usize::try_from(r[col]) {
-                    Ok(i) if i < vertices => i as u32,
-                    _ => return Err(out_of_range(row, col, r[col].to_string())),
-                };
-            }
-            out.push(t);
-        }
+        checked(array.as_array(), vertices, out_of_range)
     }
-    Ok(out)
 }
 
 /// A mesh from the arrays `v` and `f` (named `v_name`, `f_name` in errors).
