@@ -14,7 +14,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::normals::{estimate_normals, NormalOrientation};
-use super::outliers::{off_plane, off_sheet, OutlierFilter};
+use super::outliers::{off_surface, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
 use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -381,8 +381,8 @@ pub(crate) struct RimlsSupport {
     pub points_per_sample: usize,
     /// Whether the samples are among them.
     pub samples_in_support: bool,
-    /// Whether the points on no sheet at this radius ([`off_sheet`]) and those off their
-    /// neighbours' plane ([`off_plane`]) are left out.
+    /// Whether the points on no sheet at this radius and those off their neighbours' plane
+    /// ([`off_surface`](super::outliers::off_surface)) are left out.
     pub sheet_radius: Option<f64>,
 }
 
@@ -393,9 +393,9 @@ pub(crate) struct RimlsSupport {
 /// near outlier, then projects onto the others' surface instead of carrying a bubble of its
 /// own); both from `which`. Without input normals (`had_normals` false), normals are estimated
 /// on that set (PCA over 10 neighbours, oriented by `orientation`) and given to the samples as
-/// well when they are in it. With `sheet_radius` the points on no sheet at that radius
-/// ([`off_sheet`]) and those off their neighbours' plane ([`off_plane`]) are left out of the
-/// surface (the samples keep their entries).
+/// well when they are in it. With `sheet_radius` the points on no sheet at that radius and those
+/// off their neighbours' plane ([`off_surface`](super::outliers::off_surface)) are left out of
+/// the surface (the samples keep their entries).
 ///
 /// # Errors
 /// Those of [`Rimls::new`] (no points, a non-finite position or a zero normal).
@@ -430,11 +430,7 @@ pub(crate) fn rimls_of(
         support.iter().map(|p| (p.position, p.normal)).unzip();
     drop(support);
     if let Some(radius) = sheet_radius {
-        let off: Vec<bool> = off_sheet(&positions, radius)
-            .into_iter()
-            .zip(off_plane(&positions))
-            .map(|(a, b)| a || b)
-            .collect();
+        let off = off_surface(&positions, Some(radius));
         let mut keep = off.iter().map(|&o| !o);
         positions.retain(|_| keep.next().unwrap_or(true));
         let mut keep = off.iter().map(|&o| !o);

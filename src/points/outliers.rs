@@ -4,9 +4,9 @@
 //! Source: statistical outlier removal (Rusu, Marton, Blodow, Dolha, Beetz 2008, "Towards 3D
 //! point cloud based object maps for household environments", Sec. 4) for the global test, and
 //! the local outlier factor (Breunig, Kriegel, Ng, Sander 2000) simplified to one ratio of
-//! k-distances for the local one. A second test, [`off_sheet`], finds the points on no sheet of
-//! data at a given scale (strands of flying pixels); a third, [`off_plane`], the near outliers
-//! off the plane of their neighbours.
+//! k-distances for the local one. [`off_surface`] finds the points on no sheet of data at a
+//! given scale (strands of flying pixels) and the near outliers off the plane of their
+//! neighbours.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -107,77 +107,86 @@ impl OutlierFilter {
     }
 }
 
-/// Neighbours within the radius that put a point on a sheet (see [`off_sheet`]).
+/// Neighbours within the radius that put a point on a sheet (see [`off_surface`]).
 pub const SHEET_NEIGHBORS: usize = 6;
 
-/// For each of `positions`, whether fewer than `SHEET_NEIGHBORS` other points lie within
-/// `radius` of it: the point is on no two-dimensional sheet of data at that scale. A point
-/// inside a hexagonal lattice of spacing up to `radius` has six neighbours within it; a point
+/// The sheet test of [`off_surface`] on a point's nearest neighbours `found` (itself included,
+/// nearest first): whether fewer than `SHEET_NEIGHBORS` other points lie within `radius` of it,
+/// so that the point is on no two-dimensional sheet of data at that scale. A point inside a
+/// hexagonal lattice of spacing up to `radius` has six neighbours within it; a point
 /// with fewer lies on a strand or alone, as the flying pixels a range scanner leaves along depth
 /// discontinuities (strands along the view rays, a few spacings apart), which a surface through
-/// them would bridge. Any units; deterministic (parallel).
-pub fn off_sheet(positions: &[DVec3], radius: f64) -> Vec<bool> {
-    let tree = StaticTree::new(positions);
-    let r2 = radius * radius;
-    positions
-        .par_iter()
-        .map_init(Vec::new, |found, &p| {
-            tree.nearest_n(p, SHEET_NEIGHBORS + 1, found);
-            // The point itself is among them (distance 0), and so are exact duplicates.
-            let near = found.iter().filter(|&&(_, d2)| d2 <= r2).count();
-            near < SHEET_NEIGHBORS + 1
-        })
-        .collect()
+/// them would bridge.
+fn is_off_sheet(found: &[(u32, f64)], radius: f64) -> bool {
+    // The point itself is among them (distance 0), and so are exact duplicates.
+    let near = found
+        .iter()
+        .filter(|&&(_, d2)| d2 <= radius * radius)
+        .count();
+    near < SHEET_NEIGHBORS + 1
 }
 
-/// Neighbours whose least-squares plane a point is compared with (see [`off_plane`]).
+/// Neighbours whose least-squares plane a point is compared with (see [`off_surface`]).
 pub const PLANE_NEIGHBORS: usize = 16;
 
 /// A point farther from its neighbours' plane than this many times their own RMS distance to
-/// it is off the surface (see [`off_plane`]).
+/// it is off the surface (see [`off_surface`]).
 pub const PLANE_FACTOR: f64 = 4.0;
 
-/// For each of `positions`, whether it lies off the surface its `PLANE_NEIGHBORS` nearest
-/// others describe: farther from their least-squares plane than `PLANE_FACTOR` times their RMS
-/// distance to it. Of a noisy surface's points this drops a few in a thousand (0.3% of a
-/// sphere's with noise at a tenth of the spacing: a random thinning); curvature and a crease
-/// raise the neighbours' RMS as much as the point's offset, so they pass. A near outlier (a few noise widths off the surface, too close
-/// for the k-distance tests, which a surface through it would bulge to) does not. Any units;
-/// deterministic (parallel). Sets with fewer than `PLANE_NEIGHBORS + 1` points: none.
-pub fn off_plane(positions: &[DVec3]) -> Vec<bool> {
-    if positions.len() <= PLANE_NEIGHBORS {
-        return vec![false; positions.len()];
-    }
+/// For each of `positions`, whether it is off the surface its neighbours describe (the plane
+/// test, `is_off_plane`) or, with `sheet_radius`, on no sheet of data at that radius (the sheet
+/// test, `is_off_sheet`): the two tests on one kd-tree and one neighbour query per point. Any
+/// units; deterministic (parallel).
+pub fn off_surface(positions: &[DVec3], sheet_radius: Option<f64>) -> Vec<bool> {
     let tree = StaticTree::new(positions);
+    let k = (PLANE_NEIGHBORS + 1).max(SHEET_NEIGHBORS + 1);
     positions
         .par_iter()
         .enumerate()
         .map_init(
             || (Vec::new(), Vec::new()),
             |(found, near), (i, &p)| {
-                tree.nearest_n(p, PLANE_NEIGHBORS + 1, found);
-                near.clear();
-                near.extend(
-                    found
-                        .iter()
-                        .filter(|&&(j, _)| j as usize != i)
-                        .take(PLANE_NEIGHBORS)
-                        .map(|&(j, _)| positions[j as usize]),
-                );
-                let c = near.iter().sum::<DVec3>() / near.len() as f64;
-                let n = plane_normal(near);
-                if n == DVec3::ZERO {
-                    return false;
-                }
-                let ms =
-                    near.iter().map(|q| (*q - c).dot(n).powi(2)).sum::<f64>() / near.len() as f64;
-                // A floor for neighbours exactly on a plane: a millionth of their reach.
-                let reach = found.last().map_or(0.0, |&(_, d2)| d2.sqrt());
-                let rms = ms.sqrt().max(1e-6 * reach);
-                (p - c).dot(n).abs() > PLANE_FACTOR * rms
+                tree.nearest_n(p, k, found);
+                sheet_radius.is_some_and(|r| is_off_sheet(found, r))
+                    || (positions.len() > PLANE_NEIGHBORS
+                        && is_off_plane(positions, i, found, near))
             },
         )
         .collect()
+}
+
+/// The plane test of [`off_surface`] for point `i` on its nearest neighbours `found` (itself
+/// among them; `near` is a buffer): whether it lies off the surface its `PLANE_NEIGHBORS`
+/// nearest others describe, farther from their least-squares plane than `PLANE_FACTOR` times
+/// their RMS distance to it. Of a noisy surface's points this drops a few in a thousand (0.3% of
+/// a sphere's with noise at a tenth of the spacing: a random thinning); curvature and a crease
+/// raise the neighbours' RMS as much as the point's offset, so they pass. A near outlier (a few
+/// noise widths off the surface, too close for the k-distance tests, which a surface through it
+/// would bulge to) does not.
+fn is_off_plane(
+    positions: &[DVec3],
+    i: usize,
+    found: &[(u32, f64)],
+    near: &mut Vec<DVec3>,
+) -> bool {
+    near.clear();
+    near.extend(
+        found
+            .iter()
+            .filter(|&&(j, _)| j as usize != i)
+            .take(PLANE_NEIGHBORS)
+            .map(|&(j, _)| positions[j as usize]),
+    );
+    let c = near.iter().sum::<DVec3>() / near.len() as f64;
+    let n = plane_normal(near);
+    if n == DVec3::ZERO {
+        return false;
+    }
+    let ms = near.iter().map(|q| (*q - c).dot(n).powi(2)).sum::<f64>() / near.len() as f64;
+    // A floor for neighbours exactly on a plane: a millionth of their reach.
+    let reach = found.last().map_or(0.0, |&(_, d2)| d2.sqrt());
+    let rms = ms.sqrt().max(1e-6 * reach);
+    (positions[i] - c).dot(n).abs() > PLANE_FACTOR * rms
 }
 
 /// The distance from `p` to its `OUTLIER_NEIGHBORS`-th nearest point of `tree` other than
@@ -282,7 +291,7 @@ mod tests {
             .map(|k| DVec3::new(15.0, 15.0, 2.0 * k as f64))
             .collect();
         points.extend_from_slice(&strand);
-        let off = off_sheet(&points, 3.0);
+        let off = off_surface(&points, Some(3.0));
         assert!(
             off[..900].iter().all(|&o| !o),
             "a grid point is off the sheet"
@@ -295,8 +304,8 @@ mod tests {
         }
         // Duplicates are neighbours: a point repeated seven times is on a sheet of itself.
         let dup = vec![DVec3::ONE; 7];
-        assert!(off_sheet(&dup, 0.5).iter().all(|&o| !o));
-        assert!(off_sheet(&dup[..6], 0.5).iter().all(|&o| o));
+        assert!(off_surface(&dup, Some(0.5)).iter().all(|&o| !o));
+        assert!(off_surface(&dup[..6], Some(0.5)).iter().all(|&o| o));
     }
 
     #[test]
@@ -310,7 +319,7 @@ mod tests {
             .map(|p| p * 1.05)
             .collect();
         points.extend_from_slice(&far);
-        let off = off_plane(&points);
+        let off = off_surface(&points, None);
         let kept_wrongly = off[30_000..].iter().filter(|&&o| !o).count();
         assert!(kept_wrongly <= 1, "{kept_wrongly} of 30 near outliers kept");
         let dropped = off[..30_000].iter().filter(|&&o| o).count();
@@ -328,7 +337,7 @@ mod tests {
                 ]);
             }
         }
-        let off = off_plane(&cube);
+        let off = off_surface(&cube, None);
         assert_eq!(off.iter().filter(|&&o| o).count(), 0);
     }
 }

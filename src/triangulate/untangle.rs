@@ -151,8 +151,8 @@ const COLLAPSE_CANDIDATES: usize = 16;
 /// of the faces still crossing (neither end `fixed`), each collapsed to its midpoint or to
 /// either end, the legal collapse ([`EditMesh::collapse_edge`]) that leaves fewer crossings
 /// among the faces it changes than there were among the faces around the edge and the best
-/// smallest angle among them; until none cross, none helps or `max` collapses are made. Returns the collapses made and the pairs left (indices
-/// into the live faces). Deterministic.
+/// smallest angle among them; until none cross, none helps or `max` collapses are made.
+/// Returns the collapses made and the pairs left (indices into the live faces). Deterministic.
 fn collapse_folds(m: &mut EditMesh, fixed: &[bool], max: usize) -> (usize, Vec<[u32; 2]>) {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
     let mut made = 0;
