@@ -24,7 +24,6 @@ use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::linear_scan::LinearScanner;
-use crate::spatial::StaticTree;
 use crate::surface::features::FeatureDetection;
 use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
@@ -74,7 +73,6 @@ pub const DOMAIN_GAP_SIGMA_P: f64 = 0.75;
 /// The RIMLS surface restricted to where there is data: within `max_gap` of a support point.
 struct Domain<'a> {
     rimls: &'a Rimls,
-    tree: StaticTree,
     /// The projections' reach past the data (`DOMAIN_GAP_SIGMA_P` sigma_p).
     max_gap: f64,
 }
@@ -82,7 +80,7 @@ struct Domain<'a> {
 impl Domain<'_> {
     /// Whether a support point lies within `r` of `p`.
     fn within(&self, p: DVec3, r: f64) -> bool {
-        self.tree.nearest(p).is_some_and(|(_, d2)| d2 <= r * r)
+        self.rimls.nearest(p).is_some_and(|(_, d2)| d2 <= r * r)
     }
 
     fn covers_one(&self, p: DVec3) -> bool {
@@ -281,16 +279,7 @@ pub fn remesh_points(
     let mut source = ScannedInput::open(input, &scan_params, params.drop_outliers)?;
     let mut sigma_p = source.sigma_p;
     let mut scans = 0;
-    let (
-        scan,
-        kernel,
-        rimls,
-        support_tree,
-        samples,
-        mut moving,
-        unprojected_samples,
-        rescan_rejected,
-    ) = loop {
+    let (scan, kernel, rimls, samples, mut moving, unprojected_samples, rescan_rejected) = loop {
         scans += 1;
         let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE)?;
         let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
@@ -313,7 +302,6 @@ pub fn remesh_points(
             // The points are in the bbox-100 frame, a viewpoint in model units.
             params.orientation.in_frame(&scan.normalization),
         )?;
-        let support_tree = StaticTree::new(rimls.positions());
         // The samples are input points, noisy: they start on the surface.
         let positions: Vec<DVec3> = samples.iter().map(|p| p.position).collect();
         let projected = rimls.project_all(&positions);
@@ -322,11 +310,7 @@ pub fn remesh_points(
         let mut moving: Vec<SurfaceSample> = projected
             .into_iter()
             .flatten()
-            .filter(|&(position, _)| {
-                support_tree
-                    .nearest(position)
-                    .is_some_and(|(_, d2)| d2 <= reach2)
-            })
+            .filter(|&(position, _)| rimls.nearest(position).is_some_and(|(_, d2)| d2 <= reach2))
             .map(|(position, normal)| SurfaceSample {
                 position,
                 normal,
@@ -361,24 +345,12 @@ pub fn remesh_points(
                 sigma_p *= (v / n as f64).sqrt();
                 on_stage("scan");
             }
-            _ => {
-                break (
-                    scan,
-                    kernel,
-                    rimls,
-                    support_tree,
-                    samples,
-                    moving,
-                    unprojected,
-                    rejected,
-                )
-            }
+            _ => break (scan, kernel, rimls, samples, moving, unprojected, rejected),
         }
     };
     let normalization = scan.normalization;
     let domain = Domain {
         rimls: &rimls,
-        tree: support_tree,
         max_gap: DOMAIN_GAP_SIGMA_P * sigma_p,
     };
     // The RIMLS points on their own surface: the points the optimization keeps covered.

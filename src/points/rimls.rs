@@ -337,6 +337,11 @@ impl Rimls {
         self.positions.len()
     }
 
+    /// The point nearest to `p`: its index and squared distance (the surface's own kd-tree).
+    pub fn nearest(&self, p: DVec3) -> Option<(u32, f64)> {
+        self.tree.nearest(p)
+    }
+
     /// Always false ([`Rimls::new`] refuses an empty set).
     pub fn is_empty(&self) -> bool {
         self.positions.is_empty()
