@@ -20,6 +20,18 @@ use glam::DVec3;
 
 use crate::error::{Error, Result};
 
+/// A positive definite kernel with k(x, x) = 1 on points already mapped to kernel space: what
+/// the spectral measure (eq. 9, [`spectral_measure`](crate::spectral_measure)) and its
+/// evaluation by eq. 10 need of a kernel. The measure's code is written once over this trait;
+/// [`Kernel`] (surfaces in R^3, x = [p/sigma_p, n/sigma_n] in R^6) and [`GaussianKernel`]
+/// (point sets in R^d, x in R^K) implement it.
+pub trait UnitKernel {
+    /// A point in kernel space.
+    type Point: Copy;
+    /// k(x, y), with k(x, x) = 1 and every kernel matrix positive (semi-)definite.
+    fn eval(&self, x: &Self::Point, y: &Self::Point) -> f64;
+}
+
 /// The neighbourhood radius in kernel space (Sec. 6.3): k(x, y) = exp(-6.25) ≈ 0.0019 beyond it.
 pub const SUPPORT_RADIUS: f64 = 2.5;
 
@@ -170,6 +182,44 @@ impl Kernel {
     }
 }
 
+impl UnitKernel for Kernel {
+    type Point = KernelPoint;
+
+    #[inline]
+    fn eval(&self, x: &KernelPoint, y: &KernelPoint) -> f64 {
+        Kernel::eval(self, x, y)
+    }
+}
+
+/// The paper's Gaussian k(x, y) = exp(-|x - y|²) (Sec. 3) on points of R^K already scaled to
+/// kernel space: x = [p/sigma_p, n/sigma_n] for a point p of R^d with a normal n (K = 2d), or
+/// x = p/sigma_p with positions only (K = d). The kernel of point sets near a manifold of any
+/// dimension (the paper's abstract and Sec. 3; [`crate::manifold`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct GaussianKernel<const K: usize>;
+
+impl<const K: usize> GaussianKernel<K> {
+    /// Squared Euclidean distance in kernel space, |x - y|².
+    #[inline]
+    pub fn dist2(x: &[f64; K], y: &[f64; K]) -> f64 {
+        let mut d = 0.0;
+        for k in 0..K {
+            let t = x[k] - y[k];
+            d += t * t;
+        }
+        d
+    }
+}
+
+impl<const K: usize> UnitKernel for GaussianKernel<K> {
+    type Point = [f64; K];
+
+    #[inline]
+    fn eval(&self, x: &[f64; K], y: &[f64; K]) -> f64 {
+        (-Self::dist2(x, y)).exp()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -187,6 +237,21 @@ mod tests {
         let yn = kn.embed(DVec3::new(2.0, 0.0, 0.0), -DVec3::Z);
         // 1 + |2 z|^2 = 5.
         assert!((kn.eval(&xn, &yn) - (-5.0f64).exp()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_gaussian_in_r_k_is_the_surface_kernel_on_the_same_coordinates() {
+        let k = Kernel::new(1.7, 0.6).unwrap();
+        let x = k.embed(DVec3::new(0.3, -1.2, 2.0), DVec3::new(0.6, 0.0, 0.8));
+        let y = k.embed(DVec3::new(1.1, -0.4, 2.5), DVec3::Z);
+        assert_eq!(
+            GaussianKernel::<6>.eval(&x.coords, &y.coords),
+            k.eval(&x, &y)
+        );
+        assert_eq!(GaussianKernel::<2>.eval(&[0.5, 1.0], &[0.5, 1.0]), 1.0);
+        assert!(
+            (GaussianKernel::<2>.eval(&[0.0, 0.0], &[1.0, 1.0]) - (-2.0f64).exp()).abs() < 1e-16
+        );
     }
 
     #[test]

@@ -119,6 +119,7 @@ mod error;
 pub mod geometry;
 mod io;
 mod kernel;
+pub mod manifold;
 mod measure;
 mod mesh;
 mod pipeline;
@@ -201,14 +202,20 @@ pub use triangulate::{
 };
 
 // The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).
-pub use kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
+pub use kernel::{GaussianKernel, Kernel, KernelPoint, UnitKernel, SUPPORT_RADIUS};
 pub use measure::{
     measure_and_gradient, measure_and_gradient_graded, projection_coefficients, spectral_measure,
     IncrementalInverse, Measure, MeasureWorkspace, Push, DEFAULT_EPSILON,
 };
 
-// A kd-tree over fixed points (neighbourhoods of the measure).
-pub use spatial::StaticTree;
+// kd-trees: over fixed 3D points (neighbourhoods of the measure), and over points of R^K.
+pub use spatial::{DynamicKdTree, StaticKdTree, StaticTree};
+
+// Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.
+pub use manifold::{
+    estimate_dimension, resample_manifold, sample_manifold, DataProjection, ManifoldProjection,
+    ManifoldResampleParams, ManifoldSampleParams, ManifoldSampling, PointSet,
+};
 
 // Checks of a mesh: invariants (typed violations), topology, self-intersections, the distance
 // from creases to the output's edges.

@@ -6,7 +6,7 @@
 //! that duplicates one. Adding neighbours can only lower it, so the linear scan stops adding them
 //! as soon as s <= epsilon (Sec. 6.1).
 
-use crate::kernel::{Kernel, KernelPoint};
+use crate::kernel::{Kernel, KernelPoint, UnitKernel};
 
 /// The acceptance threshold of the linear scan (Sec. 6.3: epsilon = 0.5 for all the paper's
 /// results).
@@ -34,10 +34,12 @@ pub struct Measure {
 /// K_{n+1}^-1 = [[K_n^-1 + g a a^T, -g a], [-g a^T, g]],
 /// a = K_n^-1 k_n(x_{n+1}), g = (k(x_{n+1}, x_{n+1}) - k_n(x_{n+1})^T a)^-1.
 ///
-/// Costs O(n^2) per point. Reuse one value across evaluations to avoid allocation.
-#[derive(Debug, Clone, Default)]
-pub struct IncrementalInverse {
-    points: Vec<KernelPoint>,
+/// Costs O(n^2) per point. Reuse one value across evaluations to avoid allocation. `P` is the
+/// kernel's point type ([`UnitKernel::Point`]): [`KernelPoint`] for surfaces in R^3, `[f64; K]`
+/// for point sets in R^d.
+#[derive(Debug, Clone)]
+pub struct IncrementalInverse<P = KernelPoint> {
+    points: Vec<P>,
     /// K^-1, row-major, n × n.
     inv: Vec<f64>,
     scratch: Vec<f64>,
@@ -57,7 +59,19 @@ pub enum Push {
     Skipped,
 }
 
-impl IncrementalInverse {
+impl<P> Default for IncrementalInverse<P> {
+    fn default() -> Self {
+        IncrementalInverse {
+            points: Vec::new(),
+            inv: Vec::new(),
+            scratch: Vec::new(),
+            b: Vec::new(),
+            a: Vec::new(),
+        }
+    }
+}
+
+impl<P: Copy> IncrementalInverse<P> {
     /// An empty set (K is 0 × 0).
     pub fn new() -> Self {
         Self::default()
@@ -80,7 +94,7 @@ impl IncrementalInverse {
     }
 
     /// The points of K, in the order they were added.
-    pub fn points(&self) -> &[KernelPoint] {
+    pub fn points(&self) -> &[P] {
         &self.points
     }
 
@@ -95,7 +109,7 @@ impl IncrementalInverse {
     }
 
     /// Adds y to the set with eq. 10, or skips it when it is numerically in the span.
-    pub fn push(&mut self, kernel: &Kernel, y: KernelPoint) -> Push {
+    pub fn push<K: UnitKernel<Point = P>>(&mut self, kernel: &K, y: P) -> Push {
         let n = self.points.len();
         self.b.clear();
         self.b
@@ -129,20 +143,43 @@ impl IncrementalInverse {
     }
 }
 
-/// Reusable buffers for [`spectral_measure`] and [`measure_and_gradient`]; one per thread.
-#[derive(Debug, Clone, Default)]
-pub struct MeasureWorkspace {
-    inverse: IncrementalInverse,
+/// Reusable buffers for [`spectral_measure`] and [`measure_and_gradient`]; one per thread. `P` is
+/// the kernel's point type, as for [`IncrementalInverse`].
+#[derive(Debug, Clone)]
+pub struct MeasureWorkspace<P = KernelPoint> {
+    inverse: IncrementalInverse<P>,
     k: Vec<f64>,
     chol: Vec<f64>,
     z: Vec<f64>,
     kept: Vec<usize>,
 }
 
-impl MeasureWorkspace {
+impl<P> Default for MeasureWorkspace<P> {
+    fn default() -> Self {
+        MeasureWorkspace {
+            inverse: IncrementalInverse::default(),
+            k: Vec::new(),
+            chol: Vec::new(),
+            z: Vec::new(),
+            kept: Vec::new(),
+        }
+    }
+}
+
+impl<P> MeasureWorkspace<P> {
     /// Empty buffers.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// After [`solve_alpha`]: the neighbours kept (indices into its `neighbors`), with their
+    /// α_i = (K^-1 k)_i and k_i = k(x, y_i), row by row.
+    pub(crate) fn alpha_rows(&self) -> impl Iterator<Item = (usize, f64, f64)> + '_ {
+        self.kept
+            .iter()
+            .zip(&self.z)
+            .zip(&self.k)
+            .map(|((&j, &a), &k)| (j, a, k))
     }
 }
 
@@ -154,12 +191,15 @@ impl MeasureWorkspace {
 /// With no neighbour s = 1. k(x, x) = 1 for this kernel, so s = 1 - k^T K^-1 k. The update of
 /// q = k^T K^-1 k per added neighbour y is q += g (k(x, y) - a^T k)^2 (the Schur complement of
 /// eq. 10), O(n^2) per neighbour.
-pub fn spectral_measure(
-    kernel: &Kernel,
-    x: &KernelPoint,
-    neighbors: impl IntoIterator<Item = KernelPoint>,
+///
+/// Generic over the kernel ([`UnitKernel`]): the surface kernel [`Kernel`] on [`KernelPoint`]s,
+/// or [`GaussianKernel`](crate::GaussianKernel) on points of R^K.
+pub fn spectral_measure<K: UnitKernel>(
+    kernel: &K,
+    x: &K::Point,
+    neighbors: impl IntoIterator<Item = K::Point>,
     stop_at: f64,
-    ws: &mut MeasureWorkspace,
+    ws: &mut MeasureWorkspace<K::Point>,
 ) -> Measure {
     ws.inverse.clear();
     ws.k.clear();
@@ -285,11 +325,11 @@ pub fn measure_and_gradient_graded(
 /// them (squared pivot below [`SINGULAR_TOLERANCE`], exactly the neighbours eq. 10 skips) get no
 /// pair. With no neighbours `alpha` is empty and s = 1; a neighbour equal to x gets α = 1 and
 /// the others 0 (up to rounding).
-pub fn projection_coefficients(
-    kernel: &Kernel,
-    x: &KernelPoint,
-    neighbors: &[KernelPoint],
-    ws: &mut MeasureWorkspace,
+pub fn projection_coefficients<K: UnitKernel>(
+    kernel: &K,
+    x: &K::Point,
+    neighbors: &[K::Point],
+    ws: &mut MeasureWorkspace<K::Point>,
     alpha: &mut Vec<(usize, f64)>,
 ) -> f64 {
     let q = solve_alpha(kernel, x, neighbors, ws);
@@ -301,11 +341,11 @@ pub fn projection_coefficients(
 /// α = K^-1 k over `neighbors` (in the order given, near-singular ones skipped) by a Cholesky
 /// factorization built row by row: afterwards `ws.kept[r]` is the neighbour of row r, `ws.z[r]`
 /// its α and `ws.k[r]` its k(x, y). Returns q = k^T K^-1 k.
-fn solve_alpha(
-    kernel: &Kernel,
-    x: &KernelPoint,
-    neighbors: &[KernelPoint],
-    ws: &mut MeasureWorkspace,
+pub(crate) fn solve_alpha<K: UnitKernel>(
+    kernel: &K,
+    x: &K::Point,
+    neighbors: &[K::Point],
+    ws: &mut MeasureWorkspace<K::Point>,
 ) -> f64 {
     let n = neighbors.len();
     // Lower-triangular L with stride n over the kept rows; kept[r] = neighbour index of row r.

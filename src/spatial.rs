@@ -1,5 +1,7 @@
-//! Nearest-neighbour queries over 3D points: a thin layer over kiddo's kd-trees so the rest of the
-//! crate uses one vocabulary (indices into the caller's point list, squared distances named `*_2`).
+//! Nearest-neighbour queries: a thin layer over kiddo's kd-trees so the rest of the crate uses one
+//! vocabulary (indices into the caller's point list, squared distances named `*_2`). The trees
+//! over points of R^K ([`DynamicKdTree`], [`StaticKdTree`]) serve point sets of any dimension;
+//! [`DynamicTree`] and [`StaticTree`] are those trees over 3D points in a rotated frame.
 
 use std::num::NonZeroUsize;
 
@@ -44,25 +46,27 @@ const fn rotation() -> [[f64; 3]; 3] {
     ]
 }
 
-/// A kd-tree that grows one point at a time (the output set of the linear scan, Sec. 6.3).
-pub struct DynamicTree {
-    tree: MutableKdTree<f64, 3>,
+/// A kd-tree that grows one point at a time, over points of R^K (the output set of the linear
+/// scan, Sec. 6.3). Points are stored as given: a caller whose points may share coordinates
+/// exactly (an axis-aligned plane) rotates them first, as [`DynamicTree`] does.
+pub struct DynamicKdTree<const K: usize> {
+    tree: MutableKdTree<f64, K>,
     /// Points the kd-tree refused (exact ties it cannot split, for example duplicates); searched
     /// by brute force so that no point is ever missing from a query.
-    overflow: Vec<([f64; 3], u32)>,
+    overflow: Vec<([f64; K], u32)>,
     len: usize,
 }
 
-impl Default for DynamicTree {
+impl<const K: usize> Default for DynamicKdTree<K> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl DynamicTree {
+impl<const K: usize> DynamicKdTree<K> {
     /// An empty tree.
     pub fn new() -> Self {
-        DynamicTree {
+        DynamicKdTree {
             tree: MutableKdTree::default(),
             overflow: Vec::new(),
             len: 0,
@@ -70,38 +74,40 @@ impl DynamicTree {
     }
 
     /// Number of points.
-    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.len
     }
 
-    /// Adds point `p` with index `index`. A point the kd-tree cannot take (a bucket of exact
+    /// Whether the tree holds no point.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Adds point `q` with index `index`. A point the kd-tree cannot take (a bucket of exact
     /// coordinate ties) goes to a small list searched by brute force.
-    pub fn add(&mut self, p: DVec3, index: u32) {
-        let q = arr(p);
-        if self.tree.add(&q, index).is_err() {
-            self.overflow.push((q, index));
+    pub fn add(&mut self, q: &[f64; K], index: u32) {
+        if self.tree.add(q, index).is_err() {
+            self.overflow.push((*q, index));
         }
         self.len += 1;
     }
 
-    /// The nearest point to `p` as `(index, squared distance)`; `None` when empty.
-    pub fn nearest(&self, p: DVec3) -> Option<(u32, f64)> {
+    /// The nearest point to `q` as `(index, squared distance)`; `None` when empty.
+    pub fn nearest(&self, q: &[f64; K]) -> Option<(u32, f64)> {
         if self.len == 0 {
             return None;
         }
-        let q = arr(p);
         let mut best = (u32::MAX, f64::INFINITY);
         if self.len > self.overflow.len() {
             let r = self
                 .tree
-                .query(&q)
+                .query(q)
                 .nearest_one::<SquaredEuclidean<f64>>()
                 .execute();
             best = (r.item, r.distance);
         }
         for &(o, i) in &self.overflow {
-            let d = dist2(&o, &q);
+            let d = dist2(&o, q);
             if d < best.1 || (d == best.1 && i < best.0) {
                 best = (i, d);
             }
@@ -109,8 +115,8 @@ impl DynamicTree {
         Some(best)
     }
 
-    /// The `k` nearest points to `p`, nearest first, into `out` as `(index, squared distance)`.
-    pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
+    /// The `k` nearest points to `q`, nearest first, into `out` as `(index, squared distance)`.
+    pub fn nearest_n(&self, q: &[f64; K], k: usize, out: &mut Vec<(u32, f64)>) {
         out.clear();
         let Some(k_nz) = NonZeroUsize::new(k) else {
             return;
@@ -118,33 +124,31 @@ impl DynamicTree {
         if self.len == 0 {
             return;
         }
-        let q = arr(p);
         if self.len > self.overflow.len() {
             let r = self
                 .tree
-                .query(&q)
+                .query(q)
                 .nearest_n::<SquaredEuclidean<f64>>(k_nz)
                 .execute();
             out.extend(r.into_iter().map(|n| (n.item, n.distance)));
         }
         if !self.overflow.is_empty() {
-            out.extend(self.overflow.iter().map(|&(o, i)| (i, dist2(&o, &q))));
+            out.extend(self.overflow.iter().map(|&(o, i)| (i, dist2(&o, q))));
             out.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
             out.truncate(k);
         }
     }
 
-    /// All points within squared distance `radius_2` of `p`, nearest first, into `out` as
+    /// All points within squared distance `radius_2` of `q`, nearest first, into `out` as
     /// `(index, squared distance)`.
-    pub fn within(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {
+    pub fn within(&self, q: &[f64; K], radius_2: f64, out: &mut Vec<(u32, f64)>) {
         out.clear();
         if self.len == 0 {
             return;
         }
-        let q = arr(p);
         let r = self
             .tree
-            .query(&q)
+            .query(q)
             .within::<SquaredEuclidean<f64>>(radius_2)
             .execute();
         out.extend(r.into_iter().map(|n| (n.item, n.distance)));
@@ -152,7 +156,7 @@ impl DynamicTree {
             out.extend(
                 self.overflow
                     .iter()
-                    .map(|&(o, i)| (i, dist2(&o, &q)))
+                    .map(|&(o, i)| (i, dist2(&o, q)))
                     .filter(|x| x.1 <= radius_2),
             );
             out.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
@@ -160,75 +164,153 @@ impl DynamicTree {
     }
 }
 
-#[inline]
-fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
+/// A kd-tree over 3D points that grows one point at a time (the output set of the linear scan,
+/// Sec. 6.3), in the rotated frame of [`arr`] so that axis-aligned ties do not arise.
+#[derive(Default)]
+pub struct DynamicTree {
+    tree: DynamicKdTree<3>,
 }
 
-/// A kd-tree built once over a fixed point list.
-pub struct StaticTree {
-    tree: Option<ImmutableKdTree<f64, 3>>,
-}
-
-impl StaticTree {
-    /// A tree over `points`; index `i` of a result is `points[i]`.
-    pub fn new(points: &[DVec3]) -> Self {
-        let entries: Vec<[f64; 3]> = points.iter().map(|&p| arr(p)).collect();
-        let tree = if entries.is_empty() {
-            None
-        } else {
-            ImmutableKdTree::new_from_slice(&entries).ok()
-        };
-        StaticTree { tree }
+impl DynamicTree {
+    /// An empty tree.
+    pub fn new() -> Self {
+        Self::default()
     }
 
-    /// Points within squared distance `radius_2` of `p`, nearest first, as `(index, squared
-    /// distance)`.
+    /// Number of points.
+    #[cfg(test)]
+    pub fn len(&self) -> usize {
+        self.tree.len()
+    }
+
+    /// Adds point `p` with index `index` (see [`DynamicKdTree::add`]).
+    pub fn add(&mut self, p: DVec3, index: u32) {
+        self.tree.add(&arr(p), index);
+    }
+
+    /// The nearest point to `p` as `(index, squared distance)`; `None` when empty.
+    pub fn nearest(&self, p: DVec3) -> Option<(u32, f64)> {
+        self.tree.nearest(&arr(p))
+    }
+
+    /// The `k` nearest points to `p`, nearest first, into `out` as `(index, squared distance)`.
+    pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
+        self.tree.nearest_n(&arr(p), k, out);
+    }
+
+    /// All points within squared distance `radius_2` of `p`, nearest first, into `out` as
+    /// `(index, squared distance)`.
     pub fn within(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {
+        self.tree.within(&arr(p), radius_2, out);
+    }
+}
+
+#[inline]
+fn dist2<const K: usize>(a: &[f64; K], b: &[f64; K]) -> f64 {
+    let mut d = 0.0;
+    for k in 0..K {
+        d += (a[k] - b[k]).powi(2);
+    }
+    d
+}
+
+/// A kd-tree built once over a fixed list of points of R^K.
+pub struct StaticKdTree<const K: usize> {
+    tree: Option<ImmutableKdTree<f64, K>>,
+}
+
+impl<const K: usize> StaticKdTree<K> {
+    /// A tree over `points`; index `i` of a result is `points[i]`.
+    pub fn new(points: &[[f64; K]]) -> Self {
+        let tree = if points.is_empty() {
+            None
+        } else {
+            ImmutableKdTree::new_from_slice(points).ok()
+        };
+        StaticKdTree { tree }
+    }
+
+    /// Points within squared distance `radius_2` of `q`, nearest first, as `(index, squared
+    /// distance)`.
+    pub fn within(&self, q: &[f64; K], radius_2: f64, out: &mut Vec<(u32, f64)>) {
         out.clear();
         if let Some(t) = &self.tree {
             let r = t
-                .query(&arr(p))
+                .query(q)
                 .within::<SquaredEuclidean<f64>>(radius_2)
                 .execute();
             out.extend(r.into_iter().map(|q| (q.item, q.distance)));
         }
     }
 
-    /// Points within squared distance `radius_2` of `p`, in no particular order (cheaper than
-    /// [`StaticTree::within`]), as `(index, squared distance)`.
-    pub fn within_unsorted(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {
+    /// Points within squared distance `radius_2` of `q`, in no particular order (cheaper than
+    /// [`StaticKdTree::within`]), as `(index, squared distance)`.
+    pub fn within_unsorted(&self, q: &[f64; K], radius_2: f64, out: &mut Vec<(u32, f64)>) {
         out.clear();
         if let Some(t) = &self.tree {
-            t.query(&arr(p))
+            t.query(q)
                 .within::<SquaredEuclidean<f64>>(radius_2)
                 .unsorted()
                 .visit(|q| out.push((q.item, q.distance)));
         }
     }
 
-    /// The nearest point to `p` as `(index, squared distance)`; `None` when the tree is empty.
-    pub fn nearest(&self, p: DVec3) -> Option<(u32, f64)> {
+    /// The nearest point to `q` as `(index, squared distance)`; `None` when the tree is empty.
+    pub fn nearest(&self, q: &[f64; K]) -> Option<(u32, f64)> {
         let r = self
             .tree
             .as_ref()?
-            .query(&arr(p))
+            .query(q)
             .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
         Some((r.item, r.distance))
     }
 
-    /// The `k` nearest points to `p`, nearest first, as `(index, squared distance)`.
-    pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
+    /// The `k` nearest points to `q`, nearest first, as `(index, squared distance)`.
+    pub fn nearest_n(&self, q: &[f64; K], k: usize, out: &mut Vec<(u32, f64)>) {
         out.clear();
         let (Some(t), Some(k)) = (&self.tree, NonZeroUsize::new(k)) else {
             return;
         };
-        let r = t
-            .query(&arr(p))
-            .nearest_n::<SquaredEuclidean<f64>>(k)
-            .execute();
+        let r = t.query(q).nearest_n::<SquaredEuclidean<f64>>(k).execute();
         out.extend(r.into_iter().map(|q| (q.item, q.distance)));
+    }
+}
+
+/// A kd-tree built once over a fixed list of 3D points, in the rotated frame of [`arr`].
+pub struct StaticTree {
+    tree: StaticKdTree<3>,
+}
+
+impl StaticTree {
+    /// A tree over `points`; index `i` of a result is `points[i]`.
+    pub fn new(points: &[DVec3]) -> Self {
+        let entries: Vec<[f64; 3]> = points.iter().map(|&p| arr(p)).collect();
+        StaticTree {
+            tree: StaticKdTree::new(&entries),
+        }
+    }
+
+    /// Points within squared distance `radius_2` of `p`, nearest first, as `(index, squared
+    /// distance)`.
+    pub fn within(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {
+        self.tree.within(&arr(p), radius_2, out);
+    }
+
+    /// Points within squared distance `radius_2` of `p`, in no particular order (cheaper than
+    /// [`StaticTree::within`]), as `(index, squared distance)`.
+    pub fn within_unsorted(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {
+        self.tree.within_unsorted(&arr(p), radius_2, out);
+    }
+
+    /// The nearest point to `p` as `(index, squared distance)`; `None` when the tree is empty.
+    pub fn nearest(&self, p: DVec3) -> Option<(u32, f64)> {
+        self.tree.nearest(&arr(p))
+    }
+
+    /// The `k` nearest points to `p`, nearest first, as `(index, squared distance)`.
+    pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
+        self.tree.nearest_n(&arr(p), k, out);
     }
 }
 

@@ -1,7 +1,8 @@
 //! The search for the sigma_p that gives a target number of samples.
 //!
-//! On a surface the count of a linear scan grows like sigma_p^-2, so the search works on
-//! log sigma_p against log count: a first step with slope -2, then secant steps on the two
+//! On a surface the count of a linear scan grows like sigma_p^-2 (on a manifold of dimension m,
+//! like sigma_p^-m), so the search works on log sigma_p against log count: a first step with
+//! slope -m, then secant steps on the two
 //! closest evaluations, kept inside the bracket found so far (bisection in log space when a
 //! secant step leaves it).
 
@@ -30,6 +31,9 @@ pub struct TargetCountParams {
     pub tolerance: f64,
     /// Most evaluations (default 16).
     pub max_evaluations: usize,
+    /// The dimension m of the sampled manifold (default 2, a surface): the count is taken to
+    /// fall like sigma_p^-m for the first step; the secant steps after it measure the slope.
+    pub dimension: f64,
 }
 
 impl TargetCountParams {
@@ -39,6 +43,7 @@ impl TargetCountParams {
             target,
             tolerance: 0.005,
             max_evaluations: 16,
+            dimension: 2.0,
         }
     }
 }
@@ -109,12 +114,12 @@ pub fn find_sigma_p<T>(
         } else if hi.is_none_or(|h| ln_sigma < h.0) {
             hi = Some((ln_sigma, ln_count));
         }
-        // Next guess: secant across the bracket, or slope -2 from the last point.
+        // Next guess: secant across the bracket, or slope -m from the last point.
         let mut next = match (lo, hi) {
             (Some(l), Some(h)) if (h.1 - l.1).abs() > LOG_COUNT_TOLERANCE => {
                 l.0 + (ln_target - l.1) * (h.0 - l.0) / (h.1 - l.1)
             }
-            _ => ln_sigma + 0.5 * (ln_count - ln_target),
+            _ => ln_sigma + (ln_count - ln_target) / params.dimension,
         };
         if let (Some(l), Some(h)) = (lo, hi) {
             // Stay strictly inside the bracket; bisect when the secant lands near its ends.
