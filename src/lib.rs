@@ -214,7 +214,7 @@ pub use spatial::{DynamicKdTree, StaticKdTree, StaticTree};
 // Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.
 pub use manifold::{
     estimate_dimension, resample_manifold, sample_manifold, DataProjection, ManifoldProjection,
-    ManifoldResampleParams, ManifoldSampleParams, ManifoldSampling, PointSet,
+    ManifoldResampleParams, ManifoldSampleParams, ManifoldSampling, PointSet, MANIFOLD_ASCENT_STEP,
 };
 
 // Checks of a mesh: invariants (typed violations), topology, self-intersections, the distance
