@@ -48,7 +48,7 @@ const fn rotation() -> [[f64; 3]; 3] {
 
 /// A kd-tree that grows one point at a time, over points of R^K (the output set of the linear
 /// scan, Sec. 6.3). Points are stored as given: a caller whose points may share coordinates
-/// exactly (an axis-aligned plane) rotates them first, as [`DynamicTree`] does.
+/// exactly (an axis-aligned plane) rotates them first, as the 3D trees do.
 pub struct DynamicKdTree<const K: usize> {
     tree: MutableKdTree<f64, K>,
     /// Points the kd-tree refused (exact ties it cannot split, for example duplicates); searched
@@ -165,7 +165,8 @@ impl<const K: usize> DynamicKdTree<K> {
 }
 
 /// A kd-tree over 3D points that grows one point at a time (the output set of the linear scan,
-/// Sec. 6.3), in the rotated frame of [`arr`] so that axis-aligned ties do not arise.
+/// Sec. 6.3), in a fixed generic rotation of the model frame so that axis-aligned ties do not
+/// arise.
 #[derive(Default)]
 pub struct DynamicTree {
     tree: DynamicKdTree<3>,
@@ -277,7 +278,8 @@ impl<const K: usize> StaticKdTree<K> {
     }
 }
 
-/// A kd-tree built once over a fixed list of 3D points, in the rotated frame of [`arr`].
+/// A kd-tree built once over a fixed list of 3D points, in a fixed generic rotation of the model
+/// frame (no axis-aligned ties).
 pub struct StaticTree {
     tree: StaticKdTree<3>,
 }

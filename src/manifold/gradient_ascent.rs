@@ -18,6 +18,14 @@ use crate::measure::{solve_alpha, MeasureWorkspace};
 use crate::sampling::gradient_ascent::GradientAscentResult;
 use crate::spatial::StaticKdTree;
 
+/// One thread's buffers for [`step`]: the measure's workspace, the neighbours with their squared
+/// distances, the neighbours nearest first.
+type Scratch<const K: usize> = (
+    MeasureWorkspace<[f64; K]>,
+    Vec<(f64, [f64; K])>,
+    Vec<[f64; K]>,
+);
+
 /// The most samples moved together (and projected in one call) by a sweep.
 const MAX_BATCH: usize = 64;
 
@@ -184,7 +192,7 @@ fn resample_in_batches<const K: usize>(
                 .par_iter()
                 .map_init(
                     || (MeasureWorkspace::new(), Vec::new(), Vec::new()),
-                    |(ws, near, sorted): &mut (_, Vec<(f64, [f64; K])>, Vec<[f64; K]>), &i| {
+                    |(ws, near, sorted): &mut Scratch<K>, &i| {
                         let x = embedded[i];
                         near.clear();
                         for &j in &lists[i] {

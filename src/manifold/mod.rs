@@ -78,7 +78,7 @@ impl PointSet {
                 format!("{dim} coordinates are more than the {MAX_KERNEL_DIMENSION} supported"),
             );
         }
-        if positions.len() % dim != 0 {
+        if !positions.len().is_multiple_of(dim) {
             return bad(
                 "X",
                 format!("{} values are not rows of {dim}", positions.len()),

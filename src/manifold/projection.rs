@@ -35,6 +35,9 @@ pub trait ManifoldProjection {
     fn project(&self, positions: &mut [f64], normals: Option<&mut [f64]>) -> Result<()>;
 }
 
+/// Coordinates of x - c along some of the local fit's axes: `coords(x, axes)`.
+type AxisCoords<'a> = dyn Fn(&[f64], &[usize]) -> Vec<f64> + 'a;
+
 /// The k nearest data points of a query, by position, in the kd-tree of the right dimension.
 trait NearestRows: Send + Sync {
     /// The `k` nearest data points to `p` (d coordinates), nearest first, into `out` as
@@ -179,7 +182,7 @@ impl DataProjection {
     fn fitted_offsets(
         &self,
         found: &[(u32, f64)],
-        coords: &dyn Fn(&[f64], &[usize]) -> Vec<f64>,
+        coords: &AxisCoords<'_>,
         tangent: &[usize],
         normal: &[usize],
         t_p: &[f64],
