@@ -1,22 +1,33 @@
-"""Spectral sampling and remeshing of triangle meshes (Öztireli, Alexa, Gross 2010: Spectral
-Sampling of Manifolds), numpy in, numpy out.
+"""Spectral sampling of manifolds (Öztireli, Alexa, Gross 2010): remeshing of triangle meshes,
+and sampling of point sets near a manifold of any dimension in R^d, numpy in, numpy out.
+
+Triangle meshes: `read`, `remesh` and `quality`, as the `remesh` command line does them.
+Point sets of shape (n, d), d from 1 to 16 (a curve in the plane, a surface in R^3 or R^4, a
+3-manifold in R^4, ...): `sample` chooses an even subset of the points, `resample` moves the
+samples into blue noise on the manifold.
 
 Arrays in: anything ``numpy.asarray`` reads. Positions of any real dtype are converted to
-float64; face indices of any integer dtype are checked against the vertex count (a float
-array of indices is refused); non-contiguous arrays (slices, transposes, negative strides) are
-read through their strides, never refused. Errors carry the library's one-line message:
-ValueError for input or options that cannot be used, OSError for files the operating system
-refuses, RuntimeError for an internal failure (a bug) or a strict refusal. The GIL is released
-while the library works.
+float64; face and sample indices of any integer dtype are checked against the vertex or point
+count (a float array of indices is refused); non-contiguous arrays (slices, transposes,
+negative strides) are read through their strides, never refused. Errors carry the library's
+one-line message: ValueError for input or options that cannot be used, OSError for files the
+operating system refuses, RuntimeError for an internal failure (a bug) or a strict refusal.
+The GIL is released while the library works (but for the calls of a Python `project`).
 """
 
 from os import PathLike
-from typing import Any, Dict, Optional, Tuple, Union
+from typing import Any, Callable, Dict, Literal, Optional, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+
+# What `resample`'s `project` takes: Y (m, d) -> Y2 (m, d), or with normals -> (Y2, N2).
+_ProjectPoints = Callable[[npt.NDArray[np.float64]], npt.ArrayLike]
+_ProjectPointsAndNormals = Callable[
+    [npt.NDArray[np.float64]], Tuple[npt.ArrayLike, npt.ArrayLike]
+]
 
 def read(
     path: Union[str, "PathLike[str]"], /
@@ -187,5 +198,239 @@ def remesh(
     RuntimeError
         With strict=True, an output that breaks an invariant or changes the topology; or an
         internal failure.
+    """
+    ...
+
+@overload
+def sample(
+    X: npt.ArrayLike,
+    normals: Optional[npt.ArrayLike] = None,
+    *,
+    sigma_p: Optional[float] = None,
+    count: Optional[int] = None,
+    sigma_n: Optional[float] = None,
+    seed: int = 1,
+    epsilon: float = 0.5,
+    dim: Optional[int] = None,
+    return_report: Literal[False] = False,
+) -> npt.NDArray[np.int64]: ...
+@overload
+def sample(
+    X: npt.ArrayLike,
+    normals: Optional[npt.ArrayLike] = None,
+    *,
+    sigma_p: Optional[float] = None,
+    count: Optional[int] = None,
+    sigma_n: Optional[float] = None,
+    seed: int = 1,
+    epsilon: float = 0.5,
+    dim: Optional[int] = None,
+    return_report: Literal[True],
+) -> Tuple[npt.NDArray[np.int64], Dict[str, Any]]: ...
+@overload
+def sample(
+    X: npt.ArrayLike,
+    normals: Optional[npt.ArrayLike] = None,
+    *,
+    sigma_p: Optional[float] = None,
+    count: Optional[int] = None,
+    sigma_n: Optional[float] = None,
+    seed: int = 1,
+    epsilon: float = 0.5,
+    dim: Optional[int] = None,
+    return_report: bool = False,
+) -> Union[npt.NDArray[np.int64], Tuple[npt.NDArray[np.int64], Dict[str, Any]]]:
+    """Choose samples of a point set near a manifold of any dimension, by the randomized linear
+    scan (Algorithm 1 of the paper).
+
+    The points are visited in a random order (seeded) and kept when the spectral measure of the
+    Gaussian kernel exp(-|x - y|²), x = [p / sigma_p, n / sigma_n], over the points kept so far
+    exceeds epsilon: an even (blue-noise) subset of the rows of X, about sigma_p apart, on
+    curves, surfaces, volumes and higher-dimensional manifolds alike. With `count`, sigma_p is
+    searched for (a few scans). Lengths are in X's own units (no rescaling). The GIL is released
+    during the work.
+
+    Parameters
+    ----------
+    X : array_like, shape (n, d)
+        The points, any real dtype (converted to float64), n >= 1, d from 1 to 16.
+    normals : array_like, shape (n, d), or None
+        A direction per point (a hypersurface's normal, or any direction field the kernel should
+        tell apart), normalized here; used with a finite sigma_n (then d at most 8).
+    sigma_p : float or None
+        The kernel width in X's units: samples end up about this far apart.
+    count : int or None
+        About this many samples (within 0.5% when the search reaches it: the report's
+        `reached`), sigma_p searched for; 1 to n. Give exactly one of sigma_p and count.
+    sigma_n : float or None
+        The normal width (> 0; needs normals): finite values keep points whose normals differ
+        close together (denser where the normals turn). None: infinity, positions only.
+    seed : int
+        Seed of the visit order and of the dimension estimate (0 to 2^64 - 1).
+    epsilon : float
+        The acceptance threshold of the measure, in (0, 1): lower takes more samples.
+    dim : int or None
+        The dimension m of the manifold the points lie near (1 to d), for the count search's
+        first step. None: estimated from the points (Levina and Bickel).
+    return_report : bool
+        Also return the report.
+
+    Returns
+    -------
+    indices : numpy.ndarray of int64, shape (k,)
+        The samples as rows of X, increasing.
+    report : dict
+        With return_report=True: `sigma_p` (the width used, X's units), `sigma_n` (None for
+        infinity), `dim` (the manifold dimension used or estimated; None when sigma_p was given
+        without dim), `reached` (the count within its tolerance; True with sigma_p), `search`
+        (every scan of the search as a pair (sigma_p, count), in order), `count` (k),
+        `rejected_by_nearest` and `measured` (the chosen scan's points rejected by their nearest
+        sample alone, and those whose measure was evaluated).
+
+    Raises
+    ------
+    ValueError
+        An array of the wrong shape or dtype, a coordinate that is not finite or a normal of
+        length 0 (naming its row), neither or both of sigma_p and count, a count outside 1 to n,
+        a finite sigma_n without normals, or a parameter out of its range.
+    """
+    ...
+
+
+@overload
+def resample(
+    X: npt.ArrayLike,
+    indices: npt.ArrayLike,
+    normals: None = None,
+    *,
+    sigma_p: float,
+    sigma_n: Optional[float] = None,
+    iterations: int = 10,
+    seed: int = 1,
+    dim: Optional[int] = None,
+    project: Optional[_ProjectPoints] = None,
+    return_report: Literal[False] = False,
+) -> npt.NDArray[np.float64]: ...
+@overload
+def resample(
+    X: npt.ArrayLike,
+    indices: npt.ArrayLike,
+    normals: npt.ArrayLike,
+    *,
+    sigma_p: float,
+    sigma_n: Optional[float] = None,
+    iterations: int = 10,
+    seed: int = 1,
+    dim: Optional[int] = None,
+    project: Optional[_ProjectPointsAndNormals] = None,
+    return_report: Literal[False] = False,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+@overload
+def resample(
+    X: npt.ArrayLike,
+    indices: npt.ArrayLike,
+    normals: None = None,
+    *,
+    sigma_p: float,
+    sigma_n: Optional[float] = None,
+    iterations: int = 10,
+    seed: int = 1,
+    dim: Optional[int] = None,
+    project: Optional[_ProjectPoints] = None,
+    return_report: Literal[True],
+) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
+@overload
+def resample(
+    X: npt.ArrayLike,
+    indices: npt.ArrayLike,
+    normals: npt.ArrayLike,
+    *,
+    sigma_p: float,
+    sigma_n: Optional[float] = None,
+    iterations: int = 10,
+    seed: int = 1,
+    dim: Optional[int] = None,
+    project: Optional[_ProjectPointsAndNormals] = None,
+    return_report: Literal[True],
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], Dict[str, Any]]: ...
+@overload
+def resample(
+    X: npt.ArrayLike,
+    indices: npt.ArrayLike,
+    normals: Optional[npt.ArrayLike] = None,
+    *,
+    sigma_p: float,
+    sigma_n: Optional[float] = None,
+    iterations: int = 10,
+    seed: int = 1,
+    dim: Optional[int] = None,
+    project: Optional[Callable[[npt.NDArray[np.float64]], Any]] = None,
+    return_report: bool = False,
+) -> Union[
+    npt.NDArray[np.float64],
+    Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]],
+    Tuple[npt.NDArray[np.float64], Dict[str, Any]],
+    Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], Dict[str, Any]],
+]:
+    """Move samples of a point set into an even (blue-noise) arrangement on its manifold, by
+    gradient ascent on the spectral measure (eq. 11 of the paper).
+
+    The samples X[indices] (usually from `sample`) move for `iterations` sweeps, each sample in a
+    seeded random order along the gradient of its measure over its neighbours, and each move is
+    projected onto the manifold: onto the point set X itself (a local quadratic fit to the
+    nearest rows of X; the normal of the nearest row) or by the callable `project`. Lengths are
+    in X's own units. The GIL is released during the work, but for the calls of `project`.
+
+    Parameters
+    ----------
+    X : array_like, shape (n, d)
+        The points, any real dtype (converted to float64), n >= 1, d from 1 to 16.
+    indices : array_like, shape (k,)
+        The samples as rows of X (0-based), any integer dtype, each row once.
+    normals : array_like, shape (n, d), or None
+        A direction per point, normalized here; the samples' normals follow their moves.
+    sigma_p : float
+        The kernel width in X's units, the one the samples were chosen with (`sample`'s
+        report).
+    sigma_n : float or None
+        The normal width (> 0; needs normals; then d at most 8). None: infinity, positions only.
+    iterations : int
+        Sweeps over all samples (>= 0).
+    seed : int
+        Seed of the visit order and of the dimension estimate (0 to 2^64 - 1).
+    dim : int or None
+        The dimension m of the manifold (1 to d) for the projection onto X. None: estimated from
+        the points. Not with `project`.
+    project : callable or None
+        `project(Y) -> Y2`: projects each row of a float64 array Y of shape (m, d) onto the
+        manifold and returns an array-like of the same shape; with normals it returns a pair
+        (Y2, N2), N2 the normals at Y2 (normalized here). Called with the GIL held, for batches
+        of samples of which no two are neighbours. None: the projection onto X.
+    return_report : bool
+        Also return the report.
+
+    Returns
+    -------
+    Y : numpy.ndarray of float64, shape (k, d)
+        The moved samples, in the order of indices.
+    N : numpy.ndarray of float64, shape (k, d)
+        Only with normals: their unit normals.
+    report : dict
+        With return_report=True, last: `sigma_p`, `sigma_n` (None for infinity), `iterations`,
+        `dim` (the manifold dimension of the projection onto X; None with `project`), and per
+        sweep `mean_move` (the mean move, X's units), `mean_s` and `min_s` (the mean and the
+        least measure before the sweep's moves).
+
+    Raises
+    ------
+    ValueError
+        An array of the wrong shape or dtype, a coordinate that is not finite or a normal of
+        length 0 (naming its row), an index out of range or repeated, a finite sigma_n without
+        normals, a parameter out of its range, or `project` returning the wrong shape or a
+        coordinate that is not finite.
+    TypeError
+        `project` is not callable.
+    Exception
+        Whatever `project` raises, unchanged.
     """
     ...

@@ -1,32 +1,40 @@
 //! The `spectral_remesh` Python module: the library's reading, remeshing and quality report on
-//! numpy arrays (`python/spectral_remesh.pyi` documents it for Python users).
+//! numpy arrays, and the sampling of point sets near a manifold of any dimension in R^d
+//! (`sample`, `resample`; `python/spectral_remesh.pyi` documents it for Python users).
 //!
 //! Every function copies its arrays into the library's types with the GIL held, then releases
 //! the GIL (`Python::detach`) for the work. Errors become Python exceptions carrying the
 //! library's one-line message ([`to_py_err`]); a panic (a bug) is caught before it reaches the
-//! interpreter and raised as `RuntimeError`.
+//! interpreter and raised as `RuntimeError`. A Python callable `project` of `resample` is the
+//! one exception: each of its calls takes the GIL again ([`CallableProjection`]), and what it
+//! raises reaches the caller unchanged.
 //!
 //! Arrays in: any array-like numpy can read (`numpy.asarray`). Positions of any real dtype are
-//! converted to `float64`, face indices of any integer dtype checked against the vertex count;
-//! non-contiguous arrays (slices, transposes) are read through their strides. Wrong shapes,
-//! non-numeric dtypes, non-finite coordinates and indices out of range are `ValueError`s.
+//! converted to `float64`, face and sample indices of any integer dtype checked against the
+//! vertex or point count; non-contiguous arrays (slices, transposes) are read through their
+//! strides. Wrong shapes, non-numeric dtypes, non-finite coordinates and indices out of range are
+//! `ValueError`s.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
+use std::sync::Mutex;
 
 use glam::DVec3;
-use numpy::ndarray::Array2;
+use numpy::ndarray::{Array1, Array2};
 use numpy::{
-    IntoPyArray, PyArray2, PyArrayDescrMethods, PyReadonlyArray2, PyUntypedArray,
+    IntoPyArray, PyArray2, PyArrayDescrMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArray,
     PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{
     PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyRuntimeError,
-    PyValueError,
+    PyTypeError, PyValueError,
 };
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-use spectral::{Error, QualityReport, RemeshOptions, TriMesh};
+use pyo3::types::{PyDict, PyList, PyTuple};
+use spectral::{
+    DataProjection, Error, ManifoldProjection, ManifoldResampleParams, ManifoldSampleParams,
+    PointSet, QualityReport, RemeshOptions, TriMesh,
+};
 
 /// A library error as the Python exception a caller expects, with the library's one-line
 /// message: `OSError` (or its `FileNotFoundError`, `PermissionError`, `IsADirectoryError`) when
@@ -506,21 +514,577 @@ fn remesh<'py>(
     Ok((v, f, report_dict(py, &out.report)?))
 }
 
-/// Spectral sampling and remeshing of triangle meshes (Öztireli, Alexa, Gross 2010: Spectral
-/// Sampling of Manifolds), numpy in, numpy out.
+/// The largest space dimension d of a point set (the library's kernel space, K = d).
+const MAX_DIM: usize = spectral::manifold::MAX_KERNEL_DIMENSION;
+
+/// `value` as a numpy array (`numpy.asarray(value)`).
+fn asarray<'py>(
+    py: Python<'py>,
+    value: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyUntypedArray>> {
+    Ok(py
+        .import("numpy")?
+        .call_method1("asarray", (value,))?
+        .cast_into::<PyUntypedArray>()?)
+}
+
+/// Points from an array-like of shape `(n, d)`, n >= 1 and 1 <= d <= 16 (or exactly `like`,
+/// the shape of X, for normals) and a real dtype (converted to `float64`): the values row-major,
+/// read through the array's strides, and `(n, d)`. Finiteness is checked by the library
+/// ([`PointSet::new`], naming the row).
+fn point_rows(
+    py: Python<'_>,
+    name: &str,
+    value: &Bound<'_, PyAny>,
+    like: Option<(usize, usize)>,
+) -> PyResult<(Vec<f64>, usize, usize)> {
+    let array = asarray(py, value)?;
+    let shape = array.shape();
+    match like {
+        None => {
+            if shape.len() != 2 || shape[0] == 0 || shape[1] == 0 || shape[1] > MAX_DIM {
+                return Err(PyValueError::new_err(format!(
+                    "{name} must be an array of shape (n, d): n >= 1 points of 1 to {MAX_DIM} \
+                     coordinates, got shape {}",
+                    shape_text(shape)
+                )));
+            }
+        }
+        Some((n, d)) => {
+            if shape != [n, d] {
+                return Err(PyValueError::new_err(format!(
+                    "{name} must be an array of the shape of X, ({n}, {d}), got shape {}",
+                    shape_text(shape)
+                )));
+            }
+        }
+    }
+    let (n, d) = (shape[0], shape[1]);
+    let dtype = array.dtype();
+    if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
+        return Err(PyValueError::new_err(format!(
+            "{name} must hold real numbers (a float or integer dtype), got dtype {}",
+            dtype.str()?
+        )));
+    }
+    let array: PyReadonlyArray2<f64> = py
+        .import("numpy")?
+        .call_method1("asarray", (array, "float64"))?
+        .extract()?;
+    // Logical (row-major) order whatever the strides.
+    Ok((array.as_array().iter().copied().collect(), n, d))
+}
+
+/// Sample indices from a 1-D array-like of an integer dtype: each names one of the `points`
+/// rows of X (0-based), none twice.
+fn sample_indices(py: Python<'_>, value: &Bound<'_, PyAny>, points: usize) -> PyResult<Vec<usize>> {
+    let array = asarray(py, value)?;
+    let shape = array.shape();
+    if shape.len() != 1 {
+        return Err(PyValueError::new_err(format!(
+            "indices must be an array of shape (k,), got shape {}",
+            shape_text(shape)
+        )));
+    }
+    if shape[0] == 0 {
+        return Err(PyValueError::new_err(
+            "indices must name at least one point, got shape (0,)",
+        ));
+    }
+    let dtype = array.dtype();
+    let (kind, size) = (dtype.kind(), dtype.itemsize());
+    if !matches!(kind, b'i' | b'u') {
+        return Err(PyValueError::new_err(format!(
+            "indices must hold point indices (an integer dtype), got dtype {}",
+            dtype.str()?
+        )));
+    }
+    // Each index checked against the point count and the ones before it, whatever its integer
+    // type.
+    fn checked<T: Copy + ToString>(
+        values: numpy::ndarray::ArrayView1<'_, T>,
+        points: usize,
+    ) -> PyResult<Vec<usize>>
+    where
+        usize: TryFrom<T>,
+    {
+        let mut first = vec![usize::MAX; points];
+        let mut out = Vec::with_capacity(values.len());
+        for (pos, &v) in values.iter().enumerate() {
+            let i = match usize::try_from(v) {
+                Ok(i) if i < points => i,
+                _ => {
+                    return Err(PyValueError::new_err(format!(
+                        "indices[{pos}] = {} is not a point index: the points of X are numbered \
+                         0 to {} (0-based)",
+                        v.to_string(),
+                        points as i128 - 1
+                    )))
+                }
+            };
+            if first[i] != usize::MAX {
+                return Err(PyValueError::new_err(format!(
+                    "indices[{pos}] = {i} repeats indices[{}]: each sample must be a different \
+                     point",
+                    first[i]
+                )));
+            }
+            first[i] = pos;
+            out.push(i);
+        }
+        Ok(out)
+    }
+    let np = py.import("numpy")?;
+    if kind == b'u' && size == 8 {
+        // uint64 does not fit int64: read as it is.
+        let array: PyReadonlyArray1<u64> =
+            np.call_method1("asarray", (array, "uint64"))?.extract()?;
+        checked(array.as_array(), points)
+    } else {
+        let array: PyReadonlyArray1<i64> =
+            np.call_method1("asarray", (array, "int64"))?.extract()?;
+        checked(array.as_array(), points)
+    }
+}
+
+/// `seed` as the library's u64.
+fn seed_value(seed: i128) -> PyResult<u64> {
+    u64::try_from(seed).map_err(|_| {
+        PyValueError::new_err(format!(
+            "invalid parameter seed: must be an integer from 0 to 2^64 - 1, got {seed}"
+        ))
+    })
+}
+
+/// The manifold's dimension `dim` in a space of dimension `d` (the library checks 1..=d; this
+/// refuses what does not fit a usize, with the library's message).
+fn manifold_dim(dim: Option<i128>, d: usize) -> PyResult<Option<usize>> {
+    dim.map(|m| {
+        usize::try_from(m).map_err(|_| {
+            PyValueError::new_err(format!(
+                "invalid parameter dim: the manifold's dimension must be from 1 to the space's \
+                 {d}, got {m}"
+            ))
+        })
+    })
+    .transpose()
+}
+
+/// The kernel's widths checked with their Python names (the library names them as the command
+/// line spells them, `--sigma-p`): sigma_p positive and finite when given, sigma_n positive
+/// (infinity allowed) when given. Returns sigma_n as the library takes it: None is infinity
+/// (positions only).
+fn kernel_widths(sigma_p: Option<f64>, sigma_n: Option<f64>) -> PyResult<f64> {
+    if let Some(s) = sigma_p.filter(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(PyValueError::new_err(format!(
+            "invalid parameter sigma_p: must be a positive number, got {s}"
+        )));
+    }
+    if let Some(s) = sigma_n.filter(|s| !(*s > 0.0)) {
+        return Err(PyValueError::new_err(format!(
+            "invalid parameter sigma_n: must be positive (or None for infinity), got {s}"
+        )));
+    }
+    Ok(sigma_n.unwrap_or(f64::INFINITY))
+}
+
+/// A normal width as a report gives it: None for infinity.
+fn width_or_none(sigma_n: f64) -> Option<f64> {
+    sigma_n.is_finite().then_some(sigma_n)
+}
+
+/// Row-major `values` as a float64 array of shape `(values.len() / d, d)`.
+fn rows_array<'py>(py: Python<'py>, values: &[f64], d: usize) -> Bound<'py, PyArray2<f64>> {
+    // The length is a multiple of d by construction (a PointSet's).
+    Array2::from_shape_vec((values.len() / d, d), values.to_vec())
+        .unwrap_or_else(|_| Array2::zeros((0, d)))
+        .into_pyarray(py)
+}
+
+/// Choose samples of a point set near a manifold of any dimension, by the randomized linear
+/// scan (Algorithm 1 of the paper).
+///
+/// The points are visited in a random order (seeded) and kept when the spectral measure of the
+/// Gaussian kernel exp(-|x - y|²), x = [p / sigma_p, n / sigma_n], over the points kept so far
+/// exceeds epsilon: an even (blue-noise) subset of the rows of X, about sigma_p apart, on
+/// curves, surfaces, volumes and higher-dimensional manifolds alike. With `count`, sigma_p is
+/// searched for (a few scans). Lengths are in X's own units (no rescaling). The GIL is released
+/// during the work.
+///
+/// Parameters
+/// ----------
+/// X : array_like, shape (n, d)
+///     The points, any real dtype (converted to float64), n >= 1, d from 1 to 16.
+/// normals : array_like, shape (n, d), or None
+///     A direction per point (a hypersurface's normal, or any direction field the kernel should
+///     tell apart), normalized here; used with a finite sigma_n (then d at most 8).
+/// sigma_p : float or None
+///     The kernel width in X's units: samples end up about this far apart.
+/// count : int or None
+///     About this many samples (within 0.5% when the search reaches it: the report's
+///     `reached`), sigma_p searched for; 1 to n. Give exactly one of sigma_p and count.
+/// sigma_n : float or None
+///     The normal width (> 0; needs normals): finite values keep points whose normals differ
+///     close together (denser where the normals turn). None: infinity, positions only.
+/// seed : int
+///     Seed of the visit order and of the dimension estimate (0 to 2^64 - 1).
+/// epsilon : float
+///     The acceptance threshold of the measure, in (0, 1): lower takes more samples.
+/// dim : int or None
+///     The dimension m of the manifold the points lie near (1 to d), for the count search's
+///     first step. None: estimated from the points (Levina and Bickel).
+/// return_report : bool
+///     Also return the report.
+///
+/// Returns
+/// -------
+/// indices : numpy.ndarray of int64, shape (k,)
+///     The samples as rows of X, increasing.
+/// report : dict
+///     With return_report=True: `sigma_p` (the width used, X's units), `sigma_n` (None for
+///     infinity), `dim` (the manifold dimension used or estimated; None when sigma_p was given
+///     without dim), `reached` (the count within its tolerance; True with sigma_p), `search`
+///     (every scan of the search as a pair (sigma_p, count), in order), `count` (k),
+///     `rejected_by_nearest` and `measured` (the chosen scan's points rejected by their nearest
+///     sample alone, and those whose measure was evaluated).
+///
+/// Raises
+/// ------
+/// ValueError
+///     An array of the wrong shape or dtype, a coordinate that is not finite or a normal of
+///     length 0 (naming its row), neither or both of sigma_p and count, a count outside 1 to n,
+///     a finite sigma_n without normals, or a parameter out of its range.
+#[pyfunction]
+#[pyo3(signature = (
+    X, normals = None, *, sigma_p = None, count = None, sigma_n = None, seed = 1, epsilon = 0.5,
+    dim = None, return_report = false
+))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
+fn sample<'py>(
+    py: Python<'py>,
+    X: &Bound<'py, PyAny>,
+    normals: Option<&Bound<'py, PyAny>>,
+    sigma_p: Option<f64>,
+    count: Option<i128>,
+    sigma_n: Option<f64>,
+    seed: i128,
+    epsilon: f64,
+    dim: Option<i128>,
+    return_report: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (positions, n, d) = point_rows(py, "X", X, None)?;
+    let normals = normals
+        .map(|v| point_rows(py, "normals", v, Some((n, d))).map(|r| r.0))
+        .transpose()?;
+    let count = count
+        .map(|c| {
+            usize::try_from(c).map_err(|_| {
+                PyValueError::new_err(format!(
+                    "invalid parameter count: must be from 1 to the {n} points, got {c}"
+                ))
+            })
+        })
+        .transpose()?;
+    let params = ManifoldSampleParams {
+        sigma_p,
+        count,
+        sigma_n: kernel_widths(sigma_p, sigma_n)?,
+        epsilon,
+        dimension: manifold_dim(dim, d)?,
+        seed: seed_value(seed)?,
+        ..Default::default()
+    };
+    let picked = without_gil(py, move || {
+        let points = PointSet::new(d, positions, normals)?;
+        spectral::sample_manifold(&points, &params)
+    })?;
+    let indices = Array1::from_iter(picked.indices.iter().map(|&i| i as i64)).into_pyarray(py);
+    if !return_report {
+        return Ok(indices.into_any());
+    }
+    let report = PyDict::new(py);
+    report.set_item("sigma_p", picked.sigma_p)?;
+    report.set_item("sigma_n", width_or_none(picked.sigma_n))?;
+    report.set_item("dim", picked.dimension)?;
+    report.set_item("reached", picked.reached)?;
+    report.set_item("search", picked.search)?;
+    report.set_item("count", picked.indices.len())?;
+    report.set_item("rejected_by_nearest", picked.rejected_by_nearest)?;
+    report.set_item("measured", picked.measured)?;
+    Ok(PyTuple::new(py, [indices.into_any(), report.into_any()])?.into_any())
+}
+
+/// A Python callable `project(Y) -> Y2` (or `(Y2, N2)` with normals) as the library's
+/// projection: each call takes the GIL again, hands the callable a fresh float64 array (m, d)
+/// and copies its answer back, shapes checked. An exception the callable raises is kept in
+/// `raised`, to be raised again unchanged when the library returns.
+struct CallableProjection {
+    project: Py<PyAny>,
+    dim: usize,
+    raised: Mutex<Option<PyErr>>,
+}
+
+impl CallableProjection {
+    /// One call of the callable on `positions` (rows of `dim`), its answer written back.
+    fn call(
+        &self,
+        py: Python<'_>,
+        positions: &mut [f64],
+        normals: Option<&mut [f64]>,
+    ) -> PyResult<()> {
+        let d = self.dim;
+        let m = positions.len() / d;
+        let y = rows_array(py, positions, d);
+        let out = self.project.bind(py).call1((y,))?;
+        match normals {
+            None => copy_back(py, "project(Y)", &out, positions, (m, d)),
+            Some(normals) => {
+                let pair = match out.cast::<PyTuple>() {
+                    Ok(t) if t.len() == 2 => Some((t.get_item(0)?, t.get_item(1)?)),
+                    _ => match out.cast::<PyList>() {
+                        Ok(l) if l.len() == 2 => Some((l.get_item(0)?, l.get_item(1)?)),
+                        _ => None,
+                    },
+                };
+                let Some((y2, n2)) = pair else {
+                    return Err(PyValueError::new_err(format!(
+                        "project must return a pair (Y2, N2) of arrays of shape ({m}, {d}) when \
+                         normals are given, got {}",
+                        out.get_type().name()?
+                    )));
+                };
+                copy_back(py, "project(Y)[0]", &y2, positions, (m, d))?;
+                copy_back(py, "project(Y)[1]", &n2, normals, (m, d))
+            }
+        }
+    }
+}
+
+/// The callable's answer `value` (named `what`) read as float64 of shape `(m, d)` into `out`.
+fn copy_back(
+    py: Python<'_>,
+    what: &str,
+    value: &Bound<'_, PyAny>,
+    out: &mut [f64],
+    (m, d): (usize, usize),
+) -> PyResult<()> {
+    let array = py
+        .import("numpy")?
+        .call_method1("asarray", (value, "float64"))
+        .and_then(|a| Ok(a.cast_into::<PyUntypedArray>()?))
+        .map_err(|e| {
+            PyValueError::new_err(format!(
+                "{what} must be an array of float64 of shape ({m}, {d}), and numpy cannot read \
+                 it as one: {e}"
+            ))
+        })?;
+    if array.shape() != [m, d] {
+        return Err(PyValueError::new_err(format!(
+            "{what} must have the shape of Y, ({m}, {d}), got shape {}",
+            shape_text(array.shape())
+        )));
+    }
+    let array: PyReadonlyArray2<f64> = array.extract()?;
+    for (o, v) in out.iter_mut().zip(array.as_array().iter()) {
+        *o = *v;
+    }
+    Ok(())
+}
+
+impl ManifoldProjection for CallableProjection {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+
+    fn project(&self, positions: &mut [f64], normals: Option<&mut [f64]>) -> spectral::Result<()> {
+        Python::attach(|py| self.call(py, positions, normals)).map_err(|e| {
+            *self.raised.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
+            Error::InvalidParameter {
+                name: "project",
+                message: "the callable raised an exception".into(),
+            }
+        })
+    }
+}
+
+/// Move samples of a point set into an even (blue-noise) arrangement on its manifold, by
+/// gradient ascent on the spectral measure (eq. 11 of the paper).
+///
+/// The samples X[indices] (usually from `sample`) move for `iterations` sweeps, each sample in a
+/// seeded random order along the gradient of its measure over its neighbours, and each move is
+/// projected onto the manifold: onto the point set X itself (a local quadratic fit to the
+/// nearest rows of X; the normal of the nearest row) or by the callable `project`. Lengths are
+/// in X's own units. The GIL is released during the work, but for the calls of `project`.
+///
+/// Parameters
+/// ----------
+/// X : array_like, shape (n, d)
+///     The points, any real dtype (converted to float64), n >= 1, d from 1 to 16.
+/// indices : array_like, shape (k,)
+///     The samples as rows of X (0-based), any integer dtype, each row once.
+/// normals : array_like, shape (n, d), or None
+///     A direction per point, normalized here; the samples' normals follow their moves.
+/// sigma_p : float
+///     The kernel width in X's units, the one the samples were chosen with (`sample`'s
+///     report).
+/// sigma_n : float or None
+///     The normal width (> 0; needs normals; then d at most 8). None: infinity, positions only.
+/// iterations : int
+///     Sweeps over all samples (>= 0).
+/// seed : int
+///     Seed of the visit order and of the dimension estimate (0 to 2^64 - 1).
+/// dim : int or None
+///     The dimension m of the manifold (1 to d) for the projection onto X. None: estimated from
+///     the points. Not with `project`.
+/// project : callable or None
+///     `project(Y) -> Y2`: projects each row of a float64 array Y of shape (m, d) onto the
+///     manifold and returns an array-like of the same shape; with normals it returns a pair
+///     (Y2, N2), N2 the normals at Y2 (normalized here). Called with the GIL held, for batches
+///     of samples of which no two are neighbours. None: the projection onto X.
+/// return_report : bool
+///     Also return the report.
+///
+/// Returns
+/// -------
+/// Y : numpy.ndarray of float64, shape (k, d)
+///     The moved samples, in the order of indices.
+/// N : numpy.ndarray of float64, shape (k, d)
+///     Only with normals: their unit normals.
+/// report : dict
+///     With return_report=True, last: `sigma_p`, `sigma_n` (None for infinity), `iterations`,
+///     `dim` (the manifold dimension of the projection onto X; None with `project`), and per
+///     sweep `mean_move` (the mean move, X's units), `mean_s` and `min_s` (the mean and the
+///     least measure before the sweep's moves).
+///
+/// Raises
+/// ------
+/// ValueError
+///     An array of the wrong shape or dtype, a coordinate that is not finite or a normal of
+///     length 0 (naming its row), an index out of range or repeated, a finite sigma_n without
+///     normals, a parameter out of its range, or `project` returning the wrong shape or a
+///     coordinate that is not finite.
+/// TypeError
+///     `project` is not callable.
+/// Exception
+///     Whatever `project` raises, unchanged.
+#[pyfunction]
+#[pyo3(signature = (
+    X, indices, normals = None, *, sigma_p, sigma_n = None, iterations = 10, seed = 1, dim = None,
+    project = None, return_report = false
+))]
+#[allow(non_snake_case, clippy::too_many_arguments)]
+fn resample<'py>(
+    py: Python<'py>,
+    X: &Bound<'py, PyAny>,
+    indices: &Bound<'py, PyAny>,
+    normals: Option<&Bound<'py, PyAny>>,
+    sigma_p: f64,
+    sigma_n: Option<f64>,
+    iterations: i128,
+    seed: i128,
+    dim: Option<i128>,
+    project: Option<&Bound<'py, PyAny>>,
+    return_report: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (positions, n, d) = point_rows(py, "X", X, None)?;
+    let normals = normals
+        .map(|v| point_rows(py, "normals", v, Some((n, d))).map(|r| r.0))
+        .transpose()?;
+    let with_normals = normals.is_some();
+    let indices = sample_indices(py, indices, n)?;
+    let seed = seed_value(seed)?;
+    let dim = manifold_dim(dim, d)?;
+    let params = ManifoldResampleParams {
+        sigma_n: kernel_widths(Some(sigma_p), sigma_n)?,
+        iterations: count("iterations", iterations)?,
+        seed,
+        ..ManifoldResampleParams::new(sigma_p)
+    };
+    if let Some(f) = project {
+        if !f.is_callable() {
+            return Err(PyTypeError::new_err(format!(
+                "project must be a callable project(Y) -> Y2, or None, got {}",
+                f.get_type().name()?
+            )));
+        }
+        if dim.is_some() {
+            return Err(PyValueError::new_err(
+                "invalid parameter dim: the manifold's dimension is for the projection onto X; \
+                 give dim or project, not both",
+            ));
+        }
+    }
+    let callable = project.map(|f| CallableProjection {
+        project: f.clone().unbind(),
+        dim: d,
+        raised: Mutex::new(None),
+    });
+    let result = without_gil(py, || {
+        let data = PointSet::new(d, positions, normals)?;
+        let samples = data.subset(&indices);
+        match &callable {
+            Some(f) => {
+                let (out, ascent) = spectral::resample_manifold(&samples, f, &params)?;
+                Ok((out, ascent, None))
+            }
+            None => {
+                let projection = DataProjection::new(&data, dim, seed)?;
+                let (out, ascent) = spectral::resample_manifold(&samples, &projection, &params)?;
+                Ok((out, ascent, Some(projection.manifold_dim())))
+            }
+        }
+    });
+    // The callable's own exception, as it raised it.
+    if let Some(raised) =
+        callable.and_then(|c| c.raised.into_inner().unwrap_or_else(|p| p.into_inner()))
+    {
+        return Err(raised);
+    }
+    let (out, ascent, manifold) = result?;
+    let mut items = vec![rows_array(py, out.positions(), d).into_any()];
+    if let (true, Some(n)) = (with_normals, out.normals()) {
+        items.push(rows_array(py, n, d).into_any());
+    }
+    if return_report {
+        let report = PyDict::new(py);
+        report.set_item("sigma_p", params.sigma_p)?;
+        report.set_item("sigma_n", width_or_none(params.sigma_n))?;
+        report.set_item("iterations", params.iterations)?;
+        report.set_item("dim", manifold)?;
+        report.set_item("mean_move", ascent.mean_move)?;
+        report.set_item("mean_s", ascent.mean_s)?;
+        report.set_item("min_s", ascent.min_s)?;
+        items.push(report.into_any());
+    }
+    if items.len() == 1 {
+        Ok(items.swap_remove(0))
+    } else {
+        Ok(PyTuple::new(py, items)?.into_any())
+    }
+}
+
+/// Spectral sampling of manifolds (Öztireli, Alexa, Gross 2010): remeshing of triangle meshes,
+/// and sampling of point sets near a manifold of any dimension in R^d, numpy in, numpy out.
+///
+/// Triangle meshes: `read`, `remesh` and `quality`, as the `remesh` command line does them.
+/// Point sets of shape (n, d), d from 1 to 16 (a curve in the plane, a surface in R^3 or R^4, a
+/// 3-manifold in R^4, ...): `sample` chooses an even subset of the points, `resample` moves the
+/// samples into blue noise on the manifold.
 ///
 /// Arrays in: anything ``numpy.asarray`` reads. Positions of any real dtype are converted to
-/// float64; face indices of any integer dtype are checked against the vertex count (a float
-/// array of indices is refused); non-contiguous arrays (slices, transposes, negative strides) are
-/// read through their strides, never refused. Errors carry the library's one-line message:
-/// ValueError for input or options that cannot be used, OSError for files the operating system
-/// refuses, RuntimeError for an internal failure (a bug) or a strict refusal. The GIL is released
-/// while the library works.
+/// float64; face and sample indices of any integer dtype are checked against the vertex or point
+/// count (a float array of indices is refused); non-contiguous arrays (slices, transposes,
+/// negative strides) are read through their strides, never refused. Errors carry the library's
+/// one-line message: ValueError for input or options that cannot be used, OSError for files the
+/// operating system refuses, RuntimeError for an internal failure (a bug) or a strict refusal.
+/// The GIL is released while the library works (but for the calls of a Python `project`).
 #[pymodule]
 fn spectral_remesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(quality, m)?)?;
     m.add_function(wrap_pyfunction!(remesh, m)?)?;
+    m.add_function(wrap_pyfunction!(sample, m)?)?;
+    m.add_function(wrap_pyfunction!(resample, m)?)?;
     Ok(())
 }

@@ -330,29 +330,49 @@ def test_gil_is_released(spot):
 
 
 def stub_functions():
+    """The stubs' module docstring, each function's documented definition (the last of its
+    name: for overloaded functions the general overload), and every definition by name."""
     tree = ast.parse(STUBS.read_text())
-    return ast.get_docstring(tree), {
-        node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)
-    }
+    every = {}
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef):
+            every.setdefault(node.name, []).append(node)
+    return ast.get_docstring(tree), {name: nodes[-1] for name, nodes in every.items()}, every
+
+
+def stub_parameters(node):
+    args = node.args
+    stub = [(a.arg, "POSITIONAL_ONLY") for a in args.posonlyargs]
+    stub += [(a.arg, "POSITIONAL_OR_KEYWORD") for a in args.args]
+    stub += [(a.arg, "KEYWORD_ONLY") for a in args.kwonlyargs]
+    return stub
 
 
 def test_stubs_match_the_module():
     """The stubs' docstrings and signatures are the module's own (pyo3 takes both from the
-    Rust source), so the two cannot drift apart."""
-    module_doc, functions = stub_functions()
+    Rust source), so the two cannot drift apart. Overloads (`sample`, `resample`: the return
+    shape follows `normals` and `return_report`) take the same parameters; the last, general
+    one carries the docstring and the defaults."""
+    module_doc, functions, every = stub_functions()
     assert inspect.cleandoc(sr.__doc__) == module_doc
     public = {name for name in dir(sr) if not name.startswith("_") and callable(getattr(sr, name))}
     public.discard("spectral_remesh")
     assert public == set(functions)
+    assert {name for name, nodes in every.items() if len(nodes) > 1} == {"sample", "resample"}
+    for name, nodes in every.items():
+        runtime = getattr(sr, name)
+        parameters = [(p.name, p.kind.name) for p in inspect.signature(runtime).parameters.values()]
+        for node in nodes:
+            assert stub_parameters(node) == parameters, name
+            overloaded = any(getattr(d, "id", None) == "overload" for d in node.decorator_list)
+            assert overloaded == (len(nodes) > 1), name
+            if node is not nodes[-1]:
+                assert ast.get_docstring(node) is None, name
     for name, node in functions.items():
         runtime = getattr(sr, name)
         assert inspect.getdoc(runtime) == ast.get_docstring(node), name
         signature = inspect.signature(runtime)
         args = node.args
-        stub = [(a.arg, "POSITIONAL_ONLY") for a in args.posonlyargs]
-        stub += [(a.arg, "POSITIONAL_OR_KEYWORD") for a in args.args]
-        stub += [(a.arg, "KEYWORD_ONLY") for a in args.kwonlyargs]
-        assert [(p.name, p.kind.name) for p in signature.parameters.values()] == stub, name
         stub_defaults = [ast.literal_eval(d) for d in args.defaults]
         stub_defaults += [ast.literal_eval(d) for d in args.kw_defaults if d is not None]
         runtime_defaults = [
