@@ -16,7 +16,7 @@ The GIL is released while the library works (but for the calls of a Python `proj
 """
 
 from os import PathLike
-from typing import Any, Callable, Dict, Literal, Optional, Tuple, Union, overload
+from typing import Any, Callable, Dict, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -104,8 +104,10 @@ def quality(
 
 def remesh(
     V: npt.ArrayLike,
-    F: npt.ArrayLike,
+    F: Optional[npt.ArrayLike] = None,
     *,
+    normals: Optional[npt.ArrayLike] = None,
+    viewpoint: Optional[Sequence[float]] = None,
     points: Optional[int] = None,
     sigma_p: Optional[float] = None,
     sigma_n: Optional[float] = None,
@@ -124,21 +126,32 @@ def remesh(
     strict: bool = False,
     max_memory: Union[int, str, None] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], Dict[str, Any]]:
-    """Remesh a triangle mesh by spectral sampling, as the `remesh` command line does.
+    """Remesh a triangle mesh, or mesh a point set, by spectral sampling, as the `remesh` command
+    line does.
 
     The same arrays and options give the same output, bit for bit, as `remesh IN OUT` on a file
-    holding the arrays (`remesh` writes .ply, .obj and .off exactly). Each option is the command
-    line's flag of that name; None takes the command line's default. Lengths are in bbox-100
-    units: the input scaled so its bounding box's longest side is 100. The GIL is released
-    during the work.
+    holding the arrays (`remesh` writes .ply, .obj and .off exactly; a point set: a text file of
+    `x y z [nx ny nz]` lines). Each option is the command line's flag of that name; None takes
+    the command line's default. Lengths are in bbox-100 units: the input scaled so its bounding
+    box's longest side is 100. The GIL is released during the work.
 
     Parameters
     ----------
     V : array_like, shape (n, 3)
-        Vertex positions, any real dtype (converted to float64), in model units.
-    F : array_like, shape (m, 3)
+        Vertex positions, any real dtype (converted to float64), in model units; with F None,
+        the points of a point set (a scan), meshed through the RIMLS surface of the points as
+        `remesh scan.xyz out.ply` does.
+    F : array_like, shape (m, 3), or None
         Triangles as 0-based indices into V, any integer dtype. Vertices at identical positions
-        are welded and vertices no triangle uses removed first, as the reader does.
+        are welded and vertices no triangle uses removed first, as the reader does. None: V is
+        a point set (it then needs points or sigma_p; lfs_factor and chord_error are not
+        available).
+    normals : array_like, shape (n, 3), or None
+        A point set's normals, one per point (any length but zero). None: estimated, and
+        oriented outward (or towards viewpoint). Only with F None.
+    viewpoint : sequence of 3 floats or None
+        Orient a point set's estimated normals towards this point (a single scan's sensor, model
+        units; `--viewpoint`). Only with F None and no normals.
     points : int or None
         About this many output vertices (within 1%); sigma_p is searched for. 4 to 20 million.
         With neither points nor sigma_p: as many as the input has vertices.
@@ -193,8 +206,9 @@ def remesh(
     ------
     ValueError
         An array of the wrong shape or dtype, a non-finite coordinate, an index out of range,
-        no triangles, an option out of its range or two that exclude each other (named as the
-        command line names it), or a job over max_memory.
+        no triangles (no points), a normal of length zero, normals or viewpoint with F given, an
+        option out of its range or two that exclude each other (named as the command line names
+        it), or a job over max_memory.
     RuntimeError
         With strict=True, an output that breaks an invariant or changes the topology; or an
         internal failure.

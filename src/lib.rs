@@ -252,7 +252,7 @@ pub use points::{PlyPointWriter, Point, PointReader};
 // The jobs of the `remesh` command line: files in, files and report out.
 pub use app::{
     catch_panics, estimate_remesh_bytes, parse_bytes, physical_memory, quality_mesh, remesh_mesh,
-    run_points, run_quality, run_remesh, run_simplify, write_report, PointsJob, RemeshJob,
-    RemeshOptions, RemeshedMesh, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary,
-    DISTANCE_SAMPLES, MAX_SURFACE_POINTS, STDOUT,
+    remesh_point_set, run_points, run_quality, run_remesh, run_simplify, write_report, PointsJob,
+    RemeshJob, RemeshOptions, RemeshedMesh, SimplifyDensity, SimplifyDetail, SimplifyJob,
+    SimplifySummary, DISTANCE_SAMPLES, MAX_SURFACE_POINTS, STDOUT,
 };

@@ -12,9 +12,9 @@ use glam::DVec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use spectral_remesh::{
-    check_invariants, is_point_set, remesh_points, run_remesh, topology, write_mesh,
-    write_surface_points, Density, Error, PointRemeshOutput, PointRemeshParams, RemeshJob,
-    RemeshParams, TriMesh,
+    check_invariants, is_point_set, remesh_point_set, remesh_points, run_remesh, topology,
+    write_mesh, write_surface_points, Density, Error, PointRemeshOutput, PointRemeshParams,
+    RemeshJob, RemeshParams, TriMesh,
 };
 
 /// A torus around the z axis (radii `big` and `small`), `n` × `m` quads split in two, outward.
@@ -338,4 +338,75 @@ fn the_remesh_job_takes_point_files_and_keeps_meshes_meshes() {
         as_points.extra["input_points"],
         sphere.vertex_count() as u64
     );
+}
+
+/// Points held in memory (`remesh_point_set`, the Python module's path) give the mesh `remesh`
+/// gives on a text file of the same points, bit for bit, with and without normals; and its
+/// errors name the points, not the temporary file behind them.
+#[test]
+fn points_in_memory_give_the_file_jobs_mesh_and_name_themselves_in_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let (points, normals) = sphere_points(20_000, &mut rng);
+    // Scaled and moved: the values are not round numbers.
+    let points: Vec<DVec3> = points
+        .iter()
+        .map(|p| *p * 3.7 + DVec3::new(0.1, -2.3, 5.0))
+        .collect();
+    for (with_normals, seed) in [(true, 1), (false, 2)] {
+        let n = with_normals.then_some(&normals[..]);
+        let input = dir
+            .path()
+            .join(if with_normals { "p.xyzn" } else { "p.xyz" });
+        write_xyz(&input, &points, n);
+        let output = dir.path().join("out.ply");
+        let mut file_job = job(input, output.clone(), false);
+        file_job.params.seed = seed;
+        file_job.strict = false;
+        let file_report = run_remesh(&file_job, &|_| {}).unwrap();
+        let (from_file, _) = spectral_remesh::read_mesh(&output).unwrap();
+        let got = remesh_point_set(
+            &points,
+            n,
+            &file_job.params,
+            None,
+            true,
+            false,
+            None,
+            &|_| {},
+        )
+        .unwrap();
+        assert_eq!(
+            got.mesh.positions, from_file.positions,
+            "normals {with_normals}"
+        );
+        assert_eq!(
+            got.mesh.triangles, from_file.triangles,
+            "normals {with_normals}"
+        );
+        assert_eq!(got.report.distance, file_report.distance);
+        assert!(check_invariants(&got.mesh).is_empty());
+    }
+    let params = job(PathBuf::new(), PathBuf::new(), false).params;
+    let call = |p: &[DVec3], n: Option<&[DVec3]>, params: &RemeshParams| {
+        remesh_point_set(p, n, params, None, false, false, None, &|_| {})
+            .unwrap_err()
+            .to_string()
+    };
+    let mut bad = points[..100].to_vec();
+    bad[7].y = f64::NAN;
+    assert!(call(&bad, None, &params).contains("point 7"));
+    let mut zero = normals[..100].to_vec();
+    zero[3] = DVec3::ZERO;
+    assert!(call(&points[..100], Some(&zero), &params).contains("normal 3"));
+    assert!(call(&points[..100], Some(&normals[..99]), &params).contains("99 normals"));
+    assert!(call(&[], None, &params).contains("no points"));
+    // An error from the pipeline itself: sigma_n needs normals.
+    let sigma_n = RemeshParams {
+        sigma_n: 0.8,
+        ..params
+    };
+    let e = call(&points, None, &sigma_n);
+    assert!(e.contains("input points"), "{e}");
+    assert!(!e.contains(".xyz"), "{e}");
 }

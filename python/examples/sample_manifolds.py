@@ -29,7 +29,7 @@ def gap_ratio(Y):
 t = rng.uniform(0, TAU, 100_000)
 X = np.c_[np.cos(t), np.sin(t)]
 indices, report = sr.sample(X, count=200, return_report=True)
-Y = sr.resample(X, indices, sigma_p=report["sigma_p"], iterations=20)
+Y = sr.resample(X, indices, sigma_p=report["sigma_p"])
 print(
     f"circle in R^2: {len(Y)} samples (manifold dimension {report['dim']}), sigma_p "
     f"{report['sigma_p']:.4f}; gap ratio {gap_ratio(X[indices]):.2f} after the scan, "

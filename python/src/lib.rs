@@ -372,21 +372,32 @@ type Remeshed<'py> = (
     Bound<'py, PyDict>,
 );
 
-/// Remesh a triangle mesh by spectral sampling, as the `remesh` command line does.
+/// Remesh a triangle mesh, or mesh a point set, by spectral sampling, as the `remesh` command
+/// line does.
 ///
 /// The same arrays and options give the same output, bit for bit, as `remesh IN OUT` on a file
-/// holding the arrays (`remesh` writes .ply, .obj and .off exactly). Each option is the command
-/// line's flag of that name; None takes the command line's default. Lengths are in bbox-100
-/// units: the input scaled so its bounding box's longest side is 100. The GIL is released
-/// during the work.
+/// holding the arrays (`remesh` writes .ply, .obj and .off exactly; a point set: a text file of
+/// `x y z [nx ny nz]` lines). Each option is the command line's flag of that name; None takes
+/// the command line's default. Lengths are in bbox-100 units: the input scaled so its bounding
+/// box's longest side is 100. The GIL is released during the work.
 ///
 /// Parameters
 /// ----------
 /// V : array_like, shape (n, 3)
-///     Vertex positions, any real dtype (converted to float64), in model units.
-/// F : array_like, shape (m, 3)
+///     Vertex positions, any real dtype (converted to float64), in model units; with F None,
+///     the points of a point set (a scan), meshed through the RIMLS surface of the points as
+///     `remesh scan.xyz out.ply` does.
+/// F : array_like, shape (m, 3), or None
 ///     Triangles as 0-based indices into V, any integer dtype. Vertices at identical positions
-///     are welded and vertices no triangle uses removed first, as the reader does.
+///     are welded and vertices no triangle uses removed first, as the reader does. None: V is
+///     a point set (it then needs points or sigma_p; lfs_factor and chord_error are not
+///     available).
+/// normals : array_like, shape (n, 3), or None
+///     A point set's normals, one per point (any length but zero). None: estimated, and
+///     oriented outward (or towards viewpoint). Only with F None.
+/// viewpoint : sequence of 3 floats or None
+///     Orient a point set's estimated normals towards this point (a single scan's sensor, model
+///     units; `--viewpoint`). Only with F None and no normals.
 /// points : int or None
 ///     About this many output vertices (within 1%); sigma_p is searched for. 4 to 20 million.
 ///     With neither points nor sigma_p: as many as the input has vertices.
@@ -441,14 +452,15 @@ type Remeshed<'py> = (
 /// ------
 /// ValueError
 ///     An array of the wrong shape or dtype, a non-finite coordinate, an index out of range,
-///     no triangles, an option out of its range or two that exclude each other (named as the
-///     command line names it), or a job over max_memory.
+///     no triangles (no points), a normal of length zero, normals or viewpoint with F given, an
+///     option out of its range or two that exclude each other (named as the command line names
+///     it), or a job over max_memory.
 /// RuntimeError
 ///     With strict=True, an output that breaks an invariant or changes the topology; or an
 ///     internal failure.
 #[pyfunction]
 #[pyo3(signature = (
-    V, F, *, points = None, sigma_p = None, sigma_n = None, seed = 1, iterations = None,
+    V, F = None, *, normals = None, viewpoint = None, points = None, sigma_p = None, sigma_n = None, seed = 1, iterations = None,
     lfs_factor = None, chord_error = None, fit = true, smooth = None, min_angle = None,
     max_angle = None, feature_angle = None, features = true, triangulation = None,
     distance = true, strict = false, max_memory = None
@@ -457,7 +469,9 @@ type Remeshed<'py> = (
 fn remesh<'py>(
     py: Python<'py>,
     V: &Bound<'py, PyAny>,
-    F: &Bound<'py, PyAny>,
+    F: Option<&Bound<'py, PyAny>>,
+    normals: Option<&Bound<'py, PyAny>>,
+    viewpoint: Option<&Bound<'py, PyAny>>,
     points: Option<i128>,
     sigma_p: Option<f64>,
     sigma_n: Option<f64>,
@@ -506,12 +520,73 @@ fn remesh<'py>(
     };
     let params = options.params().map_err(to_py_err)?;
     let max_memory = memory_limit(max_memory)?;
+    let Some(F) = F else {
+        // A point set.
+        let points = positions(py, "V", V)?;
+        let normals = match normals {
+            None => None,
+            Some(n) => {
+                let n = positions(py, "normals", n)?;
+                if n.len() != points.len() {
+                    return Err(PyValueError::new_err(format!(
+                        "normals must have the shape of V, ({}, 3), got ({}, 3)",
+                        points.len(),
+                        n.len()
+                    )));
+                }
+                Some(n)
+            }
+        };
+        let viewpoint = viewpoint.map(point3).transpose()?;
+        if viewpoint.is_some() && normals.is_some() {
+            return Err(PyValueError::new_err(
+                "viewpoint orients estimated normals: not with normals given",
+            ));
+        }
+        let out = without_gil(py, move || {
+            spectral::remesh_point_set(
+                &points,
+                normals.as_deref(),
+                &params,
+                viewpoint,
+                distance,
+                strict,
+                max_memory,
+                &|_| {},
+            )
+        })?;
+        let (v, f) = mesh_arrays(py, out.mesh);
+        return Ok((v, f, report_dict(py, &out.report)?));
+    };
+    if normals.is_some() || viewpoint.is_some() {
+        return Err(PyValueError::new_err(
+            "normals and viewpoint are for a point set (F=None), not for a mesh",
+        ));
+    }
     let mesh = mesh_from(py, ("V", V), ("F", F))?;
     let out = without_gil(py, move || {
         spectral::remesh_mesh(mesh, &params, distance, strict, max_memory, &|_| {})
     })?;
     let (v, f) = mesh_arrays(py, out.mesh);
     Ok((v, f, report_dict(py, &out.report)?))
+}
+
+/// A point of R^3 from a sequence of three finite numbers (`viewpoint`).
+fn point3(value: &Bound<'_, PyAny>) -> PyResult<DVec3> {
+    let bad = || {
+        PyValueError::new_err(format!(
+            "viewpoint must be three finite numbers (x, y, z), got {}",
+            value
+                .repr()
+                .map(|r| r.to_string())
+                .unwrap_or_else(|_| "?".into())
+        ))
+    };
+    let v: Vec<f64> = value.extract().map_err(|_| bad())?;
+    match v[..] {
+        [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => Ok(DVec3::new(x, y, z)),
+        _ => Err(bad()),
+    }
 }
 
 /// The largest space dimension d of a point set (the library's kernel space, K = d).

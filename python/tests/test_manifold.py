@@ -152,7 +152,7 @@ def sample_and_resample(X, count, seed, **resample_options):
 @pytest.mark.parametrize("seed", [1, 2, 3, 4, 5])
 def test_a_circle_in_r2_is_sampled_evenly(seed):
     X = circle(seed)
-    scanned, Y, picked, moved = sample_and_resample(X, 200, seed, iterations=20)
+    scanned, Y, picked, moved = sample_and_resample(X, 200, seed)
     assert picked["dim"] == 1 and moved["dim"] == 1
     assert abs(len(Y) - 200) <= 1
     assert np.abs(np.hypot(Y[:, 0], Y[:, 1]) - 1).max() < 1e-6

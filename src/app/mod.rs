@@ -5,6 +5,7 @@
 mod memory;
 mod options;
 mod remesh_points;
+pub use remesh_points::remesh_point_set;
 mod simplify;
 
 pub use memory::{estimate_remesh_bytes, parse_bytes, physical_memory};

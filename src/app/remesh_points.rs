@@ -1,14 +1,21 @@
 //! `remesh IN OUT --points N` where IN is a point set: [`remesh_points`], the checks and the
-//! report as for a mesh, and the distances measured against the input points themselves.
+//! report as for a mesh, and the distances measured against the input points themselves; and
+//! [`remesh_point_set`], the same job on points held in memory.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use glam::DVec3;
 
 use super::{
     check_and_write, count_note, dropped_note, holes_note, insert_kernel_extras, memory,
-    write_output, RemeshJob, DISTANCE_SAMPLES,
+    write_output, RemeshJob, RemeshedMesh, DISTANCE_SAMPLES,
 };
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::io::{as_written, MeshFormat};
+use crate::mesh::TriMesh;
+use crate::pipeline::RemeshParams;
 use crate::pipeline::{Density, MAX_POINTS};
 use crate::point_pipeline::{remesh_points, PointRemeshParams};
 use crate::points::normals::NormalOrientation;
@@ -24,6 +31,22 @@ const DISTANCE_CHUNK: usize = 1 << 20;
 pub(super) fn run(
     job: &RemeshJob,
     format: MeshFormat,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<QualityReport> {
+    run_with(
+        job,
+        format,
+        &|mesh| write_output(job, format, mesh),
+        on_stage,
+    )
+}
+
+/// [`run`] with the output mesh (model units) handed to `write` instead of written to
+/// `job.output`.
+fn run_with(
+    job: &RemeshJob,
+    format: MeshFormat,
+    write: &dyn Fn(&TriMesh) -> Result<()>,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<QualityReport> {
     let params = PointRemeshParams {
@@ -55,7 +78,7 @@ pub(super) fn run(
     let check_seconds = t.elapsed();
     check_and_write(
         job,
-        &|mesh| write_output(job, format, mesh),
+        write,
         &out.mesh,
         &mut report,
         &out.stages,
@@ -165,4 +188,168 @@ pub(super) fn run(
         report.notes.push(holes_note(out.assembly.holes_left));
     }
     Ok(report)
+}
+
+/// The name errors and the report give points held in memory.
+const INPUT_POINTS: &str = "input points";
+
+/// Remeshes a point set held in memory exactly as [`run_remesh`](super::run_remesh) remeshes a
+/// text point file holding it (`x y z` per line, or `x y z nx ny nz` with normals: `.xyz`,
+/// `.xyzn`): the points are written to such a file in a temporary folder, each value in the
+/// shortest form that reads back to the same `f64`, and the file goes through the same reading,
+/// pipeline ([`remesh_points`]), check and report. The same arguments give the same output mesh,
+/// bit for bit, as `remesh` on that file.
+///
+/// `points` in model units; `normals` one per point (any length but zero: the reader normalizes
+/// them), or `None` (estimated, oriented outward by a spanning tree, or towards `viewpoint`, in
+/// model units, as `--viewpoint` does). `params` need a density of [`Density::Points`] or
+/// [`Density::SigmaP`]; `measure_distance`, `strict` and `max_memory` are [`RemeshJob`]'s fields
+/// of those names; `on_stage` is called with each stage's name as it starts. Errors name the
+/// points as `input points`.
+///
+/// # Errors
+/// [`Error::InvalidMesh`] for no points, a coordinate or normal that is not finite, a normal of
+/// length zero or a normal count that differs from the point count (naming the point);
+/// [`Error::Io`] when the temporary file cannot be written; whatever [`run_remesh`]
+/// (super::run_remesh) returns for a point-set file.
+#[allow(clippy::too_many_arguments)] // RemeshJob's fields, less the files
+pub fn remesh_point_set(
+    points: &[DVec3],
+    normals: Option<&[DVec3]>,
+    params: &RemeshParams,
+    viewpoint: Option<DVec3>,
+    measure_distance: bool,
+    strict: bool,
+    max_memory: Option<u64>,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<RemeshedMesh> {
+    let invalid = |message: String| Error::InvalidMesh {
+        path: PathBuf::from(INPUT_POINTS),
+        message,
+    };
+    if points.is_empty() {
+        return Err(invalid("no points".into()));
+    }
+    if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+        return Err(invalid(format!(
+            "point {i} has a coordinate that is not finite"
+        )));
+    }
+    if let Some(n) = normals {
+        if n.len() != points.len() {
+            return Err(invalid(format!(
+                "{} normals for {} points",
+                n.len(),
+                points.len()
+            )));
+        }
+        if let Some(i) = n.iter().position(|v| !(v.is_finite() && v.length() > 0.0)) {
+            return Err(invalid(format!(
+                "normal {i} has no direction (zero, or not finite)"
+            )));
+        }
+    }
+    on_stage("read");
+    let dir = tempfile::tempdir().map_err(|e| Error::Io {
+        path: std::env::temp_dir(),
+        source: e,
+    })?;
+    let input = dir.path().join(if normals.is_some() {
+        "points.xyzn"
+    } else {
+        "points.xyz"
+    });
+    write_text_points(&input, points, normals)?;
+    let job = RemeshJob {
+        input: input.clone(),
+        output: PathBuf::from("the output mesh"),
+        format: None,
+        params: *params,
+        measure_distance,
+        strict,
+        max_memory,
+        as_points: false,
+        viewpoint,
+    };
+    let handed = Mutex::new(None);
+    let report = run_with(
+        &job,
+        MeshFormat::Ply,
+        &|mesh| {
+            *handed.lock().unwrap_or_else(|e| e.into_inner()) = Some(mesh.clone());
+            Ok(())
+        },
+        on_stage,
+    )
+    .map_err(|e| rename_input(e, &input))?;
+    let mesh = handed
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner())
+        .ok_or_else(|| Error::Internal {
+            stage: "write",
+            message: "the point-set pipeline handed over no mesh".into(),
+        })?;
+    Ok(RemeshedMesh { mesh, report })
+}
+
+/// `points` (and `normals`) as a text point file at `path`, one point per line, each value in
+/// the shortest form that reads back to the same `f64`.
+fn write_text_points(path: &Path, points: &[DVec3], normals: Option<&[DVec3]>) -> Result<()> {
+    let io = |e: std::io::Error| Error::Io {
+        path: path.to_path_buf(),
+        source: e,
+    };
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    for (i, p) in points.iter().enumerate() {
+        match normals {
+            Some(n) => writeln!(
+                w,
+                "{} {} {} {} {} {}",
+                p.x, p.y, p.z, n[i].x, n[i].y, n[i].z
+            ),
+            None => writeln!(w, "{} {} {}", p.x, p.y, p.z),
+        }
+        .map_err(io)?;
+    }
+    w.flush().map_err(io)
+}
+
+/// `e` with the temporary file `input` named as [`INPUT_POINTS`].
+fn rename_input(e: Error, input: &Path) -> Error {
+    let text = input.display().to_string();
+    let rename = |path: PathBuf| {
+        if path == input {
+            PathBuf::from(INPUT_POINTS)
+        } else {
+            path
+        }
+    };
+    match e {
+        Error::Io { path, source } => Error::Io {
+            path: rename(path),
+            source,
+        },
+        Error::Parse {
+            path,
+            line,
+            message,
+        } => Error::Parse {
+            path: rename(path),
+            line,
+            message: message.replace(&text, INPUT_POINTS),
+        },
+        Error::InvalidMesh { path, message } => Error::InvalidMesh {
+            path: rename(path),
+            message: message.replace(&text, INPUT_POINTS),
+        },
+        Error::InvalidParameter { name, message } => Error::InvalidParameter {
+            name,
+            message: message.replace(&text, INPUT_POINTS),
+        },
+        Error::Internal { stage, message } => Error::Internal {
+            stage,
+            message: message.replace(&text, INPUT_POINTS),
+        },
+        other => other,
+    }
 }

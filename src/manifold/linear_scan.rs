@@ -161,6 +161,17 @@ pub(super) fn sample<const K: usize>(
         let s = run(sigma_p);
         (s.accepted.len(), s)
     });
+    if !(r.sigma_p.is_finite() && r.sigma_p > 0.0) {
+        // Coordinates so large (or so small) that the search left the floating-point range.
+        return Err(Error::InvalidParameter {
+            name: "X",
+            message: format!(
+                "the search for the sigma_p of {target} samples left the floating-point range \
+                 (sigma_p {}): rescale the points",
+                r.sigma_p
+            ),
+        });
+    }
     Ok(finish(r.sigma_p, r.value, Some(m), r.reached, r.history))
 }
 
@@ -338,7 +349,7 @@ mod tests {
             sigma_p: Some(-1.0),
             ..d
         })
-        .contains("sigma"));
+        .contains("invalid parameter sigma_p"));
         assert!(with(ManifoldSampleParams {
             sigma_p: Some(1.0),
             sigma_n: 0.5,
@@ -351,5 +362,16 @@ mod tests {
             ..d
         })
         .contains("dimension"));
+        // Coordinates near the top of the floating-point range: an error, not an infinite
+        // sigma_p reported as reached.
+        let huge = PointSet::new(2, vec![1e300, 0.0, -1e300, 0.0, 0.0, 1e300], None).unwrap();
+        let r = sample_manifold(
+            &huge,
+            &ManifoldSampleParams {
+                count: Some(1),
+                ..d
+            },
+        );
+        assert!(r.as_ref().map_or(true, |s| s.sigma_p.is_finite()), "{r:?}");
     }
 }

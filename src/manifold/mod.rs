@@ -383,7 +383,18 @@ pub(crate) use with_kernel_dim;
 /// (infinity: positions only), finite only with normals, and the kernel space (2d with a finite
 /// sigma_n) within [`MAX_KERNEL_DIMENSION`].
 fn check_widths(points: &PointSet, sigma_p: f64, sigma_n: f64) -> Result<()> {
-    crate::kernel::Kernel::new(sigma_p, sigma_n)?;
+    // The kernel's own checks, the parameters named as this module's callers name them.
+    crate::kernel::Kernel::new(sigma_p, sigma_n).map_err(|e| match e {
+        Error::InvalidParameter { name, message } => Error::InvalidParameter {
+            name: if name == "--sigma-p" {
+                "sigma_p"
+            } else {
+                "sigma_n"
+            },
+            message,
+        },
+        other => other,
+    })?;
     if sigma_n.is_finite() && points.normals.is_none() {
         return Err(Error::InvalidParameter {
             name: "sigma_n",

@@ -71,7 +71,8 @@ impl Default for GradientAscentParams {
 /// What the gradient ascent did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GradientAscentResult {
-    /// Per sweep, the mean distance a sample moved (bbox-100 units, after projection).
+    /// Per sweep, the mean distance a sample moved, after projection (bbox-100 units on a
+    /// surface; the point set's own units in R^d, `resample_manifold`).
     pub mean_move: Vec<f64>,
     /// Per sweep, the mean and the minimum of s over the moved samples before the sweep's moves.
     pub mean_s: Vec<f64>,
