@@ -1,7 +1,8 @@
 """Spectral sampling of manifolds (Öztireli, Alexa, Gross 2010): remeshing of triangle meshes,
 and sampling of point sets near a manifold of any dimension in R^d, numpy in, numpy out.
 
-Triangle meshes: `read`, `remesh` and `quality`, as the `remesh` command line does them.
+Triangle meshes: `read`, `write`, `remesh` and `quality`, as the `remesh` command line does
+them (`remesh` also meshes a point set of R^3 given without faces).
 Point sets of shape (n, d), d from 1 to 16 (a curve in the plane, a surface in R^3 or R^4, a
 3-manifold in R^4, ...): `sample` chooses an even subset of the points, `resample` moves the
 samples into blue noise on the manifold.
@@ -12,8 +13,7 @@ count (a float array of indices is refused); non-contiguous arrays (slices, tran
 negative strides) are read through their strides, never refused. Errors carry the library's
 one-line message: ValueError for input or options that cannot be used, OSError for files the
 operating system refuses, RuntimeError for an internal failure (a bug) or a strict refusal.
-The GIL is released while the library works (but for the calls of a Python `project`).
-"""
+The GIL is released while the library works (but for the calls of a Python `project`)."""
 
 from os import PathLike
 from typing import Any, Callable, Dict, Literal, Optional, Sequence, Tuple, Union, overload
@@ -56,6 +56,37 @@ def read(
     ValueError
         The extension names no mesh format, the content does not parse, or the mesh cannot be
         used (no triangles, an index out of range, a non-finite coordinate).
+    """
+
+def write(
+    path: Union[str, "PathLike[str]"],
+    V: npt.ArrayLike,
+    F: npt.ArrayLike,
+    /,
+) -> None:
+    """Write a triangle mesh to a file through the library's writers, as `remesh` writes its output.
+
+    The format is the extension's: .obj and .off (coordinates in the shortest text that reads
+    back to the same float64), .ply (binary, coordinates as double), .glb and .gltf (glTF 2.0),
+    .stl (binary). The file is written atomically: to a temporary file beside it, then renamed
+    into place, so a failure leaves nothing at the path (an existing file stays as it was).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write.
+    V : array_like, shape (n, 3)
+        Vertex positions, any real dtype (converted to float64), in model units.
+    F : array_like, shape (m, 3)
+        Triangles as 0-based indices into V, any integer dtype.
+
+    Raises
+    ------
+    ValueError
+        An array of the wrong shape or dtype, a non-finite coordinate (naming the vertex), an
+        index out of range, or an extension that names no mesh format.
+    OSError
+        The file cannot be written (missing folder, no permission, disk full).
     """
     ...
 
@@ -125,6 +156,7 @@ def remesh(
     distance: bool = True,
     strict: bool = False,
     max_memory: Union[int, str, None] = None,
+    progress: Optional[Callable[[str], Any]] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], Dict[str, Any]]:
     """Remesh a triangle mesh, or mesh a point set, by spectral sampling, as the `remesh` command
     line does.
@@ -189,6 +221,10 @@ def remesh(
     max_memory : int, str or None
         The most memory the job may take, in bytes or as a size ("512M", "8G", "2GiB"); a job
         whose estimated peak is larger is refused at once. None: the machine's physical memory.
+    progress : callable or None
+        Called with each stage's name (str: "read", "linear scan", "gradient ascent",
+        "triangulate", ...) as the stage starts, with the GIL taken for the call. An exception it
+        raises stops further calls and is raised again, unchanged, when the job returns.
 
     Returns
     -------

@@ -107,6 +107,25 @@ fn array_n3<'py>(
     Ok(array)
 }
 
+/// A 2-D array of a real dtype (floating point or integer) as `float64` (`numpy.asarray(array,
+/// "float64")`); `name` names it in the error for another dtype.
+fn real_f64<'py>(
+    py: Python<'py>,
+    name: &str,
+    array: Bound<'py, PyUntypedArray>,
+) -> PyResult<PyReadonlyArray2<'py, f64>> {
+    let dtype = array.dtype();
+    if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
+        return Err(PyValueError::new_err(format!(
+            "{name} must hold real numbers (a float or integer dtype), got dtype {}",
+            dtype.str()?
+        )));
+    }
+    py.import("numpy")?
+        .call_method1("asarray", (array, "float64"))?
+        .extract()
+}
+
 /// A shape as Python prints it: `(4,)`, `(4, 2)`.
 fn shape_text(shape: &[usize]) -> String {
     match shape {
@@ -126,18 +145,7 @@ fn shape_text(shape: &[usize]) -> String {
 /// integer; converted to `float64`). Finiteness is checked by the library
 /// ([`spectral::remesh_mesh`], [`spectral::quality_mesh`]) with the vertex named.
 fn positions(py: Python<'_>, name: &str, value: &Bound<'_, PyAny>) -> PyResult<Vec<DVec3>> {
-    let array = array_n3(py, name, "n", value)?;
-    let dtype = array.dtype();
-    if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
-        return Err(PyValueError::new_err(format!(
-            "{name} must hold real numbers (a float or integer dtype), got dtype {}",
-            dtype.str()?
-        )));
-    }
-    let array: PyReadonlyArray2<f64> = py
-        .import("numpy")?
-        .call_method1("asarray", (array, "float64"))?
-        .extract()?;
+    let array = real_f64(py, name, array_n3(py, name, "n", value)?)?;
     Ok(array
         .as_array()
         .rows()
@@ -279,6 +287,47 @@ fn read<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshArrays<'py>> {
     Ok(mesh_arrays(py, mesh))
 }
 
+/// Write a triangle mesh to a file through the library's writers, as `remesh` writes its output.
+///
+/// The format is the extension's: .obj and .off (coordinates in the shortest text that reads
+/// back to the same float64), .ply (binary, coordinates as double), .glb and .gltf (glTF 2.0),
+/// .stl (binary). The file is written atomically: to a temporary file beside it, then renamed
+/// into place, so a failure leaves nothing at the path (an existing file stays as it was).
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///     The file to write.
+/// V : array_like, shape (n, 3)
+///     Vertex positions, any real dtype (converted to float64), in model units.
+/// F : array_like, shape (m, 3)
+///     Triangles as 0-based indices into V, any integer dtype.
+///
+/// Raises
+/// ------
+/// ValueError
+///     An array of the wrong shape or dtype, a non-finite coordinate (naming the vertex), an
+///     index out of range, or an extension that names no mesh format.
+/// OSError
+///     The file cannot be written (missing folder, no permission, disk full).
+#[pyfunction]
+#[pyo3(signature = (path, V, F, /))]
+#[allow(non_snake_case)]
+fn write(
+    py: Python<'_>,
+    path: PathBuf,
+    V: &Bound<'_, PyAny>,
+    F: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let mesh = mesh_from(py, ("V", V), ("F", F))?;
+    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "V[{i}] has a coordinate that is not finite"
+        )));
+    }
+    without_gil(py, move || spectral::write_mesh(&path, &mesh))
+}
+
 /// The quality report of a triangle mesh, as `remesh quality --json` gives it.
 ///
 /// The mesh (and the reference) get the reader's checks and clean-up first (vertices at
@@ -365,6 +414,61 @@ fn count(name: &str, value: i128) -> PyResult<usize> {
     })
 }
 
+/// `remesh`'s `progress`: a Python callable given each stage's name, called with the GIL taken;
+/// its first exception is kept (and no further call made) to be raised when the job returns.
+struct Progress {
+    callable: Option<Py<PyAny>>,
+    raised: Mutex<Option<PyErr>>,
+}
+
+impl Progress {
+    /// `progress` checked: None or a callable.
+    fn new(progress: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let callable = match progress {
+            Some(p) if !p.is_none() => {
+                if !p.is_callable() {
+                    return Err(PyTypeError::new_err(format!(
+                        "progress must be callable (or None), got {}",
+                        p.get_type().name()?
+                    )));
+                }
+                Some(p.clone().unbind())
+            }
+            _ => None,
+        };
+        Ok(Progress {
+            callable,
+            raised: Mutex::new(None),
+        })
+    }
+
+    /// The library's `on_stage`: the callable on `stage`, unless it raised before.
+    fn stage(&self, stage: &str) {
+        let Some(callable) = &self.callable else {
+            return;
+        };
+        let mut raised = self.raised.lock().unwrap_or_else(|p| p.into_inner());
+        if raised.is_none() {
+            if let Err(e) = Python::attach(|py| callable.bind(py).call1((stage,)).map(|_| ())) {
+                *raised = Some(e);
+            }
+        }
+    }
+
+    /// The job's result, or the callable's exception when it raised one.
+    fn result_of<T>(progress: &Progress, out: PyResult<T>) -> PyResult<T> {
+        match progress
+            .raised
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .take()
+        {
+            Some(e) => Err(e),
+            None => out,
+        }
+    }
+}
+
 /// `remesh`'s result: the output's `V` and `F` and the report.
 type Remeshed<'py> = (
     Bound<'py, PyArray2<f64>>,
@@ -435,6 +539,10 @@ type Remeshed<'py> = (
 /// max_memory : int, str or None
 ///     The most memory the job may take, in bytes or as a size ("512M", "8G", "2GiB"); a job
 ///     whose estimated peak is larger is refused at once. None: the machine's physical memory.
+/// progress : callable or None
+///     Called with each stage's name (str: "read", "linear scan", "gradient ascent",
+///     "triangulate", ...) as the stage starts, with the GIL taken for the call. An exception it
+///     raises stops further calls and is raised again, unchanged, when the job returns.
 ///
 /// Returns
 /// -------
@@ -463,7 +571,7 @@ type Remeshed<'py> = (
     V, F = None, *, normals = None, viewpoint = None, points = None, sigma_p = None, sigma_n = None, seed = 1, iterations = None,
     lfs_factor = None, chord_error = None, fit = true, smooth = None, min_angle = None,
     max_angle = None, feature_angle = None, features = true, triangulation = None,
-    distance = true, strict = false, max_memory = None
+    distance = true, strict = false, max_memory = None, progress = None
 ))]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 fn remesh<'py>(
@@ -489,7 +597,9 @@ fn remesh<'py>(
     distance: bool,
     strict: bool,
     max_memory: Option<&Bound<'py, PyAny>>,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Remeshed<'py>> {
+    let progress = Progress::new(progress)?;
     let defaults = RemeshOptions::default();
     let seed = u64::try_from(seed).map_err(|_| {
         PyValueError::new_err(format!(
@@ -543,6 +653,7 @@ fn remesh<'py>(
                 "viewpoint orients estimated normals: not with normals given",
             ));
         }
+        let progress = &progress;
         let out = without_gil(py, move || {
             spectral::remesh_point_set(
                 &points,
@@ -552,9 +663,10 @@ fn remesh<'py>(
                 distance,
                 strict,
                 max_memory,
-                &|_| {},
+                &|stage| progress.stage(stage),
             )
-        })?;
+        });
+        let out = Progress::result_of(progress, out)?;
         let (v, f) = mesh_arrays(py, out.mesh);
         return Ok((v, f, report_dict(py, &out.report)?));
     };
@@ -564,9 +676,12 @@ fn remesh<'py>(
         ));
     }
     let mesh = mesh_from(py, ("V", V), ("F", F))?;
-    let out = without_gil(py, move || {
-        spectral::remesh_mesh(mesh, &params, distance, strict, max_memory, &|_| {})
-    })?;
+    let out = without_gil(py, || {
+        spectral::remesh_mesh(mesh, &params, distance, strict, max_memory, &|stage| {
+            progress.stage(stage)
+        })
+    });
+    let out = Progress::result_of(&progress, out)?;
     let (v, f) = mesh_arrays(py, out.mesh);
     Ok((v, f, report_dict(py, &out.report)?))
 }
@@ -635,17 +750,7 @@ fn point_rows(
         }
     }
     let (n, d) = (shape[0], shape[1]);
-    let dtype = array.dtype();
-    if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
-        return Err(PyValueError::new_err(format!(
-            "{name} must hold real numbers (a float or integer dtype), got dtype {}",
-            dtype.str()?
-        )));
-    }
-    let array: PyReadonlyArray2<f64> = py
-        .import("numpy")?
-        .call_method1("asarray", (array, "float64"))?
-        .extract()?;
+    let array = real_f64(py, name, array)?;
     // Logical (row-major) order whatever the strides.
     Ok((array.as_array().iter().copied().collect(), n, d))
 }
@@ -1141,7 +1246,8 @@ fn resample<'py>(
 /// Spectral sampling of manifolds (Öztireli, Alexa, Gross 2010): remeshing of triangle meshes,
 /// and sampling of point sets near a manifold of any dimension in R^d, numpy in, numpy out.
 ///
-/// Triangle meshes: `read`, `remesh` and `quality`, as the `remesh` command line does them.
+/// Triangle meshes: `read`, `write`, `remesh` and `quality`, as the `remesh` command line does
+/// them (`remesh` also meshes a point set of R^3 given without faces).
 /// Point sets of shape (n, d), d from 1 to 16 (a curve in the plane, a surface in R^3 or R^4, a
 /// 3-manifold in R^4, ...): `sample` chooses an even subset of the points, `resample` moves the
 /// samples into blue noise on the manifold.
@@ -1157,6 +1263,7 @@ fn resample<'py>(
 fn spectral_remesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(quality, m)?)?;
     m.add_function(wrap_pyfunction!(remesh, m)?)?;
     m.add_function(wrap_pyfunction!(sample, m)?)?;

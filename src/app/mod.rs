@@ -630,6 +630,31 @@ fn quality_read(
     Ok(report)
 }
 
+impl RemeshJob {
+    /// The job of an input held in memory ([`remesh_mesh`], [`remesh_point_set`]): `input`
+    /// names it (or is the temporary file holding it); the output is handed back, not written.
+    fn in_memory(
+        input: PathBuf,
+        params: &RemeshParams,
+        measure_distance: bool,
+        strict: bool,
+        max_memory: Option<u64>,
+        viewpoint: Option<glam::DVec3>,
+    ) -> Self {
+        RemeshJob {
+            input,
+            output: PathBuf::from("the output mesh"),
+            format: None,
+            params: *params,
+            measure_distance,
+            strict,
+            max_memory,
+            as_points: false,
+            viewpoint,
+        }
+    }
+}
+
 /// The output of [`remesh_mesh`]: the remeshed mesh and its report.
 #[derive(Debug, Clone)]
 pub struct RemeshedMesh {
@@ -668,17 +693,14 @@ pub fn remesh_mesh(
     on_stage("read");
     let t = Clock::start();
     let (input, welded_vertices) = check_and_clean(Path::new(INPUT), mesh)?;
-    let job = RemeshJob {
-        input: PathBuf::from(INPUT),
-        output: PathBuf::from("the output mesh"),
-        format: None,
-        params: *params,
+    let job = RemeshJob::in_memory(
+        PathBuf::from(INPUT),
+        params,
         measure_distance,
         strict,
         max_memory,
-        as_points: false,
-        viewpoint: None,
-    };
+        None,
+    );
     // PLY: the output is handed over in f64, exactly as PLY, OBJ and OFF store it.
     let (mesh, report) = remesh_read(
         &job,

@@ -210,8 +210,8 @@ const INPUT_POINTS: &str = "input points";
 /// # Errors
 /// [`Error::InvalidMesh`] for no points, a coordinate or normal that is not finite, a normal of
 /// length zero or a normal count that differs from the point count (naming the point);
-/// [`Error::Io`] when the temporary file cannot be written; whatever [`run_remesh`]
-/// (super::run_remesh) returns for a point-set file.
+/// [`Error::Io`] when the temporary file cannot be written; whatever
+/// [`run_remesh`](super::run_remesh) returns for a point-set file.
 #[allow(clippy::too_many_arguments)] // RemeshJob's fields, less the files
 pub fn remesh_point_set(
     points: &[DVec3],
@@ -260,17 +260,14 @@ pub fn remesh_point_set(
         "points.xyz"
     });
     write_text_points(&input, points, normals)?;
-    let job = RemeshJob {
-        input: input.clone(),
-        output: PathBuf::from("the output mesh"),
-        format: None,
-        params: *params,
+    let job = RemeshJob::in_memory(
+        input.clone(),
+        params,
         measure_distance,
         strict,
         max_memory,
-        as_points: false,
         viewpoint,
-    };
+    );
     let handed = Mutex::new(None);
     let report = run_with(
         &job,

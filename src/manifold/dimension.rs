@@ -9,11 +9,7 @@
 //! The count search's first step and the projection onto the data use it when the caller does
 //! not give the dimension.
 
-use rand::seq::SliceRandom;
-use rand::SeedableRng;
-
-use super::{tree_frame, with_kernel_dim, PointSet};
-use crate::spatial::StaticKdTree;
+use super::{random_probes, with_kernel_dim, PointSet};
 
 /// The neighbours k of each point the estimate uses.
 pub const DIMENSION_NEIGHBOURS: usize = 10;
@@ -54,15 +50,8 @@ pub fn estimate_dimension(points: &PointSet, seed: u64) -> DimensionEstimate {
 }
 
 fn estimate<const K: usize>(points: &PointSet, seed: u64) -> DimensionEstimate {
-    let all: Vec<[f64; K]> = points
-        .embed::<K>(1.0, f64::INFINITY)
-        .iter()
-        .map(tree_frame)
-        .collect();
-    let tree = StaticKdTree::<K>::new(&all);
-    let mut probe: Vec<usize> = (0..points.len()).collect();
-    probe.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed));
-    probe.truncate(DIMENSION_PROBES);
+    let (all, tree) = points.position_tree::<K>();
+    let probe = random_probes(points.len(), DIMENSION_PROBES, seed);
     let k = DIMENSION_NEIGHBOURS;
     let mut found = Vec::new();
     let (mut sum, mut used) = (0.0, 0usize);
@@ -93,7 +82,7 @@ fn estimate<const K: usize>(points: &PointSet, seed: u64) -> DimensionEstimate {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand::RngExt;
+    use rand::{RngExt, SeedableRng};
 
     /// `n` points uniform in the unit cube of R^m, embedded in R^d by a fixed rotation-like map
     /// (the first m coordinates, then sums of them).

@@ -12,13 +12,13 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
 use super::{
-    check_widths, estimate_dimension, kernel, tree_frame, ManifoldSampleParams, ManifoldSampling,
-    PointSet,
+    check_widths, estimate_dimension, kernel, random_probes, tree_frame, ManifoldSampleParams,
+    ManifoldSampling, PointSet,
 };
 use crate::error::{Error, Result};
 use crate::measure::{spectral_measure, MeasureWorkspace};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
-use crate::spatial::{DynamicKdTree, StaticKdTree};
+use crate::spatial::DynamicKdTree;
 
 /// The parameters checked against the point set (see [`super::sample_manifold`]'s errors).
 pub(super) fn check_params(points: &PointSet, params: &ManifoldSampleParams) -> Result<()> {
@@ -180,15 +180,8 @@ pub(super) fn sample<const K: usize>(
 /// 1000 points), each point stands for a volume of about h^m, and a sample of the linear scan
 /// for one of about sigma_p^m, so sigma_p ≈ h (n / target)^(1/m).
 fn first_sigma_p<const K: usize>(points: &PointSet, target: usize, m: usize, seed: u64) -> f64 {
-    let all: Vec<[f64; K]> = points
-        .embed::<K>(1.0, f64::INFINITY)
-        .iter()
-        .map(tree_frame)
-        .collect();
-    let tree = StaticKdTree::<K>::new(&all);
-    let mut probe: Vec<usize> = (0..points.len()).collect();
-    probe.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ 0x5eed));
-    probe.truncate(1000);
+    let (all, tree) = points.position_tree::<K>();
+    let probe = random_probes(points.len(), 1000, seed ^ 0x5eed);
     let mut found = Vec::new();
     let mut h: Vec<f64> = probe
         .iter()
@@ -208,26 +201,9 @@ mod tests {
     use super::super::{sample_manifold, PointSet};
     use super::*;
     use crate::kernel::Kernel;
+    use crate::sampling::linear_scan::tests::sphere_points;
     use crate::sampling::linear_scan::{LinearScanParams, LinearScanner};
-    use glam::DVec3;
     use rand::RngExt;
-
-    /// Points on a sphere of radius 20 with bumpy normals, in a random order.
-    fn sphere(n: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        (0..n)
-            .map(|_| {
-                let v = DVec3::new(
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                )
-                .normalize_or(DVec3::Z);
-                let bump = DVec3::new(0.0, (7.0 * v.x).sin() * 0.3, 0.0);
-                (20.0 * v, (v + bump).normalize())
-            })
-            .collect()
-    }
 
     /// Oracle: in R^3 the scan in kernel space makes the surface sampler's decisions
     /// (`LinearScanner`: a position kd-tree, quick tests, chunks in parallel), point for point,
@@ -235,7 +211,7 @@ mod tests {
     #[test]
     fn in_r3_the_scan_makes_the_surface_scanners_decisions() {
         for (sigma_n, seed) in [(f64::INFINITY, 1), (0.75, 2)] {
-            let pts = sphere(30_000, seed);
+            let pts = sphere_points(30_000, seed);
             let kernel = Kernel::new(1.0, sigma_n).unwrap();
             let mut scanner = LinearScanner::new(&kernel, &LinearScanParams::default());
             let mut expected = Vec::new();

@@ -8,7 +8,7 @@
 //! R^K, K = 2d (K = d with positions only, sigma_n = infinity), and two points meet with the
 //! Gaussian k(x, y) = exp(-|x - y|²) ([`GaussianKernel`]). The spectral measure is the
 //! crate's one implementation ([`spectral_measure`](crate::spectral_measure), generic over the
-//! kernel); the kd-trees are kiddo's in K dimensions ([`StaticKdTree`](crate::StaticKdTree),
+//! kernel); the kd-trees are kiddo's in K dimensions ([`StaticKdTree`],
 //! [`DynamicKdTree`](crate::DynamicKdTree)). Every routine is written once over the const
 //! dimension K and instantiated for K = 1 to [`MAX_KERNEL_DIMENSION`]: d up to 16 with positions
 //! only, up to 8 with normals.
@@ -32,6 +32,7 @@ use crate::error::{Error, Result};
 use crate::kernel::{GaussianKernel, SUPPORT_RADIUS};
 use crate::measure::DEFAULT_EPSILON;
 use crate::sampling::gradient_ascent::{GradientAscentParams, GradientAscentResult};
+use crate::spatial::StaticKdTree;
 
 pub use dimension::{estimate_dimension, DIMENSION_NEIGHBOURS};
 pub use projection::{DataProjection, ManifoldProjection, PROJECTION_ITERATIONS};
@@ -185,6 +186,18 @@ impl PointSet {
         } else {
             self.dim
         }
+    }
+
+    /// The positions in R^K (zeros past d) in the kd-trees' frame ([`tree_frame`]), and a
+    /// static kd-tree over them: index i of a query's result is point i.
+    fn position_tree<const K: usize>(&self) -> (Vec<[f64; K]>, StaticKdTree<K>) {
+        let rows: Vec<[f64; K]> = self
+            .embed::<K>(1.0, f64::INFINITY)
+            .iter()
+            .map(tree_frame)
+            .collect();
+        let tree = StaticKdTree::new(&rows);
+        (rows, tree)
     }
 
     /// Every point mapped to kernel space, x = [p/sigma_p, n/sigma_n] (zeros beyond the
@@ -497,6 +510,16 @@ fn tree_frame<const K: usize>(x: &[f64; K]) -> [f64; K] {
         *o -= c * v(k);
     }
     out
+}
+
+/// At most `most` indices below `n`, in a random order drawn with `seed`.
+fn random_probes(n: usize, most: usize, seed: u64) -> Vec<usize> {
+    use rand::seq::SliceRandom;
+    use rand::SeedableRng;
+    let mut probe: Vec<usize> = (0..n).collect();
+    probe.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(seed));
+    probe.truncate(most);
+    probe
 }
 
 /// The kernel of the manifold sampler in K dimensions.

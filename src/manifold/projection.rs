@@ -94,12 +94,7 @@ impl DataProjection {
             None => estimate_dimension(data, seed).round_dimension(d),
         };
         let tree: Box<dyn NearestRows> = with_kernel_dim!(d, K => {
-            let rows: Vec<[f64; K]> = data
-                .embed::<K>(1.0, f64::INFINITY)
-                .iter()
-                .map(tree_frame)
-                .collect();
-            Box::new(Rows::<K>(StaticKdTree::new(&rows)))
+            Box::new(Rows::<K>(data.position_tree::<K>().1))
         }, return Err(Error::Internal {
             stage: "projection",
             message: format!("no kd-tree built for dimension {d}"),

@@ -485,12 +485,12 @@ pub fn linear_scan_graded(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
 
     /// Points on a unit-ish sphere of radius 20 with outward normals, some bumps in the normals.
-    fn sphere_points(n: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
+    pub(crate) fn sphere_points(n: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         (0..n)
             .map(|_| {
