@@ -19,7 +19,8 @@ def remesh_bin():
     if given:
         return Path(given)
     out = subprocess.run(
-        ["cargo", "build", "--release", "--bin", "remesh", "--message-format=json-render-diagnostics"],
+        ["cargo", "build", "--release", "--workspace", "--bin", "remesh",
+         "--message-format=json-render-diagnostics"],
         cwd=REPO,
         check=True,
         stdout=subprocess.PIPE,

@@ -1,8 +1,9 @@
 """Tests of the spectral_remesh Python module against the `remesh` command line.
 
 Needs the models in ../shared/data beside the repository (fails without them) and the
-`remesh` binary: $REMESH_BIN, or built here with `cargo build --release --bin remesh` (a no-op
-when CI's `cargo test --release --workspace` has built it).
+`remesh` binary: $REMESH_BIN, or built here with `cargo build --release --workspace --bin
+remesh` (with --workspace the features resolve as in CI's `cargo test --release --workspace`,
+so after it the build is a no-op).
 """
 
 import ast
