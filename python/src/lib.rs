@@ -22,8 +22,8 @@ use std::sync::Mutex;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{
-    IntoPyArray, PyArray2, PyArrayDescrMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArray,
-    PyUntypedArrayMethods,
+    IntoPyArray, PyArray2, PyArrayDescrMethods, PyReadonlyArray2, PyReadonlyArrayDyn,
+    PyUntypedArray, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{
     PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyRuntimeError,
@@ -163,58 +163,59 @@ fn triangles(
     vertices: usize,
 ) -> PyResult<Vec<[u32; 3]>> {
     let array = array_n3(py, name, "m", value)?;
-    let dtype = array.dtype();
-    let (kind, size) = (dtype.kind(), dtype.itemsize());
-    if !matches!(kind, b'i' | b'u') {
-        return Err(PyValueError::new_err(format!(
-            "{name} must hold vertex indices (an integer dtype), got dtype {}",
-            dtype.str()?
-        )));
-    }
     if u32::try_from(vertices).is_err() {
         return Err(PyValueError::new_err(format!(
             "{vertices} vertices are more than 32-bit indices can name"
         )));
     }
-    let out_of_range = |row: usize, col: usize, value: String| {
-        PyValueError::new_err(format!(
-            "{name}[{row}, {col}] = {value} is not a vertex index: the vertices are numbered 0 \
-             to {} (0-based)",
-            vertices as i128 - 1
-        ))
-    };
-    let np = py.import("numpy")?;
-    // Each index checked against the vertex count, whatever its integer type.
-    fn checked<T: Copy + ToString>(
-        rows: numpy::ndarray::ArrayView2<'_, T>,
-        vertices: usize,
-        out_of_range: impl Fn(usize, usize, String) -> PyErr,
-    ) -> PyResult<Vec<[u32; 3]>>
-    where
-        usize: TryFrom<T>,
-    {
-        let mut out = Vec::with_capacity(rows.nrows());
-        for (row, r) in rows.rows().into_iter().enumerate() {
-            let mut t = [0u32; 3];
-            for col in 0..3 {
-                t[col] = match usize::try_from(r[col]) {
-                    Ok(i) if i < vertices => i as u32,
-                    _ => return Err(out_of_range(row, col, r[col].to_string())),
-                };
-            }
-            out.push(t);
+    let values = integer_values(py, name, "vertex indices", array)?;
+    let mut out = Vec::with_capacity(values.len() / 3);
+    for (row, r) in values.chunks_exact(3).enumerate() {
+        let mut t = [0u32; 3];
+        for (col, &v) in r.iter().enumerate() {
+            t[col] = match usize::try_from(v) {
+                Ok(i) if i < vertices => i as u32,
+                _ => {
+                    return Err(PyValueError::new_err(format!(
+                        "{name}[{row}, {col}] = {v} is not a vertex index: the vertices are \
+                         numbered 0 to {} (0-based)",
+                        vertices as i128 - 1
+                    )))
+                }
+            };
         }
-        Ok(out)
+        out.push(t);
     }
+    Ok(out)
+}
+
+/// The values of an integer array in logical (row-major) order, whatever its strides, as i128
+/// (every int64 and uint64 value exactly); `name` and `what` ("vertex indices") name it in the
+/// error for another dtype.
+fn integer_values(
+    py: Python<'_>,
+    name: &str,
+    what: &str,
+    array: Bound<'_, PyUntypedArray>,
+) -> PyResult<Vec<i128>> {
+    let dtype = array.dtype();
+    let (kind, size) = (dtype.kind(), dtype.itemsize());
+    if !matches!(kind, b'i' | b'u') {
+        return Err(PyValueError::new_err(format!(
+            "{name} must hold {what} (an integer dtype), got dtype {}",
+            dtype.str()?
+        )));
+    }
+    let np = py.import("numpy")?;
     if kind == b'u' && size == 8 {
         // uint64 does not fit int64: read as it is.
-        let array: PyReadonlyArray2<u64> =
+        let array: PyReadonlyArrayDyn<u64> =
             np.call_method1("asarray", (array, "uint64"))?.extract()?;
-        checked(array.as_array(), vertices, out_of_range)
+        Ok(array.as_array().iter().map(|&v| i128::from(v)).collect())
     } else {
-        let array: PyReadonlyArray2<i64> =
+        let array: PyReadonlyArrayDyn<i64> =
             np.call_method1("asarray", (array, "int64"))?.extract()?;
-        checked(array.as_array(), vertices, out_of_range)
+        Ok(array.as_array().iter().map(|&v| i128::from(v)).collect())
     }
 }
 
@@ -771,60 +772,31 @@ fn sample_indices(py: Python<'_>, value: &Bound<'_, PyAny>, points: usize) -> Py
             "indices must name at least one point, got shape (0,)",
         ));
     }
-    let dtype = array.dtype();
-    let (kind, size) = (dtype.kind(), dtype.itemsize());
-    if !matches!(kind, b'i' | b'u') {
-        return Err(PyValueError::new_err(format!(
-            "indices must hold point indices (an integer dtype), got dtype {}",
-            dtype.str()?
-        )));
-    }
-    // Each index checked against the point count and the ones before it, whatever its integer
-    // type.
-    fn checked<T: Copy + ToString>(
-        values: numpy::ndarray::ArrayView1<'_, T>,
-        points: usize,
-    ) -> PyResult<Vec<usize>>
-    where
-        usize: TryFrom<T>,
-    {
-        let mut first = vec![usize::MAX; points];
-        let mut out = Vec::with_capacity(values.len());
-        for (pos, &v) in values.iter().enumerate() {
-            let i = match usize::try_from(v) {
-                Ok(i) if i < points => i,
-                _ => {
-                    return Err(PyValueError::new_err(format!(
-                        "indices[{pos}] = {} is not a point index: the points of X are numbered \
-                         0 to {} (0-based)",
-                        v.to_string(),
-                        points as i128 - 1
-                    )))
-                }
-            };
-            if first[i] != usize::MAX {
+    let values = integer_values(py, "indices", "point indices", array)?;
+    // Each index checked against the point count and the ones before it.
+    let mut first = vec![usize::MAX; points];
+    let mut out = Vec::with_capacity(values.len());
+    for (pos, &v) in values.iter().enumerate() {
+        let i = match usize::try_from(v) {
+            Ok(i) if i < points => i,
+            _ => {
                 return Err(PyValueError::new_err(format!(
-                    "indices[{pos}] = {i} repeats indices[{}]: each sample must be a different \
-                     point",
-                    first[i]
-                )));
+                    "indices[{pos}] = {v} is not a point index: the points of X are numbered 0 \
+                     to {} (0-based)",
+                    points as i128 - 1
+                )))
             }
-            first[i] = pos;
-            out.push(i);
+        };
+        if first[i] != usize::MAX {
+            return Err(PyValueError::new_err(format!(
+                "indices[{pos}] = {i} repeats indices[{}]: each sample must be a different point",
+                first[i]
+            )));
         }
-        Ok(out)
+        first[i] = pos;
+        out.push(i);
     }
-    let np = py.import("numpy")?;
-    if kind == b'u' && size == 8 {
-        // uint64 does not fit int64: read as it is.
-        let array: PyReadonlyArray1<u64> =
-            np.call_method1("asarray", (array, "uint64"))?.extract()?;
-        checked(array.as_array(), points)
-    } else {
-        let array: PyReadonlyArray1<i64> =
-            np.call_method1("asarray", (array, "int64"))?.extract()?;
-        checked(array.as_array(), points)
-    }
+    Ok(out)
 }
 
 /// `seed` as the library's u64.

@@ -10,6 +10,7 @@
 //! not give the dimension.
 
 use super::{random_probes, with_kernel_dim, PointSet};
+use crate::spatial::StaticKdTree;
 
 /// The neighbours k of each point the estimate uses.
 pub const DIMENSION_NEIGHBOURS: usize = 10;
@@ -50,14 +51,24 @@ pub fn estimate_dimension(points: &PointSet, seed: u64) -> DimensionEstimate {
 }
 
 fn estimate<const K: usize>(points: &PointSet, seed: u64) -> DimensionEstimate {
-    let (all, tree) = points.position_tree::<K>();
-    let probe = random_probes(points.len(), DIMENSION_PROBES, seed);
+    let (rows, tree) = points.position_tree::<K>();
+    estimate_in(&rows, &tree, seed)
+}
+
+/// [`estimate_dimension`] over positions `rows` already in a kd-tree `tree`
+/// ([`PointSet::position_tree`], any K at least the space's dimension).
+pub(super) fn estimate_in<const K: usize>(
+    rows: &[[f64; K]],
+    tree: &StaticKdTree<K>,
+    seed: u64,
+) -> DimensionEstimate {
+    let probe = random_probes(rows.len(), DIMENSION_PROBES, seed);
     let k = DIMENSION_NEIGHBOURS;
     let mut found = Vec::new();
     let (mut sum, mut used) = (0.0, 0usize);
     for &i in &probe {
         // The point itself comes first, at distance 0.
-        tree.nearest_n(&all[i], k + 1, &mut found);
+        tree.nearest_n(&rows[i], k + 1, &mut found);
         if found.len() < k + 1 {
             continue;
         }

@@ -9,9 +9,7 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rayon::prelude::*;
 
-use super::{
-    check_widths, kernel, tree_frame, ManifoldProjection, ManifoldResampleParams, PointSet,
-};
+use super::{check_widths, tree_frame, ManifoldProjection, ManifoldResampleParams, PointSet};
 use crate::error::{Error, Result};
 use crate::kernel::GaussianKernel;
 use crate::measure::{solve_alpha, MeasureWorkspace};
@@ -73,7 +71,7 @@ fn step<const K: usize>(
     params: &ManifoldResampleParams,
     ws: &mut MeasureWorkspace<[f64; K]>,
 ) -> ([f64; K], f64) {
-    let q = solve_alpha(&kernel::<K>(), x, near, ws);
+    let q = solve_alpha(&GaussianKernel::<K>, x, near, ws);
     let mut g = [0.0; K];
     for (j, alpha, k) in ws.alpha_rows() {
         let c = 4.0 * alpha * k;
@@ -308,7 +306,7 @@ mod tests {
                 0.0,
             ];
             let (g, s) = step(&x, &pts, 2, &params, &mut ws);
-            let k = kernel::<4>();
+            let k = GaussianKernel::<4>;
             let at = |x: [f64; 4], ws: &mut MeasureWorkspace<[f64; 4]>| {
                 spectral_measure(&k, &x, pts.iter().copied(), -1.0, ws).s
             };

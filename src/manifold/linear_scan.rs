@@ -11,14 +11,15 @@
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
+use super::dimension::estimate_in;
 use super::{
-    check_widths, estimate_dimension, kernel, random_probes, tree_frame, ManifoldSampleParams,
-    ManifoldSampling, PointSet,
+    check_widths, random_probes, tree_frame, ManifoldSampleParams, ManifoldSampling, PointSet,
 };
 use crate::error::{Error, Result};
+use crate::kernel::{GaussianKernel, UnitKernel};
 use crate::measure::{spectral_measure, MeasureWorkspace};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
-use crate::spatial::DynamicKdTree;
+use crate::spatial::{DynamicKdTree, StaticKdTree};
 
 /// The parameters checked against the point set (see [`super::sample_manifold`]'s errors).
 pub(super) fn check_params(points: &PointSet, params: &ManifoldSampleParams) -> Result<()> {
@@ -76,7 +77,7 @@ struct Scan {
 
 /// Algorithm 1 over the kernel-space points `x`, visited in `order`.
 fn scan<const K: usize>(x: &[[f64; K]], order: &[usize], epsilon: f64, support: f64) -> Scan {
-    let k = kernel::<K>();
+    let k = GaussianKernel::<K>;
     let mut tree = DynamicKdTree::<K>::new();
     let mut kept: Vec<[f64; K]> = Vec::new();
     let mut out = Scan {
@@ -92,7 +93,7 @@ fn scan<const K: usize>(x: &[[f64; K]], order: &[usize], epsilon: f64, support: 
         let accept = match tree.nearest(&q) {
             None => true,
             Some((j, _)) => {
-                let k1 = crate::kernel::UnitKernel::eval(&k, &xi, &kept[j as usize]);
+                let k1 = k.eval(&xi, &kept[j as usize]);
                 if k1 * k1 >= 1.0 - epsilon {
                     out.rejected_by_nearest += 1;
                     false
@@ -147,16 +148,18 @@ pub(super) fn sample<const K: usize>(
         return Ok(finish(sigma_p, s, params.dimension, true, search));
     }
     let target = params.count.unwrap_or(1);
+    // One position tree for the dimension estimate and the first guess of sigma_p.
+    let (rows, tree) = points.position_tree::<K>();
     let m = match params.dimension {
         Some(m) => m,
-        None => estimate_dimension(points, params.seed).round_dimension(points.dim()),
+        None => estimate_in(&rows, &tree, params.seed).round_dimension(points.dim()),
     };
     let search = TargetCountParams {
         tolerance: params.count_tolerance,
         dimension: m as f64,
         ..TargetCountParams::new(target)
     };
-    let start = first_sigma_p::<K>(points, target, m, params.seed);
+    let start = first_sigma_p(&rows, &tree, target, m, params.seed);
     let r = find_sigma_p(&search, start, |sigma_p| {
         let s = run(sigma_p);
         (s.accepted.len(), s)
@@ -179,20 +182,27 @@ pub(super) fn sample<const K: usize>(
 /// dimension `m`: with h the median distance from a point to its nearest other (over at most
 /// 1000 points), each point stands for a volume of about h^m, and a sample of the linear scan
 /// for one of about sigma_p^m, so sigma_p ≈ h (n / target)^(1/m).
-fn first_sigma_p<const K: usize>(points: &PointSet, target: usize, m: usize, seed: u64) -> f64 {
-    let (all, tree) = points.position_tree::<K>();
-    let probe = random_probes(points.len(), 1000, seed ^ 0x5eed);
+///
+/// `rows` and `tree`: the points' positions and their kd-tree ([`PointSet::position_tree`]).
+fn first_sigma_p<const K: usize>(
+    rows: &[[f64; K]],
+    tree: &StaticKdTree<K>,
+    target: usize,
+    m: usize,
+    seed: u64,
+) -> f64 {
+    let probe = random_probes(rows.len(), 1000, seed ^ 0x5eed);
     let mut found = Vec::new();
     let mut h: Vec<f64> = probe
         .iter()
         .filter_map(|&i| {
-            tree.nearest_n(&all[i], 2, &mut found);
+            tree.nearest_n(&rows[i], 2, &mut found);
             found.get(1).map(|f| f.1.sqrt()).filter(|&h| h > 0.0)
         })
         .collect();
     h.sort_by(f64::total_cmp);
     let h = h.get(h.len() / 2).copied().unwrap_or(1.0);
-    let ratio = points.len() as f64 / target.max(1) as f64;
+    let ratio = rows.len() as f64 / target.max(1) as f64;
     h * ratio.max(1.0).powf(1.0 / m.max(1) as f64)
 }
 

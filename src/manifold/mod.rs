@@ -6,7 +6,7 @@
 //!
 //! A point p of R^d with a unit normal n (optional) is mapped to x = [p/sigma_p, n/sigma_n] in
 //! R^K, K = 2d (K = d with positions only, sigma_n = infinity), and two points meet with the
-//! Gaussian k(x, y) = exp(-|x - y|²) ([`GaussianKernel`]). The spectral measure is the
+//! Gaussian k(x, y) = exp(-|x - y|²) ([`GaussianKernel`](crate::GaussianKernel)). The spectral measure is the
 //! crate's one implementation ([`spectral_measure`](crate::spectral_measure), generic over the
 //! kernel); the kd-trees are kiddo's in K dimensions ([`StaticKdTree`],
 //! [`DynamicKdTree`](crate::DynamicKdTree)). Every routine is written once over the const
@@ -29,7 +29,7 @@ mod linear_scan;
 mod projection;
 
 use crate::error::{Error, Result};
-use crate::kernel::{GaussianKernel, SUPPORT_RADIUS};
+use crate::kernel::SUPPORT_RADIUS;
 use crate::measure::DEFAULT_EPSILON;
 use crate::sampling::gradient_ascent::{GradientAscentParams, GradientAscentResult};
 use crate::spatial::StaticKdTree;
@@ -490,24 +490,49 @@ fn unreachable_dimension<T>(k: usize) -> Result<T> {
     })
 }
 
-/// A fixed reflection of R^K (Householder, I - 2 v v^T / |v|² with a generic v): the kd-trees
+/// The vector v of [`tree_frame`]'s reflection: v_k = 0.5 + frac(0.618034 (k + 1)) (golden-ratio
+/// steps: no two alike, none zero), for every kernel dimension.
+const FRAME: [f64; MAX_KERNEL_DIMENSION] = {
+    let mut v = [0.0; MAX_KERNEL_DIMENSION];
+    let mut k = 0;
+    while k < MAX_KERNEL_DIMENSION {
+        let x = 0.618_033_988_749_895 * (k + 1) as f64;
+        // x - trunc(x), as f64::fract computes it (x is positive and below 2^53).
+        v[k] = 0.5 + (x - (x as u64) as f64);
+        k += 1;
+    }
+    v
+};
+
+/// |v|² of [`FRAME`]'s first K components.
+struct FrameNorm<const K: usize>;
+
+impl<const K: usize> FrameNorm<K> {
+    const VV: f64 = {
+        let mut vv = 0.0;
+        let mut k = 0;
+        while k < K {
+            vv += FRAME[k] * FRAME[k];
+            k += 1;
+        }
+        vv
+    };
+}
+
+/// A fixed reflection of R^K (Householder, I - 2 v v^T / |v|² with v = [`FRAME`]): the kd-trees
 /// hold points in this frame so that points sharing a coordinate exactly (a grid, an
 /// axis-aligned plane, zero normal parts) leave no bucket the tree cannot split. Distances are
 /// kept (to rounding).
 #[inline]
 fn tree_frame<const K: usize>(x: &[f64; K]) -> [f64; K] {
-    // v_k = 1 + 0.618034 k mod 1 (golden-ratio steps: no two alike, none zero).
-    let v = |k: usize| 0.5 + (0.618_033_988_749_895 * (k + 1) as f64).fract();
-    let mut vv = 0.0;
     let mut vx = 0.0;
-    for (k, xk) in x.iter().enumerate() {
-        vv += v(k) * v(k);
-        vx += v(k) * xk;
+    for (v, xk) in FRAME.iter().zip(x) {
+        vx += v * xk;
     }
-    let c = 2.0 * vx / vv;
+    let c = 2.0 * vx / FrameNorm::<K>::VV;
     let mut out = *x;
-    for (k, o) in out.iter_mut().enumerate() {
-        *o -= c * v(k);
+    for (o, v) in out.iter_mut().zip(&FRAME) {
+        *o -= c * v;
     }
     out
 }
@@ -522,15 +547,10 @@ fn random_probes(n: usize, most: usize, seed: u64) -> Vec<usize> {
     probe
 }
 
-/// The kernel of the manifold sampler in K dimensions.
-#[inline]
-fn kernel<const K: usize>() -> GaussianKernel<K> {
-    GaussianKernel
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::GaussianKernel;
 
     #[test]
     fn point_sets_are_checked_and_normals_made_unit() {

@@ -189,11 +189,15 @@ impl DataProjection {
             return vec![0.0; normal.len()];
         }
         let row = |i: u32| &self.positions[i as usize * d..(i as usize + 1) * d];
+        let t: Vec<Vec<f64>> = found
+            .iter()
+            .map(|&(i, _)| coords(row(i), tangent))
+            .collect();
         // Tangent coordinates in units of the neighbourhood's radius: features of order 1 at
         // any scale of the data.
-        let radius = found
+        let radius = t
             .iter()
-            .map(|&(i, _)| coords(row(i), tangent).iter().map(|t| t * t).sum::<f64>())
+            .map(|t| t.iter().map(|t| t * t).sum::<f64>())
             .fold(0.0, f64::max)
             .sqrt();
         if !(radius > 0.0) {
@@ -213,12 +217,11 @@ impl DataProjection {
         };
         let mut design = DMatrix::<f64>::zeros(found.len(), features);
         let mut offsets = DMatrix::<f64>::zeros(found.len(), normal.len());
-        for (r, &(i, _)) in found.iter().enumerate() {
-            let x = row(i);
-            for (col, v) in phi(&coords(x, tangent)).into_iter().enumerate() {
+        for (r, (&(i, _), t)) in found.iter().zip(&t).enumerate() {
+            for (col, v) in phi(t).into_iter().enumerate() {
                 design[(r, col)] = v;
             }
-            for (col, v) in coords(x, normal).into_iter().enumerate() {
+            for (col, v) in coords(row(i), normal).into_iter().enumerate() {
                 offsets[(r, col)] = v;
             }
         }
