@@ -197,7 +197,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
                 }
             };
             if let Ok(slots) = applied {
-                guard.changed(&slots);
+                guard.changed(m, &slots);
                 made += 1;
             }
         }
@@ -557,40 +557,36 @@ fn try_split<S: SurfaceQuery + ?Sized>(
     ok.then_some(((old, value), q))
 }
 
-/// Finds the faces a new face would cross: a BVH over the faces as they were when the pass
-/// began, and the list of the faces made or moved since (tested one by one).
+/// The axis-aligned box of the triangle `p`.
+fn triangle_box(p: [DVec3; 3]) -> Aabb {
+    Aabb::new(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+}
+
+/// Finds the faces a new face would cross: a BVH over the faces' slots whose leaves are updated
+/// as faces are made or moved ([`CrossingGuard::changed`]), so each query costs O(log F) plus the
+/// faces whose boxes overlap, however many operations came before. (A slot whose face was removed
+/// keeps its leaf; its face is skipped when the query meets it.)
 struct CrossingGuard {
     bvh: Bvh,
-    /// Whether the face in a slot was made or moved since the BVH was built.
-    stale: Vec<bool>,
-    /// Those slots.
-    changed: Vec<u32>,
 }
 
 impl CrossingGuard {
     fn new(m: &Mesh) -> Self {
         let (live, slots) = m.live_faces();
-        let boxes = live.iter().zip(&slots).map(|(&t, &f)| {
-            let [a, b, c] = m.corners(t);
-            (f as usize, Aabb::new(a.min(b).min(c), a.max(b).max(c)))
-        });
+        let boxes = live
+            .iter()
+            .zip(&slots)
+            .map(|(&t, &f)| (f as usize, triangle_box(m.corners(t))));
         CrossingGuard {
             bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
-            stale: vec![false; m.slots()],
-            changed: Vec::new(),
         }
     }
 
-    /// Records that the faces in `slots` were made or moved.
-    fn changed(&mut self, slots: &[u32]) {
+    /// Records that the faces in `slots` were made or moved: their leaves take their new boxes.
+    fn changed(&mut self, m: &Mesh, slots: &[u32]) {
         for &f in slots {
-            let i = f as usize;
-            if i >= self.stale.len() {
-                self.stale.resize(i + 1, false);
-            }
-            if !self.stale[i] {
-                self.stale[i] = true;
-                self.changed.push(f);
+            if let Some(t) = m.face(f) {
+                self.bvh.insert(triangle_box(m.corners(t)), f);
             }
         }
     }
@@ -600,8 +596,7 @@ impl CrossingGuard {
     fn crosses(&self, m: &Mesh, faces: &[[u32; 3]], replaced: &[u32]) -> bool {
         faces.iter().any(|&t| {
             let p = m.corners(t);
-            let aabb = Aabb::new(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-            let hits = |g: u32| {
+            self.bvh.intersect_aabb(&triangle_box(p)).any(|g| {
                 if replaced.contains(&g) {
                     return false;
                 }
@@ -609,12 +604,7 @@ impl CrossingGuard {
                     return false;
                 };
                 !t.iter().any(|v| u.contains(v)) && triangles_intersect(p, m.corners(u))
-            };
-            self.bvh
-                .intersect_aabb(&aabb)
-                .filter(|&g| !self.stale.get(g as usize).copied().unwrap_or(true))
-                .any(hits)
-                || self.changed.iter().any(|&g| hits(g))
+            })
         })
     }
 }
@@ -764,16 +754,17 @@ mod tests {
         let p = m.position(v);
         m.relocate_vertex(v, p - DVec3::new(0.0, 0.0, 0.5)).unwrap();
         assert!(guard.crosses(&m, &faces, &slots));
-        // Once those faces are recorded as moved, a lower face moved up through them is seen
-        // crossing them through the list of changed faces.
-        guard.changed(&slots);
+        // Moved back, and recorded: a lower face moved up through them is seen crossing them
+        // at their updated leaves.
         m.relocate_vertex(v, p).unwrap();
+        guard.changed(&m, &slots);
+        assert!(!guard.crosses(&m, &faces, &slots));
         let u = 2 * 5 + 2;
         let lower = m.faces_around(u).to_vec();
         let lower_faces: Vec<[u32; 3]> = lower.iter().map(|&f| face(&m, f)).collect();
         m.relocate_vertex(u, m.position(u) + DVec3::new(0.0, 0.0, 0.5))
             .unwrap();
-        guard.changed(&lower);
+        guard.changed(&m, &lower);
         assert!(guard.crosses(&m, &lower_faces, &lower));
         assert!(!guard.crosses(&m, &lower_faces, &[lower.clone(), slots.clone()].concat()));
     }

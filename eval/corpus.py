@@ -1,0 +1,241 @@
+"""The real-world corpus: does `remesh` finish, in bounded time, with a valid mesh, on files nobody
+here chose? (Issue 35's acceptance.)
+
+Run through eval/corpus (it builds remesh):
+
+    eval/corpus                       # every mesh file of ../shared/corpus, 3000 points, seeds 1-3
+    eval/corpus --seeds 1 --timeout 30
+    eval/corpus --only tet,box        # files whose name contains one of these
+    eval/corpus --corpus DIR          # another folder of mesh files (searched recursively)
+
+Each run is `remesh FILE OUT.obj --points N --seed S -q --no-distance --report R.json`, capped at
+--timeout seconds of wall time. The input is checked once with `remesh quality FILE --json` (its
+crossing face pairs), and every written output with `remesh quality OUT.obj --json`, which must
+agree with the run's own report on crossings and invariant violations.
+
+Outcomes of a run, worst first:
+  timeout    over --timeout seconds
+  crash      a non-zero exit other than 3 (a refusal), or a message of more than one line
+  disagree   the run's report and `remesh quality` of the file it wrote differ (crossing pairs or
+             invariant violations)
+  violation  exit 0, and the output breaks an invariant, or its faces cross while the input's do not
+  crossings  exit 0 and valid but for crossing faces, where the input's own faces cross too
+  refused    exit 3 with a one-line message (a file that holds no surface)
+  valid      exit 0, no invariant violation, no crossing
+The row of a file shows its worst outcome over the seeds, the median and worst wall time (load to
+write), the worst θmin and θmax, the most faces outside the angle bounds [--min-angle,
+--max-angle] (35°, 100°: counted here from the written file), and the topology changes the run
+reported. Then: the runs of each outcome, runs over 5 s on inputs under 200k faces, and the total
+time of each seed's pass over the corpus.
+"""
+
+import argparse
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+FORMATS = {".obj", ".ply", ".stl", ".off", ".gltf", ".glb"}
+ORDER = ["timeout", "crash", "disagree", "violation", "crossings", "refused", "valid"]
+
+
+def parse_args():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--corpus", default=str(ROOT.parent / "shared" / "corpus"))
+    ap.add_argument("--points", type=int, default=3000)
+    ap.add_argument("--seeds", default="1-3", help="e.g. 1-3 or 1,4")
+    ap.add_argument("--timeout", type=float, default=120.0, help="seconds per run")
+    ap.add_argument("--only", default="", help="comma-separated substrings of file names")
+    ap.add_argument("--min-angle", type=float, default=35.0)
+    ap.add_argument("--max-angle", type=float, default=100.0)
+    ap.add_argument("--json", help="also write the rows as JSON to this file")
+    return ap.parse_args()
+
+
+def seeds_of(text):
+    out = []
+    for part in text.split(","):
+        if "-" in part:
+            a, b = part.split("-")
+            out.extend(range(int(a), int(b) + 1))
+        else:
+            out.append(int(part))
+    return out
+
+
+def run(cmd, timeout):
+    t0 = time.monotonic()
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        return p.returncode, p.stdout, p.stderr, time.monotonic() - t0
+    except subprocess.TimeoutExpired:
+        return None, "", "", time.monotonic() - t0
+
+
+def quality(binary, path, timeout):
+    code, out, err, _ = run([binary, "quality", str(path), "--json"], timeout)
+    if code != 0:
+        return None
+    try:
+        return json.loads(out)
+    except json.JSONDecodeError:
+        return None
+
+
+def obj_angles(path):
+    """The smallest and largest angle of each face of an OBJ (triangles), degrees."""
+    v, out = [], []
+    with open(path) as f:
+        for line in f:
+            if line.startswith("v "):
+                v.append(tuple(float(x) for x in line.split()[1:4]))
+            elif line.startswith("f "):
+                idx = [int(x.split("/")[0]) for x in line.split()[1:]]
+                idx = [i - 1 if i > 0 else len(v) + i for i in idx]
+                p = [v[i] for i in idx[:3]]
+                angles = []
+                for k in range(3):
+                    a, b, c = p[k], p[(k + 1) % 3], p[(k + 2) % 3]
+                    u = [b[i] - a[i] for i in range(3)]
+                    w = [c[i] - a[i] for i in range(3)]
+                    nu = math.sqrt(sum(x * x for x in u))
+                    nw = math.sqrt(sum(x * x for x in w))
+                    if nu == 0 or nw == 0:
+                        angles.append(0.0)
+                        continue
+                    cos = max(-1.0, min(1.0, sum(u[i] * w[i] for i in range(3)) / (nu * nw)))
+                    angles.append(math.degrees(math.acos(cos)))
+                out.append((min(angles), max(angles)))
+    return out
+
+
+def violations_key(report):
+    return sorted((v["kind"], v.get("count", 1)) for v in report.get("invariant_violations", []))
+
+
+def one_run(binary, path, seed, args, tmp, input_pairs):
+    out = Path(tmp) / f"out-{seed}.obj"
+    rep = Path(tmp) / f"r-{seed}.json"
+    for p in (out, rep):
+        if p.exists():
+            p.unlink()
+    cmd = [binary, str(path), str(out), "--points", str(args.points), "--seed", str(seed),
+           "-q", "--no-distance", "--report", str(rep)]
+    code, _, err, wall = run(cmd, args.timeout)
+    row = {"seed": seed, "wall": wall, "exit": code, "message": err.strip()}
+    if code is None:
+        row["outcome"] = "timeout"
+        return row
+    lines = [l for l in err.strip().splitlines() if l.strip()]
+    if code == 3 and len(lines) == 1:
+        row["outcome"] = "refused"
+        return row
+    if code != 0 or len(lines) > 1:
+        row["outcome"] = "crash"
+        return row
+    report = json.loads(rep.read_text())
+    check = quality(binary, out, args.timeout)
+    row["pairs"] = report["self_intersections"]["pairs"]
+    row["violations"] = [v["kind"] for v in report["invariant_violations"]]
+    row["topology_changes"] = report.get("topology_changes", [])
+    faces = obj_angles(out)
+    row["theta_min"] = min((a for a, _ in faces), default=float("nan"))
+    row["theta_max"] = max((b for _, b in faces), default=float("nan"))
+    row["outside"] = sum(1 for a, b in faces if a < args.min_angle or b > args.max_angle)
+    if check is None or check["self_intersections"]["pairs"] != row["pairs"] or violations_key(
+            check) != violations_key(report):
+        row["outcome"] = "disagree"
+        row["check"] = None if check is None else {
+            "pairs": check["self_intersections"]["pairs"],
+            "violations": [v["kind"] for v in check["invariant_violations"]]}
+        return row
+    others = [v for v in row["violations"] if v != "SelfIntersection"]
+    if others or (row["pairs"] > 0 and not input_pairs):
+        row["outcome"] = "violation"
+    elif row["pairs"] > 0:
+        row["outcome"] = "crossings"
+    else:
+        row["outcome"] = "valid"
+    return row
+
+
+def change_text(changes):
+    if not changes:
+        return ""
+    parts = []
+    for c in changes:
+        if isinstance(c, dict):
+            parts.append(",".join(f"{k}:{v}" for k, v in c.items() if k != "note"))
+        else:
+            parts.append(str(c))
+    return "; ".join(parts)
+
+
+def main():
+    args = parse_args()
+    binary = os.environ.get("REMESH_BIN", str(ROOT / "target" / "release" / "remesh"))
+    corpus = Path(args.corpus)
+    if not corpus.is_dir():
+        sys.exit(f"eval/corpus: no corpus at {corpus}")
+    files = sorted(p for p in corpus.rglob("*") if p.is_file() and p.suffix.lower() in FORMATS)
+    if args.only:
+        keys = [k for k in args.only.split(",") if k]
+        files = [p for p in files if any(k in p.name for k in keys)]
+    if not files:
+        sys.exit(f"eval/corpus: no mesh files under {corpus}")
+    seeds = seeds_of(args.seeds)
+    rows = []
+    pass_time = {s: 0.0 for s in seeds}
+    slow = []
+    print(f"{'file':34} {'outcome':10} {'wall med/max s':>15} {'θmin':>6} {'θmax':>6} {'outside':>7}  topology change / message")
+    with tempfile.TemporaryDirectory(prefix="remesh-corpus-") as tmp:
+        for path in files:
+            q = quality(binary, path, args.timeout)
+            input_pairs = q["self_intersections"]["pairs"] if q else 0
+            input_faces = q["topology"]["faces"] if q else 0
+            runs = []
+            for s in seeds:
+                r = one_run(binary, path, s, args, tmp, input_pairs)
+                runs.append(r)
+                pass_time[s] += r["wall"]
+                if r["wall"] > 5.0 and input_faces < 200_000:
+                    slow.append((path.name, s, r["wall"]))
+            worst = min(runs, key=lambda r: ORDER.index(r["outcome"]))
+            walls = [r["wall"] for r in runs]
+            done = [r for r in runs if "theta_min" in r]
+            tmin = min((r["theta_min"] for r in done), default=float("nan"))
+            tmax = max((r["theta_max"] for r in done), default=float("nan"))
+            outside = max((r["outside"] for r in done), default=0)
+            note = change_text(worst.get("topology_changes")) if "topology_changes" in worst else ""
+            if worst["outcome"] in ("refused", "crash"):
+                note = worst["message"].splitlines()[0][:90] if worst["message"] else f"exit {worst['exit']}"
+            if worst["outcome"] in ("violation", "crossings", "disagree"):
+                note = f"pairs {worst.get('pairs')} (input {input_pairs}) {','.join(sorted(set(worst.get('violations', []))))} " + note
+            print(f"{path.name[:34]:34} {worst['outcome']:10} {statistics.median(walls):7.2f}/{max(walls):6.2f}"
+                  f" {tmin:6.1f} {tmax:6.1f} {outside:7d}  {note}", flush=True)
+            rows.append({"file": str(path.relative_to(corpus)), "input_faces": input_faces,
+                         "input_pairs": input_pairs, "runs": runs})
+    all_runs = [r for row in rows for r in row["runs"]]
+    print()
+    print("runs by outcome: " + ", ".join(
+        f"{o} {sum(1 for r in all_runs if r['outcome'] == o)}" for o in ORDER))
+    print("files by worst outcome: " + ", ".join(
+        f"{o} {sum(1 for row in rows if min(row['runs'], key=lambda r: ORDER.index(r['outcome']))['outcome'] == o)}"
+        for o in ORDER))
+    print(f"runs over 5 s (inputs under 200k faces): {len(slow)}"
+          + ("".join(f"\n  {n} seed {s}: {w:.1f} s" for n, s, w in slow)))
+    print("total wall time per pass over the corpus: " + ", ".join(
+        f"seed {s} {t:.1f} s" for s, t in pass_time.items()))
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()
