@@ -143,7 +143,7 @@ pub use io::{
 // The meshes: the indexed triangle mesh, its normalization to bbox 100, its consistent
 // orientation, and the editable directed-edge mesh with its local operators.
 pub use mesh::edit::{EditError, EditMesh, EditViolation, SlotPolicy};
-pub use mesh::{orient_consistently, Aabb, Normalization, OrientStats, TriMesh};
+pub use mesh::{orient_consistently, Aabb, FaceCleanup, Normalization, OrientStats, TriMesh};
 
 // The pipeline in one call.
 pub use pipeline::{
@@ -190,7 +190,7 @@ pub use sampling::WidthField;
 pub use geometry::triangle::AngleBounds;
 pub use triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
 pub use triangulate::optimize::{
-    optimize, OptimizeParams, OptimizeStats, SmoothStats, SMOOTH_ITERATIONS,
+    optimize, MendStats, OptimizeParams, OptimizeStats, SmoothStats, SMOOTH_ITERATIONS,
 };
 pub use triangulate::stray_shells::StrayShells;
 pub use triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};

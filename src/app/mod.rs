@@ -150,6 +150,19 @@ fn remesh_read(
     write: &dyn Fn(&TriMesh) -> Result<()>,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<(TriMesh, QualityReport)> {
+    // Faces without area and repeated faces (double-sided exports, duplicated faces) carry no
+    // surface of their own and only make crossings and non-manifold edges downstream.
+    let mut input = input;
+    let cleanup = input.remove_duplicate_and_zero_area_faces();
+    if cleanup.any() {
+        input.remove_unreferenced_vertices();
+        if input.triangles.is_empty() {
+            return Err(Error::invalid_mesh(
+                &job.input,
+                "no faces with area (every face is collinear or repeats another)",
+            ));
+        }
+    }
     let input_side = input.bbox().map_or(0.0, |b| b.longest_side());
     let (input, up) = into_normal_range(input);
     if up != 0 && matches!(format, MeshFormat::Gltf | MeshFormat::Glb | MeshFormat::Stl) {
@@ -216,7 +229,12 @@ fn remesh_read(
             &written
         }
     };
-    let mut report = QualityReport::new(checked);
+    // The invariants, crossings and topology are those `remesh quality` finds in the file: the
+    // mesh as stored, welded as a reader welds it, in its own bbox-100 frame (crossings are
+    // decided exactly, so a face pair that rounding makes touch is seen here as in the file).
+    let mut report = QualityReport::new(
+        &as_quality_reads(as_written(mesh_out, format)).unwrap_or_else(|| checked.clone()),
+    );
     // The input column describes the input as read: its faces before they were oriented
     // (orientation changes none of the counts the topology is compared by).
     report.set_input(&TriMesh::new(
@@ -307,6 +325,25 @@ fn remesh_read(
             input_side
         ));
     }
+    if cleanup.any() {
+        let mut parts = Vec::new();
+        if cleanup.duplicates > 0 {
+            parts.push(format!(
+                "{} duplicate faces ({} of them the back of a double-sided face)",
+                cleanup.duplicates, cleanup.opposite_duplicates
+            ));
+        }
+        if cleanup.zero_area > 0 {
+            parts.push(format!("{} faces of zero area", cleanup.zero_area));
+        }
+        report
+            .notes
+            .push(format!("the input's {} were left out", parts.join(" and ")));
+    }
+    extra.insert(
+        "input_cleanup".into(),
+        serde_json::to_value(cleanup).unwrap_or_default(),
+    );
     if welded_vertices > 0 {
         report.notes.push(format!(
             "{welded_vertices} input vertices at identical positions were merged"
@@ -758,6 +795,17 @@ fn output_format(output: &Path, format: Option<MeshFormat>) -> Result<MeshFormat
 /// 5.6e-307 model units: subnormal coordinates) scaled up by `2^k` so its longest side is
 /// between 1 and 2, and `k`; every other model as it is, and 0. Scaling by a power of two
 /// changes no digit, so the model is the same one in other units.
+/// `mesh` (model units, as a file stores it) as [`run_quality`] sees the file: identical
+/// positions welded, unreferenced vertices dropped, subnormal coordinates scaled up, in the
+/// bbox-100 frame of its own bounding box. `None` when that frame does not exist.
+fn as_quality_reads(mut mesh: TriMesh) -> Option<TriMesh> {
+    mesh.weld_identical_positions();
+    mesh.remove_unreferenced_vertices();
+    let (mesh, _) = into_normal_range(mesh);
+    let normalization = Normalization::for_bbox(&mesh.bbox()?)?;
+    Some(normalization.apply_mesh(&mesh))
+}
+
 fn into_normal_range(mesh: TriMesh) -> (TriMesh, i32) {
     let Some(bbox) = mesh.bbox() else {
         return (mesh, 0);

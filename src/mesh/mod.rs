@@ -11,4 +11,4 @@ mod trimesh;
 pub use orient::{orient_consistently, OrientStats};
 #[cfg(test)]
 pub(crate) use trimesh::test_meshes;
-pub use trimesh::{Aabb, Normalization, TriMesh};
+pub use trimesh::{Aabb, FaceCleanup, Normalization, TriMesh};

@@ -64,7 +64,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     boundary: Option<&FeatureLines>,
     fixed: &[bool],
     params: &Limits,
-) -> usize {
+) -> MendStats {
     let bound = params.final_theta_deg;
     // The faces to mend: those with a small angle, smallest first, then those that cross
     // another face.
@@ -89,18 +89,32 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
         out
     };
     let mut faces = targets(m);
+    let mut stats = MendStats {
+        budget: MEND_BUDGET_PER_FACE * m.live_faces().0.len() + MEND_BUDGET_BASE,
+        ..MendStats::default()
+    };
     if faces.is_empty() {
-        return 0;
+        return stats;
     }
     let mut guard = CrossingGuard::new(m);
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
-    let mut done = 0;
-    for _ in 0..params.final_rounds {
+    // The failed attempts at each face slot, and the vertices the previous round's operations
+    // touched (`None` in the first round, when every target is tried): a later round tries a
+    // face again only where an operation changed its neighbourhood, so it costs what the
+    // round before it touched.
+    let mut tries: Vec<u8> = vec![0; m.slots()];
+    let mut touched_before: Option<Vec<bool>> = None;
+    'rounds: for _ in 0..params.final_rounds {
         let mut made = 0;
+        let mut touched = vec![false; m.vertex_count()];
         for &f in &faces {
             let Some(t) = m.face(f) else {
                 continue;
             };
+            let slot_tries = tries.get(f as usize).copied().unwrap_or(0);
+            if slot_tries as usize >= MEND_TRIES_PER_FACE {
+                continue;
+            }
             // A face that crosses another is mended by any operation that replaces or moves it
             // without a crossing or a new angle below the bound; there, a covering vertex may
             // go too. A face with a small angle is mended by one that raises that angle.
@@ -108,6 +122,23 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             if !crossing && angle_score(m, t, params) >= bound {
                 continue;
             }
+            // After the first round, a face with a small angle is tried again only where an
+            // operation changed its neighbourhood (a crossing face also when its partner moved,
+            // which its own corners do not show).
+            if let Some(before) = &touched_before {
+                if !crossing
+                    && !t
+                        .iter()
+                        .any(|&v| before.get(v as usize).copied().unwrap_or(true))
+                {
+                    continue;
+                }
+            }
+            if stats.attempts >= stats.budget {
+                stats.exhausted = true;
+                break 'rounds;
+            }
+            stats.attempts += 1;
             let stays = |m: &Mesh, v: u32| {
                 (is_fixed(v) && !crossing && m.ring(v).iter().any(|&u| m.is_protected(v, u)))
                     || m.is_boundary_vertex(v)
@@ -179,6 +210,10 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
                 }
             }
             let Some((_, op)) = best else {
+                if f as usize >= tries.len() {
+                    tries.resize(f as usize + 1, 0);
+                }
+                tries[f as usize] = slot_tries + 1;
                 continue;
             };
             let applied = match op {
@@ -199,18 +234,60 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             if let Ok(slots) = applied {
                 guard.changed(m, &slots);
                 made += 1;
+                touched.resize(m.vertex_count(), false);
+                // The changed faces' corners and their rings: every face whose candidate
+                // operations (a flip or collapse of its edges, a move of its corners) now see
+                // a changed face.
+                for &g in &slots {
+                    if let Some(u) = m.face(g) {
+                        for v in u {
+                            touched[v as usize] = true;
+                            for w in m.ring(v) {
+                                touched[w as usize] = true;
+                            }
+                        }
+                    }
+                }
             }
         }
-        done += made;
+        stats.ops += made;
         if made == 0 {
             break;
         }
+        touched_before = Some(touched);
         faces = targets(m);
         if faces.is_empty() {
             break;
         }
     }
-    done
+    stats
+}
+
+/// Failed mend attempts per face slot over the whole pass at most: a face that no operation
+/// mends is tried again only where an operation changed its neighbourhood (or while it crosses
+/// another), and at most this often; attempts that mend count against the pass's budget only.
+const MEND_TRIES_PER_FACE: usize = 3;
+
+/// The pass's budget of mend attempts: this many per face of the mesh it starts from, plus
+/// [`MEND_BUDGET_BASE`]. Each attempt evaluates a bounded number of candidate operations (3
+/// flips, up to 12 collapses, up to 3 · (1 + 3 · 8) moves and one split, each compass search at
+/// most 64 · 8 surface projections), so the pass costs O(faces · log) with that constant.
+pub(super) const MEND_BUDGET_PER_FACE: usize = 2;
+
+/// The budget's floor, for tiny meshes.
+pub(super) const MEND_BUDGET_BASE: usize = 64;
+
+/// What [`mend_faces`] did and what it was allowed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub struct MendStats {
+    /// Operations applied (flips, collapses, moves, splits).
+    pub ops: usize,
+    /// Faces tried (each a bounded number of candidate operations).
+    pub attempts: usize,
+    /// The most attempts allowed ([`MEND_BUDGET_PER_FACE`] per face, plus [`MEND_BUDGET_BASE`]).
+    pub budget: usize,
+    /// Whether the pass stopped because the budget ran out.
+    pub exhausted: bool,
 }
 
 /// The smallest angle of the faces `t`, degrees (infinity for none).

@@ -24,6 +24,7 @@ mod relax;
 mod smooth;
 
 use angles::mend_faces;
+pub use angles::MendStats;
 use collapse::collapse_short;
 use cover::cover;
 use relax::{flip_poor, relax_poor};
@@ -179,8 +180,10 @@ pub struct OptimizeStats {
     /// Vertex moves.
     pub moves: usize,
     /// Operations of the last pass on the faces with a small angle or a crossing (flips,
-    /// collapses, moves).
+    /// collapses, moves, splits).
     pub mends: usize,
+    /// The last pass's work: faces tried, its budget, and whether it ran out.
+    pub mend: MendStats,
     /// What the tangential relaxation with valence flips did.
     pub smooth: SmoothStats,
 }
@@ -376,7 +379,8 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
             break;
         }
     }
-    stats.mends = mend_faces(&mut m, surface, boundary, &fixed, params);
+    stats.mend = mend_faces(&mut m, surface, boundary, &fixed, params);
+    stats.mends = stats.mend.ops;
     let (positions, faces, origin) = m.into_parts();
     *mesh = TriMesh::new(positions, faces);
     (stats, origin)

@@ -1,0 +1,204 @@
+//! Issue 35: real files in bounded time, with a valid mesh out. Each input is made here (the
+//! shapes of the corpus files that hung or crossed: a tetrahedron, two tetrahedra joined at a
+//! face, a duplicated face, a double-sided export, a two-part scene, a zero-area first face).
+//! Every run goes through `remesh_mesh` (the command line's own path from the mesh read on) on a
+//! thread with a hang guard, and the finishing stage's work is checked by counting its attempts
+//! against its budget, not by timing.
+
+mod common;
+
+use std::sync::mpsc;
+use std::thread;
+use std::time::Duration;
+
+use glam::DVec3;
+use spectral_remesh::{remesh_mesh, Density, QualityReport, RemeshParams, TriMesh};
+
+/// Far more than any of these runs takes on the release build (each is under 3 s); a run past it
+/// is a hang, as the tetrahedron's 5 minutes were.
+const HANG_GUARD: Duration = Duration::from_secs(120);
+
+/// `remesh_mesh` of `mesh` at `points` points and `seed` on a thread, failing the test when it
+/// does not end within [`HANG_GUARD`].
+fn remesh_guarded(mesh: TriMesh, points: usize, seed: u64) -> (TriMesh, QualityReport) {
+    let (tx, rx) = mpsc::channel();
+    thread::spawn(move || {
+        let params = RemeshParams {
+            density: Density::Points(points),
+            seed,
+            ..RemeshParams::default()
+        };
+        let out = remesh_mesh(mesh, &params, false, false, None, &|_| {});
+        let _ = tx.send(out.map(|o| (o.mesh, o.report)));
+    });
+    match rx.recv_timeout(HANG_GUARD) {
+        Ok(Ok(out)) => out,
+        Ok(Err(e)) => panic!("remesh failed: {e}"),
+        Err(_) => panic!("remesh did not end within {HANG_GUARD:?}"),
+    }
+}
+
+/// The finishing stage's last pass stayed within its budget, and that budget is linear in the
+/// output (2 attempts per face of the mesh it started from, plus 64; that mesh has at most a
+/// few more faces than the output, since the pass itself only adds faces by splits).
+fn assert_bounded_work(report: &QualityReport) {
+    let mend = &report.extra["optimize"]["mend"];
+    let attempts = mend["attempts"].as_u64().unwrap();
+    let budget = mend["budget"].as_u64().unwrap();
+    let faces = report.topology.faces as u64;
+    assert!(
+        attempts <= budget,
+        "{attempts} attempts over the budget {budget}"
+    );
+    assert!(
+        budget <= 2 * (faces + faces / 2) + 64,
+        "budget {budget} for {faces} output faces"
+    );
+}
+
+fn cleanup(report: &QualityReport) -> (u64, u64, u64) {
+    let c = &report.extra["input_cleanup"];
+    let n = |k: &str| c[k].as_u64().unwrap();
+    (n("zero_area"), n("duplicates"), n("opposite_duplicates"))
+}
+
+fn assert_valid(report: &QualityReport) {
+    assert!(
+        report.invariant_violations.is_empty(),
+        "{:?}",
+        report.invariant_violations
+    );
+    assert_eq!(report.self_intersections.pairs, 0);
+}
+
+fn tetrahedron() -> TriMesh {
+    TriMesh::new(
+        vec![
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ],
+        vec![[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]],
+    )
+}
+
+#[test]
+fn a_tetrahedron_ends_quickly_with_a_closed_valid_mesh() {
+    // Before the crossing guard's BVH was updated in place and the last pass had a budget, the
+    // 4-face tetrahedron at 3000 points ran for more than 5 minutes.
+    let (mesh, report) = remesh_guarded(tetrahedron(), 3000, 1);
+    assert_valid(&report);
+    assert!(report.topology.is_closed_manifold());
+    assert_eq!(report.topology.genus, Some(0));
+    assert!(mesh.vertex_count() > 2500);
+    assert_bounded_work(&report);
+}
+
+#[test]
+fn two_tetrahedra_joined_at_a_face_end_within_the_budget() {
+    // Two tetrahedra on either side of the face 1-2-3, each closed: that face is stored twice,
+    // once in each winding (the corpus's joined_tetrahedra.obj).
+    let mut positions = tetrahedron().positions;
+    positions.push(-positions[0]);
+    let mesh = TriMesh::new(
+        positions,
+        vec![
+            [0, 1, 2],
+            [0, 3, 1],
+            [0, 2, 3],
+            [1, 3, 2],
+            [4, 2, 1],
+            [4, 1, 3],
+            [4, 3, 2],
+            [1, 2, 3],
+        ],
+    );
+    let (_, report) = remesh_guarded(mesh, 3000, 1);
+    assert_eq!(cleanup(&report), (0, 1, 1));
+    assert_bounded_work(&report);
+}
+
+#[test]
+fn a_duplicated_face_is_left_out_and_the_output_is_valid() {
+    let mut sphere = common::icosphere(3);
+    let first = sphere.triangles[0];
+    sphere.triangles.push(first);
+    let (_, report) = remesh_guarded(sphere, 1500, 2);
+    assert_eq!(cleanup(&report), (0, 1, 0));
+    assert!(report.notes.iter().any(|n| n.contains("1 duplicate faces")));
+    assert_valid(&report);
+    assert!(report.topology.is_closed_manifold());
+    assert!(
+        report.topology_changes.is_empty(),
+        "{:?}",
+        report.topology_changes
+    );
+    assert_bounded_work(&report);
+}
+
+#[test]
+fn a_double_sided_export_is_made_single() {
+    // Every face also stored in the opposite winding (an export of both sides of each face).
+    let mut sphere = common::icosphere(3);
+    let n = sphere.triangles.len();
+    let backs: Vec<[u32; 3]> = sphere
+        .triangles
+        .iter()
+        .map(|&[a, b, c]| [a, c, b])
+        .collect();
+    sphere.triangles.extend(backs);
+    let (_, report) = remesh_guarded(sphere, 1500, 3);
+    assert_eq!(cleanup(&report), (0, n as u64, n as u64));
+    assert_valid(&report);
+    assert!(report.topology.is_closed_manifold());
+    assert_eq!(report.topology.components, 1);
+    assert_eq!(report.topology.genus, Some(0));
+    assert_bounded_work(&report);
+}
+
+#[test]
+fn a_two_part_scene_keeps_both_parts_apart() {
+    let a = common::icosphere(3);
+    let mut b = common::icosphere(3);
+    for p in &mut b.positions {
+        *p += DVec3::new(3.0, 0.0, 0.0);
+    }
+    let offset = a.positions.len() as u32;
+    let mut scene = a;
+    scene.positions.extend(b.positions);
+    scene
+        .triangles
+        .extend(b.triangles.iter().map(|t| t.map(|i| i + offset)));
+    let (_, report) = remesh_guarded(scene, 2000, 1);
+    assert_valid(&report);
+    assert_eq!(report.topology.components, 2);
+    assert!(report.topology.is_closed_manifold());
+    assert_bounded_work(&report);
+}
+
+#[test]
+fn a_zero_area_first_face_is_left_out() {
+    // Issue 36, item 1: a collinear face first panicked in parry's BVH.
+    let mesh = TriMesh::new(
+        vec![DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0), DVec3::Y],
+        vec![[0, 1, 2], [0, 1, 3]],
+    );
+    let (_, report) = remesh_guarded(mesh, 200, 1);
+    assert_eq!(cleanup(&report), (1, 0, 0));
+    assert_valid(&report);
+}
+
+#[test]
+fn only_zero_area_and_repeated_faces_is_a_clear_error() {
+    let mesh = TriMesh::new(
+        vec![DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)],
+        vec![[0, 1, 2]],
+    );
+    let params = RemeshParams {
+        density: Density::Points(100),
+        ..RemeshParams::default()
+    };
+    let e = remesh_mesh(mesh, &params, false, false, None, &|_| {}).unwrap_err();
+    assert!(e.to_string().contains("no faces with area"), "{e}");
+}
