@@ -150,8 +150,11 @@ fn remesh_read(
     write: &dyn Fn(&TriMesh) -> Result<()>,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<(TriMesh, QualityReport)> {
+    let input_side = input.bbox().map_or(0.0, |b| b.longest_side());
+    let (input, up) = into_normal_range(input);
     // Faces without area and repeated faces (double-sided exports, duplicated faces) carry no
-    // surface of their own and only make crossings and non-manifold edges downstream.
+    // surface of their own and only make crossings and non-manifold edges downstream (tested
+    // after subnormal coordinates are scaled up, where the exact area test does not underflow).
     let mut input = input;
     let cleanup = input.remove_duplicate_and_zero_area_faces();
     if cleanup.any() {
@@ -163,8 +166,6 @@ fn remesh_read(
             ));
         }
     }
-    let input_side = input.bbox().map_or(0.0, |b| b.longest_side());
-    let (input, up) = into_normal_range(input);
     if up != 0 && matches!(format, MeshFormat::Gltf | MeshFormat::Glb | MeshFormat::Stl) {
         return Err(Error::InvalidParameter {
             name: "OUTPUT",

@@ -232,6 +232,9 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     }
 }
 
+/// The most faces [`sharp_at_scale`] takes on each side of an edge.
+const PATCH_FACES: usize = 1024;
+
 /// Whether the surface within `scale` of edge `e`'s midpoint still bends by the feature angle
 /// (`cos_bound` its cosine) across the edge: the area-weighted normals of the faces on either
 /// side at least the angle apart. The patch is grown from the edge's two faces across edges to
@@ -272,12 +275,19 @@ fn sharp_at_scale(
     let scale_2 = scale * scale;
     // Each side's patch: grown from its face, across edges other than the dihedral candidates
     // (the edge itself included), to faces whose centroids are within `scale`. A bit per side.
+    // Breadth first, at most PATCH_FACES faces a side: on a finely tessellated part (tens of
+    // thousands of faces within a spacing of its creases) each patch is then the nearest faces
+    // by steps, and the test costs O(PATCH_FACES) per edge whatever the tessellation.
     let mut reached: FxHashMap<u32, u8> = FxHashMap::default();
     for (side, &seed) in faces.iter().enumerate() {
         let bit = 1u8 << side;
         *reached.entry(seed).or_default() |= bit;
-        let mut stack = vec![seed];
-        while let Some(f) = stack.pop() {
+        let mut queue = std::collections::VecDeque::from([seed]);
+        let mut taken = 1;
+        while let Some(f) = queue.pop_front() {
+            if taken >= PATCH_FACES {
+                break;
+            }
             let tri = mesh.triangles[f as usize];
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
@@ -293,7 +303,8 @@ fn sharp_at_scale(
                         let r = reached.entry(g).or_default();
                         if *r & bit == 0 {
                             *r |= bit;
-                            stack.push(g);
+                            queue.push_back(g);
+                            taken += 1;
                         }
                     }
                 }
