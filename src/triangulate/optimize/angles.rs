@@ -278,14 +278,15 @@ pub(super) const MEND_BUDGET_PER_FACE: usize = 2;
 /// The budget's floor, for tiny meshes.
 pub(super) const MEND_BUDGET_BASE: usize = 64;
 
-/// What [`mend_faces`] did and what it was allowed.
+/// What the optimization's last pass (the mending of faces outside the angle bounds or
+/// crossing another) did and what it was allowed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct MendStats {
     /// Operations applied (flips, collapses, moves, splits).
     pub ops: usize,
     /// Faces tried (each a bounded number of candidate operations).
     pub attempts: usize,
-    /// The most attempts allowed ([`MEND_BUDGET_PER_FACE`] per face, plus [`MEND_BUDGET_BASE`]).
+    /// The most attempts allowed: 2 per face of the mesh the pass starts from, plus 64.
     pub budget: usize,
     /// Whether the pass stopped because the budget ran out.
     pub exhausted: bool,
