@@ -234,7 +234,8 @@ fn remesh_read(
     // mesh as stored, welded as a reader welds it, in its own bbox-100 frame (crossings are
     // decided exactly, so a face pair that rounding makes touch is seen here as in the file).
     let mut report = QualityReport::new(
-        &as_quality_reads(as_written(mesh_out, format)).unwrap_or_else(|| checked.clone()),
+        &as_quality_reads(as_written(mesh_out, format), &job.output)
+            .unwrap_or_else(|| checked.clone()),
     );
     // The input column describes the input as read: its faces before they were oriented
     // (orientation changes none of the counts the topology is compared by).
@@ -638,11 +639,7 @@ fn quality_read(
         None => (into_normal_range(mesh).0, None),
     };
     let frame = reference.as_ref().map_or(&mesh, |(r, _)| r);
-    let bbox = frame
-        .bbox()
-        .ok_or_else(|| Error::invalid_mesh(path, "the mesh has no vertices"))?;
-    let normalization = Normalization::for_bbox(&bbox)
-        .ok_or_else(|| Error::invalid_mesh(path, Normalization::refusal(&bbox)))?;
+    let normalization = own_frame(frame, path)?;
     let m = normalization.apply_mesh(&mesh);
     let mut report = QualityReport::new(&m);
     let (wall, cpu) = t.elapsed();
@@ -792,21 +789,30 @@ fn output_format(output: &Path, format: Option<MeshFormat>) -> Result<MeshFormat
     }
 }
 
+/// `mesh` (model units, as a file stores it) as [`run_quality`] sees the file: cleaned as a
+/// reader cleans it ([`check_and_clean`]: identical positions welded, unreferenced vertices
+/// dropped), subnormal coordinates scaled up, in its own bbox-100 frame ([`own_frame`]).
+/// `None` when the file would be refused.
+fn as_quality_reads(mesh: TriMesh, path: &Path) -> Option<TriMesh> {
+    let (mesh, _) = check_and_clean(path, mesh).ok()?;
+    let (mesh, _) = into_normal_range(mesh);
+    Some(own_frame(&mesh, path).ok()?.apply_mesh(&mesh))
+}
+
+/// The bbox-100 frame of `mesh`'s own bounding box, the frame [`run_quality`] measures a mesh
+/// in when there is no reference; errors name `path`.
+fn own_frame(mesh: &TriMesh, path: &Path) -> Result<Normalization> {
+    let bbox = mesh
+        .bbox()
+        .ok_or_else(|| Error::invalid_mesh(path, "the mesh has no vertices"))?;
+    Normalization::for_bbox(&bbox)
+        .ok_or_else(|| Error::invalid_mesh(path, Normalization::refusal(&bbox)))
+}
+
 /// A model too small for the bbox-100 frame's `f64` scale (a longest side below about
 /// 5.6e-307 model units: subnormal coordinates) scaled up by `2^k` so its longest side is
 /// between 1 and 2, and `k`; every other model as it is, and 0. Scaling by a power of two
 /// changes no digit, so the model is the same one in other units.
-/// `mesh` (model units, as a file stores it) as [`run_quality`] sees the file: identical
-/// positions welded, unreferenced vertices dropped, subnormal coordinates scaled up, in the
-/// bbox-100 frame of its own bounding box. `None` when that frame does not exist.
-fn as_quality_reads(mut mesh: TriMesh) -> Option<TriMesh> {
-    mesh.weld_identical_positions();
-    mesh.remove_unreferenced_vertices();
-    let (mesh, _) = into_normal_range(mesh);
-    let normalization = Normalization::for_bbox(&mesh.bbox()?)?;
-    Some(normalization.apply_mesh(&mesh))
-}
-
 fn into_normal_range(mesh: TriMesh) -> (TriMesh, i32) {
     let Some(bbox) = mesh.bbox() else {
         return (mesh, 0);

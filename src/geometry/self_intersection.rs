@@ -77,6 +77,11 @@ fn non_adjacent_pairs(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u32; 
     pairs
 }
 
+/// The axis-aligned bounding box of the triangle with corners `p`.
+pub(crate) fn triangle_aabb(p: [DVec3; 3]) -> Aabb {
+    Aabb::new(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+}
+
 /// The faces the search of [`intersecting_pairs_counted`] takes (every index in range, every
 /// corner finite, not [`is_degenerate_face`]), in order, each with its bounding box.
 pub(crate) fn face_boxes(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<(usize, Aabb)> {
@@ -89,8 +94,10 @@ pub(crate) fn face_boxes(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<(us
                 && !is_degenerate_face(positions, t)
         })
         .map(|f| {
-            let [a, b, c] = triangles[f].map(|i| positions[i as usize]);
-            (f, Aabb::new(a.min(b).min(c), a.max(b).max(c)))
+            (
+                f,
+                triangle_aabb(triangles[f].map(|i| positions[i as usize])),
+            )
         })
         .collect()
 }

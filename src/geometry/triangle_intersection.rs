@@ -121,6 +121,18 @@ fn orient_2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
     }
 }
 
+/// Whether the corners `p` are collinear (the triangle has exactly zero area), decided exactly:
+/// its projections onto the three coordinate planes all have orientation 0. Coincident corners
+/// are collinear. Stricter than the toleranced zero-area test
+/// ([`is_degenerate_triangle`](super::triangle::is_degenerate_triangle)), which also takes
+/// triangles of almost no area.
+pub(crate) fn collinear(p: [DVec3; 3]) -> bool {
+    (0..3).all(|axis| {
+        let [a, b, c] = p.map(|v| project(v, axis));
+        orient_2d(a, b, c) == 0
+    })
+}
+
 /// Whether point `p` lies in the closed 2D triangle `t` (non-degenerate).
 fn point_in_triangle_2d(p: [f64; 2], t: [[f64; 2]; 3]) -> bool {
     let s = [

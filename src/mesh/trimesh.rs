@@ -4,6 +4,9 @@
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
+use crate::geometry::triangle_intersection::collinear;
+use crate::mesh::edit::starting_at;
+
 /// An indexed triangle mesh: `positions` is `V × 3` (model units, or bbox-100 units after
 /// [`Normalization::apply`]), `triangles` is `F × 3` indices into `positions`, counter-clockwise
 /// seen from the outside (the side the face normal points to).
@@ -286,28 +289,18 @@ impl TriMesh {
     }
 
     /// Removes the faces a remesh cannot use, in one pass in face order: faces whose corners are
-    /// collinear (zero area, decided exactly: the three coordinate-plane projections all have
-    /// orient2d = 0, Shewchuk's predicate), and faces with the same three vertices as an earlier
-    /// face, in either winding (duplicated faces, and the second sheet of a double-sided export).
-    /// The first of a set of duplicates stays. Vertices stay (see
-    /// [`TriMesh::remove_unreferenced_vertices`]). O(faces).
+    /// collinear (exactly zero area, decided by Shewchuk's exact orientation predicate on the
+    /// three coordinate-plane projections; faces of almost no area stay, for the pipeline's own
+    /// checks to name), and faces with the same three vertices as an earlier face, in either
+    /// winding (duplicated faces, and the second sheet of a double-sided export). The first of a
+    /// set of duplicates stays. Vertices stay (see [`TriMesh::remove_unreferenced_vertices`]).
+    /// O(faces).
     pub fn remove_duplicate_and_zero_area_faces(&mut self) -> FaceCleanup {
         let mut seen: FxHashMap<[u32; 3], [u32; 3]> = FxHashMap::default();
         let mut out = FaceCleanup::default();
         let positions = &self.positions;
         self.triangles.retain(|&t| {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
-            let flat = |p: DVec3, q: DVec3, r: DVec3, pick: fn(DVec3) -> [f64; 2]| {
-                let c2 = |v: DVec3| {
-                    let [x, y] = pick(v);
-                    robust::Coord { x, y }
-                };
-                robust::orient2d(c2(p), c2(q), c2(r)) == 0.0
-            };
-            if flat(a, b, c, |v| [v.x, v.y])
-                && flat(a, b, c, |v| [v.y, v.z])
-                && flat(a, b, c, |v| [v.z, v.x])
-            {
+            if collinear(t.map(|i| positions[i as usize])) {
                 out.zero_area += 1;
                 return false;
             }
@@ -316,7 +309,7 @@ impl TriMesh {
             match seen.get(&key) {
                 Some(first) => {
                     out.duplicates += 1;
-                    if !same_cycle(*first, t) {
+                    if starting_at(t, first[0]) != *first {
                         out.opposite_duplicates += 1;
                     }
                     false
@@ -362,7 +355,7 @@ impl TriMesh {
 /// What [`TriMesh::remove_duplicate_and_zero_area_faces`] removed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct FaceCleanup {
-    /// Faces whose corners are collinear (zero area).
+    /// Faces whose corners are collinear (exactly zero area).
     pub zero_area: usize,
     /// Faces with the same three vertices as an earlier face, in either winding.
     pub duplicates: usize,
@@ -375,11 +368,6 @@ impl FaceCleanup {
     pub fn any(&self) -> bool {
         self.zero_area + self.duplicates > 0
     }
-}
-
-/// Whether the triangles `a` and `b` (the same three vertices) go round them the same way.
-fn same_cycle(a: [u32; 3], b: [u32; 3]) -> bool {
-    (0..3).any(|k| [b[k], b[(k + 1) % 3], b[(k + 2) % 3]] == a)
 }
 
 /// The similarity transform that maps a model into the bbox-100 frame of Sec. 7: centred on its

@@ -3,11 +3,10 @@
 //! each guarded against leaving the input surface and against making a crossing.
 
 use glam::DVec3;
-use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 
 use super::*;
-use crate::geometry::self_intersection::intersecting_pairs;
+use crate::geometry::self_intersection::{intersecting_pairs, triangle_aabb};
 use crate::geometry::triangle_intersection::triangles_intersect;
 use crate::surface::feature_lines::FeatureLines;
 use crate::triangulate::flip::max_min_candidate;
@@ -57,8 +56,9 @@ enum Op {
 ///   [`triangles_intersect`], against the faces near it), so the pass makes no crossing and a
 ///   crossing face is replaced only by faces that cross nothing.
 ///
-/// Returns what was done ([`MendStats`]): the operations made and the attempts against the pass's budget
-/// ([`MEND_BUDGET_PER_FACE`] per face, at most [`MEND_TRIES_PER_FACE`] failed attempts a face). Deterministic.
+/// Returns what was done ([`MendStats`]): the operations made and the attempts against the
+/// pass's budget ([`MEND_BUDGET_PER_FACE`] per face, at most [`MEND_TRIES_PER_FACE`] failed
+/// attempts a face). Deterministic.
 pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
@@ -273,10 +273,10 @@ const MEND_TRIES_PER_FACE: usize = 3;
 /// [`MEND_BUDGET_BASE`]. Each attempt evaluates a bounded number of candidate operations (3
 /// flips, up to 12 collapses, up to 3 · (1 + 3 · 8) moves and one split, each compass search at
 /// most 64 · 8 surface projections), so the pass costs O(faces · log) with that constant.
-pub(super) const MEND_BUDGET_PER_FACE: usize = 2;
+const MEND_BUDGET_PER_FACE: usize = 2;
 
 /// The budget's floor, for tiny meshes.
-pub(super) const MEND_BUDGET_BASE: usize = 64;
+const MEND_BUDGET_BASE: usize = 64;
 
 /// What the optimization's last pass (the mending of faces outside the angle bounds or
 /// crossing another) did and what it was allowed.
@@ -636,11 +636,6 @@ fn try_split<S: SurfaceQuery + ?Sized>(
     ok.then_some(((old, value), q))
 }
 
-/// The axis-aligned box of the triangle `p`.
-fn triangle_box(p: [DVec3; 3]) -> Aabb {
-    Aabb::new(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
-}
-
 /// Finds the faces a new face would cross: a BVH over the faces' slots whose leaves are updated
 /// as faces are made or moved ([`CrossingGuard::changed`]), so each query costs O(log F) plus the
 /// faces whose boxes overlap, however many operations came before. (A slot whose face was removed
@@ -655,7 +650,7 @@ impl CrossingGuard {
         let boxes = live
             .iter()
             .zip(&slots)
-            .map(|(&t, &f)| (f as usize, triangle_box(m.corners(t))));
+            .map(|(&t, &f)| (f as usize, triangle_aabb(m.corners(t))));
         CrossingGuard {
             bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
         }
@@ -665,7 +660,7 @@ impl CrossingGuard {
     fn changed(&mut self, m: &Mesh, slots: &[u32]) {
         for &f in slots {
             if let Some(t) = m.face(f) {
-                self.bvh.insert(triangle_box(m.corners(t)), f);
+                self.bvh.insert(triangle_aabb(m.corners(t)), f);
             }
         }
     }
@@ -675,7 +670,7 @@ impl CrossingGuard {
     fn crosses(&self, m: &Mesh, faces: &[[u32; 3]], replaced: &[u32]) -> bool {
         faces.iter().any(|&t| {
             let p = m.corners(t);
-            self.bvh.intersect_aabb(&triangle_box(p)).any(|g| {
+            self.bvh.intersect_aabb(&triangle_aabb(p)).any(|g| {
                 if replaced.contains(&g) {
                     return false;
                 }
