@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use glam::DVec3;
 
 use super::{
-    check_and_write, count_note, dropped_note, holes_note, insert_kernel_extras, memory,
+    check_and_write, count_note, dropped_note, holes_note, insert_kernel_extras, memory, with_path,
     write_output, RemeshJob, RemeshedMesh, DISTANCE_SAMPLES,
 };
 use crate::error::{Error, Result};
@@ -62,7 +62,7 @@ fn run_with(
             memory::check_remesh_budget(0, n as f64, job.measure_distance, limit)?;
         }
     }
-    let out = remesh_points(&job.input, &params, on_stage)?;
+    let out = remesh_points(&job.input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
 
     on_stage("check");
     let t = Clock::start();

@@ -435,6 +435,19 @@ pub(crate) fn rimls_of(
         positions.retain(|_| keep.next().unwrap_or(true));
         let mut keep = off.iter().map(|&o| !o);
         normals.retain(|_| keep.next().unwrap_or(true));
+        if positions.is_empty() && !off.is_empty() {
+            // Every point is on no sheet at this radius: the data is sparser than the output
+            // asked for (or holds no surface at all). The caller names the file.
+            return Err(Error::invalid_mesh(
+                "",
+                format!(
+                    "no surface at this density: none of its {} points has enough neighbours \
+                     within {radius:.3} (bbox-100 units, from the output's spacing); ask for \
+                     fewer output points than the input has",
+                    off.len()
+                ),
+            ));
+        }
     }
     Rimls::new(positions, normals, params)
 }
