@@ -187,6 +187,7 @@ pub use sampling::WidthField;
 
 // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
 // optimization against the input, the separation of crossing faces.
+pub use geometry::self_intersection::CrossingRegions;
 pub use geometry::triangle::AngleBounds;
 pub use triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
 pub use triangulate::optimize::{

@@ -8,6 +8,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::geometry::tolerance::{DEGENERATE_AREA_TOLERANCE, ON_SURFACE_RELATIVE};
 use crate::kernel::Kernel;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
@@ -468,6 +469,12 @@ pub fn remesh(
         || BuriedTest::new(&normalized, 2 * pool_size + normalized.positions.len()),
     );
     let surface = surface?;
+    // Where the input's own faces cross (only looked for when it passes through itself): the
+    // finishing stage leaves the output's crossings there alone.
+    let input_crossing_pairs = match &buried_test {
+        Some(_) => intersecting_pairs(&normalized.positions, &normalized.triangles),
+        None => Vec::new(),
+    };
     timer.lap("normalize");
 
     on_stage("candidates");
@@ -870,6 +877,15 @@ pub fn remesh(
         let optimize_stats = match &params.optimize {
             Some(op) => {
                 let fixed: Vec<bool> = (0..samples.len()).map(|i| i < boundary_count).collect();
+                // An output face within a spacing of where two input faces cross is there.
+                let input_crossings = (!input_crossing_pairs.is_empty()).then(|| {
+                    CrossingRegions::new(
+                        &normalized.positions,
+                        &normalized.triangles,
+                        &input_crossing_pairs,
+                        sigma_p,
+                    )
+                });
                 let (st, origin) = optimize(
                     &mut mesh_normalized,
                     &surface,
@@ -877,6 +893,7 @@ pub fn remesh(
                     &fixed,
                     &feature_edges,
                     boundary_lines.as_ref(),
+                    input_crossings.as_ref(),
                     sigma_p,
                     op,
                 );

@@ -426,6 +426,7 @@ pub fn remesh_points(
                 &fixed,
                 &[],
                 None,
+                None,
                 sigma_p,
                 op,
             )

@@ -130,6 +130,48 @@ pub(crate) fn has_intersecting_pair(
     })
 }
 
+/// Where a mesh's own faces cross or touch: for each intersecting pair, the overlap of the two
+/// faces' bounding boxes, loosened by a margin, in a BVH. The finishing stage leaves alone the
+/// output faces that cross inside these regions (the crossing is the input's own: a scene's
+/// parts passing through each other, an STL's welded corners), and mends the others.
+pub struct CrossingRegions {
+    bvh: Bvh,
+    count: usize,
+}
+
+impl CrossingRegions {
+    /// The regions of the intersecting `pairs` (as [`intersecting_pairs`] gives them) of the
+    /// faces `triangles` over `positions`, each box loosened by `margin` (same units).
+    pub fn new(
+        positions: &[DVec3],
+        triangles: &[[u32; 3]],
+        pairs: &[[u32; 2]],
+        margin: f64,
+    ) -> Self {
+        let boxes = pairs.iter().enumerate().map(|(i, &[f, g])| {
+            let [a, b] =
+                [f, g].map(|h| triangle_aabb(triangles[h as usize].map(|v| positions[v as usize])));
+            let lo = a.mins.max(b.mins) - DVec3::splat(margin);
+            let hi = a.maxs.min(b.maxs) + DVec3::splat(margin);
+            (i, Aabb::new(lo, hi))
+        });
+        CrossingRegions {
+            bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
+            count: pairs.len(),
+        }
+    }
+
+    /// Whether there is no region.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Whether the triangle with corners `p` reaches into a region (its bounding box meets one).
+    pub fn meets(&self, p: [DVec3; 3]) -> bool {
+        self.count > 0 && self.bvh.intersect_aabb(&triangle_aabb(p)).next().is_some()
+    }
+}
+
 /// The intersecting pairs of [`intersecting_pairs_counted`], without the count of tests.
 pub fn intersecting_pairs(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
     intersecting_pairs_counted(positions, triangles).0

@@ -6,7 +6,7 @@ use glam::DVec3;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 
 use super::*;
-use crate::geometry::self_intersection::{intersecting_pairs, triangle_aabb};
+use crate::geometry::self_intersection::{intersecting_pairs, triangle_aabb, CrossingRegions};
 use crate::geometry::triangle_intersection::triangles_intersect;
 use crate::surface::feature_lines::FeatureLines;
 use crate::triangulate::flip::max_min_candidate;
@@ -63,9 +63,13 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
     boundary: Option<&FeatureLines>,
+    input_crossings: Option<&CrossingRegions>,
     fixed: &[bool],
     params: &Limits,
 ) -> MendStats {
+    // A crossing inside a region where the input's own faces cross is the input's: it is left
+    // as it is (and costs no attempt).
+    let own = |m: &Mesh, t: [u32; 3]| input_crossings.is_some_and(|r| r.meets(m.corners(t)));
     let bound = params.final_theta_deg;
     // The faces to mend: those with a small angle, smallest first, then those that cross
     // another face.
@@ -83,6 +87,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             .into_iter()
             .flatten()
             .map(|i| slots[i as usize])
+            .filter(|&f| !own(m, face(m, f)))
             .collect();
         crossing.sort_unstable();
         crossing.dedup();
@@ -119,7 +124,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             // A face that crosses another is mended by any operation that replaces or moves it
             // without a crossing or a new angle below the bound; there, a covering vertex may
             // go too. A face with a small angle is mended by one that raises that angle.
-            let crossing = guard.crosses(m, &[t], &[f]);
+            let crossing = guard.crosses(m, &[t], &[f]) && !own(m, t);
             if !crossing && angle_score(m, t, params) >= bound {
                 continue;
             }
@@ -414,7 +419,12 @@ fn move_targets<S: SurfaceQuery + ?Sized>(
     let mut targets: Vec<DVec3> = aims
         .iter()
         .flat_map(|&a| [1.0, 0.5, 0.25].map(|s| old.lerp(a, s)))
-        .filter_map(|p| surface.closest_point(p).map(|sp| sp.position))
+        // The vertex lies on the surface (or near it): its distance bounds the search.
+        .filter_map(|p| {
+            surface
+                .closest_point_hinted(p, p.distance(old), f64::MAX)
+                .map(|sp| sp.position)
+        })
         .collect();
     targets.extend(best_angle_position(m, surface, v, params));
     targets
@@ -527,8 +537,12 @@ fn compass_search<S: SurfaceQuery + ?Sized>(
         let mut improved = false;
         for k in 0..8 {
             let a = k as f64 * std::f64::consts::FRAC_PI_4;
-            let Some(sp) = surface.closest_point(best_p + step * (a.cos() * u + a.sin() * w))
-            else {
+            // best_p lies on the surface, `step` from the point: the search stays that near.
+            let Some(sp) = surface.closest_point_hinted(
+                best_p + step * (a.cos() * u + a.sin() * w),
+                step,
+                f64::MAX,
+            ) else {
                 continue;
             };
             let s = score(sp.position);
@@ -722,7 +736,7 @@ mod tests {
         let before = theta_min(&m);
         assert!(before < 20.0, "{before}");
         let fixed = vec![false; m.vertex_count()];
-        let made = mend_faces(&mut m, &surface, None, &fixed, &limits());
+        let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits());
         assert!(made.ops >= 1);
         assert_eq!(m.degree(v), 0, "the vertex is gone");
         assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
@@ -746,7 +760,7 @@ mod tests {
             .filter(|&v| fixed[v])
             .map(|v| m.position(v as u32))
             .collect();
-        mend_faces(&mut m, &surface, None, &fixed, &limits());
+        mend_faces(&mut m, &surface, None, None, &fixed, &limits());
         assert!(theta_min(&m) >= 25.0, "{before} -> {}", theta_min(&m));
         let after: Vec<DVec3> = (0..m.vertex_count())
             .filter(|&v| fixed[v])
@@ -762,7 +776,10 @@ mod tests {
         let (g, surface) = flat(4);
         let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
         let fixed = vec![false; m.vertex_count()];
-        assert_eq!(mend_faces(&mut m, &surface, None, &fixed, &limits()).ops, 0);
+        assert_eq!(
+            mend_faces(&mut m, &surface, None, None, &fixed, &limits()).ops,
+            0
+        );
         assert_eq!(m.to_trimesh(), g);
     }
 
@@ -790,7 +807,7 @@ mod tests {
         let fixed = vec![false; m.vertex_count()];
         // sigma_p 4: the pass may move the mesh by up to 1 off the surface, more than the poke.
         let wide = Limits::new(&OptimizeParams::default(), 4.0);
-        let made = mend_faces(&mut m, &surface, None, &fixed, &wide);
+        let made = mend_faces(&mut m, &surface, None, None, &fixed, &wide);
         assert!(made.ops >= 1);
         let out = m.to_trimesh();
         let pairs = intersecting_pairs(&out.positions, &out.triangles);
@@ -804,7 +821,7 @@ mod tests {
         assert_eq!(m.sanity_check(), Ok(()));
         // Without moves that far (sigma_p 1: 0.25), nothing is made that would cross.
         let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
-        mend_faces(&mut m, &surface, None, &fixed, &limits());
+        mend_faces(&mut m, &surface, None, None, &fixed, &limits());
         let out = m.to_trimesh();
         assert!(
             intersecting_pairs(&out.positions, &out.triangles).len()
@@ -881,7 +898,7 @@ mod tests {
         // neighbours on the boundary have two faces each (no collapse): no flip, collapse or move
         // mends the corner's faces, whose angles at it add up to 206°.
         let fixed = vec![true; m.vertex_count()];
-        let made = mend_faces(&mut m, &surface, None, &fixed, &limits());
+        let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits());
         assert!(made.ops >= 1);
         assert!(m.vertex_count() > 7, "no vertex added");
         assert!(m.degree(v) >= 3, "the corner has {} faces", m.degree(v));
@@ -911,9 +928,9 @@ mod tests {
         let before = theta_min(&m);
         assert!(before < 10.0, "{before}");
         // Without the boundary's lines, vertex 1 stays and nothing mends the face.
-        mend_faces(&mut m, &surface, None, &fixed, &limits());
+        mend_faces(&mut m, &surface, None, None, &fixed, &limits());
         assert_eq!(m.position(1), DVec3::new(0.12, 0.0, 0.0));
-        let made = mend_faces(&mut m, &surface, Some(&boundary), &fixed, &limits());
+        let made = mend_faces(&mut m, &surface, Some(&boundary), None, &fixed, &limits());
         assert!(made.ops >= 1);
         let p = m.position(1);
         assert!(p.y.abs() < 1e-12 && p.x > 0.12 && p.x < 1.0, "{p}");

@@ -4,6 +4,7 @@
 //!
 //! The operations and their guards are described on [`optimize`].
 
+use crate::geometry::self_intersection::CrossingRegions;
 use crate::geometry::tolerance::IMPROVEMENT_TOLERANCE;
 use glam::DVec3;
 use parry3d_f64::query::PointQuery;
@@ -297,7 +298,9 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// `params.cover_distance_sigma_p` · `sigma_p` from it, then flips edges and relaxes vertices
 /// around the triangles with Q below `params.q_below`. Vertices with `fixed[v]` (boundary
 /// samples) do not move, except that the last pass slides boundary vertices along `boundary`
-/// (the input's boundary curves, same units; with `None` they stay); boundary edges are not
+/// (the input's boundary curves, same units; with `None` they stay); a face that crosses another
+/// inside `input_crossings` (where the input's own faces cross) is not mended as crossing;
+/// boundary edges are not
 /// flipped, and the `protected` edges (the creases kept as edges) are neither flipped nor
 /// collapsed. New vertices are appended, so
 /// existing indices stay valid; vertices merged away by a collapse are left unreferenced.
@@ -340,6 +343,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     protected: &[[u32; 2]],
     boundary: Option<&FeatureLines>,
+    input_crossings: Option<&CrossingRegions>,
     sigma_p: f64,
     params: &OptimizeParams,
 ) -> (OptimizeStats, Vec<Option<u32>>) {
@@ -379,7 +383,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
             break;
         }
     }
-    stats.mend = mend_faces(&mut m, surface, boundary, &fixed, params);
+    stats.mend = mend_faces(&mut m, surface, boundary, input_crossings, &fixed, params);
     stats.mends = stats.mend.ops;
     let (positions, faces, origin) = m.into_parts();
     *mesh = TriMesh::new(positions, faces);
@@ -450,7 +454,7 @@ mod tests {
         surface: &MeshSurface,
         fixed: &[bool],
     ) -> (OptimizeStats, Vec<Option<u32>>) {
-        optimize(mesh, surface, &[], fixed, &[], None, 1.0, &no_cover())
+        optimize(mesh, surface, &[], fixed, &[], None, None, 1.0, &no_cover())
     }
 
     fn no_cover() -> OptimizeParams {
@@ -582,6 +586,7 @@ mod tests {
             &input.positions,
             &fixed,
             &[],
+            None,
             None,
             1.0,
             &OptimizeParams::default(),
