@@ -191,7 +191,7 @@ pub use geometry::self_intersection::CrossingRegions;
 pub use geometry::triangle::AngleBounds;
 pub use triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
 pub use triangulate::optimize::{
-    optimize, MendStats, OptimizeParams, OptimizeStats, SmoothStats, SMOOTH_ITERATIONS,
+    optimize, FacesLeft, MendStats, OptimizeParams, OptimizeStats, SmoothStats, SMOOTH_ITERATIONS,
 };
 pub use triangulate::stray_shells::StrayShells;
 pub use triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};

@@ -50,6 +50,23 @@ fn assert_bounded_work(report: &QualityReport) {
         attempts <= budget,
         "{attempts} attempts over the budget {budget}"
     );
+    // Faces left outside the angle bounds are reported, with where they are.
+    let left = &mend["left"];
+    let total = left["total"].as_u64().unwrap();
+    let parts: u64 = ["at_creases", "on_boundary", "at_input_crossings"]
+        .iter()
+        .map(|k| left[k].as_u64().unwrap())
+        .sum();
+    assert!(parts <= total);
+    assert_eq!(
+        total > 0,
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains("outside the angle bounds")),
+        "{:?}",
+        report.notes
+    );
     assert!(
         budget <= 2 * (faces + faces / 2) + 64,
         "budget {budget} for {faces} output faces"

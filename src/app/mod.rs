@@ -342,6 +342,33 @@ fn remesh_read(
             .notes
             .push(format!("the input's {} were left out", parts.join(" and ")));
     }
+    let left = out.optimize.mend.left;
+    if let (true, Some(op)) = (left.total > 0, params.optimize.as_ref()) {
+        let elsewhere = left.total - left.at_creases - left.on_boundary - left.at_input_crossings;
+        let parts: Vec<String> = [
+            (left.at_creases, "at a kept crease"),
+            (left.on_boundary, "on the boundary"),
+            (left.at_input_crossings, "where the input's own faces cross"),
+            (elsewhere, "elsewhere"),
+        ]
+        .into_iter()
+        .filter(|&(n, _)| n > 0)
+        .map(|(n, where_)| format!("{n} {where_}"))
+        .collect();
+        report.notes.push(format!(
+            "{} faces are outside the angle bounds [{}°, {}°] after the last pass ({}): no flip, \
+             collapse, move or split within the guards mends them{}",
+            left.total,
+            op.final_theta_deg,
+            op.final_theta_max_deg,
+            parts.join(", "),
+            if out.optimize.mend.exhausted {
+                ", and the pass's budget ran out"
+            } else {
+                ""
+            }
+        ));
+    }
     extra.insert(
         "input_cleanup".into(),
         serde_json::to_value(cleanup).unwrap_or_default(),

@@ -100,6 +100,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
         ..MendStats::default()
     };
     if faces.is_empty() {
+        stats.left = faces_left(m, params, |t| own(m, t));
         return stats;
     }
     let mut guard = CrossingGuard::new(m);
@@ -266,7 +267,47 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             break;
         }
     }
+    stats.left = faces_left(m, params, |t| own(m, t));
     stats
+}
+
+/// The faces still outside the angle bounds, each counted once under the first reason that
+/// holds: a corner on a kept crease (where creases meet at a smaller angle than the bound, or
+/// a crease turns, no face there can be in bounds), on the boundary, inside a region where the
+/// input's own faces cross (`own`), or none of these.
+fn faces_left(m: &Mesh, params: &Limits, own: impl Fn([u32; 3]) -> bool) -> FacesLeft {
+    let mut left = FacesLeft::default();
+    let (live, _) = m.live_faces();
+    for t in live {
+        if angle_score(m, t, params) >= params.final_theta_deg {
+            continue;
+        }
+        left.total += 1;
+        if t.iter()
+            .any(|&v| m.ring(v).iter().any(|&u| m.is_protected(v, u)))
+        {
+            left.at_creases += 1;
+        } else if t.iter().any(|&v| m.is_boundary_vertex(v)) {
+            left.on_boundary += 1;
+        } else if own(t) {
+            left.at_input_crossings += 1;
+        }
+    }
+    left
+}
+
+/// The faces the last pass leaves outside the angle bounds, by where they are (see
+/// [`MendStats::left`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+pub struct FacesLeft {
+    /// All of them.
+    pub total: usize,
+    /// With a corner on a kept crease.
+    pub at_creases: usize,
+    /// Of the rest, with a corner on the boundary.
+    pub on_boundary: usize,
+    /// Of the rest, where the input's own faces cross.
+    pub at_input_crossings: usize,
 }
 
 /// Failed mend attempts per face slot over the whole pass at most: a face that no operation
@@ -295,6 +336,8 @@ pub struct MendStats {
     pub budget: usize,
     /// Whether the pass stopped because the budget ran out.
     pub exhausted: bool,
+    /// The faces it left outside the angle bounds, by where they are.
+    pub left: FacesLeft,
 }
 
 /// The smallest angle of the faces `t`, degrees (infinity for none).
@@ -721,6 +764,34 @@ mod tests {
 
     fn limits() -> Limits {
         Limits::new(&OptimizeParams::default(), 1.0)
+    }
+
+    #[test]
+    fn the_faces_left_out_of_bounds_are_counted_by_where_they_are() {
+        // A 6 × 6 grid of unit squares (45°, 45°, 90°: in bounds) with an interior vertex pulled
+        // most of the way to a neighbour (its faces out of bounds), then a boundary one.
+        let (g, _) = flat(6);
+        let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+        let none = |_: [u32; 3]| false;
+        assert_eq!(faces_left(&m, &limits(), none), FacesLeft::default());
+        let v = 3 * 7 + 3;
+        let p = m.position(v);
+        m.relocate_vertex(v, p + DVec3::new(0.8, 0.0, 0.0)).unwrap();
+        let left = faces_left(&m, &limits(), none);
+        assert!(left.total > 0);
+        assert_eq!((left.at_creases, left.on_boundary), (0, 0));
+        assert_eq!(
+            faces_left(&m, &limits(), |_| true).at_input_crossings,
+            left.total
+        );
+        m.protect_edge(v, v + 1);
+        assert_eq!(faces_left(&m, &limits(), none).at_creases, left.total);
+        let b = 3 * 7;
+        let q = m.position(b);
+        m.relocate_vertex(b, q + DVec3::new(0.8, 0.0, 0.0)).unwrap();
+        let more = faces_left(&m, &limits(), none);
+        assert!(more.on_boundary > 0);
+        assert_eq!(more.total, more.at_creases + more.on_boundary);
     }
 
     #[test]

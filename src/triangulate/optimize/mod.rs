@@ -25,7 +25,7 @@ mod relax;
 mod smooth;
 
 use angles::mend_faces;
-pub use angles::MendStats;
+pub use angles::{FacesLeft, MendStats};
 use collapse::collapse_short;
 use cover::cover;
 use relax::{flip_poor, relax_poor};
