@@ -182,21 +182,32 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     // corner, a patch either side takes in the sheet beyond the other crease), and leaves alone
     // a fold narrower than the spacing that no crease leads to (its flanks are sheets between
     // candidates too).
-    let none = FxHashSet::default();
+    let adjacency = FaceAdjacency::new(mesh, &uses, &candidates);
     let mut sharp: Vec<bool> = candidates
         .par_iter()
-        .map(|(e, faces)| {
-            sharp_at_scale(surface, &uses, &none, *e, *faces, params.scale, cos_bound)
-        })
+        .map_init(
+            || PatchScratch::new(mesh.triangles.len()),
+            |scratch, (e, faces)| {
+                sharp_at_scale(
+                    surface,
+                    &adjacency,
+                    false,
+                    scratch,
+                    *e,
+                    *faces,
+                    params.scale,
+                    cos_bound,
+                )
+            },
+        )
         .collect();
     if params.scale > 0.0 && sharp.iter().any(|&s| !s) {
-        let barriers: FxHashSet<(u32, u32)> =
-            candidates.iter().map(|(e, _)| (e[0], e[1])).collect();
         let mut at_vertex: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
         for (i, (e, _)) in candidates.iter().enumerate() {
             at_vertex.entry(e[0]).or_default().push(i);
             at_vertex.entry(e[1]).or_default().push(i);
         }
+        let mut scratch = PatchScratch::new(mesh.triangles.len());
         // Grown from the creases, one vertex at a time; each edge tested at most once.
         let mut tested = sharp.clone();
         let mut stack: Vec<usize> = (0..candidates.len()).filter(|&i| sharp[i]).collect();
@@ -208,8 +219,16 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
                     }
                     tested[j] = true;
                     let (e, faces) = candidates[j];
-                    if sharp_at_scale(surface, &uses, &barriers, e, faces, params.scale, cos_bound)
-                    {
+                    if sharp_at_scale(
+                        surface,
+                        &adjacency,
+                        true,
+                        &mut scratch,
+                        e,
+                        faces,
+                        params.scale,
+                        cos_bound,
+                    ) {
                         sharp[j] = true;
                         stack.push(j);
                     }
@@ -232,21 +251,108 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     }
 }
 
+/// Each face's neighbour across each of its edges (`tri[k]`–`tri[k + 1]`): the other face of
+/// an edge with exactly two faces, [`FaceAdjacency::NONE`] across a boundary or non-manifold
+/// edge; and whether that edge is a dihedral candidate. Built once, so the patches of
+/// [`sharp_at_scale`] are walked by index instead of by hashing each edge.
+struct FaceAdjacency {
+    across: Vec<[u32; 3]>,
+    candidate: Vec<[bool; 3]>,
+}
+
+impl FaceAdjacency {
+    const NONE: u32 = u32::MAX;
+
+    fn new(
+        mesh: &TriMesh,
+        uses: &FxHashMap<(u32, u32), ([u32; 2], u32)>,
+        candidates: &[([u32; 2], [u32; 2])],
+    ) -> Self {
+        let candidate_edges: FxHashSet<(u32, u32)> =
+            candidates.iter().map(|(e, _)| (e[0], e[1])).collect();
+        let (across, candidate) = mesh
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(f, tri)| {
+                let mut across = [Self::NONE; 3];
+                let mut candidate = [false; 3];
+                for k in 0..3 {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    let key = (a.min(b), a.max(b));
+                    candidate[k] = candidate_edges.contains(&key);
+                    if let Some(&(pair, 2)) = uses.get(&key) {
+                        across[k] = if pair[0] == f as u32 {
+                            pair[1]
+                        } else {
+                            pair[0]
+                        };
+                    }
+                }
+                (across, candidate)
+            })
+            .unzip();
+        FaceAdjacency { across, candidate }
+    }
+}
+
+/// The faces a patch of [`sharp_at_scale`] reached, with a bit per side: a byte per face of
+/// the mesh and the list of those set, so each patch costs what it reaches (one per thread).
+struct PatchScratch {
+    bits: Vec<u8>,
+    reached: Vec<u32>,
+}
+
+impl PatchScratch {
+    fn new(faces: usize) -> Self {
+        PatchScratch {
+            bits: vec![0; faces],
+            reached: Vec::new(),
+        }
+    }
+
+    /// Sets `bit` on face `f`; whether it was not set before.
+    fn mark(&mut self, f: u32, bit: u8) -> bool {
+        let b = &mut self.bits[f as usize];
+        if *b & bit != 0 {
+            return false;
+        }
+        if *b == 0 {
+            self.reached.push(f);
+        }
+        *b |= bit;
+        true
+    }
+
+    /// The faces reached with their bits, in face order; the scratch is empty after.
+    fn take_sorted(&mut self) -> Vec<(u32, u8)> {
+        self.reached.sort_unstable();
+        let out = self
+            .reached
+            .iter()
+            .map(|&f| (f, std::mem::take(&mut self.bits[f as usize])))
+            .collect();
+        self.reached.clear();
+        out
+    }
+}
+
 /// The most faces [`sharp_at_scale`] takes on each side of an edge.
 const PATCH_FACES: usize = 1024;
 
 /// Whether the surface within `scale` of edge `e`'s midpoint still bends by the feature angle
 /// (`cos_bound` its cosine) across the edge: the area-weighted normals of the faces on either
 /// side at least the angle apart. The patch is grown from the edge's two faces across edges to
-/// faces whose centroids are within `scale`, never across another dihedral candidate (one of
-/// `barriers`): so near a corner where creases meet, each side is the smooth sheet beside the
+/// faces whose centroids are within `scale` (over `adjacency`), never across a dihedral
+/// candidate when `barriers` is set: so near a corner where creases meet, each side is the smooth sheet beside the
 /// edge and not a sheet beyond another crease. Each face of the patch counts on the side of the
 /// edge it lies on (the half of the patch nearer one of the two faces' half-planes). True when
 /// `scale` is 0.
 fn sharp_at_scale(
     surface: &MeshSurface,
-    uses: &FxHashMap<(u32, u32), ([u32; 2], u32)>,
-    barriers: &FxHashSet<(u32, u32)>,
+    adjacency: &FaceAdjacency,
+    barriers: bool,
+    scratch: &mut PatchScratch,
     e: [u32; 2],
     faces: [u32; 2],
     scale: f64,
@@ -278,34 +384,24 @@ fn sharp_at_scale(
     // Breadth first, at most PATCH_FACES faces a side: on a finely tessellated part (tens of
     // thousands of faces within a spacing of its creases) each patch is then the nearest faces
     // by steps, and the test costs O(PATCH_FACES) per edge whatever the tessellation.
-    let mut reached: FxHashMap<u32, u8> = FxHashMap::default();
     for (side, &seed) in faces.iter().enumerate() {
         let bit = 1u8 << side;
-        *reached.entry(seed).or_default() |= bit;
+        scratch.mark(seed, bit);
         let mut queue = std::collections::VecDeque::from([seed]);
         let mut taken = 1;
         while let Some(f) = queue.pop_front() {
             if taken >= PATCH_FACES {
                 break;
             }
-            let tri = mesh.triangles[f as usize];
             for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let key = (a.min(b), a.max(b));
-                if barriers.contains(&key) {
+                let g = adjacency.across[f as usize][k];
+                if g == FaceAdjacency::NONE || (barriers && adjacency.candidate[f as usize][k]) {
                     continue;
                 }
-                let Some(&(pair, 2)) = uses.get(&key) else {
-                    continue;
-                };
-                for g in pair {
-                    if centroid(g).distance_squared(mid) <= scale_2 {
-                        let r = reached.entry(g).or_default();
-                        if *r & bit == 0 {
-                            *r |= bit;
-                            queue.push_back(g);
-                            taken += 1;
-                        }
+                if centroid(g).distance_squared(mid) <= scale_2 {
+                    if scratch.mark(g, bit) {
+                        queue.push_back(g);
+                        taken += 1;
                     }
                 }
             }
@@ -314,9 +410,7 @@ fn sharp_at_scale(
     // A face reached from one side only counts on that side; one reached from both (round the
     // end of a crease, or across a fold that is not one) on the side of the edge it lies on.
     let mut sides = [DVec3::ZERO; 2];
-    let mut patch: Vec<(u32, u8)> = reached.into_iter().collect();
-    patch.sort_unstable();
-    for (f, bits) in patch {
+    for (f, bits) in scratch.take_sorted() {
         let t = mesh.corners(f as usize);
         // Area-weighted normal: the cross product's half.
         let weighted = (t[1] - t[0]).cross(t[2] - t[0]);
