@@ -189,7 +189,6 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
             || PatchScratch::new(mesh.triangles.len()),
             |scratch, (e, faces)| {
                 sharp_at_scale(
-                    surface,
                     &adjacency,
                     false,
                     scratch,
@@ -220,7 +219,6 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
                     tested[j] = true;
                     let (e, faces) = candidates[j];
                     if sharp_at_scale(
-                        surface,
                         &adjacency,
                         true,
                         &mut scratch,
@@ -251,20 +249,21 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     }
 }
 
-/// Each face's neighbour across each of its edges (`tri[k]`–`tri[k + 1]`): the other face of
+/// The faces of `mesh` and each face's neighbour across each of its edges (`tri[k]`–`tri[k + 1]`): the other face of
 /// an edge with exactly two faces, [`FaceAdjacency::NONE`] across a boundary or non-manifold
 /// edge; and whether that edge is a dihedral candidate. Built once, so the patches of
 /// [`sharp_at_scale`] are walked by index instead of by hashing each edge.
-struct FaceAdjacency {
+struct FaceAdjacency<'a> {
+    mesh: &'a TriMesh,
     across: Vec<[u32; 3]>,
     candidate: Vec<[bool; 3]>,
 }
 
-impl FaceAdjacency {
+impl<'a> FaceAdjacency<'a> {
     const NONE: u32 = u32::MAX;
 
     fn new(
-        mesh: &TriMesh,
+        mesh: &'a TriMesh,
         uses: &FxHashMap<(u32, u32), ([u32; 2], u32)>,
         candidates: &[([u32; 2], [u32; 2])],
     ) -> Self {
@@ -292,7 +291,11 @@ impl FaceAdjacency {
                 (across, candidate)
             })
             .unzip();
-        FaceAdjacency { across, candidate }
+        FaceAdjacency {
+            mesh,
+            across,
+            candidate,
+        }
     }
 }
 
@@ -349,7 +352,6 @@ const PATCH_FACES: usize = 1024;
 /// edge it lies on (the half of the patch nearer one of the two faces' half-planes). True when
 /// `scale` is 0.
 fn sharp_at_scale(
-    surface: &MeshSurface,
     adjacency: &FaceAdjacency,
     barriers: bool,
     scratch: &mut PatchScratch,
@@ -361,7 +363,7 @@ fn sharp_at_scale(
     if !(scale > 0.0) {
         return true;
     }
-    let mesh = surface.mesh();
+    let mesh = adjacency.mesh;
     let (pa, pb) = (mesh.positions[e[0] as usize], mesh.positions[e[1] as usize]);
     let mid = 0.5 * (pa + pb);
     let along = (pb - pa).normalize_or_zero();
@@ -398,11 +400,9 @@ fn sharp_at_scale(
                 if g == FaceAdjacency::NONE || (barriers && adjacency.candidate[f as usize][k]) {
                     continue;
                 }
-                if centroid(g).distance_squared(mid) <= scale_2 {
-                    if scratch.mark(g, bit) {
-                        queue.push_back(g);
-                        taken += 1;
-                    }
+                if centroid(g).distance_squared(mid) <= scale_2 && scratch.mark(g, bit) {
+                    queue.push_back(g);
+                    taken += 1;
                 }
             }
         }
