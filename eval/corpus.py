@@ -18,8 +18,11 @@ Outcomes of a run, worst first:
   crash      a non-zero exit other than 3 (a refusal), or a message of more than one line
   disagree   the run's report and `remesh quality` of the file it wrote differ (crossing pairs or
              invariant violations)
-  violation  exit 0, and the output breaks an invariant, or its faces cross while the input's do not
-  crossings  exit 0 and valid but for crossing faces, where the input's own faces cross too
+  violation  exit 0, and the output breaks an invariant, or its faces cross where the input's
+             neither cross nor meet (the report's extra.output_crossings counts the pairs that lie
+             where the input's own faces cross or its parts meet at a non-manifold edge)
+  crossings  exit 0 and valid but for crossing faces, all where the input's own faces cross or
+             its parts meet
   refused    exit 3 with a one-line message (a file that holds no surface)
   valid      exit 0, no invariant violation, no crossing
 The row of a file shows its worst outcome over the seeds, the median and worst wall time (load to
@@ -157,7 +160,11 @@ def one_run(binary, path, seed, args, tmp, input_pairs):
             "violations": [v["kind"] for v in check["invariant_violations"]]}
         return row
     others = [v for v in row["violations"] if v != "Crossing"]
-    if others or (row["pairs"] > 0 and not input_pairs):
+    # The run's report counts the crossing pairs that lie where the input's own faces cross
+    # or its parts meet at a non-manifold edge; any other crossing is the output's own.
+    theirs = report.get("extra", {}).get("output_crossings", {}).get("where_input_crosses", 0)
+    row["pairs_where_input_crosses"] = theirs
+    if others or row["pairs"] > theirs:
         row["outcome"] = "violation"
     elif row["pairs"] > 0:
         row["outcome"] = "crossings"
@@ -217,7 +224,7 @@ def main():
             if worst["outcome"] in ("refused", "crash"):
                 note = worst["message"].splitlines()[0][:90] if worst["message"] else f"exit {worst['exit']}"
             if worst["outcome"] in ("violation", "crossings", "disagree"):
-                note = f"pairs {worst.get('pairs')} (input {input_pairs}) {','.join(sorted(set(worst.get('violations', []))))} " + note
+                note = f"pairs {worst.get('pairs')} ({worst.get('pairs_where_input_crosses', 0)} at the input's; input {input_pairs}) {','.join(sorted(set(worst.get('violations', []))))} " + note
             print(f"{path.name[:34]:34} {worst['outcome']:10} {statistics.median(walls):7.2f}/{max(walls):6.2f}"
                   f" {tmin:6.1f} {tmax:6.1f} {outside:7d}  {note}", flush=True)
             rows.append({"file": str(path.relative_to(corpus)), "input_faces": input_faces,

@@ -12,6 +12,7 @@ use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::geometry::tolerance::{DEGENERATE_AREA_TOLERANCE, ON_SURFACE_RELATIVE};
 use crate::kernel::Kernel;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
+use crate::mesh::sheets::Sheets;
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{
     boundary_curves, boundary_sample_count, curve_length, sample_curves_and_features,
@@ -265,6 +266,18 @@ pub struct FeatureStats {
     pub crease_distance: Option<crate::check::CreaseDistance>,
 }
 
+/// The output's crossing face pairs when the pipeline ends (non-adjacent faces that share a
+/// point, as [`intersecting_pairs`] finds them), and how many of them lie where the input's own
+/// faces cross or its parts meet at a non-manifold edge (both faces reach into a
+/// [`CrossingRegions`] region, loosened by sigma_p).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct OutputCrossings {
+    /// Crossing pairs.
+    pub pairs: usize,
+    /// Of those, the pairs where the input's own faces cross or its parts meet.
+    pub where_input_crosses: usize,
+}
+
 /// The output of [`remesh`].
 #[derive(Debug, Clone)]
 pub struct RemeshOutput {
@@ -309,6 +322,9 @@ pub struct RemeshOutput {
     pub optimize: OptimizeStats,
     /// What the separation of crossing faces did.
     pub untangle: UntangleStats,
+    /// The output's crossing face pairs at the end, and how many lie where the input's own
+    /// faces cross or its parts meet.
+    pub output_crossings: OutputCrossings,
     /// What the least-squares fit to the input did (`None` when it was off).
     pub fit: Option<crate::triangulate::fit::FitStats>,
     /// How each face of `mesh` came in.
@@ -475,6 +491,8 @@ pub fn remesh(
         Some(_) => intersecting_pairs(&normalized.positions, &normalized.triangles),
         None => Vec::new(),
     };
+    // Where parts of the input meet at non-manifold edges (the triangulation keeps them apart).
+    let junction_faces = Sheets::new(&normalized).junction_faces(&normalized);
     timer.lap("normalize");
 
     on_stage("candidates");
@@ -873,19 +891,22 @@ pub fn remesh(
             RecoverStats::default()
         };
         timer.lap("triangulate");
+        // Where the input's faces cross or its parts meet: an output face within a spacing of
+        // there is there.
+        let input_crossings = (!input_crossing_pairs.is_empty() || !junction_faces.is_empty())
+            .then(|| {
+                CrossingRegions::new(
+                    &normalized.positions,
+                    &normalized.triangles,
+                    &input_crossing_pairs,
+                    &junction_faces,
+                    sigma_p,
+                )
+            });
         on_stage("optimize");
         let optimize_stats = match &params.optimize {
             Some(op) => {
                 let fixed: Vec<bool> = (0..samples.len()).map(|i| i < boundary_count).collect();
-                // An output face within a spacing of where two input faces cross is there.
-                let input_crossings = (!input_crossing_pairs.is_empty()).then(|| {
-                    CrossingRegions::new(
-                        &normalized.positions,
-                        &normalized.triangles,
-                        &input_crossing_pairs,
-                        sigma_p,
-                    )
-                });
                 let (st, origin) = optimize(
                     &mut mesh_normalized,
                     &surface,
@@ -946,6 +967,22 @@ pub fn remesh(
         if stray.shells > 0 {
             mesh_normalized.remove_unreferenced_vertices();
         }
+        // The crossings left, and how many are the input's own.
+        let output_crossings = if untangle_stats.pairs_after > 0 {
+            let pairs = intersecting_pairs(&mesh_normalized.positions, &mesh_normalized.triangles);
+            OutputCrossings {
+                pairs: pairs.len(),
+                where_input_crosses: input_crossings.as_ref().map_or(0, |r| {
+                    r.count_inside(
+                        &mesh_normalized.positions,
+                        &mesh_normalized.triangles,
+                        &pairs,
+                    )
+                }),
+            }
+        } else {
+            OutputCrossings::default()
+        };
         // The output follows the input's orientation: its closed parts are turned outward.
         let output_orientation = orient_consistently(&mut mesh_normalized, true);
         timer.lap("untangle");
@@ -999,6 +1036,7 @@ pub fn remesh(
                 restricted_delaunay,
                 optimize: optimize_stats,
                 untangle: untangle_stats,
+                output_crossings,
                 fit: fit_stats,
                 face_sources,
                 dropped_samples,

@@ -1,6 +1,6 @@
 //! Issue 35: real files in bounded time, with a valid mesh out. Each input is made here (the
 //! shapes of the corpus files that hung or crossed: a tetrahedron, two tetrahedra joined at a
-//! face, a duplicated face, a double-sided export, a two-part scene, a zero-area first face).
+//! face (their shared face a wall inside the solid), two boxes welded on one edge, a duplicated face, a double-sided export, a two-part scene, a zero-area first face).
 //! Every run goes through `remesh_mesh` (the command line's own path from the mesh read on) on a
 //! thread with a hang guard, and the finishing stage's work is checked by counting its attempts
 //! against its budget, not by timing.
@@ -132,7 +132,18 @@ fn two_tetrahedra_joined_at_a_face_end_within_the_budget() {
         ],
     );
     let (_, report) = remesh_guarded(mesh, 3000, 1);
-    assert_eq!(cleanup(&report), (0, 1, 1));
+    // The shared face is a wall inside the bipyramid the two make: both copies go, and the
+    // output is the bipyramid's closed surface.
+    assert_eq!(cleanup(&report), (0, 1, 0));
+    assert_eq!(report.extra["input_cleanup"]["internal_walls"], 1);
+    assert!(report
+        .notes
+        .iter()
+        .any(|n| n.contains("1 faces between two closed parts")));
+    assert_valid(&report);
+    assert!(report.topology.is_closed_manifold());
+    assert_eq!(report.topology.genus, Some(0));
+    assert_eq!(report.topology.components, 1);
     assert_bounded_work(&report);
 }
 
@@ -192,6 +203,43 @@ fn a_two_part_scene_keeps_both_parts_apart() {
     assert_eq!(report.topology.components, 2);
     assert!(report.topology.is_closed_manifold());
     assert_bounded_work(&report);
+}
+
+#[test]
+fn two_boxes_on_one_edge_come_out_as_two_closed_parts() {
+    // The corpus's shared.STL: two solids welded where they touch, along an edge whose four
+    // faces make it non-manifold. Triangulated as one point set, the cells there ran from one
+    // box onto the other (Euler characteristic 3 -> -4, and faces crossing).
+    let a = common::grid_box(DVec3::ZERO, DVec3::ONE, 2);
+    let b = common::grid_box(DVec3::new(1.0, 1.0, 0.0), DVec3::new(2.0, 2.0, 1.0), 2);
+    let offset = a.positions.len() as u32;
+    let mut scene = a;
+    scene.positions.extend(b.positions);
+    scene
+        .triangles
+        .extend(b.triangles.iter().map(|t| t.map(|i| i + offset)));
+    assert_eq!(scene.weld_identical_positions(), 3);
+    for seed in 1..=2 {
+        let (_, report) = remesh_guarded(scene.clone(), 1500, seed);
+        let input = report.input_topology.as_ref().unwrap();
+        assert_eq!(input.non_manifold_edges, 2);
+        assert!(report.notes.iter().any(|n| n.contains("triangulated apart")));
+        assert_eq!(report.topology.components, 2);
+        assert!(report.topology.is_closed_manifold());
+        assert_eq!(report.topology.genus, Some(0));
+        // Where the boxes meet, their outputs may touch; nowhere else do they cross.
+        let crossings = &report.extra["output_crossings"];
+        assert_eq!(
+            crossings["pairs"].as_u64().unwrap(),
+            report.self_intersections.pairs as u64
+        );
+        assert_eq!(
+            crossings["where_input_crosses"],
+            crossings["pairs"],
+            "{crossings:?}"
+        );
+        assert_bounded_work(&report);
+    }
 }
 
 #[test]

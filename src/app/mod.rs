@@ -247,8 +247,15 @@ fn remesh_read(
         if t.non_manifold_vertices > 0 || t.non_manifold_edges > 0 {
             report.notes.push(format!(
                 "the input has {} non-manifold vertices and {} non-manifold edges; the sampler \
-                 works on the surface as a point set and the output is rebuilt manifold",
-                t.non_manifold_vertices, t.non_manifold_edges
+                 works on the surface as a point set and the output is rebuilt manifold{}",
+                t.non_manifold_vertices,
+                t.non_manifold_edges,
+                if t.non_manifold_edges > 0 {
+                    " (parts that meet at a non-manifold edge are triangulated apart, each \
+                     closed on its own)"
+                } else {
+                    ""
+                }
             ));
         }
     }
@@ -312,6 +319,26 @@ fn remesh_read(
         serde_json::to_value(out.untangle).unwrap_or_default(),
     );
     extra.insert(
+        "output_crossings".into(),
+        serde_json::to_value(out.output_crossings).unwrap_or_default(),
+    );
+    let crossing = report.self_intersections.pairs;
+    if crossing > 0 {
+        let theirs = out.output_crossings.where_input_crosses.min(crossing);
+        report.notes.push(if theirs == crossing {
+            format!(
+                "all {crossing} crossing pairs of the output lie where the input's own faces \
+                 cross or its parts meet at non-manifold edges"
+            )
+        } else {
+            format!(
+                "{} of the output's {crossing} crossing pairs lie where the input's faces \
+                 neither cross nor meet ({theirs} where they do)",
+                crossing - theirs
+            )
+        });
+    }
+    extra.insert(
         "features".into(),
         serde_json::to_value(&out.features).unwrap_or_default(),
     );
@@ -330,9 +357,21 @@ fn remesh_read(
     if cleanup.any() {
         let mut parts = Vec::new();
         if cleanup.duplicates > 0 {
+            let copies = cleanup.duplicates - cleanup.opposite_duplicates;
+            parts.push(match (cleanup.opposite_duplicates, copies) {
+                (0, n) => format!("{n} duplicate faces"),
+                (m, 0) => format!("{m} faces that are the back of a double-sided face"),
+                (m, n) => format!(
+                    "{} duplicate faces ({m} of them the back of a double-sided face)",
+                    m + n
+                ),
+            });
+        }
+        if cleanup.internal_walls > 0 {
             parts.push(format!(
-                "{} duplicate faces ({} of them the back of a double-sided face)",
-                cleanup.duplicates, cleanup.opposite_duplicates
+                "{} faces between two closed parts (walls inside the solid they make, given in \
+                 both windings)",
+                cleanup.internal_walls
             ));
         }
         if cleanup.zero_area > 0 {

@@ -131,34 +131,63 @@ pub(crate) fn has_intersecting_pair(
 }
 
 /// Where a mesh's own faces cross or touch: for each intersecting pair, the overlap of the two
-/// faces' bounding boxes, loosened by a margin, in a BVH. The finishing stage leaves alone the
-/// output faces that cross inside these regions (the crossing is the input's own: a scene's
-/// parts passing through each other, an STL's welded corners), and mends the others.
+/// faces' bounding boxes, and the box of each face where two parts meet at a non-manifold edge
+/// (the faces of a [`Sheets`](crate::mesh::sheets::Sheets) junction: parts that share an edge,
+/// or lie on each other along a face), each loosened by a margin, in a BVH. The finishing stage
+/// leaves alone the output faces that cross inside these regions (the crossing is the input's
+/// own: a scene's parts passing through or lying on each other, an STL's welded corners), and
+/// mends the others; the report counts the output's crossings inside them apart.
 pub struct CrossingRegions {
     bvh: Bvh,
     count: usize,
 }
 
 impl CrossingRegions {
-    /// The regions of the intersecting `pairs` (as [`intersecting_pairs`] gives them) of the
-    /// faces `triangles` over `positions`, each box loosened by `margin` (same units).
+    /// The regions of the intersecting `pairs` (as [`intersecting_pairs`] gives them) and of the
+    /// `touching` faces of the faces `triangles` over `positions`, each box loosened by `margin`
+    /// (same units).
     pub fn new(
         positions: &[DVec3],
         triangles: &[[u32; 3]],
         pairs: &[[u32; 2]],
+        touching: &[u32],
         margin: f64,
     ) -> Self {
-        let boxes = pairs.iter().enumerate().map(|(i, &[f, g])| {
-            let [a, b] =
-                [f, g].map(|h| triangle_aabb(triangles[h as usize].map(|v| positions[v as usize])));
-            let lo = a.mins.max(b.mins) - DVec3::splat(margin);
-            let hi = a.maxs.min(b.maxs) + DVec3::splat(margin);
-            (i, Aabb::new(lo, hi))
+        let face_box = |h: u32| triangle_aabb(triangles[h as usize].map(|v| positions[v as usize]));
+        let loosen = DVec3::splat(margin);
+        let overlaps = pairs.iter().map(|&[f, g]| {
+            let [a, b] = [f, g].map(face_box);
+            (a.mins.max(b.mins), a.maxs.min(b.maxs))
         });
+        let faces = touching.iter().map(|&f| {
+            let a = face_box(f);
+            (a.mins, a.maxs)
+        });
+        let boxes = overlaps
+            .chain(faces)
+            .enumerate()
+            .map(|(i, (lo, hi))| (i, Aabb::new(lo - loosen, hi + loosen)));
         CrossingRegions {
             bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
-            count: pairs.len(),
+            count: pairs.len() + touching.len(),
         }
+    }
+
+    /// How many of the crossing `pairs` of the faces `triangles` over `positions` (another mesh
+    /// in the same frame, the output) lie in a region: both faces reach into one.
+    pub fn count_inside(
+        &self,
+        positions: &[DVec3],
+        triangles: &[[u32; 3]],
+        pairs: &[[u32; 2]],
+    ) -> usize {
+        pairs
+            .iter()
+            .filter(|p| {
+                p.iter()
+                    .all(|&f| self.meets(triangles[f as usize].map(|v| positions[v as usize])))
+            })
+            .count()
     }
 
     /// Whether there is no region.

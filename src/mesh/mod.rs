@@ -6,6 +6,7 @@
 pub mod bisect;
 pub mod edit;
 mod orient;
+pub mod sheets;
 mod trimesh;
 
 pub use orient::{orient_consistently, OrientStats};

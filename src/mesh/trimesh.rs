@@ -2,7 +2,7 @@
 //! Sec. 7 of the paper (longest side scaled to 100).
 
 use glam::DVec3;
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::geometry::triangle_intersection::collinear;
 use crate::mesh::edit::starting_at;
@@ -293,11 +293,15 @@ impl TriMesh {
     /// three coordinate-plane projections; faces of almost no area stay, for the pipeline's own
     /// checks to name), and faces with the same three vertices as an earlier face, in either
     /// winding (duplicated faces, and the second sheet of a double-sided export). The first of a
-    /// set of duplicates stays. Vertices stay (see [`TriMesh::remove_unreferenced_vertices`]).
-    /// O(faces).
+    /// set of duplicates stays. Then a face that came in both windings and whose three edges
+    /// each still have more than two faces goes as well: it is a wall between two volumes
+    /// (two closed parts glued at that face, as two tetrahedra joined into a bipyramid), inside
+    /// the solid they make together; a double-sided sheet, whose edges are left with one or two
+    /// faces, stays. Vertices stay (see [`TriMesh::remove_unreferenced_vertices`]). O(faces).
     pub fn remove_duplicate_and_zero_area_faces(&mut self) -> FaceCleanup {
         let mut seen: FxHashMap<[u32; 3], [u32; 3]> = FxHashMap::default();
         let mut out = FaceCleanup::default();
+        let mut both_windings: Vec<[u32; 3]> = Vec::new();
         let positions = &self.positions;
         self.triangles.retain(|&t| {
             if collinear(t.map(|i| positions[i as usize])) {
@@ -311,6 +315,7 @@ impl TriMesh {
                     out.duplicates += 1;
                     if starting_at(t, first[0]) != *first {
                         out.opposite_duplicates += 1;
+                        both_windings.push(key);
                     }
                     false
                 }
@@ -320,6 +325,32 @@ impl TriMesh {
                 }
             }
         });
+        if both_windings.is_empty() {
+            return out;
+        }
+        let mut faces_on_edge: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *faces_on_edge.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let is_wall = |&[a, b, c]: &[u32; 3]| {
+            [(a, b), (b, c), (a, c)]
+                .iter()
+                .all(|e| faces_on_edge.get(e).is_some_and(|&n| n > 2))
+        };
+        // A wall's other winding is no double-sided face.
+        out.opposite_duplicates -= both_windings.iter().filter(|k| is_wall(k)).count();
+        let walls: FxHashSet<[u32; 3]> = both_windings.into_iter().filter(is_wall).collect();
+        if !walls.is_empty() {
+            self.triangles.retain(|&t| {
+                let mut key = t;
+                key.sort_unstable();
+                !walls.contains(&key)
+            });
+            out.internal_walls = walls.len();
+        }
         out
     }
 
@@ -361,12 +392,16 @@ pub struct FaceCleanup {
     pub duplicates: usize,
     /// Of those, the ones whose winding is the opposite of the earlier face's (double-sided).
     pub opposite_duplicates: usize,
+    /// Faces given in both windings that are walls between two volumes (every edge shared by
+    /// more than two faces), removed with their copies (which count in `duplicates`, not in
+    /// `opposite_duplicates`).
+    pub internal_walls: usize,
 }
 
 impl FaceCleanup {
     /// Whether anything was removed.
     pub fn any(&self) -> bool {
-        self.zero_area + self.duplicates > 0
+        self.zero_area + self.duplicates + self.internal_walls > 0
     }
 }
 
@@ -664,6 +699,53 @@ mod tests {
         }
         let flat = Aabb::of(&[DVec3::ONE, DVec3::ONE]).unwrap();
         assert!(Normalization::for_bbox(&flat).is_none());
+    }
+
+    #[test]
+    fn a_face_in_both_windings_goes_when_it_is_a_wall_and_stays_when_it_is_a_sheet() {
+        // Two tetrahedra glued at the face 0-1-2, each with its copy of it.
+        let positions = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::Z,
+            DVec3::new(0.2, 0.2, -1.0),
+        ];
+        let mut glued = TriMesh::new(
+            positions.clone(),
+            vec![
+                [0, 2, 1],
+                [0, 1, 3],
+                [1, 2, 3],
+                [2, 0, 3],
+                [0, 1, 2],
+                [0, 4, 1],
+                [1, 4, 2],
+                [2, 4, 0],
+            ],
+        );
+        let c = glued.remove_duplicate_and_zero_area_faces();
+        assert_eq!(
+            (c.duplicates, c.opposite_duplicates, c.internal_walls),
+            (1, 0, 1)
+        );
+        assert_eq!(glued.triangles.len(), 6);
+        assert!(!glued.triangles.iter().any(|t| {
+            let mut k = *t;
+            k.sort_unstable();
+            k == [0, 1, 2]
+        }));
+        // One sheet of two faces, exported double-sided: the backs go, the fronts stay.
+        let mut sheet = TriMesh::new(
+            positions[..4].to_vec(),
+            vec![[0, 1, 2], [1, 3, 2], [0, 2, 1], [1, 2, 3]],
+        );
+        let c = sheet.remove_duplicate_and_zero_area_faces();
+        assert_eq!(
+            (c.duplicates, c.opposite_duplicates, c.internal_walls),
+            (2, 2, 0)
+        );
+        assert_eq!(sheet.triangles, vec![[0, 1, 2], [1, 3, 2]]);
     }
 
     #[test]

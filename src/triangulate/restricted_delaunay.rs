@@ -23,6 +23,7 @@ use std::collections::BinaryHeap;
 
 use super::tangent_delaunay::VotedTriangle;
 use crate::mesh::bisect::bisect_to_length;
+use crate::mesh::sheets::Sheets;
 use crate::spatial::StaticTree;
 use crate::surface::MeshSurface;
 
@@ -78,8 +79,33 @@ pub fn restricted_delaunay(
     let budget = params
         .max_added_per_sample
         .saturating_mul(positions.len().max(1));
-    let refined = bisect_to_length(surface.mesh(), params.resolution * spacing, budget)?;
+    // Parts that meet at non-manifold edges are refined apart (each sheet with its
+    // own copy of the vertices it shares), so that no cell grows from one onto the other: each
+    // part's triangles join only its own samples.
+    let sheets = Sheets::new(surface.mesh());
+    let split = sheets.split(surface.mesh());
+    let sheet = &sheets.of_face;
+    let refined = bisect_to_length(
+        split.as_ref().unwrap_or(surface.mesh()),
+        params.resolution * spacing,
+        budget,
+    )?;
     let n = refined.positions.len();
+    // The sheet of each refined vertex, where there are sheets to tell apart.
+    let vertex_sheet: Option<Vec<u32>> = split.as_ref().map(|_| {
+        let mut of = vec![0u32; n];
+        for (t, &f) in refined.triangles.iter().zip(&refined.parent) {
+            for &v in t {
+                of[v as usize] = sheet[f as usize];
+            }
+        }
+        of
+    });
+    let on_sheet = |v: u32, f: u32| {
+        vertex_sheet
+            .as_ref()
+            .is_none_or(|of| of[v as usize] == sheet[f as usize])
+    };
     // Vertex -> its neighbours.
     let neighbours = Rows::new(n, &refined.triangles);
     // Seeds: the refined vertices around each sample's closest point, on its input face.
@@ -113,10 +139,17 @@ pub fn restricted_delaunay(
             let on_face: Vec<u32> = near
                 .iter()
                 .map(|q| q.0)
-                .filter(|&v| lies_in(surface, sp.face, refined.positions[v as usize], tolerance))
+                .filter(|&v| {
+                    on_sheet(v, sp.face)
+                        && lies_in(surface, sp.face, refined.positions[v as usize], tolerance)
+                })
                 .collect();
             if on_face.is_empty() {
-                near.iter().map(|q| q.0).take(1).collect()
+                near.iter()
+                    .map(|q| q.0)
+                    .filter(|&v| on_sheet(v, sp.face))
+                    .take(1)
+                    .collect()
             } else {
                 on_face
             }
