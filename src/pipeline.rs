@@ -40,6 +40,7 @@ use crate::surface::MeshSurface;
 use crate::surface::SurfaceSample;
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
+use crate::triangulate::degenerate::mend_degenerate_faces;
 use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
 use crate::triangulate::recover::{close_slits, flip_crease_slivers, recover_edges, RecoverStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
@@ -322,6 +323,8 @@ pub struct RemeshOutput {
     pub optimize: OptimizeStats,
     /// What the separation of crossing faces did.
     pub untangle: UntangleStats,
+    /// What the mending of faces of no area did.
+    pub degenerate: crate::triangulate::degenerate::DegenerateStats,
     /// The output's crossing face pairs at the end, and how many lie where the input's own
     /// faces cross or its parts meet.
     pub output_crossings: OutputCrossings,
@@ -923,7 +926,8 @@ pub fn remesh(
             }
             None => OptimizeStats::default(),
         };
-        // Connectivity is final here (untangle only moves vertices).
+        // Connectivity is final here but for the collapses of untangle's folds (where the output
+        // crosses itself where the input does not).
         let feature_edges_kept = edges_present(&mesh_normalized, &feature_edges);
         let dropped_samples = mesh_normalized.remove_unreferenced_vertices();
         timer.lap("optimize");
@@ -944,7 +948,23 @@ pub fn remesh(
                 params.optimize.as_ref().map(OptimizeParams::angle_bounds),
             )
         });
-        let untangle_stats = untangle(&mut mesh_normalized, &fixed, sigma_p, &params.untangle);
+        let (untangle_stats, origin) = untangle(
+            &mut mesh_normalized,
+            &fixed,
+            sigma_p,
+            &params.untangle,
+            input_crossings.as_ref(),
+        );
+        if untangle_stats.collapses > 0 {
+            face_sources = carried_sources(&origin, &face_sources);
+            mesh_normalized.remove_unreferenced_vertices();
+        }
+        // No face of no area is written.
+        let (degenerate_stats, origin) = mend_degenerate_faces(&mut mesh_normalized, &fixed);
+        if let Some(origin) = origin {
+            face_sources = carried_sources(&origin, &face_sources);
+            mesh_normalized.remove_unreferenced_vertices();
+        }
         // Tiny shells split off at tips too thin for the count (four samples closing into a
         // tetrahedron) go when the output has more parts than the input.
         let stray = match &grading {
@@ -1036,6 +1056,7 @@ pub fn remesh(
                 restricted_delaunay,
                 optimize: optimize_stats,
                 untangle: untangle_stats,
+                degenerate: degenerate_stats,
                 output_crossings,
                 fit: fit_stats,
                 face_sources,

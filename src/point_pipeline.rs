@@ -412,7 +412,7 @@ pub fn remesh_points(
         ..rp.untangle
     };
     let no_fixed = vec![false; mesh.positions.len()];
-    let untangle_umbrellas = untangle(&mut mesh, &no_fixed, sigma_p, &untangle_params);
+    let (untangle_umbrellas, _) = untangle(&mut mesh, &no_fixed, sigma_p, &untangle_params, None);
     timer.lap("triangulate");
 
     on_stage("optimize");
@@ -441,7 +441,9 @@ pub fn remesh_points(
     // 0.77, 0.60 without, at 1.8 times the run time (each of its moves is a RIMLS projection).
     let fixed = vec![false; mesh.positions.len()];
     on_stage("untangle");
-    let untangle_stats = untangle(&mut mesh, &fixed, sigma_p, &untangle_params);
+    let (untangle_stats, _) = untangle(&mut mesh, &fixed, sigma_p, &untangle_params, None);
+    // No face of no area is written.
+    crate::triangulate::degenerate::mend_degenerate_faces(&mut mesh, &fixed);
     let collapsed = mesh.remove_unreferenced_vertices();
     // A tiny closed shell (a few samples closing into a tetrahedron where a tip is thinner than
     // the spacing) is no part of the surface: a real part 4 sigma_p across would have tens of

@@ -223,7 +223,10 @@ fn two_boxes_on_one_edge_come_out_as_two_closed_parts() {
         let (_, report) = remesh_guarded(scene.clone(), 1500, seed);
         let input = report.input_topology.as_ref().unwrap();
         assert_eq!(input.non_manifold_edges, 2);
-        assert!(report.notes.iter().any(|n| n.contains("triangulated apart")));
+        assert!(report
+            .notes
+            .iter()
+            .any(|n| n.contains("triangulated apart")));
         assert_eq!(report.topology.components, 2);
         assert!(report.topology.is_closed_manifold());
         assert_eq!(report.topology.genus, Some(0));
@@ -234,8 +237,7 @@ fn two_boxes_on_one_edge_come_out_as_two_closed_parts() {
             report.self_intersections.pairs as u64
         );
         assert_eq!(
-            crossings["where_input_crosses"],
-            crossings["pairs"],
+            crossings["where_input_crosses"], crossings["pairs"],
             "{crossings:?}"
         );
         assert_bounded_work(&report);

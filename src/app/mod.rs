@@ -251,8 +251,7 @@ fn remesh_read(
                 t.non_manifold_vertices,
                 t.non_manifold_edges,
                 if t.non_manifold_edges > 0 {
-                    " (parts that meet at a non-manifold edge are triangulated apart, each \
-                     closed on its own)"
+                    " (parts that meet at a non-manifold edge are triangulated apart)"
                 } else {
                     ""
                 }
@@ -318,6 +317,12 @@ fn remesh_read(
         "untangle".into(),
         serde_json::to_value(out.untangle).unwrap_or_default(),
     );
+    if out.degenerate.found > 0 {
+        extra.insert(
+            "degenerate".into(),
+            serde_json::to_value(out.degenerate).unwrap_or_default(),
+        );
+    }
     extra.insert(
         "output_crossings".into(),
         serde_json::to_value(out.output_crossings).unwrap_or_default(),

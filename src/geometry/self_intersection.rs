@@ -132,7 +132,7 @@ pub(crate) fn has_intersecting_pair(
 
 /// Where a mesh's own faces cross or touch: for each intersecting pair, the overlap of the two
 /// faces' bounding boxes, and the box of each face where two parts meet at a non-manifold edge
-/// (the faces of a [`Sheets`](crate::mesh::sheets::Sheets) junction: parts that share an edge,
+/// (the faces at the junction of the input's sheets, `mesh::sheets`: parts that share an edge,
 /// or lie on each other along a face), each loosened by a margin, in a BVH. The finishing stage
 /// leaves alone the output faces that cross inside these regions (the crossing is the input's
 /// own: a scene's parts passing through or lying on each other, an STL's welded corners), and

@@ -2,6 +2,7 @@
 //! manifold clean-up.
 
 pub mod cleanup;
+pub mod degenerate;
 pub mod fit;
 mod flip;
 pub mod optimize;

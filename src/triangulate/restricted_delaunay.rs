@@ -84,7 +84,7 @@ pub fn restricted_delaunay(
     // part's triangles join only its own samples.
     let sheets = Sheets::new(surface.mesh());
     let split = sheets.split(surface.mesh());
-    let sheet = &sheets.of_face;
+    let sheet = &sheets.part;
     let refined = bisect_to_length(
         split.as_ref().unwrap_or(surface.mesh()),
         params.resolution * spacing,

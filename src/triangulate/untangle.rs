@@ -9,11 +9,19 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::geometry::self_intersection::intersecting_pairs;
-use crate::geometry::triangle::{is_degenerate_face, triangle_min_angle_deg};
+use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+
+use crate::geometry::self_intersection::{intersecting_pairs, triangle_aabb, CrossingRegions};
+use crate::geometry::triangle::{
+    is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,
+};
 use crate::geometry::triangle_intersection::triangles_intersect;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
+
+/// The edit mesh of [`untangle`]: each face labelled with its index in the mesh given, `None`
+/// once a collapse changed it.
+type Mesh = EditMesh<Option<u32>>;
 
 /// Parameters of [`untangle`]. Lengths are in units of σ_p.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -24,10 +32,10 @@ pub struct UntangleParams {
     pub margin_sigma_p: f64,
     /// The longest move of a vertex in one round (σ_p units). Default 0.25.
     pub max_step_sigma_p: f64,
-    /// Edge collapses at most when moves leave crossing pairs (default 0: none). Only where the
-    /// surface cannot pass through itself (a point set's RIMLS surface is a level set): a
-    /// crossing is then the triangulation's fold, which collapsing its edges removes; on an input
-    /// mesh that passes through itself it is the input's, and collapses would eat the part.
+    /// Edge collapses at most when moves leave crossing pairs (default 100). Only for pairs that
+    /// are the triangulation's own folds, which collapsing their edges removes: where the input
+    /// mesh passes through itself or its parts meet (the [`CrossingRegions`] given to
+    /// [`untangle`]) a crossing is the input's, and collapses would eat the part.
     pub max_collapses: usize,
 }
 
@@ -37,7 +45,7 @@ impl Default for UntangleParams {
             max_rounds: 30,
             margin_sigma_p: 0.01,
             max_step_sigma_p: 0.25,
-            max_collapses: 0,
+            max_collapses: 100,
         }
     }
 }
@@ -67,8 +75,10 @@ pub struct UntangleStats {
 /// they are; at most `max_step_sigma_p · σ_p` per round). A move of a vertex marked in `fixed`
 /// (a boundary sample) counts as four times as long, so those move only when nothing else
 /// separates the pair. A round that does not lower the number of crossing pairs is undone and
-/// tried again with moves half as long (never worse than before). Connectivity is unchanged;
-/// faces that cross nothing do not move.
+/// tried again with moves half as long (never worse than before). Faces that cross nothing do
+/// not move. Then, for pairs still crossing that are not the input's own (both faces reaching
+/// into `input_crossings`, where the input's faces cross or its parts meet), edges are
+/// collapsed (at most `params.max_collapses`; the only change of connectivity).
 ///
 /// The moves are local and small where the output merely grazes itself, and they press the
 /// crossing sheet onto the other where the input itself passes through itself (the output then
@@ -78,9 +88,10 @@ pub fn untangle(
     fixed: &[bool],
     sigma_p: f64,
     params: &UntangleParams,
-) -> UntangleStats {
+    input_crossings: Option<&CrossingRegions>,
+) -> (UntangleStats, Vec<Option<u32>>) {
     let start = mesh.positions.clone();
-    let mut m: EditMesh = EditMesh::from_trimesh(mesh, |_| (), SlotPolicy::Reuse);
+    let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
     let triangles = m.live_faces().0;
     let mut stats = UntangleStats::default();
     let mut moved = vec![false; m.vertex_count()];
@@ -125,14 +136,26 @@ pub fn untangle(
             }
         }
     }
+    // A pair is the output's own fold unless both faces lie where the input's faces cross or
+    // its parts meet (there a collapse would eat the part).
+    let own = |m: &Mesh, pair: [u32; 2]| {
+        input_crossings.is_none_or(|r| {
+            !pair
+                .iter()
+                .all(|&f| m.face(f).is_some_and(|t| r.meets(m.corners(t))))
+        })
+    };
+    let mut pairs_after = pairs.len();
     if !pairs.is_empty() && params.max_collapses > 0 {
-        let (collapses, left) = collapse_folds(&mut m, fixed, params.max_collapses);
+        let (collapses, left) = collapse_folds(&mut m, fixed, params.max_collapses, &own);
         stats.collapses = collapses;
-        pairs = left;
-        mesh.triangles = m.live_faces().0;
+        pairs_after = left;
     }
-    mesh.positions = m.positions().to_vec();
-    stats.pairs_after = pairs.len();
+    // Each face's index before, or None for a face a collapse changed.
+    let (positions, triangles, origin) = m.into_parts();
+    mesh.positions = positions;
+    mesh.triangles = triangles;
+    stats.pairs_after = pairs_after;
     stats.vertices_moved = moved.iter().filter(|&&m| m).count();
     stats.max_displacement = mesh
         .positions
@@ -141,27 +164,52 @@ pub fn untangle(
         .map(|(a, b)| a.distance(*b))
         .fold(0.0, f64::max)
         / sigma_p;
-    stats
+    (stats, origin)
 }
 
 /// Edges tried per collapse: the shortest edges of the faces still crossing.
 const COLLAPSE_CANDIDATES: usize = 16;
 
 /// Collapses edges of crossing faces, one at a time: of the `COLLAPSE_CANDIDATES` shortest edges
-/// of the faces still crossing (neither end `fixed`), each collapsed to its midpoint or to
-/// either end, the legal collapse ([`EditMesh::collapse_edge`]) that leaves fewer crossings
-/// among the faces it changes than there were among the faces around the edge and the best
-/// smallest angle among them; until none cross, none helps or `max` collapses are made.
-/// Returns the collapses made and the pairs left (indices into the live faces). Deterministic.
-fn collapse_folds(m: &mut EditMesh, fixed: &[bool], max: usize) -> (usize, Vec<[u32; 2]>) {
+/// of the faces of pairs that `own` keeps (neither end `fixed`), each collapsed to its midpoint
+/// or to either end, the legal collapse ([`EditMesh::collapse_edge`]) that leaves fewer
+/// crossings among the faces it makes than there were among the faces around the edge, and of
+/// those the best smallest angle among the faces it makes; until no pair is left to `own`, none
+/// helps, or `max` collapses are made. The faces are in a BVH whose leaves follow the collapses,
+/// and the crossing pairs are updated around each collapse: a collapse costs O(log F) per face
+/// it tries, not O(F). Returns the collapses made and the crossing pairs left. Deterministic.
+fn collapse_folds(
+    m: &mut Mesh,
+    fixed: &[bool],
+    max: usize,
+    own: &dyn Fn(&Mesh, [u32; 2]) -> bool,
+) -> (usize, usize) {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
+    let (live, slots) = m.live_faces();
+    let mut bvh = Bvh::from_iter(
+        BvhBuildStrategy::Binned,
+        live.iter()
+            .zip(&slots)
+            .map(|(&t, &f)| (f as usize, triangle_aabb(m.corners(t)))),
+    );
+    // Crossing pairs of slots, each as [f, g] with f < g.
+    let mut pairs: Vec<[u32; 2]> = intersecting_pairs(m.positions(), &live)
+        .into_iter()
+        .map(|[f, g]| {
+            let (a, b) = (slots[f as usize], slots[g as usize]);
+            [a.min(b), a.max(b)]
+        })
+        .collect();
+    drop((live, slots));
     let mut made = 0;
-    let mut pairs = intersecting_pairs(m.positions(), &m.live_faces().0);
-    while !pairs.is_empty() && made < max {
-        let triangles = m.live_faces().0;
+    while made < max {
+        let folds: Vec<[u32; 2]> = pairs.iter().copied().filter(|&p| own(m, p)).collect();
+        if folds.is_empty() {
+            break;
+        }
         let mut edges: Vec<(f64, u32, u32)> = Vec::new();
-        for &f in pairs.iter().flatten() {
-            let t = triangles[f as usize];
+        for &f in folds.iter().flatten() {
+            let Some(t) = m.face(f) else { continue };
             for k in 0..3 {
                 let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
                 if !is_fixed(a) && !is_fixed(b) {
@@ -171,42 +219,87 @@ fn collapse_folds(m: &mut EditMesh, fixed: &[bool], max: usize) -> (usize, Vec<[
         }
         edges.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
         edges.dedup_by(|x, y| (x.1, x.2) == (y.1, y.2));
-        // Of the collapses that lower the crossings around the edge, the one leaving the best
-        // smallest angle around the kept vertex (either end kept, at either end or midway).
-        let mut better: Option<(f64, EditMesh)> = None;
+        // The collapses that lower the crossings around their edge, best smallest angle first.
+        let mut better: Vec<(f64, u32, u32, DVec3)> = Vec::new();
         for &(_, a, b) in edges.iter().take(COLLAPSE_CANDIDATES) {
-            let around: Vec<u32> = faces_around_both(m, a, b);
-            let before = crossings_of(m, &around);
+            let around = faces_around_both(m, a, b);
+            let before = crossings_around(m, &bvh, &around);
             let (pa, pb) = (m.position(a), m.position(b));
             for (removed, kept, at) in [(a, b, 0.5 * (pa + pb)), (a, b, pb), (b, a, pa)] {
-                let mut trial = m.clone();
-                if trial.collapse_edge(removed, kept, at, ()).is_err() {
+                let fan: Vec<[u32; 3]> = around
+                    .iter()
+                    .filter_map(|&g| m.face(g))
+                    .filter(|t| !(t.contains(&removed) && t.contains(&kept)))
+                    .map(|t| t.map(|u| if u == removed { kept } else { u }))
+                    .collect();
+                let corners = |t: [u32; 3]| t.map(|u| if u == kept { at } else { m.position(u) });
+                if fan.iter().any(|&t| is_degenerate_triangle(corners(t))) {
                     continue;
                 }
-                let fan = trial.faces_around(kept);
-                if crossings_of(&trial, fan) >= before {
+                let after: usize = fan
+                    .iter()
+                    .map(|&t| {
+                        let p = corners(t);
+                        bvh.intersect_aabb(&triangle_aabb(p))
+                            .filter(|&g| !around.contains(&g))
+                            .filter_map(|g| m.face(g))
+                            .filter(|u| {
+                                !t.iter().any(|v| u.contains(v))
+                                    && triangles_intersect(p, m.corners(*u))
+                            })
+                            .count()
+                    })
+                    .sum();
+                if after >= before {
                     continue;
                 }
                 let angle = fan
                     .iter()
-                    .filter_map(|&f| trial.face(f))
-                    .map(|t| triangle_min_angle_deg(trial.corners(t)))
+                    .map(|&t| triangle_min_angle_deg(corners(t)))
                     .fold(f64::INFINITY, f64::min);
-                if better.as_ref().is_none_or(|(best, _)| angle > *best) {
-                    better = Some((angle, trial));
+                better.push((angle, removed, kept, at));
+            }
+        }
+        better.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+        // The best one the mesh allows (the link condition, protected edges).
+        let Some((around, kept)) = better.iter().find_map(|&(_, removed, kept, at)| {
+            let around = faces_around_both(m, removed, kept);
+            m.collapse_edge(removed, kept, at, None)
+                .ok()
+                .map(|_| (around, kept))
+        }) else {
+            break;
+        };
+        made += 1;
+        // The faces around the edge went or changed: their pairs go, the new fan's come in.
+        pairs.retain(|p| !p.iter().any(|f| around.contains(f)));
+        let fan: Vec<u32> = m.faces_around(kept).to_vec();
+        for &f in &fan {
+            if let Some(t) = m.face(f) {
+                bvh.insert(triangle_aabb(m.corners(t)), f);
+            }
+        }
+        for &f in &fan {
+            let Some(t) = m.face(f) else { continue };
+            let p = m.corners(t);
+            for g in bvh.intersect_aabb(&triangle_aabb(p)) {
+                if g == f || (fan.contains(&g) && g < f) {
+                    continue;
+                }
+                let Some(u) = m.face(g) else { continue };
+                if !t.iter().any(|v| u.contains(v)) && triangles_intersect(p, m.corners(u)) {
+                    pairs.push([f.min(g), f.max(g)]);
                 }
             }
         }
-        let Some((_, trial)) = better else { break };
-        *m = trial;
-        pairs = intersecting_pairs(m.positions(), &m.live_faces().0);
-        made += 1;
+        pairs.sort_unstable();
+        pairs.dedup();
     }
-    (made, pairs)
+    (made, pairs.len())
 }
 
 /// The faces (slots) around `a` or `b`, each once.
-fn faces_around_both(m: &EditMesh, a: u32, b: u32) -> Vec<u32> {
+fn faces_around_both(m: &Mesh, a: u32, b: u32) -> Vec<u32> {
     let mut faces: Vec<u32> = m.faces_around(a).to_vec();
     faces.extend_from_slice(m.faces_around(b));
     faces.sort_unstable();
@@ -215,22 +308,18 @@ fn faces_around_both(m: &EditMesh, a: u32, b: u32) -> Vec<u32> {
 }
 
 /// The crossing pairs of live faces with at least one face in `faces` (slots), as
-/// [`intersecting_pairs`] counts them: faces sharing a vertex and degenerate faces left out.
-/// A linear pass over the faces per face of `faces` (a handful).
-fn crossings_of(m: &EditMesh, faces: &[u32]) -> usize {
+/// [`intersecting_pairs`] counts them (faces sharing a vertex and degenerate faces left out),
+/// found through `bvh` (leaves: slots at their current boxes).
+fn crossings_around(m: &Mesh, bvh: &Bvh, faces: &[u32]) -> usize {
     let p = m.positions();
-    let bbox = |t: [u32; 3]| {
-        let c = t.map(|v| p[v as usize]);
-        (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]))
-    };
     let mut count = 0;
     for &f in faces {
         let Some(t) = m.face(f) else { continue };
         if is_degenerate_face(p, t) {
             continue;
         }
-        let (lo, hi) = bbox(t);
-        for g in 0..m.slots() as u32 {
+        let c = m.corners(t);
+        for g in bvh.intersect_aabb(&triangle_aabb(c)) {
             // A pair inside `faces` is counted once, from its smaller slot.
             if g == f || (g < f && faces.contains(&g)) {
                 continue;
@@ -239,11 +328,7 @@ fn crossings_of(m: &EditMesh, faces: &[u32]) -> usize {
             if u.iter().any(|v| t.contains(v)) || is_degenerate_face(p, u) {
                 continue;
             }
-            let (ulo, uhi) = bbox(u);
-            if ulo.cmpgt(hi).any() || uhi.cmplt(lo).any() {
-                continue;
-            }
-            if triangles_intersect(t.map(|v| p[v as usize]), u.map(|v| p[v as usize])) {
+            if triangles_intersect(c, m.corners(u)) {
                 count += 1;
             }
         }
@@ -255,7 +340,7 @@ fn crossings_of(m: &EditMesh, faces: &[u32]) -> usize {
 /// order against the positions as moved so far (a pair an earlier move already separated is
 /// skipped), so one move of a vertex poking through a sheet resolves all its pairs.
 fn round_moves(
-    m: &EditMesh,
+    m: &Mesh,
     triangles: &[[u32; 3]],
     pairs: &[[u32; 2]],
     fixed: &[bool],
@@ -345,7 +430,7 @@ mod tests {
         m.positions[poke].z = -0.3;
         assert!(!intersecting_pairs(&m.positions, &m.triangles).is_empty());
         let fixed = vec![false; m.positions.len()];
-        let s = untangle(&mut m, &fixed, 1.0, &UntangleParams::default());
+        let (s, _) = untangle(&mut m, &fixed, 1.0, &UntangleParams::default(), None);
         assert!(s.pairs_before > 0 && s.pairs_after == 0, "{s:?}");
         assert!(
             check_invariants(&m).is_empty(),
@@ -360,14 +445,14 @@ mod tests {
         m2.positions[poke].z = -0.3;
         let mut fixed = vec![false; m2.positions.len()];
         fixed[poke] = true;
-        let s = untangle(&mut m2, &fixed, 1.0, &UntangleParams::default());
+        let (s, _) = untangle(&mut m2, &fixed, 1.0, &UntangleParams::default(), None);
         assert_eq!(s.pairs_after, 0, "{s:?}");
         assert_eq!(m2.positions[poke].z, -0.3);
         // A mesh without crossings is unchanged.
         let a = grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0));
         let mut clean = a.clone();
         let none = vec![false; clean.positions.len()];
-        let s = untangle(&mut clean, &none, 1.0, &UntangleParams::default());
+        let (s, _) = untangle(&mut clean, &none, 1.0, &UntangleParams::default(), None);
         assert_eq!((s.pairs_before, s.rounds, s.vertices_moved), (0, 0, 0));
         assert_eq!(clean.positions, a.positions);
     }
@@ -385,7 +470,7 @@ mod tests {
         m.triangles
             .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
         let fixed = vec![false; m.positions.len()];
-        let s = untangle(&mut m, &fixed, 1.0, &UntangleParams::default());
+        let (s, _) = untangle(&mut m, &fixed, 1.0, &UntangleParams::default(), None);
         assert!(s.pairs_after <= s.pairs_before, "{s:?}");
         assert_eq!(
             s.pairs_after,
@@ -410,7 +495,7 @@ mod tests {
             ..Default::default()
         };
         let mut without = m.clone();
-        let s = untangle(
+        let (s, _) = untangle(
             &mut without,
             &fixed,
             1.0,
@@ -418,9 +503,22 @@ mod tests {
                 max_collapses: 0,
                 ..only_collapses
             },
+            None,
         );
         assert_eq!((s.pairs_after, s.collapses), (before, 0), "{s:?}");
-        let s = untangle(&mut m, &fixed, 1.0, &only_collapses);
+        // Where the input's own faces cross (here: a region over the whole grid), the crossing
+        // is the input's, and no collapse eats it.
+        let mut kept = m.clone();
+        let everywhere = CrossingRegions::new(
+            &m.positions,
+            &m.triangles,
+            &[],
+            &(0..m.triangles.len() as u32).collect::<Vec<_>>(),
+            0.1,
+        );
+        let (s, _) = untangle(&mut kept, &fixed, 1.0, &only_collapses, Some(&everywhere));
+        assert_eq!((s.pairs_after, s.collapses), (before, 0), "{s:?}");
+        let (s, _) = untangle(&mut m, &fixed, 1.0, &only_collapses, None);
         assert!(s.collapses >= 1 && s.pairs_after == 0, "{s:?}");
         assert!(intersecting_pairs(&m.positions, &m.triangles).is_empty());
         m.remove_unreferenced_vertices();
