@@ -267,18 +267,6 @@ pub struct FeatureStats {
     pub crease_distance: Option<crate::check::CreaseDistance>,
 }
 
-/// The output's crossing face pairs when the pipeline ends (non-adjacent faces that share a
-/// point, as [`intersecting_pairs`] finds them), and how many of them lie where the input's own
-/// faces cross or its parts meet at a non-manifold edge (both faces reach into a
-/// [`CrossingRegions`] region, loosened by sigma_p).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
-pub struct OutputCrossings {
-    /// Crossing pairs.
-    pub pairs: usize,
-    /// Of those, the pairs where the input's own faces cross or its parts meet.
-    pub where_input_crosses: usize,
-}
-
 /// The output of [`remesh`].
 #[derive(Debug, Clone)]
 pub struct RemeshOutput {
@@ -325,9 +313,13 @@ pub struct RemeshOutput {
     pub untangle: UntangleStats,
     /// What the mending of faces of no area did.
     pub degenerate: crate::triangulate::degenerate::DegenerateStats,
-    /// The output's crossing face pairs at the end, and how many lie where the input's own
-    /// faces cross or its parts meet.
-    pub output_crossings: OutputCrossings,
+    /// The pairs of `input_normalized`'s faces that cross (looked for only when the input
+    /// passes through itself), as [`intersecting_pairs`] gives them.
+    pub input_crossing_pairs: Vec<[u32; 2]>,
+    /// The faces of `input_normalized` where closed parts meet at a non-manifold edge (the
+    /// junction of `mesh::sheets::Sheets`). With `input_crossing_pairs`, what
+    /// [`CrossingRegions`] are built from: where the output's crossings are the input's own.
+    pub junction_faces: Vec<u32>,
     /// What the least-squares fit to the input did (`None` when it was off).
     pub fit: Option<crate::triangulate::fit::FitStats>,
     /// How each face of `mesh` came in.
@@ -987,22 +979,6 @@ pub fn remesh(
         if stray.shells > 0 {
             mesh_normalized.remove_unreferenced_vertices();
         }
-        // The crossings left, and how many are the input's own.
-        let output_crossings = if untangle_stats.pairs_after > 0 {
-            let pairs = intersecting_pairs(&mesh_normalized.positions, &mesh_normalized.triangles);
-            OutputCrossings {
-                pairs: pairs.len(),
-                where_input_crosses: input_crossings.as_ref().map_or(0, |r| {
-                    r.count_inside(
-                        &mesh_normalized.positions,
-                        &mesh_normalized.triangles,
-                        &pairs,
-                    )
-                }),
-            }
-        } else {
-            OutputCrossings::default()
-        };
         // The output follows the input's orientation: its closed parts are turned outward.
         let output_orientation = orient_consistently(&mut mesh_normalized, true);
         timer.lap("untangle");
@@ -1057,7 +1033,8 @@ pub fn remesh(
                 optimize: optimize_stats,
                 untangle: untangle_stats,
                 degenerate: degenerate_stats,
-                output_crossings,
+                input_crossing_pairs: input_crossing_pairs.clone(),
+                junction_faces: junction_faces.clone(),
                 fit: fit_stats,
                 face_sources,
                 dropped_samples,

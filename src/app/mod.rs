@@ -12,7 +12,10 @@ pub use memory::{estimate_remesh_bytes, parse_bytes, physical_memory};
 pub use options::RemeshOptions;
 pub use simplify::{run_simplify, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary};
 
+use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::timing::Clock;
+use crate::RemeshOutput;
+use glam::DVec3;
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
@@ -233,10 +236,8 @@ fn remesh_read(
     // The invariants, crossings and topology are those `remesh quality` finds in the file: the
     // mesh as stored, welded as a reader welds it, in its own bbox-100 frame (crossings are
     // decided exactly, so a face pair that rounding makes touch is seen here as in the file).
-    let mut report = QualityReport::new(
-        &as_quality_reads(as_written(mesh_out, format), &job.output)
-            .unwrap_or_else(|| checked.clone()),
-    );
+    let file = as_quality_reads(as_written(mesh_out, format), &job.output);
+    let mut report = QualityReport::new(file.as_ref().map_or(checked, |(m, _)| m));
     // The input column describes the input as read: its faces before they were oriented
     // (orientation changes none of the counts the topology is compared by).
     report.set_input(&TriMesh::new(
@@ -323,13 +324,18 @@ fn remesh_read(
             serde_json::to_value(out.degenerate).unwrap_or_default(),
         );
     }
+    let crossing = report.self_intersections.pairs;
+    // The file's crossing pairs, and of them those where the input's own faces cross or its
+    // closed parts meet.
+    let theirs = match (&file, crossing) {
+        (Some((m, frame)), 1..) => crossings_of_the_input(&out, m, frame, up).0,
+        _ => 0,
+    };
     extra.insert(
         "output_crossings".into(),
-        serde_json::to_value(out.output_crossings).unwrap_or_default(),
+        serde_json::json!({"pairs": crossing, "where_input_crosses": theirs}),
     );
-    let crossing = report.self_intersections.pairs;
     if crossing > 0 {
-        let theirs = out.output_crossings.where_input_crosses.min(crossing);
         report.notes.push(if theirs == crossing {
             format!(
                 "all {crossing} crossing pairs of the output lie where the input's own faces \
@@ -864,10 +870,67 @@ fn output_format(output: &Path, format: Option<MeshFormat>) -> Result<MeshFormat
 /// reader cleans it ([`check_and_clean`]: identical positions welded, unreferenced vertices
 /// dropped), subnormal coordinates scaled up, in its own bbox-100 frame ([`own_frame`]).
 /// `None` when the file would be refused.
-fn as_quality_reads(mesh: TriMesh, path: &Path) -> Option<TriMesh> {
+/// With it, the map from model units (before the subnormal scaling) into that frame.
+fn as_quality_reads(mesh: TriMesh, path: &Path) -> Option<(TriMesh, FileFrame)> {
     let (mesh, _) = check_and_clean(path, mesh).ok()?;
-    let (mesh, _) = into_normal_range(mesh);
-    Some(own_frame(&mesh, path).ok()?.apply_mesh(&mesh))
+    let (mesh, up) = into_normal_range(mesh);
+    let frame = own_frame(&mesh, path).ok()?;
+    Some((frame.apply_mesh(&mesh), FileFrame { frame, up }))
+}
+
+/// The frame [`as_quality_reads`] puts a file's mesh in: scaled by `2^up`, then `frame`.
+#[derive(Debug, Clone, Copy)]
+struct FileFrame {
+    frame: Normalization,
+    up: i32,
+}
+
+impl FileFrame {
+    /// A point in model units (before the run's own subnormal scaling by `2^run_up`) in this
+    /// frame; `None` when the two scalings differ by more than `f64` holds exactly here.
+    fn map(&self, run_up: i32) -> Option<impl Fn(DVec3) -> DVec3 + '_> {
+        let k = self.up - run_up;
+        (k.abs() < 1000).then_some(move |p: DVec3| self.frame.apply(p * 2f64.powi(k)))
+    }
+}
+
+/// How many of the crossing pairs of `checked` (the written mesh as [`as_quality_reads`] sees
+/// it, in `file`'s frame) lie where the input's own faces cross or its closed parts meet (both
+/// faces reach into the input's [`CrossingRegions`], loosened by sigma_p, mapped into that
+/// frame), and the pairs in all.
+fn crossings_of_the_input(
+    out: &RemeshOutput,
+    checked: &TriMesh,
+    file: &FileFrame,
+    run_up: i32,
+) -> (usize, usize) {
+    let pairs = intersecting_pairs(&checked.positions, &checked.triangles);
+    if out.input_crossing_pairs.is_empty() && out.junction_faces.is_empty() {
+        return (0, pairs.len());
+    }
+    let Some(to_file) = file.map(run_up) else {
+        return (0, pairs.len());
+    };
+    let input = &out.input_normalized;
+    let positions: Vec<DVec3> = input
+        .positions
+        .iter()
+        .map(|&p| to_file(out.normalization.invert(p)))
+        .collect();
+    // sigma_p in the file's frame: the two frames differ by a scale.
+    let unit = to_file(out.normalization.invert(DVec3::X))
+        - to_file(out.normalization.invert(DVec3::ZERO));
+    let regions = CrossingRegions::new(
+        &positions,
+        &input.triangles,
+        &out.input_crossing_pairs,
+        &out.junction_faces,
+        out.sigma_p * unit.length(),
+    );
+    (
+        regions.count_inside(&checked.positions, &checked.triangles, &pairs),
+        pairs.len(),
+    )
 }
 
 /// The bbox-100 frame of `mesh`'s own bounding box, the frame [`run_quality`] measures a mesh
