@@ -1,6 +1,7 @@
 //! Issue 35: real files in bounded time, with a valid mesh out. Each input is made here (the
 //! shapes of the corpus files that hung or crossed: a tetrahedron, two tetrahedra joined at a
-//! face (their shared face a wall inside the solid), two boxes welded on one edge, a duplicated face, a double-sided export, a two-part scene, a zero-area first face).
+//! face (their shared face a wall inside the solid), a wedge sharper than the angle bounds (the
+//! angle block's corners), two boxes welded on one edge, a duplicated face, a double-sided export, a two-part scene, a zero-area first face).
 //! Every run goes through `remesh_mesh` (the command line's own path from the mesh read on) on a
 //! thread with a hang guard, and the finishing stage's work is checked by counting its attempts
 //! against its budget, not by timing.
@@ -145,6 +146,45 @@ fn two_tetrahedra_joined_at_a_face_end_within_the_budget() {
     assert_eq!(report.topology.genus, Some(0));
     assert_eq!(report.topology.components, 1);
     assert_bounded_work(&report);
+}
+
+#[test]
+fn a_wedge_sharper_than_the_bounds_ends_within_the_budget() {
+    // The corpus's angle_block.STL spent 148 s in the last pass (863 mends) trying to bring the
+    // faces at its sharp corners into [35°, 100°]. Here: a prism whose profile has a 15° apex, so
+    // the apex edge is a crease with a 15° dihedral angle and the end caps' apex corners are
+    // 15°: the faces there can never reach 35° while the creases are kept.
+    let half = 7.5f64.to_radians().tan();
+    let profile = [(0.0, 0.0), (4.0, -4.0 * half), (4.0, 4.0 * half)];
+    let mut positions = Vec::new();
+    for z in [0.0, 1.0] {
+        for (x, y) in profile {
+            positions.push(DVec3::new(x, y, z));
+        }
+    }
+    let wedge = TriMesh::new(
+        positions,
+        vec![
+            [0, 2, 1],
+            [3, 4, 5],
+            [0, 1, 4],
+            [0, 4, 3],
+            [1, 2, 5],
+            [1, 5, 4],
+            [2, 0, 3],
+            [2, 3, 5],
+        ],
+    );
+    for seed in 1..=2 {
+        let (_, report) = remesh_guarded(wedge.clone(), 2000, seed);
+        assert_valid(&report);
+        assert!(report.topology.is_closed_manifold());
+        assert_eq!(report.topology.genus, Some(0));
+        assert_bounded_work(&report);
+        // The faces left are counted, those at the sharp creases among them.
+        let left = &report.extra["optimize"]["mend"]["left"];
+        assert!(left["at_creases"].as_u64().unwrap() > 0, "{left:?}");
+    }
 }
 
 #[test]
