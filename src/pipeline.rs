@@ -487,7 +487,8 @@ pub fn remesh(
         None => Vec::new(),
     };
     // Where parts of the input meet at non-manifold edges (the triangulation keeps them apart).
-    let junction_faces = Sheets::new(&normalized).junction_faces(&normalized);
+    let sheets = Sheets::new(&normalized);
+    let junction_faces = sheets.junction_faces(&normalized);
     timer.lap("normalize");
 
     on_stage("candidates");
@@ -855,7 +856,7 @@ pub fn remesh(
                 // The sample spacing is about sigma_p (SAMPLES_PER_SIGMA2 samples per
                 // sigma_p^2 of area; on boundary curves one per sigma_p or closer).
                 let spacing = sigma_p / SAMPLES_PER_SIGMA2.sqrt();
-                triangulate_restricted(&set, &surface, spacing, &params.triangulate, &rd)
+                triangulate_restricted(&set, &surface, &sheets, spacing, &params.triangulate, &rd)
             }
         };
         let (faces, face_sources, mut assembly, restricted_delaunay) = match restricted {

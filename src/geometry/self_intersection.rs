@@ -181,13 +181,17 @@ impl CrossingRegions {
         triangles: &[[u32; 3]],
         pairs: &[[u32; 2]],
     ) -> usize {
+        let corners = |f: u32| triangles[f as usize].map(|v| positions[v as usize]);
         pairs
             .iter()
-            .filter(|p| {
-                p.iter()
-                    .all(|&f| self.meets(triangles[f as usize].map(|v| positions[v as usize])))
-            })
+            .filter(|&&[f, g]| self.holds(corners(f), corners(g)))
             .count()
+    }
+
+    /// Whether the crossing pair of triangles with corners `f` and `g` lies in a region: both
+    /// reach into one.
+    pub fn holds(&self, f: [DVec3; 3], g: [DVec3; 3]) -> bool {
+        self.meets(f) && self.meets(g)
     }
 
     /// Whether there is no region.

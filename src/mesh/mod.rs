@@ -4,6 +4,7 @@
 //! orientation of an input ([`orient_consistently`]).
 
 pub mod bisect;
+pub(crate) mod crossing_guard;
 pub mod edit;
 mod orient;
 pub mod sheets;

@@ -19,6 +19,7 @@ pub use refine::RefineParams;
 pub use restricted_delaunay::{RestrictedDelaunayParams, RestrictedDelaunayStats};
 pub use tangent_delaunay::{vote_triangles, SampleSet, TangentDelaunayParams, VotedTriangle};
 
+use crate::mesh::sheets::Sheets;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
@@ -68,10 +69,11 @@ pub fn triangulate(
 /// and cleans it up as [`triangulate`] does. `spacing`: the sample spacing (units of the
 /// positions). Returns also what the restricted Delaunay step did; `None` when its refinement of
 /// the input would be too large (see [`RestrictedDelaunayParams::max_added_per_sample`]) or it
-/// gives no triangle.
+/// gives no triangle. `sheets`: those of `surface`'s mesh (`Sheets::new`, made once per input).
 pub fn triangulate_restricted(
     set: &SampleSet,
     surface: &MeshSurface,
+    sheets: &Sheets,
     spacing: f64,
     params: &TriangulateParams,
     rd: &RestrictedDelaunayParams,
@@ -79,7 +81,7 @@ pub fn triangulate_restricted(
     let mut rd_stats = None;
     let (faces, sources, stats) = on_distinct(set, |s| {
         let Some((voted, st)) =
-            restricted_delaunay::restricted_delaunay(surface, s.positions, spacing, rd)
+            restricted_delaunay::restricted_delaunay(surface, sheets, s.positions, spacing, rd)
         else {
             return (Vec::new(), Vec::new(), AssemblyStats::default());
         };

@@ -67,11 +67,14 @@ pub struct RestrictedDelaunayStats {
 
 /// The dual triangles of the samples' restricted Voronoi cells on `surface`'s mesh, as
 /// candidates for [`assemble`](super::assemble): each with 3 votes, oriented like the input,
-/// the ones met at more refined faces first. `positions`: the samples (units of the mesh, on or
-/// near the surface); `spacing`: the sample spacing (same units). `None` when the refinement
+/// the ones met at more refined faces first. `sheets`: those of `surface`'s mesh (closed parts
+/// that meet at a non-manifold edge are refined apart). `positions`: the samples (units of the
+/// mesh, on or near the surface); `spacing`: the sample spacing (same units). `None` when the
+/// refinement
 /// would add more than `params.max_added_per_sample` vertices per sample.
 pub fn restricted_delaunay(
     surface: &MeshSurface,
+    sheets: &Sheets,
     positions: &[DVec3],
     spacing: f64,
     params: &RestrictedDelaunayParams,
@@ -82,7 +85,6 @@ pub fn restricted_delaunay(
     // Parts that meet at non-manifold edges are refined apart (each sheet with its
     // own copy of the vertices it shares), so that no cell grows from one onto the other: each
     // part's triangles join only its own samples.
-    let sheets = Sheets::new(surface.mesh());
     let split = sheets.split(surface.mesh());
     let sheet = &sheets.part;
     let refined = bisect_to_length(
@@ -338,6 +340,7 @@ mod tests {
             triangulate_restricted(
                 &set,
                 surface,
+                &Sheets::new(surface.mesh()),
                 1.0,
                 &params,
                 &RestrictedDelaunayParams::default(),
@@ -378,6 +381,7 @@ mod tests {
     fn samples_on_a_sphere_give_a_closed_sphere() {
         let mesh = test_meshes::uv_sphere(10.0, 24, 48);
         let surface = MeshSurface::new(&mesh).unwrap();
+        let sheets = Sheets::new(&mesh);
         let positions: Vec<DVec3> = test_meshes::fibonacci_sphere(300)
             .into_iter()
             .map(|u| surface.closest_point(10.0 * u).unwrap().position)
@@ -390,13 +394,15 @@ mod tests {
             boundary_edges: &[],
         };
         let (voted, stats) =
-            restricted_delaunay(&surface, &positions, spacing, &Default::default()).unwrap();
+            restricted_delaunay(&surface, &sheets, &positions, spacing, &Default::default())
+                .unwrap();
         assert_eq!(stats.empty_cells, 0);
         // On a sphere the dual alone is the whole triangulation: 2V - 4 faces.
         assert_eq!(voted.len(), 2 * 300 - 4);
         let (faces, _, _, _) = triangulate_restricted(
             &set,
             &surface,
+            &sheets,
             spacing,
             &TriangulateParams::default(),
             &Default::default(),

@@ -9,13 +9,12 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
-
-use crate::geometry::self_intersection::{intersecting_pairs, triangle_aabb, CrossingRegions};
+use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::geometry::triangle::{
     is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,
 };
 use crate::geometry::triangle_intersection::triangles_intersect;
+use crate::mesh::crossing_guard::CrossingGuard;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 
@@ -138,11 +137,10 @@ pub fn untangle(
     }
     // A pair is the output's own fold unless both faces lie where the input's faces cross or
     // its parts meet (there a collapse would eat the part).
-    let own = |m: &Mesh, pair: [u32; 2]| {
-        input_crossings.is_none_or(|r| {
-            !pair
-                .iter()
-                .all(|&f| m.face(f).is_some_and(|t| r.meets(m.corners(t))))
+    let own = |m: &Mesh, [f, g]: [u32; 2]| {
+        input_crossings.is_none_or(|r| match (m.face(f), m.face(g)) {
+            (Some(t), Some(u)) => !r.holds(m.corners(t), m.corners(u)),
+            _ => true,
         })
     };
     let mut pairs_after = pairs.len();
@@ -175,7 +173,8 @@ const COLLAPSE_CANDIDATES: usize = 16;
 /// or to either end, the legal collapse ([`EditMesh::collapse_edge`]) that leaves fewer
 /// crossings among the faces it makes than there were among the faces around the edge, and of
 /// those the best smallest angle among the faces it makes; until no pair is left to `own`, none
-/// helps, or `max` collapses are made. The faces are in a BVH whose leaves follow the collapses,
+/// helps, or `max` collapses are made. The faces are in a [`CrossingGuard`] (a BVH whose leaves
+/// follow the collapses),
 /// and the crossing pairs are updated around each collapse: a collapse costs O(log F) per face
 /// it tries, not O(F). Returns the collapses made and the crossing pairs left. Deterministic.
 fn collapse_folds(
@@ -186,12 +185,7 @@ fn collapse_folds(
 ) -> (usize, usize) {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
     let (live, slots) = m.live_faces();
-    let mut bvh = Bvh::from_iter(
-        BvhBuildStrategy::Binned,
-        live.iter()
-            .zip(&slots)
-            .map(|(&t, &f)| (f as usize, triangle_aabb(m.corners(t)))),
-    );
+    let mut guard = CrossingGuard::new(m);
     // Crossing pairs of slots, each as [f, g] with f < g.
     let mut pairs: Vec<[u32; 2]> = intersecting_pairs(m.positions(), &live)
         .into_iter()
@@ -223,7 +217,7 @@ fn collapse_folds(
         let mut better: Vec<(f64, u32, u32, DVec3)> = Vec::new();
         for &(_, a, b) in edges.iter().take(COLLAPSE_CANDIDATES) {
             let around = faces_around_both(m, a, b);
-            let before = crossings_around(m, &bvh, &around);
+            let before = crossings_around(m, &guard, &around);
             let (pa, pb) = (m.position(a), m.position(b));
             for (removed, kept, at) in [(a, b, 0.5 * (pa + pb)), (a, b, pb), (b, a, pa)] {
                 let fan: Vec<[u32; 3]> = around
@@ -238,17 +232,7 @@ fn collapse_folds(
                 }
                 let after: usize = fan
                     .iter()
-                    .map(|&t| {
-                        let p = corners(t);
-                        bvh.intersect_aabb(&triangle_aabb(p))
-                            .filter(|&g| !around.contains(&g))
-                            .filter_map(|g| m.face(g))
-                            .filter(|u| {
-                                !t.iter().any(|v| u.contains(v))
-                                    && triangles_intersect(p, m.corners(*u))
-                            })
-                            .count()
-                    })
+                    .map(|&t| guard.count_crossed(m, t, corners(t), &around))
                     .sum();
                 if after >= before {
                     continue;
@@ -274,23 +258,16 @@ fn collapse_folds(
         // The faces around the edge went or changed: their pairs go, the new fan's come in.
         pairs.retain(|p| !p.iter().any(|f| around.contains(f)));
         let fan: Vec<u32> = m.faces_around(kept).to_vec();
-        for &f in &fan {
-            if let Some(t) = m.face(f) {
-                bvh.insert(triangle_aabb(m.corners(t)), f);
-            }
-        }
+        guard.changed(m, &fan);
         for &f in &fan {
             let Some(t) = m.face(f) else { continue };
-            let p = m.corners(t);
-            for g in bvh.intersect_aabb(&triangle_aabb(p)) {
-                if g == f || (fan.contains(&g) && g < f) {
-                    continue;
-                }
-                let Some(u) = m.face(g) else { continue };
-                if !t.iter().any(|v| u.contains(v)) && triangles_intersect(p, m.corners(u)) {
+            guard.visit_crossed(m, t, m.corners(t), &[], |g| {
+                // A pair inside the fan once, from its larger slot.
+                if !(fan.contains(&g) && g < f) {
                     pairs.push([f.min(g), f.max(g)]);
                 }
-            }
+                false
+            });
         }
         pairs.sort_unstable();
         pairs.dedup();
@@ -309,8 +286,8 @@ fn faces_around_both(m: &Mesh, a: u32, b: u32) -> Vec<u32> {
 
 /// The crossing pairs of live faces with at least one face in `faces` (slots), as
 /// [`intersecting_pairs`] counts them (faces sharing a vertex and degenerate faces left out),
-/// found through `bvh` (leaves: slots at their current boxes).
-fn crossings_around(m: &Mesh, bvh: &Bvh, faces: &[u32]) -> usize {
+/// found through `guard`.
+fn crossings_around(m: &Mesh, guard: &CrossingGuard, faces: &[u32]) -> usize {
     let p = m.positions();
     let mut count = 0;
     for &f in faces {
@@ -318,20 +295,14 @@ fn crossings_around(m: &Mesh, bvh: &Bvh, faces: &[u32]) -> usize {
         if is_degenerate_face(p, t) {
             continue;
         }
-        let c = m.corners(t);
-        for g in bvh.intersect_aabb(&triangle_aabb(c)) {
+        guard.visit_crossed(m, t, m.corners(t), &[], |g| {
             // A pair inside `faces` is counted once, from its smaller slot.
-            if g == f || (g < f && faces.contains(&g)) {
-                continue;
-            }
-            let Some(u) = m.face(g) else { continue };
-            if u.iter().any(|v| t.contains(v)) || is_degenerate_face(p, u) {
-                continue;
-            }
-            if triangles_intersect(c, m.corners(u)) {
+            let twice = g < f && faces.contains(&g);
+            if !twice && m.face(g).is_some_and(|u| !is_degenerate_face(p, u)) {
                 count += 1;
             }
-        }
+            false
+        });
     }
     count
 }

@@ -3,11 +3,10 @@
 //! each guarded against leaving the input surface and against making a crossing.
 
 use glam::DVec3;
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 
 use super::*;
-use crate::geometry::self_intersection::{intersecting_pairs, triangle_aabb, CrossingRegions};
-use crate::geometry::triangle_intersection::triangles_intersect;
+use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
+use crate::mesh::crossing_guard::CrossingGuard;
 use crate::surface::feature_lines::FeatureLines;
 use crate::triangulate::flip::max_min_candidate;
 
@@ -699,53 +698,6 @@ fn try_split<S: SurfaceQuery + ?Sized>(
     let value = worst_angle(m, new, params);
     m.pop_vertex();
     ok.then_some(((old, value), q))
-}
-
-/// Finds the faces a new face would cross: a BVH over the faces' slots whose leaves are updated
-/// as faces are made or moved ([`CrossingGuard::changed`]), so each query costs O(log F) plus the
-/// faces whose boxes overlap, however many operations came before. (A slot whose face was removed
-/// keeps its leaf; its face is skipped when the query meets it.)
-struct CrossingGuard {
-    bvh: Bvh,
-}
-
-impl CrossingGuard {
-    fn new(m: &Mesh) -> Self {
-        let (live, slots) = m.live_faces();
-        let boxes = live
-            .iter()
-            .zip(&slots)
-            .map(|(&t, &f)| (f as usize, triangle_aabb(m.corners(t))));
-        CrossingGuard {
-            bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
-        }
-    }
-
-    /// Records that the faces in `slots` were made or moved: their leaves take their new boxes.
-    fn changed(&mut self, m: &Mesh, slots: &[u32]) {
-        for &f in slots {
-            if let Some(t) = m.face(f) {
-                self.bvh.insert(triangle_aabb(m.corners(t)), f);
-            }
-        }
-    }
-
-    /// Whether one of `faces` (at the mesh's current positions) shares a point with a live face
-    /// of `m` that is not in `replaced` and has no vertex in common with it.
-    fn crosses(&self, m: &Mesh, faces: &[[u32; 3]], replaced: &[u32]) -> bool {
-        faces.iter().any(|&t| {
-            let p = m.corners(t);
-            self.bvh.intersect_aabb(&triangle_aabb(p)).any(|g| {
-                if replaced.contains(&g) {
-                    return false;
-                }
-                let Some(u) = m.face(g) else {
-                    return false;
-                };
-                !t.iter().any(|v| u.contains(v)) && triangles_intersect(p, m.corners(u))
-            })
-        })
-    }
 }
 
 #[cfg(test)]

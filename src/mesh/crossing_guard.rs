@@ -1,0 +1,92 @@
+//! The faces a new or moved face of an edit mesh would cross: a BVH over the faces' slots whose
+//! leaves are updated as faces are made or moved ([`CrossingGuard::changed`]), so each query
+//! costs O(log F) plus the faces whose boxes overlap, however many operations came before. (A
+//! slot whose face was removed keeps its leaf; its face is skipped when a query meets it.) The
+//! guard of the finishing stage's operators and of untangle's fold collapses.
+
+use glam::DVec3;
+use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+
+use super::edit::EditMesh;
+use crate::geometry::self_intersection::triangle_aabb;
+use crate::geometry::triangle_intersection::triangles_intersect;
+
+/// A BVH over the live faces of an edit mesh, by slot (see the module).
+pub(crate) struct CrossingGuard {
+    bvh: Bvh,
+}
+
+impl CrossingGuard {
+    /// The guard of `m`'s live faces at their current positions.
+    pub(crate) fn new<L: Copy>(m: &EditMesh<L>) -> Self {
+        let (live, slots) = m.live_faces();
+        let boxes = live
+            .iter()
+            .zip(&slots)
+            .map(|(&t, &f)| (f as usize, triangle_aabb(m.corners(t))));
+        CrossingGuard {
+            bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
+        }
+    }
+
+    /// Records that the faces in `slots` were made or moved: their leaves take their new boxes.
+    pub(crate) fn changed<L: Copy>(&mut self, m: &EditMesh<L>, slots: &[u32]) {
+        for &f in slots {
+            if let Some(t) = m.face(f) {
+                self.bvh.insert(triangle_aabb(m.corners(t)), f);
+            }
+        }
+    }
+
+    /// Calls `visit` with each live face (slot) of `m` that the face `t` with corners `p` (its
+    /// vertices' positions, or where an operation would put them) shares a point with, leaving
+    /// out the slots in `replaced` and the faces with a vertex of `t` (exact test), until
+    /// `visit` returns true; whether it did.
+    pub(crate) fn visit_crossed<L: Copy>(
+        &self,
+        m: &EditMesh<L>,
+        t: [u32; 3],
+        p: [DVec3; 3],
+        replaced: &[u32],
+        mut visit: impl FnMut(u32) -> bool,
+    ) -> bool {
+        self.bvh.intersect_aabb(&triangle_aabb(p)).any(|g| {
+            if replaced.contains(&g) {
+                return false;
+            }
+            let Some(u) = m.face(g) else {
+                return false;
+            };
+            !t.iter().any(|v| u.contains(v)) && triangles_intersect(p, m.corners(u)) && visit(g)
+        })
+    }
+
+    /// How many live faces the face `t` with corners `p` crosses (as [`Self::visit_crossed`]).
+    pub(crate) fn count_crossed<L: Copy>(
+        &self,
+        m: &EditMesh<L>,
+        t: [u32; 3],
+        p: [DVec3; 3],
+        replaced: &[u32],
+    ) -> usize {
+        let mut n = 0;
+        self.visit_crossed(m, t, p, replaced, |_| {
+            n += 1;
+            false
+        });
+        n
+    }
+
+    /// Whether one of `faces` (at the mesh's current positions) shares a point with a live face
+    /// of `m` that is not in `replaced` and has no vertex in common with it.
+    pub(crate) fn crosses<L: Copy>(
+        &self,
+        m: &EditMesh<L>,
+        faces: &[[u32; 3]],
+        replaced: &[u32],
+    ) -> bool {
+        faces
+            .iter()
+            .any(|&t| self.visit_crossed(m, t, m.corners(t), replaced, |_| true))
+    }
+}
