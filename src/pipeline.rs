@@ -941,11 +941,16 @@ pub fn remesh(
                 params.optimize.as_ref().map(OptimizeParams::angle_bounds),
             )
         });
+        // Faces that would touch once written in model units are separated too.
+        let untangle_params = UntangleParams {
+            near: params.untangle.near.max(normalization.written_rounding()),
+            ..params.untangle
+        };
         let (untangle_stats, origin) = untangle(
             &mut mesh_normalized,
             &fixed,
             sigma_p,
-            &params.untangle,
+            &untangle_params,
             input_crossings.as_ref(),
         );
         if untangle_stats.collapses > 0 {

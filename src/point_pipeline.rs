@@ -407,8 +407,10 @@ pub fn remesh_points(
     // of its two sides see each other), which collapsing its edges removes when moving its
     // vertices does not. Untangled before the optimization (which then shapes the triangles the
     // collapses left) and after it.
+    // Faces that would touch once written in model units are separated too.
     let untangle_params = UntangleParams {
         max_collapses: POINT_UNTANGLE_COLLAPSES,
+        near: rp.untangle.near.max(normalization.written_rounding()),
         ..rp.untangle
     };
     let no_fixed = vec![false; mesh.positions.len()];

@@ -3,12 +3,12 @@
 //! ([`triangles_intersect`]).
 
 use glam::DVec3;
-use parry3d_f64::bounding_volume::Aabb;
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 use rayon::prelude::*;
 
 use super::triangle::is_degenerate_face;
-use super::triangle_intersection::triangles_intersect;
+use super::triangle_intersection::{triangles_intersect, triangles_within};
 
 /// The pairs of `boxes` (items of [`face_boxes`]: a face index and its bounding box) whose
 /// closed boxes overlap, each once as `[f, g]` with f < g (face indices), sorted. The boxes go
@@ -47,7 +47,7 @@ pub fn intersecting_pairs_counted(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
 ) -> (Vec<[u32; 2]>, usize) {
-    let candidates = non_adjacent_pairs(positions, triangles);
+    let candidates = non_adjacent_pairs(positions, triangles, 0.0);
     let pairs: Vec<[u32; 2]> = candidates
         .par_iter()
         .copied()
@@ -61,15 +61,43 @@ pub fn intersecting_pairs_counted(
     (pairs, candidates.len())
 }
 
+/// The pairs of [`intersecting_pairs`] and the pairs of non-adjacent faces that come within
+/// `near` of each other ([`triangles_within`]; the same units as `positions`), in the same
+/// order: the faces that may share a point once their corners are rounded by up to `near / 2`.
+/// Boxes loosened by `near / 2` each; the same cost as [`intersecting_pairs_counted`] for a
+/// `near` short against the faces.
+pub(crate) fn pairs_within(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    near: f64,
+) -> Vec<[u32; 2]> {
+    non_adjacent_pairs(positions, triangles, near)
+        .into_par_iter()
+        .filter(|&[f, g]| {
+            triangles_within(
+                corners(positions, triangles, f),
+                corners(positions, triangles, g),
+                near,
+            )
+        })
+        .collect()
+}
+
 /// The corners of face `f`.
 fn corners(positions: &[DVec3], triangles: &[[u32; 3]], f: u32) -> [DVec3; 3] {
     triangles[f as usize].map(|i| positions[i as usize])
 }
 
 /// The pairs of faces of [`face_boxes`] whose bounding boxes overlap and that share no vertex
-/// index, as [`overlapping_box_pairs`] gives them.
-fn non_adjacent_pairs(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut pairs = overlapping_box_pairs(&face_boxes(positions, triangles));
+/// index, as [`overlapping_box_pairs`] gives them, each box loosened by `near / 2`.
+fn non_adjacent_pairs(positions: &[DVec3], triangles: &[[u32; 3]], near: f64) -> Vec<[u32; 2]> {
+    let mut boxes = face_boxes(positions, triangles);
+    if near > 0.0 {
+        for (_, b) in &mut boxes {
+            *b = b.loosened(0.5 * near);
+        }
+    }
+    let mut pairs = overlapping_box_pairs(&boxes);
     pairs.retain(|&[f, g]| {
         let tf = triangles[f as usize];
         !tf.iter().any(|i| triangles[g as usize].contains(i))

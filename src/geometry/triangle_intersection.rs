@@ -58,6 +58,62 @@ pub fn triangles_intersect(a: [DVec3; 3], b: [DVec3; 3]) -> bool {
         || (0..3).any(|k| segment_meets_triangle(b[k], b[(k + 1) % 3], a))
 }
 
+/// Whether the closed triangles `a` and `b` (non-degenerate) share a point
+/// ([`triangles_intersect`], exact) or come within `near` of each other (any length unit; `near`
+/// ≤ 0 is the exact test alone). Two triangles that do not meet are nearest between a corner of
+/// one and the other triangle or between two edges, so the distance is the least of those 15;
+/// it is computed only when no plane of either triangle has the other's corners all farther
+/// than `near` on one side.
+///
+/// This is the test for faces that touch once rounded: a mesh mapped into another frame or
+/// written as `f32` moves each corner by up to its rounding, so faces nearer than that may share
+/// a point in the file though not before.
+pub(crate) fn triangles_within(a: [DVec3; 3], b: [DVec3; 3], near: f64) -> bool {
+    if triangles_intersect(a, b) {
+        return true;
+    }
+    if near.is_nan() || near <= 0.0 {
+        return false;
+    }
+    for (s, t) in [(a, b), (b, a)] {
+        if let Some(n) = (s[1] - s[0]).cross(s[2] - s[0]).try_normalize() {
+            let d = t.map(|p| n.dot(p - s[0]));
+            if d.iter().all(|&x| x > near) || d.iter().all(|&x| x < -near) {
+                return false;
+            }
+        }
+    }
+    triangle_distance(a, b) <= near
+}
+
+/// The distance between the closed triangles `a` and `b`, which do not meet: the least distance
+/// from a corner of one to the other triangle and between an edge of one and an edge of the
+/// other.
+fn triangle_distance(a: [DVec3; 3], b: [DVec3; 3]) -> f64 {
+    use parry3d_f64::query::closest_points::closest_points_segment_segment_with_locations_nD;
+    use parry3d_f64::query::PointQuery;
+    use parry3d_f64::shape::{Segment, Triangle};
+    let (ta, tb) = (
+        Triangle::new(a[0], a[1], a[2]),
+        Triangle::new(b[0], b[1], b[2]),
+    );
+    let corners = a
+        .iter()
+        .map(|&p| tb.distance_to_local_point(p, true))
+        .chain(b.iter().map(|&p| ta.distance_to_local_point(p, true)));
+    let edges = (0..3).flat_map(|i| {
+        (0..3).map(move |j| {
+            let (p0, p1) = (a[i], a[(i + 1) % 3]);
+            let (q0, q1) = (b[j], b[(j + 1) % 3]);
+            let (la, lb) = closest_points_segment_segment_with_locations_nD((&p0, &p1), (&q0, &q1));
+            Segment::new(p0, p1)
+                .point_at(&la)
+                .distance(Segment::new(q0, q1).point_at(&lb))
+        })
+    });
+    corners.chain(edges).fold(f64::INFINITY, f64::min)
+}
+
 /// Whether the closed segment `p q` meets the closed triangle `t` (non-degenerate), exactly.
 pub fn segment_meets_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
     let sp = orient(t[0], t[1], t[2], p);
@@ -182,6 +238,31 @@ mod tests {
 
     fn v(x: f64, y: f64, z: f64) -> DVec3 {
         DVec3::new(x, y, z)
+    }
+
+    #[test]
+    fn triangles_within_a_distance_of_each_other() {
+        let a = [v(0., 0., 0.), v(4., 0., 0.), v(0., 4., 0.)];
+        let h = 1e-6;
+        // A corner h above a's interior: the corner's distance decides.
+        let b = [v(1., 1., h), v(3., 3., 2.), v(1., 3., 2.)];
+        assert!(!triangles_intersect(a, b));
+        assert!(triangles_within(a, b, 2.0 * h));
+        assert!(!triangles_within(a, b, 0.5 * h));
+        assert!(!triangles_within(a, b, 0.0));
+        // An edge of b passing h over a's edge on the x axis, every corner of b farther than 1
+        // from a (b lies in the plane x = 2, and below a's plane only where y < 0): the edges'
+        // distance, h / sqrt 2, decides.
+        let b = [v(2., -1., h - 1.), v(2., 1., h + 1.), v(2., -1., h + 3.)];
+        assert!(!triangles_intersect(a, b));
+        assert!(triangles_within(a, b, 0.75 * h));
+        assert!(!triangles_within(a, b, 0.65 * h));
+        // Crossing triangles are within any distance, apart ones within none short of theirs.
+        let c = [v(1., 1., -1.), v(1., 1., 1.), v(2., 1., 0.)];
+        assert!(triangles_within(a, c, 0.0));
+        let far = a.map(|p| p + v(0., 0., 3.));
+        assert!(!triangles_within(a, far, 2.9));
+        assert!(triangles_within(a, far, 3.1));
     }
 
     #[test]

@@ -9,16 +9,25 @@ use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 
 use super::edit::EditMesh;
 use crate::geometry::self_intersection::triangle_aabb;
-use crate::geometry::triangle_intersection::triangles_intersect;
+use crate::geometry::triangle_intersection::triangles_within;
+use parry3d_f64::bounding_volume::BoundingVolume;
 
 /// A BVH over the live faces of an edit mesh, by slot (see the module).
 pub(crate) struct CrossingGuard {
     bvh: Bvh,
+    /// Faces nearer than this count as sharing a point (`triangles_within`); 0: the exact test.
+    near: f64,
 }
 
 impl CrossingGuard {
     /// The guard of `m`'s live faces at their current positions.
     pub(crate) fn new<L: Copy>(m: &EditMesh<L>) -> Self {
+        Self::within(m, 0.0)
+    }
+
+    /// The guard of `m`'s live faces at their current positions, for which two faces nearer
+    /// than `near` (the mesh's units) share a point: faces that touch once rounded by `near / 2`.
+    pub(crate) fn within<L: Copy>(m: &EditMesh<L>, near: f64) -> Self {
         let (live, slots) = m.live_faces();
         let boxes = live
             .iter()
@@ -26,6 +35,7 @@ impl CrossingGuard {
             .map(|(&t, &f)| (f as usize, triangle_aabb(m.corners(t))));
         CrossingGuard {
             bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
+            near: near.max(0.0),
         }
     }
 
@@ -40,7 +50,8 @@ impl CrossingGuard {
 
     /// Calls `visit` with each live face (slot) of `m` that the face `t` with corners `p` (its
     /// vertices' positions, or where an operation would put them) shares a point with, leaving
-    /// out the slots in `replaced` and the faces with a vertex of `t` (exact test), until
+    /// out the slots in `replaced` and the faces with a vertex of `t` (exact test, or nearer
+    /// than the guard's `near`), until
     /// `visit` returns true; whether it did.
     pub(crate) fn visit_crossed<L: Copy>(
         &self,
@@ -50,15 +61,19 @@ impl CrossingGuard {
         replaced: &[u32],
         mut visit: impl FnMut(u32) -> bool,
     ) -> bool {
-        self.bvh.intersect_aabb(&triangle_aabb(p)).any(|g| {
+        let query = triangle_aabb(p).loosened(self.near);
+        let found = self.bvh.intersect_aabb(&query).any(|g| {
             if replaced.contains(&g) {
                 return false;
             }
             let Some(u) = m.face(g) else {
                 return false;
             };
-            !t.iter().any(|v| u.contains(v)) && triangles_intersect(p, m.corners(u)) && visit(g)
-        })
+            !t.iter().any(|v| u.contains(v))
+                && triangles_within(p, m.corners(u), self.near)
+                && visit(g)
+        });
+        found
     }
 
     /// How many live faces the face `t` with corners `p` crosses (as [`Self::visit_crossed`]).

@@ -481,6 +481,18 @@ impl Normalization {
         p / self.scale + self.center
     }
 
+    /// How far apart, in bbox-100 units, two faces of a mesh in this frame must be to stay
+    /// apart once written in model units as `f32` (the coarsest coordinates any of our formats
+    /// writes): four times the distance a corner moves when each coordinate of a point of the
+    /// bounding box is rounded to `f32` (half its unit in the last place, √3 times, in bbox-100
+    /// units), the mapping's own `f64` rounding far below it. For a model centred near the
+    /// origin about 2e-5; larger for one far from it (a scan in UTM coordinates).
+    pub fn written_rounding(&self) -> f64 {
+        let half_side = 0.5 * Self::TARGET_SIZE / self.scale;
+        let largest = self.center.abs().max_element() + half_side;
+        4.0 * 3f64.sqrt() * 0.5 * f64::from(f32::EPSILON) * largest * self.scale
+    }
+
     /// A copy of `mesh` in bbox-100 units.
     pub fn apply_mesh(&self, mesh: &TriMesh) -> TriMesh {
         TriMesh {
@@ -684,6 +696,34 @@ pub(crate) mod test_meshes {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn written_rounding_bounds_the_f32_rounding_of_the_model_frame() {
+        // A box near the origin and the same box at UTM-like coordinates: every corner and a
+        // grid of points inside, written as f32 model coordinates, move by at most a quarter
+        // of the written rounding (bbox-100 units); the far box's rounding is far larger.
+        let mut last = 0.0;
+        for offset in [DVec3::ZERO, DVec3::new(512_345.0, 4_123_456.0, 120.0)] {
+            let lo = offset + DVec3::new(-3.0, 1.0, 2.0);
+            let hi = offset + DVec3::new(7.0, 4.5, 2.5);
+            let n = Normalization::for_bbox(&Aabb::of(&[lo, hi]).unwrap()).unwrap();
+            let r = n.written_rounding();
+            for k in 0..=1000 {
+                let t = DVec3::new(
+                    (k % 11) as f64 / 10.0,
+                    (k / 11 % 11) as f64 / 10.0,
+                    (k / 121 % 9) as f64 / 8.0,
+                );
+                let p = lo + (hi - lo) * t;
+                let written = p.as_vec3().as_dvec3();
+                let moved = n.apply(written).distance(n.apply(p));
+                assert!(moved <= 0.25 * r, "{moved:e} > {r:e} / 4 at {p}");
+            }
+            assert!(r > last);
+            last = r;
+        }
+        assert!(last > 0.1, "{last}");
+    }
 
     #[test]
     fn normalization_round_trips_and_scales_longest_side_to_100() {

@@ -9,11 +9,11 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
+use crate::geometry::self_intersection::{pairs_within, CrossingRegions};
 use crate::geometry::triangle::{
     is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,
 };
-use crate::geometry::triangle_intersection::triangles_intersect;
+use crate::geometry::triangle_intersection::triangles_within;
 use crate::mesh::crossing_guard::CrossingGuard;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
@@ -36,6 +36,11 @@ pub struct UntangleParams {
     /// mesh passes through itself or its parts meet (the [`CrossingRegions`] given to
     /// [`untangle`]) a crossing is the input's, and collapses would eat the part.
     pub max_collapses: usize,
+    /// Faces nearer than this count as crossing (bbox-100 units, not σ_p; at most a tenth of
+    /// the margin is used): faces that would share a point once the mesh is written, whose
+    /// coordinates are rounded ([`Normalization::written_rounding`](crate::Normalization::written_rounding)).
+    /// Default 0: the exact test alone.
+    pub near: f64,
 }
 
 impl Default for UntangleParams {
@@ -45,6 +50,7 @@ impl Default for UntangleParams {
             margin_sigma_p: 0.01,
             max_step_sigma_p: 0.25,
             max_collapses: 100,
+            near: 0.0,
         }
     }
 }
@@ -67,7 +73,8 @@ pub struct UntangleStats {
 }
 
 /// Moves vertices of `mesh` (bbox-100 units) until no two non-adjacent faces intersect
-/// ([`intersecting_pairs`]) or `params.max_rounds` rounds have run. In a round the crossing pairs
+/// ([`intersecting_pairs`](crate::geometry::intersecting_pairs)), nor come within `params.near`
+/// of each other (faces that would touch once written), or `params.max_rounds` rounds have run. In a round the crossing pairs
 /// are taken in order; for a pair that still crosses, the shortest of four moves separates it
 /// (for either face: its corners behind the other's plane move along that plane's normal to
 /// `margin_sigma_p · σ_p` in front of it, or the other face moves back along its normal until
@@ -95,7 +102,8 @@ pub fn untangle(
     let mut stats = UntangleStats::default();
     let mut moved = vec![false; m.vertex_count()];
     let margin = params.margin_sigma_p * sigma_p;
-    let mut pairs = intersecting_pairs(&mesh.positions, &mesh.triangles);
+    let near = params.near.min(0.1 * margin).max(0.0);
+    let mut pairs = pairs_within(&mesh.positions, &mesh.triangles, near);
     stats.pairs_before = pairs.len();
     let mut scale = 1.0;
     while !pairs.is_empty() && stats.rounds < params.max_rounds {
@@ -107,6 +115,7 @@ pub fn untangle(
             fixed,
             margin,
             scale * params.max_step_sigma_p * sigma_p,
+            near,
         );
         if moves.is_empty() {
             break;
@@ -117,7 +126,7 @@ pub fn untangle(
             relocated &= m.relocate_vertex(v, m.position(v) + d).is_ok();
         }
         // Moves change positions only: the faces are still `triangles`.
-        let after = intersecting_pairs(m.positions(), &triangles);
+        let after = pairs_within(m.positions(), &triangles, near);
         if relocated && after.len() < pairs.len() {
             for &(v, _) in &moves {
                 moved[v as usize] = true;
@@ -145,7 +154,7 @@ pub fn untangle(
     };
     let mut pairs_after = pairs.len();
     if !pairs.is_empty() && params.max_collapses > 0 {
-        let (collapses, left) = collapse_folds(&mut m, fixed, params.max_collapses, &own);
+        let (collapses, left) = collapse_folds(&mut m, fixed, params.max_collapses, near, &own);
         stats.collapses = collapses;
         pairs_after = left;
     }
@@ -181,13 +190,14 @@ fn collapse_folds(
     m: &mut Mesh,
     fixed: &[bool],
     max: usize,
+    near: f64,
     own: &dyn Fn(&Mesh, [u32; 2]) -> bool,
 ) -> (usize, usize) {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
     let (live, slots) = m.live_faces();
-    let mut guard = CrossingGuard::new(m);
+    let mut guard = CrossingGuard::within(m, near);
     // Crossing pairs of slots, each as [f, g] with f < g.
-    let mut pairs: Vec<[u32; 2]> = intersecting_pairs(m.positions(), &live)
+    let mut pairs: Vec<[u32; 2]> = pairs_within(m.positions(), &live, near)
         .into_iter()
         .map(|[f, g]| {
             let (a, b) = (slots[f as usize], slots[g as usize]);
@@ -285,7 +295,8 @@ fn faces_around_both(m: &Mesh, a: u32, b: u32) -> Vec<u32> {
 }
 
 /// The crossing pairs of live faces with at least one face in `faces` (slots), as
-/// [`intersecting_pairs`] counts them (faces sharing a vertex and degenerate faces left out),
+/// untangle counts them (faces sharing a vertex and degenerate faces left out; faces within the
+/// guard's `near` count),
 /// found through `guard`.
 fn crossings_around(m: &Mesh, guard: &CrossingGuard, faces: &[u32]) -> usize {
     let p = m.positions();
@@ -317,13 +328,14 @@ fn round_moves(
     fixed: &[bool],
     margin: f64,
     max_step: f64,
+    near: f64,
 ) -> Vec<(u32, DVec3)> {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
     let mut positions = m.positions().to_vec();
     let mut total = vec![DVec3::ZERO; positions.len()];
     let corners = |p: &[DVec3], f: u32| triangles[f as usize].map(|v| p[v as usize]);
     for &[f, g] in pairs {
-        if !triangles_intersect(corners(&positions, f), corners(&positions, g)) {
+        if !triangles_within(corners(&positions, f), corners(&positions, g), near) {
             continue;
         }
         // Two ways to separate face a from face b: a's corners behind b's plane move forward
@@ -390,6 +402,7 @@ fn round_moves(
 mod tests {
     use super::*;
     use crate::check::check_invariants;
+    use crate::geometry::self_intersection::intersecting_pairs;
     use crate::mesh::test_meshes::grid;
 
     #[test]
@@ -426,6 +439,37 @@ mod tests {
         let (s, _) = untangle(&mut clean, &none, 1.0, &UntangleParams::default(), None);
         assert_eq!((s.pairs_before, s.rounds, s.vertices_moved), (0, 0, 0));
         assert_eq!(clean.positions, a.positions);
+    }
+
+    #[test]
+    fn faces_nearer_than_near_are_separated_and_left_when_near_is_zero() {
+        // A vertex of the upper of two grids 0.2 apart lowered to 1e-7 above the lower one: no
+        // face crosses, but the faces around it would touch once rounded.
+        let (mut m, off) = crate::mesh::test_meshes::stacked_grids(6);
+        let poke = off as usize + 3 * 7 + 3;
+        let below = m.positions[3 * 7 + 3].z;
+        m.positions[poke].z = below + 1e-7;
+        assert!(intersecting_pairs(&m.positions, &m.triangles).is_empty());
+        let fixed = vec![false; m.positions.len()];
+        let exact = m.clone();
+        let mut left = m.clone();
+        let (s, _) = untangle(&mut left, &fixed, 1.0, &UntangleParams::default(), None);
+        assert_eq!((s.pairs_before, s.vertices_moved), (0, 0), "{s:?}");
+        assert_eq!(left.positions, exact.positions);
+        let params = UntangleParams {
+            near: 1e-5,
+            ..UntangleParams::default()
+        };
+        let (s, _) = untangle(&mut m, &fixed, 1.0, &params, None);
+        assert!(s.pairs_before > 0 && s.pairs_after == 0, "{s:?}");
+        assert!(pairs_within(&m.positions, &m.triangles, 1e-5).is_empty());
+        // Apart by at least the margin now, by a short move.
+        assert!(
+            m.positions[poke].z - below >= 0.01 - 1e-12,
+            "{}",
+            m.positions[poke].z
+        );
+        assert!(s.max_displacement < 0.05, "{s:?}");
     }
 
     #[test]
