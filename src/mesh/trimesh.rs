@@ -293,11 +293,11 @@ impl TriMesh {
     /// three coordinate-plane projections; faces of almost no area stay, for the pipeline's own
     /// checks to name), and faces with the same three vertices as an earlier face, in either
     /// winding (duplicated faces, and the second sheet of a double-sided export). The first of a
-    /// set of duplicates stays. Then a face that came in both windings and whose three edges
-    /// each still have more than two faces goes as well: it is a wall between two volumes
-    /// (two closed parts glued at that face, as two tetrahedra joined into a bipyramid), inside
-    /// the solid they make together; a double-sided sheet, whose edges are left with one or two
-    /// faces, stays. Vertices stay (see [`TriMesh::remove_unreferenced_vertices`]). O(faces).
+    /// set of duplicates stays. Then the faces that came in both windings go as well where they
+    /// make a wall between two volumes ([`walls_among`]: two closed parts glued at those faces,
+    /// as two tetrahedra joined into a bipyramid or the stories of a building stacked on each
+    /// other's floors), inside the solid the parts make together; a double-sided sheet, whose
+    /// edges are left with one or two faces, stays. Vertices stay (see [`TriMesh::remove_unreferenced_vertices`]). O(faces).
     pub fn remove_duplicate_and_zero_area_faces(&mut self) -> FaceCleanup {
         let mut seen: FxHashMap<[u32; 3], [u32; 3]> = FxHashMap::default();
         let mut out = FaceCleanup::default();
@@ -335,14 +335,12 @@ impl TriMesh {
                 *faces_on_edge.entry((a.min(b), a.max(b))).or_default() += 1;
             }
         }
-        let is_wall = |&[a, b, c]: &[u32; 3]| {
-            [(a, b), (b, c), (a, c)]
-                .iter()
-                .all(|e| faces_on_edge.get(e).is_some_and(|&n| n > 2))
-        };
+        let mut patch = both_windings.clone();
+        patch.sort_unstable();
+        patch.dedup();
+        let walls = walls_among(&patch, &faces_on_edge);
         // A wall's other winding is no double-sided face.
-        out.opposite_duplicates -= both_windings.iter().filter(|k| is_wall(k)).count();
-        let walls: FxHashSet<[u32; 3]> = both_windings.into_iter().filter(is_wall).collect();
+        out.opposite_duplicates -= both_windings.iter().filter(|k| walls.contains(*k)).count();
         if !walls.is_empty() {
             self.triangles.retain(|&t| {
                 let mut key = t;
@@ -381,6 +379,56 @@ impl TriMesh {
             .retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
         merged
     }
+}
+
+/// The faces of `both_windings` (faces given in both windings, vertices sorted, each once) that are walls
+/// between two volumes: the faces of `both_windings` joined across their shared edges make
+/// patches, and a patch is a wall when each edge on its rim (an edge of one face of the patch)
+/// has at least two faces besides the patch's, one on either side (`faces_on_edge`: the faces
+/// on each edge, one copy of each face counted). A single face is a patch of its own; a
+/// floor between two stories, triangulated as a fan, is one patch whose inner edges have the
+/// patch's faces only. A double-sided sheet's rim has at most one other face on an edge. O(the
+/// faces given), deterministic.
+fn walls_among(
+    both_windings: &[[u32; 3]],
+    faces_on_edge: &FxHashMap<(u32, u32), u32>,
+) -> FxHashSet<[u32; 3]> {
+    let edges = |[a, b, c]: [u32; 3]| [(a, b), (b, c), (a, c)];
+    // The patch faces on each edge, in order.
+    let mut on_edge: FxHashMap<(u32, u32), Vec<usize>> = FxHashMap::default();
+    for (i, &t) in both_windings.iter().enumerate() {
+        for e in edges(t) {
+            on_edge.entry(e).or_default().push(i);
+        }
+    }
+    // Patches: union-find over faces sharing an edge.
+    let mut parent: Vec<usize> = (0..both_windings.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for faces in on_edge.values() {
+        for &j in &faces[1..] {
+            let (a, b) = (root(&mut parent, faces[0]), root(&mut parent, j));
+            parent[a.max(b)] = a.min(b);
+        }
+    }
+    let mut open_rim = vec![false; both_windings.len()];
+    for (e, faces) in &on_edge {
+        let all = faces_on_edge.get(e).copied().unwrap_or(0) as usize;
+        let others = all.saturating_sub(faces.len());
+        if faces.len() == 1 && others < 2 {
+            let r = root(&mut parent, faces[0]);
+            open_rim[r] = true;
+        }
+    }
+    (0..both_windings.len())
+        .filter(|&i| !open_rim[root(&mut parent, i)])
+        .map(|i| both_windings[i])
+        .collect()
 }
 
 /// What [`TriMesh::remove_duplicate_and_zero_area_faces`] removed.
@@ -786,6 +834,49 @@ mod tests {
             (2, 2, 0)
         );
         assert_eq!(sheet.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+    }
+
+    #[test]
+    fn a_floor_between_two_stacked_boxes_is_a_wall_though_its_diagonal_has_two_faces() {
+        // Two unit cubes stacked; each has the square between them as two triangles, the
+        // lower one's top in one winding, the upper one's bottom in the other. The square's
+        // diagonal has only the square's two faces; its rim has the sides of both cubes.
+        let mut positions = Vec::new();
+        for z in 0..3 {
+            for (x, y) in [(0, 0), (1, 0), (1, 1), (0, 1)] {
+                positions.push(DVec3::new(x as f64, y as f64, z as f64));
+            }
+        }
+        let quad = |a: u32, b: u32, c: u32, d: u32| [[a, b, c], [a, c, d]];
+        let cube = |lo: u32| {
+            let hi = lo + 4;
+            let mut t = Vec::new();
+            t.extend(quad(lo, lo + 3, lo + 2, lo + 1));
+            t.extend(quad(hi, hi + 1, hi + 2, hi + 3));
+            for k in 0..4 {
+                let (a, b) = (lo + k, lo + (k + 1) % 4);
+                t.extend(quad(a, b, b + 4, a + 4));
+            }
+            t
+        };
+        let mut triangles = cube(0);
+        triangles.extend(cube(4));
+        let mut stacked = TriMesh::new(positions, triangles);
+        let c = stacked.remove_duplicate_and_zero_area_faces();
+        assert_eq!(
+            (c.duplicates, c.opposite_duplicates, c.internal_walls),
+            (2, 0, 2)
+        );
+        // One closed box of 20 faces: every edge has two.
+        assert_eq!(stacked.triangles.len(), 20);
+        let mut on_edge: FxHashMap<(u32, u32), usize> = FxHashMap::default();
+        for t in &stacked.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *on_edge.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        assert!(on_edge.values().all(|&n| n == 2), "{on_edge:?}");
     }
 
     #[test]
