@@ -31,6 +31,10 @@ pub struct UntangleParams {
     pub margin_sigma_p: f64,
     /// The longest move of a vertex in one round (σ_p units). Default 0.25.
     pub max_step_sigma_p: f64,
+    /// The farthest a vertex moves in all (σ_p units). Default 1: a press of one sheet onto
+    /// another where the input passes through itself stays near the input, and the crossings
+    /// left there are the input's own.
+    pub max_shift_sigma_p: f64,
     /// Edge collapses at most when moves leave crossing pairs (default 100). Only for pairs that
     /// are the triangulation's own folds, which collapsing their edges removes: where the input
     /// mesh passes through itself or its parts meet (the [`CrossingRegions`] given to
@@ -49,6 +53,7 @@ impl Default for UntangleParams {
             max_rounds: 30,
             margin_sigma_p: 0.01,
             max_step_sigma_p: 0.25,
+            max_shift_sigma_p: 1.0,
             max_collapses: 100,
             near: 0.0,
         }
@@ -82,7 +87,7 @@ pub struct UntangleStats {
 /// (a boundary sample) counts as four times as long, so those move only when nothing else
 /// separates the pair. A round that does not lower the number of crossing pairs is undone and
 /// tried again with moves half as long (never worse than before). Faces that cross nothing do
-/// not move. Then, for pairs still crossing that are not the input's own (both faces reaching
+/// not move, and no vertex moves farther than `max_shift_sigma_p · σ_p` in all. Then, for pairs still crossing that are not the input's own (both faces reaching
 /// into `input_crossings`, where the input's faces cross or its parts meet), edges are
 /// collapsed (at most `params.max_collapses`; the only change of connectivity).
 ///
@@ -103,6 +108,7 @@ pub fn untangle(
     let mut moved = vec![false; m.vertex_count()];
     let margin = params.margin_sigma_p * sigma_p;
     let near = params.near.min(0.1 * margin).max(0.0);
+    let shift = params.max_shift_sigma_p * sigma_p;
     let mut pairs = pairs_within(&mesh.positions, &mesh.triangles, near);
     stats.pairs_before = pairs.len();
     let mut scale = 1.0;
@@ -117,6 +123,17 @@ pub fn untangle(
             scale * params.max_step_sigma_p * sigma_p,
             near,
         );
+        // No vertex goes farther than `max_shift_sigma_p` from where it started.
+        let moves: Vec<(u32, DVec3)> = moves
+            .into_iter()
+            .filter_map(|(v, d)| {
+                let from = start[v as usize];
+                let to = m.position(v) + d;
+                let to = from + (to - from).clamp_length_max(shift);
+                let d = to - m.position(v);
+                (d != DVec3::ZERO).then_some((v, d))
+            })
+            .collect();
         if moves.is_empty() {
             break;
         }
@@ -128,8 +145,8 @@ pub fn untangle(
         // Moves change positions only: the faces are still `triangles`.
         let after = pairs_within(m.positions(), &triangles, near);
         if relocated && after.len() < pairs.len() {
-            for &(v, _) in &moves {
-                moved[v as usize] = true;
+            for &(v, p) in &saved {
+                moved[v as usize] |= m.position(v) != p;
             }
             pairs = after;
             scale = 1.0;
@@ -470,6 +487,32 @@ mod tests {
             m.positions[poke].z
         );
         assert!(s.max_displacement < 0.05, "{s:?}");
+    }
+
+    #[test]
+    fn no_vertex_moves_farther_than_the_shift_allowed() {
+        // The dent of the test above needs a move of more than 0.3; allowed 0.1, the vertices
+        // stop there and the pair stays.
+        let (mut m, off) = crate::mesh::test_meshes::stacked_grids(6);
+        let poke = off as usize + 3 * 7 + 3;
+        m.positions[poke].z = -0.3;
+        let start = m.positions.clone();
+        let fixed = vec![false; m.positions.len()];
+        let params = UntangleParams {
+            max_shift_sigma_p: 0.1,
+            max_collapses: 0,
+            ..UntangleParams::default()
+        };
+        let (s, _) = untangle(&mut m, &fixed, 1.0, &params, None);
+        assert!(s.pairs_after > 0, "{s:?}");
+        assert!(s.max_displacement <= 0.1 + 1e-12, "{s:?}");
+        let farthest = m
+            .positions
+            .iter()
+            .zip(&start)
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0, f64::max);
+        assert!(farthest <= 0.1 + 1e-12, "{farthest}");
     }
 
     #[test]
