@@ -383,11 +383,12 @@ impl TriMesh {
 
 /// The faces of `both_windings` (faces given in both windings, vertices sorted, each once) that are walls
 /// between two volumes: the faces of `both_windings` joined across their shared edges make
-/// patches, and a patch is a wall when each edge on its rim (an edge of one face of the patch)
-/// has at least two faces besides the patch's, one on either side (`faces_on_edge`: the faces
+/// patches, and a patch is a wall when it has a rim (edges of one face of the patch) and each
+/// edge on its rim has at least two faces besides the patch's, one on either side (`faces_on_edge`: the faces
 /// on each edge, one copy of each face counted). A single face is a patch of its own; a
 /// floor between two stories, triangulated as a fan, is one patch whose inner edges have the
-/// patch's faces only. A double-sided sheet's rim has at most one other face on an edge. O(the
+/// patch's faces only. A double-sided sheet's rim has at most one other face on an edge, and a
+/// closed surface given double-sided has no rim. O(the
 /// faces given), deterministic.
 fn walls_among(
     both_windings: &[[u32; 3]],
@@ -416,17 +417,24 @@ fn walls_among(
             parent[a.max(b)] = a.min(b);
         }
     }
+    // Per patch: whether it has a rim, and whether an edge of the rim has fewer than two other
+    // faces.
+    let mut rim = vec![false; both_windings.len()];
     let mut open_rim = vec![false; both_windings.len()];
     for (e, faces) in &on_edge {
-        let all = faces_on_edge.get(e).copied().unwrap_or(0) as usize;
-        let others = all.saturating_sub(faces.len());
-        if faces.len() == 1 && others < 2 {
-            let r = root(&mut parent, faces[0]);
-            open_rim[r] = true;
+        if faces.len() != 1 {
+            continue;
         }
+        let all = faces_on_edge.get(e).copied().unwrap_or(0) as usize;
+        let r = root(&mut parent, faces[0]);
+        rim[r] = true;
+        open_rim[r] |= all.saturating_sub(1) < 2;
     }
     (0..both_windings.len())
-        .filter(|&i| !open_rim[root(&mut parent, i)])
+        .filter(|&i| {
+            let r = root(&mut parent, i);
+            rim[r] && !open_rim[r]
+        })
         .map(|i| both_windings[i])
         .collect()
 }
@@ -877,6 +885,19 @@ mod tests {
             }
         }
         assert!(on_edge.values().all(|&n| n == 2), "{on_edge:?}");
+        // A closed surface given in both windings has no rim: no wall, it is made single.
+        let mut tet = TriMesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]],
+        );
+        let backs: Vec<[u32; 3]> = tet.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect();
+        tet.triangles.extend(backs);
+        let c = tet.remove_duplicate_and_zero_area_faces();
+        assert_eq!(
+            (c.duplicates, c.opposite_duplicates, c.internal_walls),
+            (4, 4, 0)
+        );
+        assert_eq!(tet.triangles.len(), 4);
     }
 
     #[test]
