@@ -595,7 +595,8 @@ pub fn remesh(
     // The sampler's count is searched for; the triangulation may set a few samples aside (at
     // parts thinner than the sampling), so when the output's vertex count misses the target by
     // more than the search tolerance, the search runs again for a target raised by the
-    // shortfall (at most twice).
+    // shortfall, once: the retry's miss is how closely the count can be aimed on this input, and
+    // a second retry aims no closer, at the cost of a third run.
     let mut goal = match density {
         Target::Points(n) => n,
         Target::SigmaP(_) => 0,
@@ -996,7 +997,7 @@ pub fn remesh(
                 let miss = n as f64 - v;
                 // A raised target helps only where the sampler reached its own: a count the
                 // search could not reach is not reached by asking for more.
-                let done = attempt >= 3
+                let done = attempt >= 2
                     || miss.abs() <= params.count_tolerance * n as f64
                     || (dropped_samples == 0 && miss.abs() <= 0.01 * n as f64)
                     || !target_reached;
