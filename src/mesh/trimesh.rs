@@ -294,7 +294,7 @@ impl TriMesh {
     /// checks to name), and faces with the same three vertices as an earlier face, in either
     /// winding (duplicated faces, and the second sheet of a double-sided export). The first of a
     /// set of duplicates stays. Then the faces that came in both windings go as well where they
-    /// make a wall between two volumes ([`walls_among`]: two closed parts glued at those faces,
+    /// make a wall between two volumes (`walls_among`: two closed parts glued at those faces,
     /// as two tetrahedra joined into a bipyramid or the stories of a building stacked on each
     /// other's floors), inside the solid the parts make together; a double-sided sheet, whose
     /// edges are left with one or two faces, stays. Vertices stay (see [`TriMesh::remove_unreferenced_vertices`]). O(faces).
