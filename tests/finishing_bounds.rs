@@ -1,10 +1,11 @@
 //! Issue 35: real files in bounded time, with a valid mesh out. Each input is made here (the
 //! shapes of the corpus files that hung or crossed: a tetrahedron, two tetrahedra joined at a
 //! face (their shared face a wall inside the solid), a wedge sharper than the angle bounds (the
-//! angle block's corners), two boxes welded on one edge, a duplicated face, a double-sided export, a two-part scene, a zero-area first face).
-//! Every run goes through `remesh_mesh` (the command line's own path from the mesh read on) on a
-//! thread with a hang guard, and the finishing stage's work is checked by counting its attempts
-//! against its budget, not by timing.
+//! angle block's corners), two boxes welded on one edge, a duplicated face, a double-sided
+//! export, a two-part scene, a zero-area first face). Every run goes through `remesh_mesh` (the
+//! command line's own path from the mesh read on) on a thread with a hang guard, and the
+//! finishing stage's work is checked by counting its attempts against its budget, not by
+//! timing.
 
 mod common;
 

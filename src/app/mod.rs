@@ -328,7 +328,7 @@ fn remesh_read(
     // The file's crossing pairs, and of them those where the input's own faces cross or its
     // closed parts meet.
     let theirs = match (&file, crossing) {
-        (Some((m, frame)), 1..) => crossings_of_the_input(&out, m, frame, up).0,
+        (Some((m, frame)), 1..) => crossings_of_the_input(&out, m, frame, up),
         _ => 0,
     };
     extra.insert(
@@ -897,19 +897,18 @@ impl FileFrame {
 /// How many of the crossing pairs of `checked` (the written mesh as [`as_quality_reads`] sees
 /// it, in `file`'s frame) lie where the input's own faces cross or its closed parts meet (both
 /// faces reach into the input's [`CrossingRegions`], loosened by sigma_p, mapped into that
-/// frame), and the pairs in all.
+/// frame).
 fn crossings_of_the_input(
     out: &RemeshOutput,
     checked: &TriMesh,
     file: &FileFrame,
     run_up: i32,
-) -> (usize, usize) {
-    let pairs = intersecting_pairs(&checked.positions, &checked.triangles);
+) -> usize {
     if out.input_crossing_pairs.is_empty() && out.junction_faces.is_empty() {
-        return (0, pairs.len());
+        return 0;
     }
     let Some(to_file) = file.map(run_up) else {
-        return (0, pairs.len());
+        return 0;
     };
     let input = &out.input_normalized;
     let positions: Vec<DVec3> = input
@@ -927,10 +926,8 @@ fn crossings_of_the_input(
         &out.junction_faces,
         out.sigma_p * unit.length(),
     );
-    (
-        regions.count_inside(&checked.positions, &checked.triangles, &pairs),
-        pairs.len(),
-    )
+    let pairs = intersecting_pairs(&checked.positions, &checked.triangles);
+    regions.count_inside(&checked.positions, &checked.triangles, &pairs)
 }
 
 /// The bbox-100 frame of `mesh`'s own bounding box, the frame [`run_quality`] measures a mesh

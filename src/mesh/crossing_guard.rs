@@ -5,12 +5,12 @@
 //! guard of the finishing stage's operators and of untangle's fold collapses.
 
 use glam::DVec3;
+use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
 
 use super::edit::EditMesh;
 use crate::geometry::self_intersection::triangle_aabb;
 use crate::geometry::triangle_intersection::triangles_within;
-use parry3d_f64::bounding_volume::BoundingVolume;
 
 /// A BVH over the live faces of an edit mesh, by slot (see the module).
 pub(crate) struct CrossingGuard {
@@ -51,8 +51,7 @@ impl CrossingGuard {
     /// Calls `visit` with each live face (slot) of `m` that the face `t` with corners `p` (its
     /// vertices' positions, or where an operation would put them) shares a point with, leaving
     /// out the slots in `replaced` and the faces with a vertex of `t` (exact test, or nearer
-    /// than the guard's `near`), until
-    /// `visit` returns true; whether it did.
+    /// than the guard's `near`), until `visit` returns true; whether it did.
     pub(crate) fn visit_crossed<L: Copy>(
         &self,
         m: &EditMesh<L>,

@@ -4,6 +4,7 @@
 use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
+use crate::disjoint_sets::Dsu;
 use crate::geometry::triangle_intersection::collinear;
 use crate::mesh::edit::starting_at;
 
@@ -297,7 +298,8 @@ impl TriMesh {
     /// make a wall between two volumes (`walls_among`: two closed parts glued at those faces,
     /// as two tetrahedra joined into a bipyramid or the stories of a building stacked on each
     /// other's floors), inside the solid the parts make together; a double-sided sheet, whose
-    /// edges are left with one or two faces, stays. Vertices stay (see [`TriMesh::remove_unreferenced_vertices`]). O(faces).
+    /// edges are left with one or two faces, stays. Vertices stay (see
+    /// [`TriMesh::remove_unreferenced_vertices`]). O(faces).
     pub fn remove_duplicate_and_zero_area_faces(&mut self) -> FaceCleanup {
         let mut seen: FxHashMap<[u32; 3], [u32; 3]> = FxHashMap::default();
         let mut out = FaceCleanup::default();
@@ -381,15 +383,15 @@ impl TriMesh {
     }
 }
 
-/// The faces of `both_windings` (faces given in both windings, vertices sorted, each once) that are walls
-/// between two volumes: the faces of `both_windings` joined across their shared edges make
-/// patches, and a patch is a wall when it has a rim (edges of one face of the patch) and each
-/// edge on its rim has at least two faces besides the patch's, one on either side (`faces_on_edge`: the faces
-/// on each edge, one copy of each face counted). A single face is a patch of its own; a
-/// floor between two stories, triangulated as a fan, is one patch whose inner edges have the
-/// patch's faces only. A double-sided sheet's rim has at most one other face on an edge, and a
-/// closed surface given double-sided has no rim. O(the
-/// faces given), deterministic.
+/// The faces of `both_windings` (faces given in both windings, vertices sorted, each once)
+/// that are walls between two volumes: the faces of `both_windings` joined across their shared
+/// edges make patches, and a patch is a wall when it has a rim (edges of one face of the patch)
+/// and each edge on its rim has at least two faces besides the patch's, one on either side
+/// (`faces_on_edge`: the faces on each edge, one copy of each face counted). A single face is a
+/// patch of its own; a floor between two stories, triangulated as a fan, is one patch whose
+/// inner edges have the patch's faces only. A double-sided sheet's rim has at most one other
+/// face on an edge, and a closed surface given double-sided has no rim. O(the faces given),
+/// deterministic.
 fn walls_among(
     both_windings: &[[u32; 3]],
     faces_on_edge: &FxHashMap<(u32, u32), u32>,
@@ -402,19 +404,11 @@ fn walls_among(
             on_edge.entry(e).or_default().push(i);
         }
     }
-    // Patches: union-find over faces sharing an edge.
-    let mut parent: Vec<usize> = (0..both_windings.len()).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
+    // Patches: faces joined across shared edges.
+    let mut patches = Dsu::new(both_windings.len());
     for faces in on_edge.values() {
         for &j in &faces[1..] {
-            let (a, b) = (root(&mut parent, faces[0]), root(&mut parent, j));
-            parent[a.max(b)] = a.min(b);
+            patches.union(faces[0], j, false);
         }
     }
     // Per patch: whether it has a rim, and whether an edge of the rim has fewer than two other
@@ -426,13 +420,13 @@ fn walls_among(
             continue;
         }
         let all = faces_on_edge.get(e).copied().unwrap_or(0) as usize;
-        let r = root(&mut parent, faces[0]);
+        let r = patches.find(faces[0]).0;
         rim[r] = true;
         open_rim[r] |= all.saturating_sub(1) < 2;
     }
     (0..both_windings.len())
         .filter(|&i| {
-            let r = root(&mut parent, i);
+            let r = patches.find(i).0;
             rim[r] && !open_rim[r]
         })
         .map(|i| both_windings[i])

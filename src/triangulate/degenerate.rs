@@ -31,9 +31,10 @@ pub struct DegenerateStats {
 /// its longest edge when that edge has two faces and both new faces have an area, else the
 /// collapse of one of its two shorter edges onto an end (never removing a vertex in `fixed`, a
 /// boundary sample, that is on the mesh's boundary), when [`EditMesh::collapse_edge`] allows
-/// it, else the move of the corner off the longest edge to the mean of its ring's vertices. Returns what was
-/// done and each face's index in `mesh` before (`None` for a face an operator made or changed),
-/// as `EditMesh::into_parts` gives it. A mesh without such faces is left as it is.
+/// it, else the move of the corner off the longest edge to the mean of its ring's vertices.
+/// Returns what was done and each face's index in `mesh` before (`None` for a face an operator
+/// made or changed), as `EditMesh::into_parts` gives it. A mesh without such faces is left as
+/// it is.
 pub fn mend_degenerate_faces(
     mesh: &mut TriMesh,
     fixed: &[bool],

@@ -38,8 +38,9 @@ pub struct UntangleParams {
     pub max_collapses: usize,
     /// Faces nearer than this count as crossing (bbox-100 units, not σ_p; at most a tenth of
     /// the margin is used): faces that would share a point once the mesh is written, whose
-    /// coordinates are rounded ([`Normalization::written_rounding`](crate::Normalization::written_rounding)).
-    /// Default 0: the exact test alone.
+    /// coordinates are rounded
+    /// ([`Normalization::written_rounding`](crate::Normalization::written_rounding)). Default 0:
+    /// the exact test alone.
     pub near: f64,
 }
 
@@ -75,19 +76,20 @@ pub struct UntangleStats {
 /// Moves vertices of `mesh` (bbox-100 units) until no two non-adjacent faces intersect
 /// ([`intersecting_pairs`](crate::geometry::intersecting_pairs)), nor come within `params.near`
 /// of each other (faces that would touch once written), or `params.max_rounds` rounds have
-/// run. In a round the crossing pairs are taken in order; for a pair that still crosses, the shortest of four moves separates it
-/// (for either face: its corners behind the other's plane move along that plane's normal to
-/// `margin_sigma_p · σ_p` in front of it, or the other face moves back along its normal until
-/// they are; at most `max_step_sigma_p · σ_p` per round). A move of a vertex marked in `fixed`
-/// (a boundary sample) counts as four times as long, so those move only when nothing else
-/// separates the pair. The moves of a round that made a pair outside the input's own crossings
-/// (`input_crossings`) go back, vertex by vertex: a press never trades a crossing where the
-/// input crosses for one where it does not. A round that then does not lower the number of
-/// crossing pairs, or raises the number outside the input's crossings, is undone and tried
-/// again with moves half as long (never worse than before). Faces that cross nothing do not
-/// move. Then, for pairs still crossing that are not the input's own (both faces reaching
-/// into `input_crossings`, where the input's faces cross or its parts meet), edges are
-/// collapsed (at most `params.max_collapses`; the only change of connectivity).
+/// run. In a round the crossing pairs are taken in order; for a pair that still crosses, the
+/// shortest of four moves separates it (for either face: its corners behind the other's plane
+/// move along that plane's normal to `margin_sigma_p · σ_p` in front of it, or the other face
+/// moves back along its normal until they are; at most `max_step_sigma_p · σ_p` per round). A
+/// move of a vertex marked in `fixed` (a boundary sample) counts as four times as long, so
+/// those move only when nothing else separates the pair. The moves of a round that made a
+/// pair outside the input's own crossings (`input_crossings`) go back, vertex by vertex: a
+/// press never trades a crossing where the input crosses for one where it does not. A round
+/// that then does not lower the number of crossing pairs, or raises the number outside the
+/// input's crossings, is undone and tried again with moves half as long (never worse than
+/// before). Faces that cross nothing do not move. Then, for pairs still crossing that are not
+/// the input's own (both faces reaching into `input_crossings`, where the input's faces cross
+/// or its parts meet), edges are collapsed (at most `params.max_collapses`; the only change of
+/// connectivity).
 ///
 /// The moves are local and small where the output merely grazes itself, and they press the
 /// crossing sheet onto the other where the input itself passes through itself (the output then
@@ -233,9 +235,9 @@ const COLLAPSE_CANDIDATES: usize = 16;
 /// crossings among the faces it makes than there were among the faces around the edge, and of
 /// those the best smallest angle among the faces it makes; until no pair is left to `own`, none
 /// helps, or `max` collapses are made. The faces are in a [`CrossingGuard`] (a BVH whose leaves
-/// follow the collapses),
-/// and the crossing pairs are updated around each collapse: a collapse costs O(log F) per face
-/// it tries, not O(F). Returns the collapses made and the crossing pairs left. Deterministic.
+/// follow the collapses), and the crossing pairs are updated around each collapse: a collapse
+/// costs O(log F) per face it tries, not O(F). Returns the collapses made and the crossing
+/// pairs left. Deterministic.
 fn collapse_folds(
     m: &mut Mesh,
     fixed: &[bool],
@@ -346,8 +348,7 @@ fn faces_around_both(m: &Mesh, a: u32, b: u32) -> Vec<u32> {
 
 /// The crossing pairs of live faces with at least one face in `faces` (slots), as
 /// untangle counts them (faces sharing a vertex and degenerate faces left out; faces within the
-/// guard's `near` count),
-/// found through `guard`.
+/// guard's `near` count), found through `guard`.
 fn crossings_around(m: &Mesh, guard: &CrossingGuard, faces: &[u32]) -> usize {
     let p = m.positions();
     let mut count = 0;
