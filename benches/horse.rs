@@ -49,6 +49,7 @@ fn remesh_job(c: &mut Criterion) {
         max_memory: None,
         as_points: false,
         viewpoint: None,
+        report: None,
     };
     // The split per stage of one run, which criterion's total does not show.
     let report = run_remesh(&job, &|_| {}).expect("remesh");

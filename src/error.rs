@@ -20,7 +20,7 @@ pub enum Error {
     },
 
     /// A file's extension names no format we read or write.
-    #[error("{}: unsupported format (expected .obj, .ply, .gltf or .glb)", path.display())]
+    #[error("{}: unsupported format (expected .obj, .ply, .off, .stl, .gltf or .glb)", path.display())]
     UnsupportedFormat {
         /// The file concerned.
         path: PathBuf,

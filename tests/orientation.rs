@@ -39,6 +39,7 @@ fn remesh(
         max_memory: None,
         as_points: false,
         viewpoint: None,
+        report: None,
     };
     let report = run_remesh(&job, &|_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
     let (out, _) = read_mesh(&output).unwrap();

@@ -290,6 +290,7 @@ fn job(input: PathBuf, output: PathBuf, as_points: bool) -> RemeshJob {
         max_memory: None,
         as_points,
         viewpoint: None,
+        report: None,
     }
 }
 

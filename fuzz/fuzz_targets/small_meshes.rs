@@ -287,6 +287,7 @@ pub fn assert_remesh_is_sound(data: &[u8], dir: &Path) {
         max_memory: None,
         as_points: false,
         viewpoint: None,
+        report: None,
         format: None,
     };
     match run_remesh(&job, &|_| {}) {

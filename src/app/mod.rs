@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 use crate::io::{
-    as_written, check_and_clean, encode_mesh, read_mesh, write_atomically, MeshFormat,
+    as_written, check_and_clean, encode_mesh, read_mesh, write_atomically, AtomicFile, MeshFormat,
 };
 use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::pipeline::{
@@ -68,6 +68,9 @@ pub struct RemeshJob {
     /// single scan's sensor) instead of being oriented outward by a spanning tree. Not used for
     /// meshes.
     pub viewpoint: Option<glam::DVec3>,
+    /// Where the JSON report goes as well (`--report`): written with the mesh, both only once
+    /// everything has been written. `None`: nowhere.
+    pub report: Option<PathBuf>,
 }
 
 /// Reads, remeshes, writes, and reports. `on_stage` is called with each stage name as it starts.
@@ -75,7 +78,9 @@ pub struct RemeshJob {
 /// The mesh goes to `job.output`, atomically, or with an output of `-` ([`STDOUT`]) to standard
 /// output in `job.format` (OBJ by default); either way its bytes are built in memory and written
 /// only once every check has passed, so an error (or `--strict`) never leaves a part of a mesh
-/// behind.
+/// behind. The report goes to `job.report` the same way; both files are created (as temporary
+/// files beside their targets) before any work and renamed into place only when both are
+/// written, so a run that fails leaves every file it would write as it was.
 ///
 /// The output's invariants ([`check_invariants`](crate::check_invariants)) are checked before it
 /// is written, on the mesh as the output format stores it (glTF positions rounded to `f32`
@@ -85,7 +90,9 @@ pub struct RemeshJob {
 ///
 /// # Errors
 /// Whatever reading, the pipeline or writing return, each naming the file concerned; an
-/// [`Error::InvalidParameter`] when the output path is the input path; with `job.strict`, an
+/// [`Error::InvalidParameter`] when the output or the report path is the input's, or the
+/// report's is the output's; [`Error::Write`] (before any work) for an output or report path
+/// that is a directory or a special file or whose folder is missing; with `job.strict`, an
 /// [`Error::Internal`] (stage `invariant check`) naming the violations when the output breaks
 /// an invariant or its topology differs from the input's, and then nothing is written;
 /// [`Error::InvalidParameter`] (usage errors, before any work) for an output extension no
@@ -109,7 +116,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             });
         }
     }
-    if !to_stdout && same_file(&job.input, &job.output) {
+    if !to_stdout && same_target(&job.input, &job.output) {
         return Err(Error::InvalidParameter {
             name: "OUTPUT",
             message: format!(
@@ -118,26 +125,77 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             ),
         });
     }
-    if job.as_points || crate::is_point_set(&job.input)? {
-        return remesh_points::run(job, format, on_stage);
+    if let Some(report) = &job.report {
+        let mut others = vec![(job.input.as_path(), "the input file")];
+        if !to_stdout {
+            others.push((job.output.as_path(), "the output mesh"));
+        }
+        check_report_path(report, &others)?;
     }
-    if let Some(limit) = job.max_memory {
-        memory::check_input_size(&job.input, limit)?;
-    }
-    on_stage("read");
-    let t = Clock::start();
-    let (input, stats) = read_mesh(&job.input)?;
-    let write = |mesh: &TriMesh| write_output(job, format, mesh);
-    let (_, report) = remesh_read(
-        job,
-        format,
-        input,
-        stats.welded_vertices,
-        t,
-        &write,
-        on_stage,
-    )?;
+    // Every file the job writes is opened (as a temporary beside it) before the work: a path
+    // that cannot be written is an error now, not after the run.
+    let outputs = Outputs {
+        mesh: std::cell::RefCell::new(if to_stdout {
+            None
+        } else {
+            Some(AtomicFile::create(&job.output)?)
+        }),
+        written: std::cell::Cell::new(false),
+        report: job.report.as_deref().map(AtomicFile::create).transpose()?,
+    };
+    let write = |mesh: &TriMesh| write_output(job, format, mesh, &outputs);
+    let report = if job.as_points || crate::is_point_set(&job.input)? {
+        remesh_points::run(job, format, &write, on_stage)?
+    } else {
+        if let Some(limit) = job.max_memory {
+            memory::check_input_size(&job.input, limit)?;
+        }
+        on_stage("read");
+        let t = Clock::start();
+        let (input, stats) = read_mesh(&job.input)?;
+        let (_, report) = remesh_read(
+            job,
+            format,
+            input,
+            stats.welded_vertices,
+            t,
+            &write,
+            on_stage,
+        )?;
+        report
+    };
+    outputs.commit(&report)?;
     Ok(report)
+}
+
+/// The files a [`RemeshJob`] writes, open as temporary files until [`Outputs::commit`]: the
+/// mesh (`None` for standard output), whether its bytes went in, and the report.
+struct Outputs {
+    mesh: std::cell::RefCell<Option<AtomicFile>>,
+    written: std::cell::Cell<bool>,
+    report: Option<AtomicFile>,
+}
+
+impl Outputs {
+    /// Writes `report` into its file, then renames the mesh and the report into place.
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming the file that could not be written; the temporary files are
+    /// removed (a mesh renamed before the report's rename failed stays).
+    fn commit(self, report: &QualityReport) -> Result<()> {
+        use std::io::Write;
+        let mut report_file = self.report;
+        if let Some(f) = &mut report_file {
+            f.write_all(report.to_json().as_bytes())
+                .map_err(|e| f.error(format!("cannot write: {e}")))?;
+        }
+        if let Some(mesh) = self.mesh.into_inner() {
+            if self.written.get() {
+                mesh.commit()?;
+            }
+        }
+        report_file.map_or(Ok(()), AtomicFile::commit)
+    }
 }
 
 /// [`run_remesh`] from the mesh read on (shared with [`remesh_mesh`]): the pipeline, the check,
@@ -604,9 +662,20 @@ fn refuse_if_strict(job: &RemeshJob, report: &mut QualityReport) -> Result<()> {
 
 /// Writes `mesh` to `job.output` in `format`, atomically, or to standard output: the complete
 /// bytes or nothing.
-fn write_output(job: &RemeshJob, format: MeshFormat, mesh: &TriMesh) -> Result<()> {
+fn write_output(
+    job: &RemeshJob,
+    format: MeshFormat,
+    mesh: &TriMesh,
+    outputs: &Outputs,
+) -> Result<()> {
+    use std::io::Write;
     let bytes = encode_mesh(&job.output, mesh, format)?;
-    if is_stdout(&job.output) {
+    if let Some(file) = outputs.mesh.borrow_mut().as_mut() {
+        file.write_all(&bytes)
+            .map_err(|e| file.error(format!("cannot write: {e}")))?;
+        outputs.written.set(true);
+        Ok(())
+    } else {
         use std::io::Write;
         let mut stdout = std::io::stdout().lock();
         stdout
@@ -616,8 +685,6 @@ fn write_output(job: &RemeshJob, format: MeshFormat, mesh: &TriMesh) -> Result<(
                 path: job.output.clone(),
                 message: format!("cannot write to standard output: {e}"),
             })
-    } else {
-        write_atomically(&job.output, |w| w.write_all(&bytes))
     }
 }
 
@@ -763,6 +830,7 @@ impl RemeshJob {
             max_memory,
             as_points: false,
             viewpoint,
+            report: None,
         }
     }
 }
@@ -847,8 +915,8 @@ fn output_format(output: &Path, format: Option<MeshFormat>) -> Result<MeshFormat
     let by_extension = MeshFormat::from_path(output).map_err(|_| Error::InvalidParameter {
         name: "OUTPUT",
         message: format!(
-            "{}: unsupported output format (expected .obj, .ply, .gltf or .glb, or - for \
-             standard output)",
+            "{}: unsupported output format (expected .obj, .ply, .off, .stl, .gltf or .glb, or - \
+             for standard output)",
             output.display()
         ),
     })?;
@@ -988,10 +1056,35 @@ fn with_path(e: Error, path: &Path) -> Error {
 
 /// Whether two paths name the same existing file.
 fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            // Hard links too: one file, two names.
+            return (x.dev(), x.ino()) == (y.dev(), y.ino());
+        }
+    }
     match (a.canonicalize(), b.canonicalize()) {
         (Ok(x), Ok(y)) => x == y,
         _ => false,
     }
+}
+
+/// Whether writing to `a` and to `b` would write one file: [`same_file`] for files that exist,
+/// and for one that does not yet, the same name in the same (canonical) folder.
+fn same_target(a: &Path, b: &Path) -> bool {
+    if same_file(a, b) {
+        return true;
+    }
+    let place = |p: &Path| -> Option<PathBuf> {
+        let name = p.file_name()?;
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Some(dir.canonicalize().ok()?.join(name))
+    };
+    matches!((place(a), place(b)), (Some(x), Some(y)) if x == y)
 }
 
 /// The most points a [`PointsJob`] draws: 10^9, about 24 GB of binary PLY (a bound on the disk
@@ -1067,6 +1160,24 @@ pub(crate) fn require_ply_output(output: &Path) -> Result<()> {
 pub fn write_report(path: &Path, report: &QualityReport) -> Result<()> {
     let json = report.to_json();
     write_atomically(path, |w| w.write_all(json.as_bytes()))
+}
+
+/// Checks, before any work, that a JSON report can go to `report` without replacing a file the
+/// job reads or writes: `others` are those paths, each with what it is ("the input file").
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `--report` when `report` is one of `others` (the same
+/// file under any name, or the same name in the same folder); [`Error::Write`] naming `report`
+/// when it is a directory or a special file, or its folder is missing or not writable.
+pub fn check_report_path(report: &Path, others: &[(&Path, &str)]) -> Result<()> {
+    if let Some((_, what)) = others.iter().find(|(p, _)| same_target(report, p)) {
+        return Err(Error::InvalidParameter {
+            name: "--report",
+            message: format!("{} is {what}; choose another report path", report.display()),
+        });
+    }
+    // Creating the temporary file (removed when dropped) is the test of the folder.
+    AtomicFile::create(report).map(drop)
 }
 
 /// Runs `job`, turning a panic (a bug) into an [`Error::Internal`] with stage `panic`, the

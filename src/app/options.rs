@@ -10,6 +10,11 @@ use crate::surface::features::FeatureDetection;
 use crate::triangulate::optimize::SMOOTH_ITERATIONS;
 use crate::triangulate::TriangulationMethod;
 
+/// The most sweeps `--iterations` (gradient ascent), `--smooth` (finishing relaxation) and
+/// `simplify --resample` take: 1000, a hundred times the defaults (the ascent has converged
+/// after a few tens, Sec. 5.2); more only runs longer.
+pub const MAX_SWEEPS: usize = 1000;
+
 /// The pipeline options of `remesh INPUT OUTPUT`, one field per flag, as given (unchecked);
 /// [`RemeshOptions::default`] holds the command line's defaults. Lengths are in bbox-100 units
 /// (the input scaled so its bounding box's longest side is 100), angles in degrees.
@@ -96,6 +101,14 @@ impl RemeshOptions {
             seed: self.seed,
             ..Default::default()
         };
+        for (name, value) in [("--iterations", self.iterations), ("--smooth", self.smooth)] {
+            if value > MAX_SWEEPS {
+                return Err(Error::InvalidParameter {
+                    name,
+                    message: format!("must be at most {MAX_SWEEPS}, got {value}"),
+                });
+            }
+        }
         params.gradient_ascent.iterations = self.iterations;
         if !(self.lfs_factor.is_finite() && self.lfs_factor >= 0.0) {
             return Err(Error::InvalidParameter {

@@ -10,7 +10,7 @@ use glam::DVec3;
 
 use super::{
     check_and_write, count_note, dropped_note, holes_note, insert_kernel_extras, memory, with_path,
-    write_output, RemeshJob, RemeshedMesh, DISTANCE_SAMPLES,
+    RemeshJob, RemeshedMesh, DISTANCE_SAMPLES,
 };
 use crate::error::{Error, Result};
 use crate::io::{as_written, MeshFormat};
@@ -28,22 +28,8 @@ use crate::timing::Clock;
 const DISTANCE_CHUNK: usize = 1 << 20;
 
 /// The point-set branch of [`run_remesh`](super::run_remesh), after its usage checks.
+/// `write` takes the output mesh (model units).
 pub(super) fn run(
-    job: &RemeshJob,
-    format: MeshFormat,
-    on_stage: &(dyn Fn(&str) + Sync),
-) -> Result<QualityReport> {
-    run_with(
-        job,
-        format,
-        &|mesh| write_output(job, format, mesh),
-        on_stage,
-    )
-}
-
-/// [`run`] with the output mesh (model units) handed to `write` instead of written to
-/// `job.output`.
-fn run_with(
     job: &RemeshJob,
     format: MeshFormat,
     write: &dyn Fn(&TriMesh) -> Result<()>,
@@ -269,7 +255,7 @@ pub fn remesh_point_set(
         viewpoint,
     );
     let handed = Mutex::new(None);
-    let report = run_with(
+    let report = run(
         &job,
         MeshFormat::Ply,
         &|mesh| {

@@ -101,6 +101,16 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
             message: "must be at least 1".into(),
         });
     }
+    if job.resample > super::options::MAX_SWEEPS {
+        return Err(Error::InvalidParameter {
+            name: "--resample",
+            message: format!(
+                "must be at most {}, got {}",
+                super::options::MAX_SWEEPS,
+                job.resample
+            ),
+        });
+    }
     let t = Instant::now();
     if job.sigma_n.is_some_and(f64::is_finite) && !PointReader::open(&job.input)?.has_normals() {
         return Err(Error::InvalidParameter {

@@ -2,16 +2,16 @@
 //! call per subcommand, prints, and maps errors to exit codes (2 usage, 3 input, 4 output,
 //! 1 internal). All work lives in the library (`spectral_remesh::run_remesh` and the other jobs).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
-    catch_panics, parse_bytes, physical_memory, remove_temporaries, run_points, run_quality,
-    run_remesh, run_simplify, write_report, Error, MeshFormat, PointsJob, RemeshJob, RemeshOptions,
-    SimplifyDensity, SimplifyJob, STDOUT,
+    catch_panics, check_report_path, parse_bytes, physical_memory, remove_temporaries, run_points,
+    run_quality, run_remesh, run_simplify, write_report, Error, MeshFormat, PointsJob, RemeshJob,
+    RemeshOptions, SimplifyDensity, SimplifyJob, STDOUT,
 };
 
 const EXAMPLES: &str = "\
@@ -34,6 +34,7 @@ Examples:
 #[derive(Parser, Debug)]
 #[command(name = "remesh", version, after_help = EXAMPLES)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+#[command(allow_negative_numbers = true)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -58,7 +59,7 @@ struct Cli {
 
     /// Number of output vertices (within 1%); sigma_p is searched for and printed. Default: the
     /// input's vertex count.
-    #[arg(long, conflicts_with = "sigma_p")]
+    #[arg(long, conflicts_with = "sigma_p", value_parser = whole::<usize>)]
     points: Option<usize>,
 
     /// Kernel width sigma_p in bbox-100 units (the model is scaled so its longest side is 100),
@@ -97,7 +98,12 @@ struct Cli {
     /// Iterations of the finishing relaxation: vertices move towards where their triangles
     /// would be equilateral, on the input, with valence flips (horse at 8600: Qave 0.903 without,
     /// 0.941 after 10). 0 turns it off (the triangulated samples as the paper leaves them).
-    #[arg(long, default_value_t = spectral_remesh::SMOOTH_ITERATIONS, value_name = "N")]
+    #[arg(
+        long,
+        default_value_t = spectral_remesh::SMOOTH_ITERATIONS,
+        value_name = "N",
+        value_parser = whole::<usize>
+    )]
     smooth: usize,
 
     /// The smallest angle the last pass of the optimization works towards, degrees: faces with a
@@ -132,14 +138,15 @@ struct Cli {
     triangulation: String,
 
     /// Gradient-ascent sweeps (Sec. 6.2).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = whole::<usize>)]
     iterations: usize,
 
     /// Seed of every random choice: the same seed gives the same output, byte for byte.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = whole::<u64>)]
     seed: u64,
 
-    /// Write the quality report as JSON to this file.
+    /// Write the quality report as JSON to this file (written with the mesh, both only once
+    /// the run has succeeded); - prints it on standard output instead of the table.
     #[arg(long, value_name = "FILE.json")]
     report: Option<PathBuf>,
 
@@ -178,6 +185,7 @@ struct Cli {
 enum Command {
     /// Report on any mesh: Table 1 triangle measures, topology, and with --ref the distance to a
     /// reference surface.
+    #[command(allow_negative_numbers = true)]
     Quality {
         /// The mesh to measure.
         mesh: PathBuf,
@@ -187,15 +195,16 @@ enum Command {
         /// Print the report as JSON instead of a table.
         #[arg(long)]
         json: bool,
-        /// Also write the JSON report to this file.
+        /// Also write the JSON report to this file (- : on standard output, as --json).
         #[arg(long, value_name = "FILE.json")]
         report: Option<PathBuf>,
         /// Seed of the distance sampling.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = whole::<u64>)]
         seed: u64,
     },
     /// Simplify a point set (PLY) out of core with the randomized linear scan (Sec. 6.1):
     /// memory bounded by the output plus a fixed buffer. Writes the samples as PLY with normals.
+    #[command(allow_negative_numbers = true)]
     Simplify {
         /// The input point set: .ply (ascii or binary) or XYZ/CSV text (.xyz .csv .txt .pts:
         /// `x y z` or `x y z nx ny nz` per line, or named columns), with or without normals.
@@ -218,10 +227,16 @@ enum Command {
         sigma_n: Option<f64>,
         /// After the scan, K sweeps of gradient-ascent resampling (Sec. 6.2; 10 is typical), each
         /// move projected onto the RIMLS surface of the input (same sigma_p, sigma_n).
-        #[arg(long, value_name = "K", default_value_t = 0, conflicts_with = "levels")]
+        #[arg(
+            long,
+            value_name = "K",
+            default_value_t = 0,
+            conflicts_with = "levels",
+            value_parser = whole::<usize>
+        )]
         resample: usize,
         /// Seed of the visit order.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = whole::<u64>)]
         seed: u64,
         /// For an input without normals: orient the estimated normals towards this point
         /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
@@ -233,17 +248,22 @@ enum Command {
     },
     /// Draw random points with normals uniformly by area from a mesh's surface and write them as
     /// binary PLY (streamed: any count fits in memory). Makes large point-cloud inputs.
+    #[command(allow_negative_numbers = true)]
     Points {
         /// The mesh to draw from (.obj, .ply, .gltf, .glb).
         mesh: PathBuf,
         /// The output point set (.ply; not - : point sets need a file).
         output: PathBuf,
         /// How many points.
-        #[arg(long)]
+        #[arg(long, value_parser = whole::<u64>)]
         count: u64,
         /// Seed of the random draw.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = whole::<u64>)]
         seed: u64,
+        /// Print nothing but errors (taken as the other commands take it; this one prints
+        /// nothing else).
+        #[arg(short, long)]
+        quiet: bool,
     },
 }
 
@@ -275,8 +295,9 @@ impl From<OutputFormat> for MeshFormat {
 enum Config {
     Remesh {
         job: Box<RemeshJob>,
-        report: Option<PathBuf>,
         quiet: bool,
+        /// The JSON report on standard output instead of the table (`--report -`).
+        json: bool,
     },
     Quality {
         mesh: PathBuf,
@@ -304,13 +325,17 @@ fn config(mut cli: Cli) -> Result<Config, Error> {
             json,
             report,
             seed,
-        }) => Ok(Config::Quality {
-            mesh,
-            reference,
-            seed,
-            json,
-            report,
-        }),
+        }) => {
+            // `--report -`: the JSON report on standard output, as --json.
+            let to_stdout = report.as_deref() == Some(Path::new(STDOUT));
+            Ok(Config::Quality {
+                mesh,
+                reference,
+                seed,
+                json: json || to_stdout,
+                report: report.filter(|_| !to_stdout),
+            })
+        }
         Some(Command::Simplify {
             input,
             output,
@@ -350,6 +375,7 @@ fn config(mut cli: Cli) -> Result<Config, Error> {
             output,
             count,
             seed,
+            quiet: _,
         }) => Ok(Config::Points(PointsJob {
             mesh,
             output,
@@ -374,11 +400,26 @@ fn config(mut cli: Cli) -> Result<Config, Error> {
                 max_memory: cli.max_memory.or_else(physical_memory),
                 as_points: cli.as_points,
                 viewpoint: cli.viewpoint.map(glam::DVec3::from),
+                report: cli.report,
             };
+            // `--report -`: the JSON report on standard output, in place of the table.
+            let mut job = job;
+            let json = job.report.as_deref() == Some(Path::new(STDOUT));
+            if json {
+                if job.output.as_os_str() == STDOUT {
+                    return Err(Error::InvalidParameter {
+                        name: "--report",
+                        message: "- (standard output) is where the mesh goes (OUTPUT -); give \
+                                  the report a file"
+                            .into(),
+                    });
+                }
+                job.report = None;
+            }
             Ok(Config::Remesh {
                 job: Box::new(job),
-                report: cli.report,
                 quiet: cli.quiet,
+                json,
             })
         }
     }
@@ -407,12 +448,14 @@ fn remesh_options(cli: &Cli) -> RemeshOptions {
 /// Runs a [`Config`]: one library call, then what it prints and the JSON report.
 fn execute(config: Config) -> Result<(), Error> {
     match config {
-        Config::Remesh { job, report, quiet } => {
+        Config::Remesh { job, quiet, json } => {
             let bar = progress(quiet);
             let result = run_remesh(&job, &|stage: &str| bar.set_message(stage.to_string()));
             bar.finish_and_clear();
             let r = result?;
-            if !quiet {
+            if json {
+                emit(&format!("{}\n", r.to_json()));
+            } else if !quiet {
                 // With the mesh on standard output, the report goes to standard error.
                 let to_stdout = job.output.as_os_str() == STDOUT;
                 let text = format!(
@@ -430,7 +473,7 @@ fn execute(config: Config) -> Result<(), Error> {
                     emit(&text);
                 }
             }
-            report.map_or(Ok(()), |p| write_report(&p, &r))
+            Ok(())
         }
         Config::Quality {
             mesh,
@@ -439,6 +482,13 @@ fn execute(config: Config) -> Result<(), Error> {
             json,
             report,
         } => {
+            if let Some(p) = &report {
+                let mut others = vec![(mesh.as_path(), "the mesh to report on")];
+                if let Some(r) = &reference {
+                    others.push((r.as_path(), "the reference mesh"));
+                }
+                check_report_path(p, &others)?;
+            }
             let r = run_quality(&mesh, reference.as_deref(), seed)?;
             emit(&if json {
                 format!("{}\n", r.to_json())
@@ -492,8 +542,40 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
     }
 }
 
+/// A whole number of type `T` (a count, a seed), with a message that says so for a negative
+/// or fractional one.
+fn whole<T: std::str::FromStr>(s: &str) -> Result<T, String> {
+    s.trim()
+        .parse::<T>()
+        .map_err(|_| format!("must be a whole number >= 0, got {s}"))
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
+                e.exit();
+            }
+            // One line, as every other error: clap's message up to its tips and usage.
+            let text = e.to_string();
+            let message: Vec<&str> = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            let message = message.join(" ");
+            let message = message.strip_prefix("error: ").unwrap_or(&message);
+            eprintln!("remesh: error: {message} (see --help)");
+            return ExitCode::from(2);
+        }
+    };
     // Interrupted (SIGINT, SIGTERM, SIGHUP): the temporary files and bucket folders of the run
     // are removed and the target stays as it was. Exit 130, as a shell reports an interrupt.
     let _ = ctrlc::set_handler(|| {

@@ -153,9 +153,9 @@ fn resample_in_batches<const K: usize>(
     };
     let r2 = params.support_radius * params.support_radius;
     let mut result = GradientAscentResult {
-        mean_move: Vec::with_capacity(params.iterations),
-        mean_s: Vec::with_capacity(params.iterations),
-        min_s: Vec::with_capacity(params.iterations),
+        mean_move: Vec::new(),
+        mean_s: Vec::new(),
+        min_s: Vec::new(),
     };
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(params.seed);
     let mut order: Vec<usize> = (0..n).collect();

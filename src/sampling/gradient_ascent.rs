@@ -137,9 +137,9 @@ pub fn gradient_ascent_graded<S: Projection + ?Sized>(
     let lists = neighbour_lists(samples, fixed, r_pos);
 
     let mut result = GradientAscentResult {
-        mean_move: Vec::with_capacity(params.iterations),
-        mean_s: Vec::with_capacity(params.iterations),
-        min_s: Vec::with_capacity(params.iterations),
+        mean_move: Vec::new(),
+        mean_s: Vec::new(),
+        min_s: Vec::new(),
     };
     if params.sequential {
         use rand::seq::SliceRandom;

@@ -1,0 +1,295 @@
+//! Issue 36: the defects a careless and then a hostile user found, one named test each, on inputs
+//! the test makes. Each run is either a result or a one-line error with the exit code of its
+//! kind (2 usage, 3 input, 4 output); never a panic, a hang, or a file lost or half-replaced.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+mod common;
+
+fn remesh(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .args(args)
+        .output()
+        .expect("run remesh")
+}
+
+/// `path` as the `&str` a command line takes (the test folders have UTF-8 names).
+fn arg(path: &Path) -> &str {
+    path.to_str().expect("a UTF-8 path")
+}
+
+fn write(dir: &Path, name: &str, content: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, content).unwrap();
+    p
+}
+
+/// A small sphere (an icosahedron subdivided twice, 320 faces) written as OBJ in `dir`.
+fn sphere(dir: &Path) -> PathBuf {
+    let p = dir.join("sphere.obj");
+    spectral_remesh::write_mesh(&p, &common::icosphere(2)).unwrap();
+    p
+}
+
+/// The run failed with `code` and printed one line on stderr mentioning each of `mentions`.
+fn assert_error(o: &Output, code: i32, mentions: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(code), "stderr: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    assert!(err.starts_with("remesh: error: "), "{err}");
+    for m in mentions {
+        assert!(err.contains(m), "{err:?} does not mention {m:?}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+/// No temporary file of a write is left in `dir`.
+fn assert_no_temporaries(dir: &Path) {
+    let left: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
+}
+
+/// Item 1: a zero-area face that comes first (parry's BVH panicked on it when it led the list).
+#[test]
+fn a_zero_area_first_face_is_left_out_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(
+        dir.path(),
+        "c.obj",
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n",
+    );
+    let out = dir.path().join("o.obj");
+    let o = remesh(&[arg(&input), arg(&out), "--points", "200", "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (mesh, _) = spectral_remesh::read_mesh(&out).unwrap();
+    assert!(mesh.face_count() > 0);
+    // The same face many times over, first.
+    let mut many = String::from("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\n");
+    many.push_str(&"f 1 2 3\n".repeat(10_000));
+    many.push_str("f 1 2 4\n");
+    let input = write(dir.path(), "many.obj", many);
+    let o = remesh(&[arg(&input), arg(&out), "--points", "200", "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// Item 2: `--report` naming the input or the output is refused before any work, and both
+/// files stay as they were (also when the report names the output's file by another path).
+#[test]
+fn the_report_never_replaces_the_input_or_the_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let before = std::fs::read(&input).unwrap();
+    let out = write(dir.path(), "o.obj", "KEEP\n");
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "300",
+        "--report",
+        arg(&input),
+    ]);
+    assert_error(&o, 2, &["--report", "input"]);
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+    assert_eq!(std::fs::read(&out).unwrap(), b"KEEP\n");
+    let other_name = dir.path().join(".").join("o.obj");
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "300",
+        "--report",
+        arg(&other_name),
+    ]);
+    assert_error(&o, 2, &["--report", "output"]);
+    assert_eq!(std::fs::read(&out).unwrap(), b"KEEP\n");
+    // An output that does not exist yet, named twice.
+    let new = dir.path().join("new.obj");
+    let o = remesh(&[
+        arg(&input),
+        arg(&new),
+        "--points",
+        "300",
+        "--report",
+        arg(&new),
+    ]);
+    assert_error(&o, 2, &["--report", "output"]);
+    assert!(!new.exists());
+    // A hard link to the input is the input.
+    let link = dir.path().join("link.obj");
+    std::fs::hard_link(&input, &link).unwrap();
+    let o = remesh(&[arg(&input), arg(&link), "--points", "300"]);
+    assert_error(&o, 2, &["OUTPUT", "input"]);
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+    // `quality --report` on the mesh it reads.
+    let o = remesh(&["quality", arg(&input), "--report", arg(&input)]);
+    assert_error(&o, 2, &["--report"]);
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+    assert_no_temporaries(dir.path());
+}
+
+/// Item 3: a run whose report cannot be written fails before any work and leaves an existing
+/// output as it was; a run that succeeds writes both.
+#[test]
+fn a_failed_run_leaves_the_existing_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = write(dir.path(), "k.obj", "KEEP\n");
+    let missing = dir.path().join("nosuch").join("r.json");
+    let folder = dir.path().join("folder");
+    std::fs::create_dir(&folder).unwrap();
+    for report in [missing.as_path(), folder.as_path()] {
+        let o = remesh(&[
+            arg(&input),
+            arg(&out),
+            "--points",
+            "300",
+            "--report",
+            arg(report),
+        ]);
+        assert_error(&o, 4, &[arg(report)]);
+        assert_eq!(std::fs::read(&out).unwrap(), b"KEEP\n");
+    }
+    assert!(folder.is_dir());
+    // An output that cannot be written leaves the report's path alone.
+    let report = write(dir.path(), "r.json", "KEEP\n");
+    let folder_obj = dir.path().join("folder.obj");
+    std::fs::create_dir(&folder_obj).unwrap();
+    let o = remesh(&[
+        arg(&input),
+        arg(&folder_obj),
+        "--points",
+        "300",
+        "--report",
+        arg(&report),
+    ]);
+    assert_error(&o, 4, &[arg(&folder_obj)]);
+    assert_eq!(std::fs::read(&report).unwrap(), b"KEEP\n");
+    assert_no_temporaries(dir.path());
+    // Both written when the run succeeds.
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "300",
+        "-q",
+        "--report",
+        arg(&report),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(spectral_remesh::read_mesh(&out).is_ok());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(json["topology"]["vertices"].as_i64().unwrap() > 250);
+    assert_no_temporaries(dir.path());
+}
+
+/// Item 5: sweep counts far beyond any use are refused at once (they aborted allocating, or ran
+/// for minutes), naming the option.
+#[test]
+fn sweep_counts_have_upper_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    for flag in ["--iterations", "--smooth"] {
+        let o = remesh(&[
+            arg(&input),
+            arg(&out),
+            "--points",
+            "300",
+            flag,
+            "1000000000",
+        ]);
+        assert_error(&o, 2, &[flag, "1000000000"]);
+        assert!(!out.exists());
+    }
+    let points = write(dir.path(), "p.xyz", "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n");
+    let simplified = dir.path().join("s.ply");
+    let o = remesh(&[
+        "simplify",
+        arg(&points),
+        arg(&simplified),
+        "--points",
+        "3",
+        "--resample",
+        "1000000000",
+    ]);
+    assert_error(&o, 2, &["--resample", "1000000000"]);
+    assert!(!simplified.exists());
+    // The bound itself is taken.
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "300",
+        "--smooth",
+        "1000",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// Item 12: negative and fractional numbers reach each option's own one-line check, or a
+/// one-line message that the option takes a whole number.
+#[test]
+fn negative_values_get_one_line_answers() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    for (flag, value, says) in [
+        ("--sigma-p", "-1", "positive"),
+        ("--feature-angle", "-1", "0 to 180"),
+        ("--points", "-5", "whole number"),
+        ("--points", "2.5", "whole number"),
+        ("--seed", "-3", "whole number"),
+    ] {
+        let o = remesh(&[arg(&input), arg(&out), flag, value]);
+        assert_error(&o, 2, &[flag, value, says]);
+        assert!(!out.exists());
+    }
+    // clap's own errors are one line too.
+    let o = remesh(&[arg(&input)]);
+    assert_error(&o, 2, &["OUTPUT"]);
+    let o = remesh(&[arg(&input), arg(&out), "--no-such-flag"]);
+    assert_error(&o, 2, &["--no-such-flag"]);
+}
+
+/// Item 13 (messages): the formats named, `--report -` on standard output (not a file named
+/// `-`), `-q` taken by every command.
+#[test]
+fn messages_name_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let o = remesh(&[
+        arg(&input),
+        arg(&dir.path().join("o.xyz")),
+        "--points",
+        "300",
+    ]);
+    assert_error(&o, 2, &[".stl", ".off"]);
+    let o = remesh(&[
+        arg(&dir.path().join("in.abc")),
+        arg(&dir.path().join("o.obj")),
+    ]);
+    assert_error(&o, 3, &["in.abc", ".stl", ".off"]);
+    // `--report -`: the JSON on standard output.
+    let out = dir.path().join("o.obj");
+    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .current_dir(dir.path())
+        .args([arg(&input), arg(&out), "--points", "300", "--report", "-"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
+    assert!(json["topology"]["vertices"].as_i64().unwrap() > 250);
+    assert!(!dir.path().join("-").exists());
+    let o = remesh(&[arg(&input), "-", "--points", "300", "--report", "-"]);
+    assert_error(&o, 2, &["--report"]);
+    let points = dir.path().join("p.ply");
+    let o = remesh(&["points", arg(&input), arg(&points), "--count", "100", "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
