@@ -293,3 +293,115 @@ fn messages_name_what_is_wrong() {
     let o = remesh(&["points", arg(&input), arg(&points), "--count", "100", "-q"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// `remesh ARGS` with `TMPDIR` set to `tmp`.
+fn remesh_in(tmp: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .env("TMPDIR", tmp)
+        .args(args)
+        .output()
+        .expect("run remesh")
+}
+
+/// A binary little-endian PLY point set: the header announces `announced` points (`x y z` as
+/// float), the body holds `points` of them.
+fn ply_points(announced: u64, points: usize) -> Vec<u8> {
+    let mut bytes = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {announced}\nproperty float x\n\
+         property float y\nproperty float z\nend_header\n"
+    )
+    .into_bytes();
+    for k in 0..points {
+        let t = k as f32 * 0.37;
+        for c in [t.cos(), t.sin(), (k % 7) as f32 * 0.1] {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    bytes
+}
+
+/// Item 4: a header announcing 10^12 points over a body of 100 is refused from the file's
+/// length before anything is sized by it, by `remesh` and `simplify`, and no bucket folder is
+/// left behind.
+#[test]
+fn a_header_count_beyond_the_file_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let tmp = dir.path().join("tmp");
+    std::fs::create_dir(&tmp).unwrap();
+    let input = write(dir.path(), "big.ply", ply_points(1_000_000_000_000, 100));
+    let out = dir.path().join("o.obj");
+    let o = remesh_in(&tmp, &[arg(&input), arg(&out), "--points", "50"]);
+    assert_error(&o, 3, &["big.ply", "1000000000000", "at most 100"]);
+    let simplified = dir.path().join("s.ply");
+    let o = remesh_in(
+        &tmp,
+        &["simplify", arg(&input), arg(&simplified), "--points", "50"],
+    );
+    assert_error(&o, 3, &["big.ply", "1000000000000", "at most 100"]);
+    assert!(!out.exists() && !simplified.exists());
+    assert_eq!(
+        std::fs::read_dir(&tmp).unwrap().count(),
+        0,
+        "left in TMPDIR"
+    );
+}
+
+/// Item 10: bytes after a binary body's last element (garbage, or an ascii body under a binary
+/// header) are an input error, for meshes and point sets.
+#[test]
+fn bytes_after_a_binary_body_are_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let ply = dir.path().join("m.ply");
+    let o = remesh(&[arg(&input), arg(&ply), "--points", "200", "-q"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut bytes = std::fs::read(&ply).unwrap();
+    bytes.extend_from_slice(b"GARBAGE");
+    let garbage = write(dir.path(), "garbage.ply", &bytes);
+    let out = dir.path().join("o.obj");
+    let o = remesh(&[arg(&garbage), arg(&out), "--points", "100"]);
+    assert_error(&o, 3, &["garbage.ply", "7 bytes after"]);
+    // Points: a body one point longer than announced.
+    let points = write(dir.path(), "points.ply", ply_points(99, 100));
+    let o = remesh(&[arg(&points), arg(&out), "--points", "50"]);
+    assert_error(&o, 3, &["points.ply", "12 bytes after"]);
+    // An ascii body under a binary header.
+    let ascii = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+                 property float y\nproperty float z\nelement face 1\n\
+                 property list uchar int vertex_indices\nend_header\n\
+                 0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    let ascii = write(dir.path(), "ascii-body.ply", ascii);
+    let o = remesh(&[arg(&ascii), arg(&out), "--points", "50"]);
+    assert_error(&o, 3, &["ascii-body.ply"]);
+    assert!(!out.exists());
+}
+
+/// Item 11: files other tools read: an OFF whose records wrap over several lines (OFF is
+/// whitespace-separated), and an OBJ or OFF starting with a UTF-8 byte-order mark, read as the
+/// same mesh as their plain forms.
+#[test]
+fn wrapped_off_records_and_byte_order_marks_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n\
+                 3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+    let wrapped = "OFF\n4 4 0\n0 0\n0\n1 0 0\n0 1 0\n0 0 1\n\
+                   3 0 2\n1\n3\n0 1 3\n3 1 2 3 255 0 0\n3 0 3 2\n";
+    let read = |name: &str, text: &[u8]| {
+        let p = write(dir.path(), name, text);
+        spectral_remesh::read_mesh(&p)
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .0
+    };
+    let a = read("plain.off", plain.as_bytes());
+    let b = read("wrapped.off", wrapped.as_bytes());
+    assert_eq!(a.positions, b.positions);
+    assert_eq!(a.triangles, b.triangles);
+    let bom_off = read("bom.off", &[b"\xEF\xBB\xBF", plain.as_bytes()].concat());
+    assert_eq!(bom_off.triangles, a.triangles);
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+    let c = read("plain.obj", obj.as_bytes());
+    let d = read("bom.obj", &[b"\xEF\xBB\xBF", obj.as_bytes()].concat());
+    assert_eq!(d.positions.len(), 4);
+    assert_eq!(c.positions, d.positions);
+    assert_eq!(c.triangles, d.triangles);
+}

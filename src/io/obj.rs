@@ -19,7 +19,9 @@ use crate::mesh::TriMesh;
 /// faces triangulated in file order, polygons in their plane ([`triangulate_polygon`]; indices
 /// checked against the vertex count, 1-based in messages).
 pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
-    let data = read_file(path)?;
+    let file = read_file(path)?;
+    // A UTF-8 byte-order mark (some Windows editors write one) is not part of the first line.
+    let data = file.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&file);
     let mut positions: Vec<DVec3> = Vec::new();
     // Every face's corners, one after another, and where each face ends in `face_corners`:
     // polygons are triangulated once every vertex is read (a face may name a later vertex).

@@ -20,7 +20,8 @@ use crate::mesh::TriMesh;
 /// per-vertex values ignored).
 pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let data = read_file(path)?;
-    let text = String::from_utf8_lossy(&data);
+    // A UTF-8 byte-order mark is not part of the keyword.
+    let text = String::from_utf8_lossy(data.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&data));
     // Lines without comments, numbered from 1, blank ones skipped.
     let mut lines = text
         .lines()
@@ -78,10 +79,24 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
         })
     };
     let mut positions = Vec::with_capacity(nv.min(1 << 24));
+    // A record's tokens: its line's, and the next lines' while it needs more (OFF is
+    // whitespace-separated; some writers wrap long records). Values past those it needs on its
+    // last line (colours) are left out.
+    let mut tokens_of = |k: usize, n: usize, what: &str, need: &dyn Fn(&[&str]) -> usize| {
+        let (no, line) = record(k, n, what)?;
+        let mut tokens: Vec<&str> = line.split_whitespace().collect();
+        while tokens.len() < need(&tokens) {
+            match record(k, n, what) {
+                Ok((_, more)) => tokens.extend(more.split_whitespace()),
+                Err(_) => break,
+            }
+        }
+        Ok::<_, Error>((no, tokens))
+    };
     for k in 0..nv {
-        let (no, line) = record(k, nv, "vertices")?;
+        let (no, tokens) = tokens_of(k, nv, "vertices", &|_| 3)?;
         let mut p = [0.0f64; 3];
-        let mut tokens = line.split_whitespace();
+        let mut tokens = tokens.into_iter();
         for c in &mut p {
             let tok = tokens
                 .next()
@@ -95,8 +110,12 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let mut triangles = Vec::with_capacity(nf.min(1 << 24));
     let mut corners: Vec<u32> = Vec::new();
     for k in 0..nf {
-        let (no, line) = record(k, nf, "faces")?;
-        let mut tokens = line.split_whitespace();
+        let (no, tokens) = tokens_of(k, nf, "faces", &|t: &[&str]| {
+            t.first()
+                .and_then(|c| c.parse::<usize>().ok())
+                .map_or(0, |size| size.saturating_add(1))
+        })?;
+        let mut tokens = tokens.into_iter();
         let index = |tok: Option<&str>| -> Result<u32> {
             let tok =
                 tok.ok_or_else(|| err(no, "the face has fewer corners than it says".into()))?;

@@ -554,6 +554,10 @@ pub fn simplify_progressive(
     })
 }
 
+/// The most bucket files of one run: open files and their write buffers are bounded whatever
+/// the input's size (512 files of 2^20 points hold 2^29 points; larger inputs get larger buckets).
+const MAX_BUCKETS: u64 = 512;
+
 /// The input, bucket-shuffled into temporary files (pass 1 of [`simplify_out_of_core`]).
 struct Buckets {
     dir: tempfile::TempDir,
@@ -576,7 +580,10 @@ impl Buckets {
             return Err(Error::invalid_mesh(input, "the point set is empty"));
         }
         let had_normals = reader.has_normals();
-        let count = total.div_ceil(params.bucket_points.max(1) as u64).max(1) as usize;
+        // At most MAX_BUCKETS files open at once (beyond 2^29 points the buckets grow instead).
+        let count = total
+            .div_ceil(params.bucket_points.max(1) as u64)
+            .clamp(1, MAX_BUCKETS) as usize;
         let dir = tempfile::Builder::new()
             .prefix("remesh-buckets")
             .tempdir_in(params.temp_dir.clone().unwrap_or_else(std::env::temp_dir))
@@ -587,7 +594,7 @@ impl Buckets {
         let mut writers: Vec<BufWriter<File>> = (0..count)
             .map(|b| {
                 File::create(dir.path().join(format!("{b}.bin")))
-                    .map(|f| BufWriter::with_capacity(1 << 20, f))
+                    .map(|f| BufWriter::with_capacity(1 << 16, f))
             })
             .collect::<std::io::Result<_>>()
             .map_err(io_err)?;

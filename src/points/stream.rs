@@ -5,7 +5,7 @@
 //! a binary vertex record in one pass without per-property dispatch through the parser.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader, Read, Seek};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -227,7 +227,35 @@ impl PointReader {
                 properties[i].1 = Some(3 + k);
             }
         }
-        let record_size = properties.iter().map(|p| p.0.size()).sum();
+        let record_size: usize = properties.iter().map(|p| p.0.size()).sum();
+        // The header's count against what the file can hold, before anything is sized by it:
+        // a binary record takes `record_size` bytes, an ascii one at least a character and a
+        // separator per property. Binary points that end the file fill it exactly.
+        let position = input.stream_position().map_err(|e| Error::io(path, e))?;
+        let length = input
+            .get_ref()
+            .metadata()
+            .map_err(|e| Error::io(path, e))?
+            .len();
+        let body = length.saturating_sub(position);
+        let least = match encoding {
+            Encoding::Ascii => 2 * properties.len() as u64,
+            _ => record_size as u64,
+        };
+        let last = at + 1 == header.elements.len();
+        let fits = body / least.max(1);
+        if fits < count {
+            return Err(parse(format!(
+                "truncated: the header announces {count} points, the file holds at most {fits}"
+            )));
+        }
+        if last && encoding != Encoding::Ascii && body > count * least {
+            return Err(parse(format!(
+                "{} bytes after the last of the {count} points the header announces (a binary \
+                 body must end with its last element)",
+                body - count * least
+            )));
+        }
         Ok(PointReader {
             path: path.to_path_buf(),
             input,
@@ -769,13 +797,14 @@ mod tests {
         w.finish().unwrap();
         let bytes = std::fs::read(&path).unwrap();
         std::fs::write(&path, &bytes[..bytes.len() - 10]).unwrap();
-        let mut r = PointReader::open(&path).unwrap();
-        let err = r.read_chunk(&mut Vec::new(), 100).unwrap_err().to_string();
+        // Found when the file is opened, from its length (issue 36, item 4: a header's count is
+        // checked before anything is sized by it).
+        let err = PointReader::open(&path).err().unwrap().to_string();
         assert!(err.contains("truncated") && err.contains("t.ply"), "{err}");
-        // Issue 14, item 11: the message said "ends after 0" whatever was read; it gives the
-        // complete points before the end (4 of 5 here) and the count the header promised.
+        // Issue 14, item 11: the message gives the complete points before the end (4 of 5
+        // here) and the count the header promised.
         assert!(
-            err.contains("announces 5 points, the file ends after 4"),
+            err.contains("announces 5 points, the file holds at most 4"),
             "{err}"
         );
         let short = dir.path().join("short.ply");

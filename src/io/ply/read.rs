@@ -1,6 +1,6 @@
 //! Reading triangle meshes from PLY with `ply-rs-bw` (ascii and binary of either byte order).
 
-use std::io::{BufReader, Cursor};
+use std::io::{BufReader, Cursor, Read};
 use std::path::Path;
 
 use glam::DVec3;
@@ -215,6 +215,26 @@ pub(crate) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
         };
         Error::parse(path, line, one_line(&strip_line_prefix(&e.to_string())))
     })?;
+    // Nothing may follow a binary body's last element: bytes there are a body that does not
+    // match its header (an ascii body under a binary header, a count too small) or garbage. An
+    // ascii body may run on (MeshLab writes files with a line more than their header counts,
+    // and reads them).
+    let mut rest = Vec::new();
+    reader
+        .into_inner()
+        .read_to_end(&mut rest)
+        .map_err(|e| Error::io(path, e))?;
+    if header.encoding != Encoding::Ascii && !rest.is_empty() {
+        return Err(Error::parse(
+            path,
+            None,
+            format!(
+                "{} bytes after the last element the header announces (the body does not \
+                 match the header)",
+                rest.len()
+            ),
+        ));
+    }
 
     let vertices = payload.get("vertex").map_or(&[][..], |v| &v[..]);
     let faces = payload.get("face").map_or(&[][..], |f| &f[..]);
