@@ -405,3 +405,51 @@ fn wrapped_off_records_and_byte_order_marks_are_read() {
     assert_eq!(c.positions, d.positions);
     assert_eq!(c.triangles, d.triangles);
 }
+
+/// A glTF file of one triangle whose buffer (`byte_length` bytes) is at `uri`.
+fn gltf_with_buffer(uri: &str, byte_length: usize) -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"{uri}","byteLength":{byte_length}}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3",
+        "min":[0,0,0],"max":[1,1,0]}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+        "nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}],"scene":0}}"#
+    )
+}
+
+/// Item 6: a glTF buffer URI naming a device (`/dev/zero`, reached by `../` or `file:`) or a
+/// FIFO is refused at once (it read 2 GB, or hung); a buffer file longer than its `byteLength`
+/// is read only that far.
+#[cfg(unix)]
+#[test]
+fn gltf_buffers_come_from_regular_files_and_no_further_than_their_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.obj");
+    let up = "../".repeat(dir.path().components().count() + 2);
+    let made = Command::new("mkfifo")
+        .arg(dir.path().join("fifo.bin"))
+        .status()
+        .expect("run mkfifo");
+    assert!(made.success());
+    for (name, uri) in [
+        ("zero.gltf", format!("{up}dev/zero")),
+        ("file.gltf", "file:///dev/zero".to_string()),
+        ("fifo.gltf", "fifo.bin".to_string()),
+    ] {
+        let input = write(dir.path(), name, gltf_with_buffer(&uri, 36));
+        let o = remesh(&[arg(&input), arg(&out), "--points", "50"]);
+        assert_error(&o, 3, &[name, "not a regular file"]);
+    }
+    // 36 bytes of triangle, then a megabyte the buffer does not hold.
+    let mut bin: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    bin.resize(36 + (1 << 20), 0xFF);
+    write(dir.path(), "long.bin", &bin);
+    let input = write(dir.path(), "long.gltf", gltf_with_buffer("long.bin", 36));
+    let (mesh, _) = spectral_remesh::read_mesh(&input).unwrap();
+    assert_eq!(mesh.face_count(), 1);
+}

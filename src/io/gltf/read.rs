@@ -1,5 +1,6 @@
 //! Reading a glTF 2.0 scene's triangles, in world coordinates.
 
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use ::gltf::accessor::{DataType, Dimensions};
@@ -288,7 +289,10 @@ fn load_buffers(
             Source::Uri(uri) if uri.starts_with("data:") => {
                 ("embedded data URI".to_string(), decode_data_uri(uri))
             }
-            Source::Uri(uri) => (format!("'{}'", one_line(uri)), read_uri(&base, uri)),
+            Source::Uri(uri) => (
+                format!("'{}'", one_line(uri)),
+                read_uri(&base, uri, buffer.length()),
+            ),
         };
         let mut data = data.map_err(|e| match e {
             BufferError::Io(io) => Error::io(
@@ -350,8 +354,10 @@ const BASE64_LENIENT: GeneralPurpose = GeneralPurpose::new(
 );
 
 /// Reads the file a buffer URI names: a percent-encoded path relative to `base` (the glTF
-/// file's folder) or a `file:` URI. Other schemes (`http:`, ...) are refused.
-fn read_uri(base: &Path, uri: &str) -> std::result::Result<Vec<u8>, BufferError> {
+/// file's folder) or a `file:` URI; at most `length` bytes (the buffer's `byteLength`), and
+/// only from a regular file (a device such as `/dev/zero` never ends, a FIFO may never open).
+/// Other schemes (`http:`, ...) are refused.
+fn read_uri(base: &Path, uri: &str, length: usize) -> std::result::Result<Vec<u8>, BufferError> {
     let (relative, encoded) = match uri.strip_prefix("file:") {
         Some(rest) => (false, rest.strip_prefix("//").unwrap_or(rest)),
         None if uri.contains(':') => {
@@ -369,7 +375,17 @@ fn read_uri(base: &Path, uri: &str) -> std::result::Result<Vec<u8>, BufferError>
     } else {
         PathBuf::from(&*decoded)
     };
-    std::fs::read(file).map_err(BufferError::Io)
+    // The kind of file before it is opened (opening a FIFO waits for a writer).
+    if !std::fs::metadata(&file).map_err(BufferError::Io)?.is_file() {
+        return Err(BufferError::Invalid(
+            "not a regular file (a folder, device, FIFO or socket)".to_string(),
+        ));
+    }
+    let mut data = Vec::new();
+    std::fs::File::open(&file)
+        .and_then(|f| f.take(length as u64).read_to_end(&mut data))
+        .map_err(BufferError::Io)?;
+    Ok(data)
 }
 
 /// The triangles gathered so far in a scene walk.
@@ -733,14 +749,14 @@ mod tests {
     fn buffer_files_by_percent_encoded_relative_path_or_file_uri() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("a b.bin"), [7u8, 8]).unwrap();
-        let read = |uri: &str| read_uri(dir.path(), uri).ok().unwrap();
+        let read = |uri: &str| read_uri(dir.path(), uri, 1 << 20).ok().unwrap();
         assert_eq!(read("a%20b.bin"), [7, 8]);
         let absolute = format!("file://{}/a%20b.bin", dir.path().display());
         assert_eq!(read(&absolute), [7, 8]);
-        assert!(invalid(read_uri(dir.path(), "%FF%FE.bin")).contains("UTF-8"));
-        assert!(invalid(read_uri(dir.path(), "https://example.org/a.bin")).contains("scheme"));
+        assert!(invalid(read_uri(dir.path(), "%FF%FE.bin", 4)).contains("UTF-8"));
+        assert!(invalid(read_uri(dir.path(), "https://example.org/a.bin", 4)).contains("scheme"));
         assert!(matches!(
-            read_uri(dir.path(), "missing.bin"),
+            read_uri(dir.path(), "missing.bin", 4),
             Err(BufferError::Io(_))
         ));
     }
