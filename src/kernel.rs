@@ -113,13 +113,19 @@ impl Kernel {
         if !(sigma_p.is_finite() && sigma_p > 0.0) {
             return Err(Error::InvalidParameter {
                 name: "--sigma-p",
-                message: format!("must be a positive number, got {sigma_p}"),
+                message: format!(
+                    "must be a positive number, got {}",
+                    crate::error::shown(sigma_p)
+                ),
             });
         }
         if sigma_n.is_nan() || sigma_n <= 0.0 {
             return Err(Error::InvalidParameter {
                 name: "--sigma-n",
-                message: format!("must be positive (or infinite), got {sigma_n}"),
+                message: format!(
+                    "must be positive (or infinite), got {}",
+                    crate::error::shown(sigma_n)
+                ),
             });
         }
         Ok(Kernel { sigma_p, sigma_n })

@@ -399,7 +399,7 @@ pub fn remesh(
         Target::SigmaP(s) if !(s.is_finite() && s > 0.0) => {
             return Err(Error::InvalidParameter {
                 name: "--sigma-p",
-                message: format!("must be a positive number, got {s}"),
+                message: format!("must be a positive number, got {}", crate::error::shown(s)),
             })
         }
         _ => {}
@@ -462,9 +462,15 @@ pub fn remesh(
             return Err(Error::InvalidParameter {
                 name: "--sigma-p",
                 message: format!(
-                    "sigma_p {s} would give about {expected:.2e} samples on this surface, more \
-                     than the {MAX_POINTS} this remesher holds in memory; the smallest sigma_p \
-                     it takes here is {smallest:.4} (bbox-100 units)"
+                    "sigma_p {} would give {} samples on this surface, more than the \
+                     {MAX_POINTS} this remesher holds in memory; the smallest sigma_p it takes \
+                     here is {smallest:.4} (bbox-100 units)",
+                    crate::error::shown(s),
+                    if expected.is_finite() {
+                        format!("about {expected:.2e}")
+                    } else {
+                        "too many".to_string()
+                    }
                 ),
             });
         }

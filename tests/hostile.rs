@@ -453,3 +453,37 @@ fn gltf_buffers_come_from_regular_files_and_no_further_than_their_length() {
     let (mesh, _) = spectral_remesh::read_mesh(&input).unwrap();
     assert_eq!(mesh.face_count(), 1);
 }
+
+/// Item 13 (the rest): every message names the file, shows numbers briefly, keeps to one line
+/// whatever a file name holds, and gives the input's faults exit 3.
+#[test]
+fn messages_name_the_file_briefly_on_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let flat = write(
+        dir.path(),
+        "flat.obj",
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+    );
+    let points = dir.path().join("p.ply");
+    let o = remesh(&["points", arg(&flat), arg(&points), "--count", "10"]);
+    assert_error(&o, 3, &["flat.obj: ", "no area"]);
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    let o = remesh(&[arg(&input), arg(&out), "--sigma-p", "1e-300"]);
+    assert_error(&o, 2, &["--sigma-p", "1e-300"]);
+    assert!(
+        o.stderr.len() < 300,
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let nan = write(
+        dir.path(),
+        "nan.xyz",
+        "x y z nx ny nz\n0 0 0 nan 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n1 1 0 0 0 1\n",
+    );
+    let o = remesh(&[arg(&nan), arg(&out), "--points", "3", "--sigma-n", "1"]);
+    assert_error(&o, 3, &["nan.xyz", "non-finite normal"]);
+    let odd = dir.path().join("a\nb.obj");
+    let o = remesh(&[arg(&odd), arg(&out)]);
+    assert_error(&o, 3, &["a\\nb.obj"]);
+}

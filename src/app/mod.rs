@@ -1123,6 +1123,7 @@ pub fn run_points(job: &PointsJob) -> Result<()> {
     }
     let (mesh, _) = read_mesh(&job.mesh)?;
     crate::points::generate::write_surface_points(&mesh, job.count, job.seed, &job.output)
+        .map_err(|e| with_path(e, &job.mesh))
 }
 
 /// Point sets are written as binary PLY only: any other extension of `output` is a usage error

@@ -113,7 +113,10 @@ impl RemeshOptions {
         if !(self.lfs_factor.is_finite() && self.lfs_factor >= 0.0) {
             return Err(Error::InvalidParameter {
                 name: "--lfs-factor",
-                message: format!("must be a number >= 0, got {}", self.lfs_factor),
+                message: format!(
+                    "must be a number >= 0, got {}",
+                    crate::error::shown(self.lfs_factor)
+                ),
             });
         }
         params.features = match self.feature_angle {
@@ -150,7 +153,10 @@ impl RemeshOptions {
         if !(self.chord_error.is_finite() && self.chord_error >= 0.0) {
             return Err(Error::InvalidParameter {
                 name: "--chord-error",
-                message: format!("must be a number >= 0, got {}", self.chord_error),
+                message: format!(
+                    "must be a number >= 0, got {}",
+                    crate::error::shown(self.chord_error)
+                ),
             });
         }
         params.fit_iterations = if self.no_fit { 0 } else { FIT_ITERATIONS };

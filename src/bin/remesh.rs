@@ -586,7 +586,20 @@ fn main() -> ExitCode {
     match catch_panics(|| config(cli).and_then(execute)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("remesh: error: {e}");
+            // One line whatever a file name holds: control characters (a newline) escaped.
+            let message: String = e
+                .to_string()
+                .chars()
+                .flat_map(|c| {
+                    let escaped: Vec<char> = if c.is_control() {
+                        c.escape_default().collect()
+                    } else {
+                        vec![c]
+                    };
+                    escaped
+                })
+                .collect();
+            eprintln!("remesh: error: {message}");
             ExitCode::from(e.exit_code() as u8)
         }
     }

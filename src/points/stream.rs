@@ -484,7 +484,18 @@ impl PointReader {
             });
         }
         let normal = if self.has_normals {
-            DVec3::new(v[3], v[4], v[5]).normalize_or_zero()
+            let n = DVec3::new(v[3], v[4], v[5]);
+            if !n.is_finite() {
+                return Err(Error::Parse {
+                    path: self.path.clone(),
+                    line: None,
+                    message: format!(
+                        "point {} has a non-finite normal ({} {} {})",
+                        self.read, n.x, n.y, n.z
+                    ),
+                });
+            }
+            n.normalize_or_zero()
         } else {
             DVec3::ZERO
         };
