@@ -415,8 +415,11 @@ fn count(name: &str, value: i128) -> PyResult<usize> {
     })
 }
 
-/// `remesh`'s `progress`: a Python callable given each stage's name, called with the GIL taken;
-/// its first exception is kept (and no further call made) to be raised when the job returns.
+/// The payload a job unwinds with when [`Progress::stage`] stops it.
+struct Stopped;
+
+/// `remesh`'s `progress`: a Python callable given each stage's name, called with the GIL taken,
+/// after Python's signal handlers; the first exception of either stops the job and is raised.
 struct Progress {
     callable: Option<Py<PyAny>>,
     raised: Mutex<Option<PyErr>>,
@@ -443,16 +446,26 @@ impl Progress {
         })
     }
 
-    /// The library's `on_stage`: the callable on `stage`, unless it raised before.
+    /// The library's `on_stage`: Python's signal handlers run (Ctrl-C raises
+    /// `KeyboardInterrupt` there), then the callable on `stage`. An exception from either
+    /// stops the job at once: it unwinds with [`Stopped`] (without the panic hook: nothing is
+    /// printed), and [`Progress::result_of`] raises the exception.
     fn stage(&self, stage: &str) {
-        let Some(callable) = &self.callable else {
-            return;
-        };
         let mut raised = self.raised.lock().unwrap_or_else(|p| p.into_inner());
-        if raised.is_none() {
-            if let Err(e) = Python::attach(|py| callable.bind(py).call1((stage,)).map(|_| ())) {
-                *raised = Some(e);
+        if raised.is_some() {
+            std::panic::resume_unwind(Box::new(Stopped));
+        }
+        let result = Python::attach(|py| {
+            py.check_signals()?;
+            match &self.callable {
+                Some(callable) => callable.bind(py).call1((stage,)).map(|_| ()),
+                None => Ok(()),
             }
+        });
+        if let Err(e) = result {
+            *raised = Some(e);
+            drop(raised);
+            std::panic::resume_unwind(Box::new(Stopped));
         }
     }
 

@@ -343,6 +343,25 @@ def test_progress_names_each_stage_and_its_exception_comes_back(spot):
         sr.remesh(*spot, points=500, progress=3)
 
 
+def test_ctrl_c_stops_a_job_at_its_next_stage(spot):
+    """Issue 36, item 7: Ctrl-C (SIGINT) during `remesh` raises KeyboardInterrupt when the job
+    reaches its next stage, not when it ends: the stages it went through stop short of the
+    write. The signal comes 0.2 s into a job of several seconds."""
+    import os
+    import signal
+    import threading
+
+    stages = []
+    timer = threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sr.remesh(*spot, points=40000, distance=False, progress=stages.append)
+    finally:
+        timer.cancel()
+    assert stages and "write" not in stages, stages
+
+
 def test_gil_is_released(spot, gil_released):
     """Another Python thread runs while remesh works (about 0.6 s here)."""
     gil_released(lambda: sr.remesh(*spot, points=5000, distance=False))
