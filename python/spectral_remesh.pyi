@@ -220,7 +220,8 @@ def remesh(
         topology differs from the input's.
     max_memory : int, str or None
         The most memory the job may take, in bytes or as a size ("512M", "8G", "2GiB"); a job
-        whose estimated peak is larger is refused at once. None: the machine's physical memory.
+        whose estimated peak is larger is refused at once. None: the smallest of the machine's
+        physical memory and the process's memory limits (cgroup, address space).
     progress : callable or None
         Called with each stage's name (str: "read", "linear scan", "gradient ascent",
         "triangulate", ...) as the stage starts, with the GIL taken for the call. An exception it

@@ -252,8 +252,9 @@ pub use points::{PlyPointWriter, Point, PointReader};
 
 // The jobs of the `remesh` command line: files in, files and report out.
 pub use app::{
-    catch_panics, check_report_path, estimate_remesh_bytes, parse_bytes, physical_memory,
-    quality_mesh, remesh_mesh, remesh_point_set, run_points, run_quality, run_remesh, run_simplify,
-    write_report, PointsJob, RemeshJob, RemeshOptions, RemeshedMesh, SimplifyDensity,
-    SimplifyDetail, SimplifyJob, SimplifySummary, DISTANCE_SAMPLES, MAX_SURFACE_POINTS, STDOUT,
+    catch_panics, check_report_path, estimate_remesh_bytes, memory_limit, parse_bytes,
+    physical_memory, quality_mesh, remesh_mesh, remesh_point_set, run_points, run_quality,
+    run_remesh, run_simplify, write_report, PointsJob, RemeshJob, RemeshOptions, RemeshedMesh,
+    SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary, DISTANCE_SAMPLES,
+    MAX_SURFACE_POINTS, STDOUT,
 };

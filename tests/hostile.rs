@@ -487,3 +487,23 @@ fn messages_name_the_file_briefly_on_one_line() {
     let o = remesh(&[arg(&odd), arg(&out)]);
     assert_error(&o, 3, &["a\\nb.obj"]);
 }
+
+/// Item 8: the default memory limit is the smallest of the machine's and the process's own: a
+/// job far larger than an address-space limit (`ulimit -v`) is refused at once, naming
+/// `--max-memory`, instead of aborting when an allocation fails.
+#[cfg(target_os = "linux")]
+#[test]
+fn the_process_memory_limit_is_the_default_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    let script = format!(
+        "ulimit -v 1500000 && exec '{}' '{}' '{}' --points 1000000",
+        env!("CARGO_BIN_EXE_remesh"),
+        arg(&input),
+        arg(&out)
+    );
+    let o = Command::new("sh").args(["-c", &script]).output().unwrap();
+    assert_error(&o, 2, &["--max-memory"]);
+    assert!(!out.exists());
+}

@@ -387,11 +387,11 @@ fn quality<'py>(
     report_dict(py, &report)
 }
 
-/// `max_memory` as bytes: an int, a size such as `"8G"`, or `None` for the machine's physical
-/// memory (the command line's default).
+/// `max_memory` as bytes: an int, a size such as `"8G"`, or `None` for the smallest of the
+/// machine's physical memory and the process's limits (the command line's default).
 fn memory_limit(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<u64>> {
     let Some(value) = value else {
-        return Ok(spectral::physical_memory());
+        return Ok(spectral::memory_limit());
     };
     if let Ok(text) = value.extract::<String>() {
         return spectral::parse_bytes(&text)
@@ -552,7 +552,8 @@ type Remeshed<'py> = (
 ///     topology differs from the input's.
 /// max_memory : int, str or None
 ///     The most memory the job may take, in bytes or as a size ("512M", "8G", "2GiB"); a job
-///     whose estimated peak is larger is refused at once. None: the machine's physical memory.
+///     whose estimated peak is larger is refused at once. None: the smallest of the machine's
+///     physical memory and the process's memory limits (cgroup, address space).
 /// progress : callable or None
 ///     Called with each stage's name (str: "read", "linear scan", "gradient ascent",
 ///     "triangulate", ...) as the stage starts, with the GIL taken for the call. An exception it

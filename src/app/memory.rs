@@ -6,17 +6,23 @@
 //!
 //! | job | input faces | output points | peak RSS | model |
 //! |---|---|---|---|---|
-//! | spot → 2000 | 5,856 | 2,000 | 12 MB | 19 MB |
-//! | spot → 50,000 | 5,856 | 50,000 | 122 MB | 134 MB |
-//! | beetle → 3000 | 2,053 | 3,000 | 13 MB | 19 MB |
-//! | horse → 2000 | 96,966 | 2,000 | 74 MB | 88 MB |
-//! | horse → 2000, with the distance | 96,966 | 2,000 | 95 MB | 120 MB |
-//! | horse → 100,000 | 96,966 | 100,000 | 288 MB | 323 MB |
-//! | a 200k-face horse → 10,000 | 199,996 | 10,000 | 149 MB | 184 MB |
+//! | spot → 2000 | 5,856 | 2,000 | 12 MB | 24 MB |
+//! | spot → 50,000 | 5,856 | 50,000 | 122 MB | 235 MB |
+//! | beetle → 3000 | 2,053 | 3,000 | 13 MB | 25 MB |
+//! | horse → 2000 | 96,966 | 2,000 | 74 MB | 92 MB |
+//! | horse → 2000, with the distance | 96,966 | 2,000 | 95 MB | 126 MB |
+//! | horse → 100,000 | 96,966 | 100,000 | 288 MB | 523 MB |
+//! | a 200k-face horse → 10,000 | 199,996 | 10,000 | 149 MB | 204 MB |
+//! | a 1,280-face sphere → 100,000 | 1,280 | 100,000 | 352 MB | 451 MB |
+//! | a 1,280-face sphere → 300,000 | 1,280 | 300,000 | 1,160 MB | 1,331 MB |
+//! | a 1,280-face sphere → 1,000,000 | 1,280 | 1,000,000 | 4,024 MB | 4,411 MB |
 //!
 //! The per-point cost is the candidate pool (10 candidates per output point), the samples, the
-//! kd-trees and the triangulation's umbrellas; the per-face cost is the input mesh, its BVH and
-//! its normalized copy.
+//! kd-trees, the restricted Delaunay triangulation's refined copy of the input and the output
+//! mesh with its checks; the per-face cost is the input mesh, its BVH and its normalized copy.
+//! Upsampling a coarse input costs the most per point (3.4 KB at 100,000 points, 3.9 KB at a
+//! million, growing slowly with the count: the sphere rows) and sets the constant; downsampling
+//! costs less (horse → 100,000: 2.0 KB a point), where the estimate is loose.
 
 use std::path::Path;
 
@@ -28,8 +34,8 @@ pub const BASE_BYTES: u64 = 10 << 20;
 /// queries, the boundary and winding structures).
 pub const BYTES_PER_INPUT_FACE: u64 = 750;
 /// Bytes per output point (10 candidates each, the samples, kd-trees, triangulation, the output
-/// mesh and its checks).
-pub const BYTES_PER_OUTPUT_POINT: u64 = 2_400;
+/// mesh and its checks), set by upsampling a coarse input (see the module's table).
+pub const BYTES_PER_OUTPUT_POINT: u64 = 4_400;
 /// Bytes the report's distance measurement adds (200,000 samples a side and their queries).
 pub const DISTANCE_BYTES: u64 = 32 << 20;
 
@@ -61,6 +67,76 @@ pub fn physical_memory() -> Option<u64> {
     let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     kib.checked_mul(1024)
+}
+
+/// The default limit of a job: the smallest of the machine's physical memory
+/// ([`physical_memory`]), the memory limit of the process's control group (cgroup v2
+/// `memory.max` or v1 `memory.limit_in_bytes`, along its path) and its address-space limit
+/// (`RLIMIT_AS`, `ulimit -v`) less a reserve for what is mapped without being resident (thread
+/// stacks, the allocator's per-thread arenas: [`ADDRESS_SPACE_RESERVE_PER_THREAD`] per core
+/// and as much again). Under such a limit a job too large is refused before it starts instead
+/// of aborting when an allocation fails. `None` when none can be read.
+pub fn memory_limit() -> Option<u64> {
+    [physical_memory(), cgroup_limit(), address_space_limit()]
+        .into_iter()
+        .flatten()
+        .min()
+}
+
+/// Address space mapped per thread beyond resident memory (a glibc malloc arena reserves 64
+/// MiB, a stack 2 to 8 MiB), for the reserve of [`memory_limit`].
+pub const ADDRESS_SPACE_RESERVE_PER_THREAD: u64 = 128 << 20;
+
+/// The soft `RLIMIT_AS` (`Max address space` of `/proc/self/limits`) less the reserve, or
+/// `None` when unlimited or unreadable.
+fn address_space_limit() -> Option<u64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    let soft: u64 = line
+        .trim_start_matches("Max address space")
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64 + 1;
+    Some(soft.saturating_sub(threads.saturating_mul(ADDRESS_SPACE_RESERVE_PER_THREAD)))
+}
+
+/// The smallest memory limit of the process's control group and its ancestors, or `None`
+/// when there is none (`max`, or a v1 value of 2^62 and above) or it cannot be read.
+fn cgroup_limit() -> Option<u64> {
+    let groups = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let mut files = Vec::new();
+    for line in groups.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (Some(id), Some(controllers), Some(path)) = (parts.next(), parts.next(), parts.next())
+        else {
+            continue;
+        };
+        let (root, file) = if id == "0" && controllers.is_empty() {
+            ("/sys/fs/cgroup", "memory.max")
+        } else if controllers.split(',').any(|c| c == "memory") {
+            ("/sys/fs/cgroup/memory", "memory.limit_in_bytes")
+        } else {
+            continue;
+        };
+        // The group and its ancestors; in a container the group is often the mount's root.
+        let mut dir = std::path::PathBuf::from(format!("{root}{path}"));
+        loop {
+            files.push(dir.join(file));
+            if dir.as_os_str().len() <= root.len() || !dir.pop() {
+                break;
+            }
+        }
+        files.push(Path::new(root).join(file));
+    }
+    files
+        .iter()
+        .filter_map(|f| std::fs::read_to_string(f).ok()?.trim().parse::<u64>().ok())
+        .filter(|&v| v < 1 << 62)
+        .min()
 }
 
 /// Refuses, before it is read, an input file larger than `limit` bytes: its faces take far more

@@ -9,7 +9,7 @@ use std::time::Duration;
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::{
-    catch_panics, check_report_path, parse_bytes, physical_memory, remove_temporaries, run_points,
+    catch_panics, check_report_path, memory_limit, parse_bytes, remove_temporaries, run_points,
     run_quality, run_remesh, run_simplify, write_report, Error, MeshFormat, PointsJob, RemeshJob,
     RemeshOptions, SimplifyDensity, SimplifyJob, STDOUT,
 };
@@ -162,7 +162,8 @@ struct Cli {
 
     /// The most memory the job may take (e.g. 512M, 8G, 2GiB): a job whose estimated peak is
     /// larger is refused at once (exit 2), before reading an input file too large for it.
-    /// Default: the machine's physical memory.
+    /// Default: the smallest of the machine's physical memory, the process's control-group
+    /// memory limit and its address-space limit (ulimit -v).
     #[arg(long, value_name = "SIZE", value_parser = parse_bytes)]
     max_memory: Option<u64>,
 
@@ -397,7 +398,7 @@ fn config(mut cli: Cli) -> Result<Config, Error> {
                 params,
                 measure_distance: !cli.no_distance,
                 strict: cli.strict,
-                max_memory: cli.max_memory.or_else(physical_memory),
+                max_memory: cli.max_memory.or_else(memory_limit),
                 as_points: cli.as_points,
                 viewpoint: cli.viewpoint.map(glam::DVec3::from),
                 report: cli.report,
