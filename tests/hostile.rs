@@ -507,3 +507,50 @@ fn the_process_memory_limit_is_the_default_limit() {
     assert_error(&o, 2, &["--max-memory"]);
     assert!(!out.exists());
 }
+
+/// Item 9: one far stray point in a scan at UTM-like coordinates does not set the scale: it is
+/// left out and said so, by `remesh` (a mesh of the scan) and `simplify` (the count asked for).
+#[test]
+fn a_far_stray_point_does_not_set_the_scale() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::new();
+    let sphere = common::icosphere(4);
+    for p in &sphere.positions {
+        let q = glam::DVec3::new(5e5, 4e6, 100.0) + 10.0 * *p;
+        text += &format!("{} {} {}\n", q.x, q.y, q.z);
+    }
+    text += "0 0 0\n";
+    let input = write(dir.path(), "scan.xyz", text);
+    let out = dir.path().join("o.obj");
+    let report = dir.path().join("r.json");
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "500",
+        "-q",
+        "--no-distance",
+        "--report",
+        arg(&report),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let v = r["topology"]["vertices"].as_i64().unwrap();
+    assert!((v - 500).abs() <= 25, "{v} vertices for 500");
+    assert_eq!(r["topology"]["components"].as_i64(), Some(1));
+    let notes = r["notes"].to_string();
+    assert!(notes.contains("isolated points"), "{notes}");
+    let simplified = dir.path().join("s.ply");
+    let o = remesh(&["simplify", arg(&input), arg(&simplified), "--points", "500"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(said.contains("1 far isolated points left out"), "{said}");
+    let samples: usize = said
+        .split(" samples")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap();
+    assert!((450..=550).contains(&samples), "{said}");
+}

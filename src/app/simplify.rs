@@ -53,6 +53,9 @@ pub struct SimplifySummary {
     pub output: PathBuf,
     /// Points read.
     pub input_points: u64,
+    /// Far isolated points left out: they would have set the scale (a stray `0 0 0` in a scan
+    /// at UTM coordinates).
+    pub far_points: u64,
     /// Points written.
     pub samples: usize,
     /// Whether the input had normals.
@@ -136,7 +139,7 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
         seed: job.seed,
         ..Default::default()
     };
-    let (input_points, samples, had_normals, detail) = match &job.density {
+    let (input_points, far_points, samples, had_normals, detail) = match &job.density {
         SimplifyDensity::Levels(levels) => {
             let r = simplify_progressive(&job.input, levels, &params)?;
             let mut w = PlyPointWriter::create_with_levels(&job.output, r.samples.len() as u64)?;
@@ -147,7 +150,13 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
                 level_ends: r.level_ends.clone(),
                 seconds: r.seconds.clone(),
             };
-            (r.input_points, r.samples.len(), r.had_normals, detail)
+            (
+                r.input_points,
+                r.far_points,
+                r.samples.len(),
+                r.had_normals,
+                detail,
+            )
         }
         _ => {
             let r = simplify_out_of_core(&job.input, &params)?;
@@ -160,13 +169,20 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
                 measured: r.measured as u64,
                 seconds: [r.seconds[0], r.seconds[1], r.seconds[2], r.seconds[3]],
             };
-            (r.input_points, r.samples.len(), r.had_normals, detail)
+            (
+                r.input_points,
+                r.far_points,
+                r.samples.len(),
+                r.had_normals,
+                detail,
+            )
         }
     };
     Ok(SimplifySummary {
         input: job.input.clone(),
         output: job.output.clone(),
         input_points,
+        far_points,
         samples,
         had_normals,
         detail,
@@ -182,6 +198,10 @@ impl fmt::Display for SimplifySummary {
             "; the input has no normals: positions only, normals estimated on the output"
         };
         let (input, output) = (self.input.display(), self.output.display());
+        let far = match self.far_points {
+            0 => String::new(),
+            n => format!(" ({n} far isolated points left out: they would have set the scale)"),
+        };
         match &self.detail {
             SimplifyDetail::Levels {
                 sigma_p,
@@ -190,7 +210,7 @@ impl fmt::Display for SimplifySummary {
             } => {
                 writeln!(
                     f,
-                    "{input} -> {output}: {} points -> {} samples in {} nested levels{no_normals}",
+                    "{input} -> {output}: {} points{far} -> {} samples in {} nested levels{no_normals}",
                     self.input_points,
                     self.samples,
                     level_ends.len(),
@@ -220,7 +240,7 @@ impl fmt::Display for SimplifySummary {
             } => {
                 writeln!(
                     f,
-                    "{input} -> {output}: {} points -> {} samples, sigma_p {sigma_p:.4} (bbox-100 units){no_normals}; {rejected_by_nearest} rejected by the nearest sample, {measured} measured",
+                    "{input} -> {output}: {} points{far} -> {} samples, sigma_p {sigma_p:.4} (bbox-100 units){no_normals}; {rejected_by_nearest} rejected by the nearest sample, {measured} measured",
                     self.input_points, self.samples,
                 )?;
                 writeln!(

@@ -52,6 +52,11 @@ impl Aabb {
     pub fn center(&self) -> DVec3 {
         0.5 * (self.min + self.max)
     }
+
+    /// Whether `p` lies in the box (its faces included).
+    pub fn contains(&self, p: DVec3) -> bool {
+        p.cmpge(self.min).all() && p.cmple(self.max).all()
+    }
 }
 
 impl TriMesh {

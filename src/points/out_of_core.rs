@@ -14,7 +14,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::normals::{estimate_normals, NormalOrientation};
-use super::outliers::{off_surface, OutlierFilter};
+use super::outliers::{far_isolated, off_surface, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
 use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -70,8 +70,10 @@ impl Default for OutOfCoreParams {
 pub struct OutOfCoreResult {
     /// The output set O in the input's units, in the order the scan accepted it.
     pub samples: Vec<Point>,
-    /// Points read.
+    /// Points read, less the far isolated ones.
     pub input_points: u64,
+    /// Far isolated points left out ([`far_isolated`]): they would have set the scale.
+    pub far_points: u64,
     /// Whether the input had normals (without them the kernel uses positions only).
     pub had_normals: bool,
     /// The sigma_p used, bbox-100 units.
@@ -126,6 +128,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         mut samples,
         support,
         input_points,
+        far_points,
         had_normals,
         sigma_p,
         normalization,
@@ -152,6 +155,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
     Ok(OutOfCoreResult {
         samples,
         input_points,
+        far_points,
         had_normals,
         sigma_p,
         normalization,
@@ -175,8 +179,10 @@ pub(crate) struct ScanOutput {
     /// The first bucket's points, shuffled (a uniformly random subset of the input), up to
     /// `support_per_sample` per sample, bbox-100 units.
     pub support: Vec<Point>,
-    /// Points read.
+    /// Points read, less the far isolated ones.
     pub input_points: u64,
+    /// Far isolated points left out ([`far_isolated`]).
+    pub far_points: u64,
     /// Whether the input had normals.
     pub had_normals: bool,
     /// The sigma_p used, bbox-100 units.
@@ -289,7 +295,7 @@ impl ScannedInput {
                 support = pts;
             }
         })?;
-        let mut outliers_removed = 0;
+        let mut outliers_removed = self.buckets.far_points as usize;
         if let Some(f) = &self.filter {
             outliers_removed += f.retain(&mut samples, |p| p.position);
         }
@@ -302,6 +308,7 @@ impl ScannedInput {
             samples,
             support,
             input_points: self.buckets.total,
+            far_points: self.buckets.far_points,
             had_normals: self.buckets.had_normals,
             sigma_p,
             normalization: self.buckets.normalization,
@@ -466,6 +473,8 @@ pub struct ProgressiveResult {
     pub sigma_p: Vec<f64>,
     /// Points read.
     pub input_points: u64,
+    /// Far isolated points left out ([`far_isolated`]).
+    pub far_points: u64,
     /// Whether the input had normals.
     pub had_normals: bool,
     /// Model units ↔ bbox-100 units.
@@ -548,11 +557,27 @@ pub fn simplify_progressive(
         level_ends,
         sigma_p,
         input_points: buckets.total,
+        far_points: buckets.far_points,
         had_normals: buckets.had_normals,
         normalization: norm,
         seconds,
     })
 }
+
+/// Bucket `b`'s points in `dir` as written (model units, in file order).
+fn read_bucket(dir: &Path, b: usize) -> Result<Vec<Point>> {
+    let mut bytes = Vec::new();
+    File::open(dir.join(format!("{b}.bin")))
+        .and_then(|f| BufReader::new(f).read_to_end(&mut bytes))
+        .map_err(|e| Error::io(dir, e))?;
+    Ok(bytes
+        .chunks_exact(RECORD_BYTES)
+        .map(decode_record)
+        .collect())
+}
+
+/// Points of the first bucket the far-isolation test compares with (see [`far_isolated`]).
+const FAR_REFERENCE_POINTS: usize = 1 << 16;
 
 /// The most bucket files of one run: open files and their write buffers are bounded whatever
 /// the input's size (512 files of 2^20 points hold 2^29 points; larger inputs get larger buckets).
@@ -565,11 +590,65 @@ struct Buckets {
     _registered: crate::io::temporaries::Registered,
     /// Number of bucket files.
     count: usize,
-    /// Points read.
+    /// Points kept (read, less the far isolated ones).
     total: u64,
     had_normals: bool,
     normalization: Normalization,
+    /// The box (model units) of the points kept, when far isolated points were left out
+    /// ([`far_isolated`]): points outside it are not loaded.
+    keep: Option<Aabb>,
+    /// Far isolated points left out.
+    far_points: u64,
 }
+
+/// Points with the most extreme coordinate along each of the six axis directions, the most
+/// extreme first: the candidates of [`far_isolated`].
+struct Extremes {
+    lists: [Vec<(f64, DVec3)>; 6],
+}
+
+impl Extremes {
+    /// How many points each direction keeps.
+    const PER_DIRECTION: usize = 16;
+
+    fn new() -> Self {
+        Extremes {
+            lists: Default::default(),
+        }
+    }
+
+    fn offer(&mut self, p: DVec3) {
+        for (d, list) in self.lists.iter_mut().enumerate() {
+            let v = if d % 2 == 0 { p[d / 2] } else { -p[d / 2] };
+            if list.len() < Self::PER_DIRECTION || list.last().is_some_and(|&(w, _)| v > w) {
+                let at = list.partition_point(|&(w, _)| w >= v);
+                list.insert(at, (v, p));
+                list.truncate(Self::PER_DIRECTION);
+            }
+        }
+    }
+
+    /// The box of the points without those `far` says are far isolated: on each side, the
+    /// most extreme candidate that is not far. `None` when no candidate is far, or when every
+    /// candidate of some direction is (too many far points to tell the box).
+    fn box_without(&self, far: impl Fn(DVec3) -> bool) -> Option<Aabb> {
+        let mut any = false;
+        let mut bound = [0.0f64; 6];
+        for (d, list) in self.lists.iter().enumerate() {
+            any |= list.iter().any(|&(_, p)| far(p));
+            let &(v, _) = list.iter().find(|&&(_, p)| !far(p))?;
+            bound[d] = if d % 2 == 0 { v } else { -v };
+        }
+        any.then(|| Aabb {
+            min: DVec3::new(bound[1], bound[3], bound[5]),
+            max: DVec3::new(bound[0], bound[2], bound[4]),
+        })
+    }
+}
+
+/// Far isolated points are looked for in point sets of at least this many points (in a
+/// handful of points every point is far from the others).
+const FAR_MIN_POINTS: u64 = 1000;
 
 impl Buckets {
     /// Streams `input` once: its bounding box, and every point to a random bucket file.
@@ -599,12 +678,14 @@ impl Buckets {
             .collect::<std::io::Result<_>>()
             .map_err(io_err)?;
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        let mut extremes = Extremes::new();
         let mut chunk = Vec::new();
         let mut staged: Vec<Vec<u8>> = vec![Vec::new(); count];
         while reader.read_chunk(&mut chunk, 1 << 16)? > 0 {
             for p in &chunk {
                 lo = lo.min(p.position);
                 hi = hi.max(p.position);
+                extremes.offer(p.position);
                 encode_record(p, &mut staged[rng.random_range(0..count)]);
             }
             for (w, bytes) in writers.iter_mut().zip(staged.iter_mut()) {
@@ -616,7 +697,36 @@ impl Buckets {
             w.flush().map_err(io_err)?;
         }
         drop(writers);
-        let bbox = Aabb { min: lo, max: hi };
+        // Far isolated points (a stray `0 0 0` in a scan at UTM coordinates) do not set the
+        // scale: they are left out, judged against a random subset of the points (the first
+        // bucket's).
+        let mut keep = None;
+        let mut far_points = 0;
+        if total >= FAR_MIN_POINTS {
+            let reference: Vec<DVec3> = read_bucket(dir.path(), 0)?
+                .into_iter()
+                .take(FAR_REFERENCE_POINTS)
+                .map(|p| p.position)
+                .collect();
+            let candidates: Vec<DVec3> = extremes.lists.iter().flatten().map(|&(_, p)| p).collect();
+            let far = far_isolated(&candidates, &reference);
+            let far_set: std::collections::HashSet<[u64; 3]> = candidates
+                .iter()
+                .zip(&far)
+                .filter(|(_, &f)| f)
+                .map(|(c, _)| c.to_array().map(f64::to_bits))
+                .collect();
+            keep = extremes.box_without(|p| far_set.contains(&p.to_array().map(f64::to_bits)));
+            if let Some(b) = keep {
+                for k in 0..count {
+                    far_points += read_bucket(dir.path(), k)?
+                        .iter()
+                        .filter(|p| !b.contains(p.position))
+                        .count() as u64;
+                }
+            }
+        }
+        let bbox = keep.unwrap_or(Aabb { min: lo, max: hi });
         let normalization = Normalization::for_bbox(&bbox).ok_or_else(|| {
             Error::invalid_mesh(
                 input,
@@ -631,9 +741,11 @@ impl Buckets {
             _registered: registered,
             dir,
             count,
-            total,
+            total: total - far_points,
             had_normals,
             normalization,
+            keep,
+            far_points,
         })
     }
 
@@ -670,18 +782,12 @@ impl Buckets {
 
     /// Bucket `b`'s points in bbox-100 units, shuffled.
     fn load(&self, b: usize, rng: &mut ChaCha8Rng) -> Result<Vec<Point>> {
-        let mut bytes = Vec::new();
-        File::open(self.dir.path().join(format!("{b}.bin")))
-            .and_then(|f| BufReader::new(f).read_to_end(&mut bytes))
-            .map_err(|e| Error::io(self.dir.path(), e))?;
-        let mut pts: Vec<Point> = bytes
-            .chunks_exact(RECORD_BYTES)
-            .map(|r| {
-                let p = decode_record(r);
-                Point {
-                    position: self.normalization.apply(p.position),
-                    normal: p.normal,
-                }
+        let mut pts: Vec<Point> = read_bucket(self.dir.path(), b)?
+            .into_iter()
+            .filter(|p| self.keep.is_none_or(|k| k.contains(p.position)))
+            .map(|p| Point {
+                position: self.normalization.apply(p.position),
+                normal: p.normal,
             })
             .collect();
         pts.shuffle(rng);
