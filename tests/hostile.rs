@@ -44,6 +44,27 @@ fn assert_error(o: &Output, code: i32, mentions: &[&str]) {
     assert!(!err.contains("panicked"), "{err}");
 }
 
+/// `remesh quality` of the written `mesh` agrees with the run's own `report` (JSON): the same
+/// topology, crossing pairs and invariant violations, and the same triangle measures up to the
+/// rounding of the frames they are measured in (1e-9 relative).
+fn assert_quality_agrees(mesh: &Path, report: &serde_json::Value) {
+    let o = remesh(&["quality", arg(mesh), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let q: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for key in ["topology", "self_intersections", "invariant_violations"] {
+        assert_eq!(q[key], report[key], "{key} of {}", mesh.display());
+    }
+    let (ours, theirs) = (&report["triangles"], &q["triangles"]);
+    for (name, value) in ours.as_object().expect("triangle measures") {
+        let (a, b) = (value.as_f64().unwrap(), theirs[name].as_f64().unwrap());
+        assert!(
+            (a - b).abs() <= 1e-9 * a.abs().max(1.0),
+            "{name} of {}: {a} in the run, {b} read back",
+            mesh.display()
+        );
+    }
+}
+
 /// No temporary file of a write is left in `dir`.
 fn assert_no_temporaries(dir: &Path) {
     let left: Vec<_> = std::fs::read_dir(dir)
@@ -185,6 +206,7 @@ fn a_failed_run_leaves_the_existing_output() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert!(json["topology"]["vertices"].as_i64().unwrap() > 250);
+    assert_quality_agrees(&out, &json);
     assert_no_temporaries(dir.path());
 }
 
@@ -286,6 +308,7 @@ fn messages_name_what_is_wrong() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let json: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
     assert!(json["topology"]["vertices"].as_i64().unwrap() > 250);
+    assert_quality_agrees(&out, &json);
     assert!(!dir.path().join("-").exists());
     let o = remesh(&[arg(&input), "-", "--points", "300", "--report", "-"]);
     assert_error(&o, 2, &["--report"]);
@@ -541,6 +564,7 @@ fn a_far_stray_point_does_not_set_the_scale() {
     assert_eq!(r["topology"]["components"].as_i64(), Some(1));
     let notes = r["notes"].to_string();
     assert!(notes.contains("isolated points"), "{notes}");
+    assert_quality_agrees(&out, &r);
     let simplified = dir.path().join("s.ply");
     let o = remesh(&["simplify", arg(&input), arg(&simplified), "--points", "500"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

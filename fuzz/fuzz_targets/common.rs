@@ -24,7 +24,10 @@ pub fn read_bytes(data: &[u8], ext: &str) {
     }
     if let Ok((mesh, _)) = read_mesh(&path) {
         assert!(!mesh.triangles.is_empty(), "a mesh without faces was read");
-        assert!(mesh.check_indices().is_none(), "an index out of range was read");
+        assert!(
+            mesh.check_indices().is_none(),
+            "an index out of range was read"
+        );
         assert!(
             mesh.positions.iter().all(|p| p.is_finite()),
             "a non-finite coordinate was read"

@@ -8,6 +8,10 @@ use libfuzzer_sys::fuzz_target;
 mod common;
 
 fuzz_target!(|data: &[u8]| {
-    let ext = if data.starts_with(b"glTF") { "glb" } else { "gltf" };
+    let ext = if data.starts_with(b"glTF") {
+        "glb"
+    } else {
+        "gltf"
+    };
     common::read_bytes(data, ext);
 });

@@ -2,8 +2,10 @@
 //! (tests/fuzz_regressions.rs) so that a finding replays exactly: a small mesh (a sphere, a
 //! torus, an open sheet, a box, two spheres some gap apart, a sharp cone) made messy as the bytes
 //! say (noise, regions of reversed faces, quads and pentagons as polygons, near-degenerate and
-//! zero-area faces, holes, duplicate faces, a vertex pulled far out), written as OBJ text; the
-//! whole `remesh` job run on it; and what every run must keep.
+//! zero-area faces, holes, duplicate faces, a vertex pulled far out; then, from a last byte, a
+//! second copy passing through it, every face again reversed (a double-sided export), a
+//! zero-area face first), written as OBJ text; the whole `remesh` job run on it; and what every
+//! run must keep.
 
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
@@ -247,6 +249,42 @@ pub fn small_mesh(data: &[u8]) -> (String, usize, u64) {
             }
         }
     }
+    let points = 20 + b.below(400);
+    let seed = b.byte() as u64 % 5 + 1;
+    // Scene-level changes from one more byte, read so that an input without it (the byte
+    // reads 0x5a past the end) changes nothing, and earlier inputs replay as they were.
+    let extras = b.byte() ^ 0x5a;
+    if extras & 1 != 0 {
+        // A second copy of the mesh passing through the first (a scene's parts that overlap),
+        // moved by up to the model's size along x.
+        let shift = 0.2 + 1.5 * b.unit();
+        let n = p.len();
+        p.extend_from_within(..);
+        for v in &mut p[n..] {
+            v[0] += shift;
+        }
+        let copies: Faces = f
+            .iter()
+            .map(|t| t.iter().map(|i| i + n).collect())
+            .collect();
+        f.extend(copies);
+    }
+    if extras & 2 != 0 {
+        // Exported double-sided: every face again, reversed.
+        let back: Faces = f
+            .iter()
+            .map(|t| t.iter().rev().copied().collect())
+            .collect();
+        f.extend(back);
+    }
+    if extras & 4 != 0 && !f.is_empty() {
+        // A zero-area face first (parry's BVH once panicked on one that led the list).
+        let q = p[f[0][0]];
+        let n = p.len();
+        p.push([q[0] + 1.0, q[1], q[2]]);
+        p.push([q[0] + 2.0, q[1], q[2]]);
+        f.insert(0, vec![f[0][0], n, n + 1]);
+    }
     let mut obj = String::new();
     for v in &p {
         obj += &format!("v {} {} {}\n", v[0], v[1], v[2]);
@@ -258,8 +296,6 @@ pub fn small_mesh(data: &[u8]) -> (String, usize, u64) {
         }
         obj += "\n";
     }
-    let points = 20 + b.below(400);
-    let seed = b.byte() as u64 % 5 + 1;
     (obj, points, seed)
 }
 
