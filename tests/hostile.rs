@@ -578,3 +578,23 @@ fn a_far_stray_point_does_not_set_the_scale() {
         .unwrap();
     assert!((450..=550).contains(&samples), "{said}");
 }
+
+/// Item 9 (the rest): a point set of a handful of points is refused saying so, naming the file.
+#[test]
+fn a_handful_of_points_is_too_few_for_a_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.obj");
+    for n in [3usize, 5] {
+        let mut text = format!(
+            "ply\nformat ascii 1.0\nelement vertex {n}\nproperty float x\nproperty float y\n\
+             property float z\nend_header\n"
+        );
+        for k in 0..n {
+            text += &format!("{} {} {}\n", k % 2, k / 2 % 2, k / 4);
+        }
+        let name = format!("p{n}.ply");
+        let input = write(dir.path(), &name, text);
+        let o = remesh(&[arg(&input), arg(&out), "--points", "2"]);
+        assert_error(&o, 3, &[&name, &format!("{n} points are too few")]);
+    }
+}

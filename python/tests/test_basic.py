@@ -362,6 +362,15 @@ def test_ctrl_c_stops_a_job_at_its_next_stage(spot):
     assert stages and "write" not in stages, stages
 
 
+def test_sweep_counts_have_upper_bounds(spot):
+    """Issue 36, item 5: iterations=10**9 killed the interpreter (an allocation by the count);
+    it is a ValueError at once, as is smooth=10**9."""
+    with pytest.raises(ValueError, match="iterations"):
+        sr.remesh(*spot, points=500, iterations=10**9)
+    with pytest.raises(ValueError, match="smooth"):
+        sr.remesh(*spot, points=500, smooth=10**9)
+
+
 def test_gil_is_released(spot, gil_released):
     """Another Python thread runs while remesh works (about 0.6 s here)."""
     gil_released(lambda: sr.remesh(*spot, points=5000, distance=False))

@@ -445,14 +445,22 @@ pub(crate) fn rimls_of(
         if positions.is_empty() && !off.is_empty() {
             // Every point is on no sheet at this radius: the data is sparser than the output
             // asked for (or holds no surface at all). The caller names the file.
+            let n = off.len();
             return Err(Error::invalid_mesh(
                 "",
-                format!(
-                    "no surface at this density: none of its {} points has enough neighbours \
-                     within {radius:.3} (bbox-100 units, from the output's spacing); ask for \
-                     fewer output points than the input has",
-                    off.len()
-                ),
+                if n <= super::outliers::SHEET_NEIGHBORS {
+                    format!(
+                        "{n} points are too few to hold a surface: a point on one needs {} \
+                         others around it",
+                        super::outliers::SHEET_NEIGHBORS
+                    )
+                } else {
+                    format!(
+                        "no surface at this density: none of its {n} points has enough \
+                         neighbours within {radius:.3} (bbox-100 units, from the output's \
+                         spacing); ask for fewer output points than the input has"
+                    )
+                },
             ));
         }
     }
