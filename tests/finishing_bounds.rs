@@ -346,7 +346,7 @@ fn a_point_set_sparser_than_the_output_is_a_one_line_refusal() {
     assert_eq!(run.status.code(), Some(3), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(
-        err.contains("five.ply") && err.contains("no surface at this density"),
+        err.contains("five.ply") && err.contains("5 points are too few to hold a surface"),
         "{err}"
     );
     assert!(!out.exists());
