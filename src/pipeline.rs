@@ -634,6 +634,12 @@ pub fn remesh(
             }),
             sigma_ref,
         };
+        // The creases' total length (the curves the scan samples besides the boundary).
+        let crease_length: f64 = features
+            .curves
+            .iter()
+            .map(|c| c.length(&normalized.positions))
+            .sum();
         let scan = |sigma_p: f64,
                     widths: &Widths,
                     pool_widths: Option<&[f64]>|
@@ -641,6 +647,15 @@ pub fn remesh(
             let kernel = Kernel::new(sigma_p, params.sigma_n)?;
             let spacing = BOUNDARY_SPACING_PER_SIGMA * sigma_p;
             let feature_spacing = FEATURE_SPACING_PER_SIGMA * sigma_p;
+            // The curves' samples from their lengths, before any is placed: a sigma_p whose
+            // curves would take four times the limit is answered without placing them (a crease
+            // of 10^8 spacings, a sliver's edge at a tiny sigma_p, filled the memory before the
+            // count below was reached). Four times: creases crowded out by others take no
+            // samples, so the count below can be lower than this one, not that much lower.
+            let least = boundary_length / spacing + crease_length / feature_spacing;
+            if !(least <= 4.0 * boundary_limit) {
+                return Ok((least.min(usize::MAX as f64) as usize, None));
+            }
             // The boundary curves, cut where creases end on them, and the creases long enough
             // to take samples at their spacing.
             let width = widths.active().then_some(|p: DVec3| widths.width(p));

@@ -49,3 +49,15 @@ fn the_remesh_target_checks_hold_on_a_fixed_sample_of_its_inputs() {
         small_meshes::assert_remesh_is_sound(&data, dir.path());
     }
 }
+
+/// Found by the remesh fuzz target (issue 36's run): a thin box with a vertex pulled 10^12 out
+/// and a copy passing through it. Its sliver faces' creases are 100 bbox-100 units long while the
+/// count asks for a sigma_p of about 10^-6: the sigma_p search placed every crease's samples
+/// before counting them, and took 8 GB. A sigma_p whose curves would take four times the limit
+/// is now answered from their lengths.
+#[test]
+fn fuzz_regression_a_long_crease_at_a_tiny_sigma_p_filled_the_memory() {
+    let data = include_bytes!("fuzz/remesh-sliver-crease-memory.bin");
+    let dir = tempfile::tempdir().unwrap();
+    small_meshes::assert_remesh_is_sound(data, dir.path());
+}
