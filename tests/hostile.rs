@@ -400,8 +400,8 @@ fn bytes_after_a_binary_body_are_an_error() {
 }
 
 /// Item 11: files other tools read: an OFF whose records wrap over several lines (OFF is
-/// whitespace-separated), and an OBJ or OFF starting with a UTF-8 byte-order mark, read as the
-/// same mesh as their plain forms.
+/// whitespace-separated) or whose vertex count is written against its keyword, and an OBJ or
+/// OFF starting with a UTF-8 byte-order mark, read as the same mesh as their plain forms.
 #[test]
 fn wrapped_off_records_and_byte_order_marks_are_read() {
     let dir = tempfile::tempdir().unwrap();
@@ -421,6 +421,13 @@ fn wrapped_off_records_and_byte_order_marks_are_read() {
     assert_eq!(a.triangles, b.triangles);
     let bom_off = read("bom.off", &[b"\xEF\xBB\xBF", plain.as_bytes()].concat());
     assert_eq!(bom_off.triangles, a.triangles);
+    // The vertex count written against the keyword (trimesh's whitespace.off).
+    let glued = read(
+        "glued.off",
+        plain.replacen("OFF\n4", "\t  OFF4", 1).as_bytes(),
+    );
+    assert_eq!(glued.positions, a.positions);
+    assert_eq!(glued.triangles, a.triangles);
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
     let c = read("plain.obj", obj.as_bytes());
     let d = read("bom.obj", &[b"\xEF\xBB\xBF", obj.as_bytes()].concat());

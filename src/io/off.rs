@@ -33,7 +33,15 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
         .next()
         .ok_or_else(|| Error::parse(path, None, "no OFF header (the file has no content)"))?;
     let mut head = first.split_whitespace();
-    let keyword = head.next().unwrap_or("");
+    let word = head.next().unwrap_or("");
+    // The keyword, and a count written against it (`OFF8 6 12`, which trimesh reads).
+    let (keyword, glued) = ["CNOFF", "COFF", "NOFF", "OFF"]
+        .iter()
+        .find_map(|k| {
+            let rest = word.strip_prefix(k)?;
+            (rest.is_empty() || rest.bytes().all(|b| b.is_ascii_digit())).then_some((*k, rest))
+        })
+        .unwrap_or((word, ""));
     if !matches!(keyword, "OFF" | "COFF" | "NOFF" | "CNOFF") {
         return Err(err(
             first_no,
@@ -43,7 +51,11 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
             ),
         ));
     }
-    let rest: Vec<&str> = head.collect();
+    let rest: Vec<&str> = (!glued.is_empty())
+        .then_some(glued)
+        .into_iter()
+        .chain(head)
+        .collect();
     let (counts_no, counts) = if rest.is_empty() {
         lines
             .next()
