@@ -73,9 +73,9 @@ pub fn physical_memory() -> Option<u64> {
 /// ([`physical_memory`]), the memory limit of the process's control group (cgroup v2
 /// `memory.max` or v1 `memory.limit_in_bytes`, along its path) and its address-space limit
 /// (`RLIMIT_AS`, `ulimit -v`) less a reserve for what is mapped without being resident (thread
-/// stacks, the allocator's per-thread arenas: [`ADDRESS_SPACE_RESERVE_PER_THREAD`] per core
-/// and as much again). Under such a limit a job too large is refused before it starts instead
-/// of aborting when an allocation fails. `None` when none can be read.
+/// stacks, the allocator's per-thread arenas: 128 MiB per core and as much again). Under such
+/// a limit a job too large is refused before it starts instead of aborting when an allocation
+/// fails. `None` when none can be read.
 pub fn memory_limit() -> Option<u64> {
     [physical_memory(), cgroup_limit(), address_space_limit()]
         .into_iter()

@@ -72,7 +72,8 @@ pub struct OutOfCoreResult {
     pub samples: Vec<Point>,
     /// Points read, less the far isolated ones.
     pub input_points: u64,
-    /// Far isolated points left out ([`far_isolated`]): they would have set the scale.
+    /// Far isolated points left out (`points::outliers::far_isolated`): they would have set
+    /// the scale.
     pub far_points: u64,
     /// Whether the input had normals (without them the kernel uses positions only).
     pub had_normals: bool,
@@ -181,7 +182,7 @@ pub(crate) struct ScanOutput {
     pub support: Vec<Point>,
     /// Points read, less the far isolated ones.
     pub input_points: u64,
-    /// Far isolated points left out ([`far_isolated`]).
+    /// Far isolated points left out (`points::outliers::far_isolated`).
     pub far_points: u64,
     /// Whether the input had normals.
     pub had_normals: bool,
@@ -481,7 +482,7 @@ pub struct ProgressiveResult {
     pub sigma_p: Vec<f64>,
     /// Points read.
     pub input_points: u64,
-    /// Far isolated points left out ([`far_isolated`]).
+    /// Far isolated points left out (`points::outliers::far_isolated`).
     pub far_points: u64,
     /// Whether the input had normals.
     pub had_normals: bool,
