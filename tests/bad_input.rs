@@ -60,14 +60,7 @@ fn remesh(args: &[&str]) -> Output {
 /// The run failed with `code`, printed exactly one line on stderr that contains every one of
 /// `mentions`, and left `output` absent.
 fn assert_error(o: &Output, code: i32, mentions: &[&str], output: &Path) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(code), "stderr: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-    assert!(err.starts_with("remesh: error: "), "{err}");
-    for m in mentions {
-        assert!(err.contains(m), "{err:?} does not mention {m:?}");
-    }
-    assert!(!err.contains("panicked"), "{err}");
+    common::assert_one_line_error(o, code, mentions);
     assert!(!output.exists(), "{} was written", output.display());
 }
 

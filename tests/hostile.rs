@@ -34,14 +34,7 @@ fn sphere(dir: &Path) -> PathBuf {
 
 /// The run failed with `code` and printed one line on stderr mentioning each of `mentions`.
 fn assert_error(o: &Output, code: i32, mentions: &[&str]) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(code), "stderr: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-    assert!(err.starts_with("remesh: error: "), "{err}");
-    for m in mentions {
-        assert!(err.contains(m), "{err:?} does not mention {m:?}");
-    }
-    assert!(!err.contains("panicked"), "{err}");
+    common::assert_one_line_error(o, code, mentions);
 }
 
 /// `remesh quality` of the written `mesh` agrees with the run's own `report` (JSON): the same

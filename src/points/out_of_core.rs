@@ -14,7 +14,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::normals::{estimate_normals, NormalOrientation};
-use super::outliers::{far_isolated, off_surface, OutlierFilter};
+use super::outliers::{far_isolated, flagged, off_surface, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
 use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -718,13 +718,7 @@ impl Buckets {
                 .map(|p| p.position)
                 .collect();
             let candidates: Vec<DVec3> = extremes.lists.iter().flatten().map(|&(_, p)| p).collect();
-            let far = far_isolated(&candidates, &reference);
-            let far_set: std::collections::HashSet<[u64; 3]> = candidates
-                .iter()
-                .zip(&far)
-                .filter(|(_, &f)| f)
-                .map(|(c, _)| c.to_array().map(f64::to_bits))
-                .collect();
+            let far_set = flagged(&candidates, &far_isolated(&candidates, &reference));
             keep = extremes.box_without(|p| far_set.contains(&p.to_array().map(f64::to_bits)));
             if let Some(b) = keep {
                 for k in 0..count {

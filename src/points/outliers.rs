@@ -148,12 +148,7 @@ pub fn far_isolated(candidates: &[DVec3], reference: &[DVec3]) -> Vec<bool> {
         .collect();
     let mut far = vec![false; candidates.len()];
     for _ in 0..8 {
-        let far_points: std::collections::HashSet<[u64; 3]> = candidates
-            .iter()
-            .zip(&far)
-            .filter(|(_, &f)| f)
-            .map(|(c, _)| c.to_array().map(f64::to_bits))
-            .collect();
+        let far_points = flagged(candidates, &far);
         let (lo, hi) = all
             .iter()
             .filter(|p| !far_points.contains(&p.to_array().map(f64::to_bits)))
@@ -169,6 +164,16 @@ pub fn far_isolated(candidates: &[DVec3], reference: &[DVec3]) -> Vec<bool> {
         far = next;
     }
     far
+}
+
+/// The positions of `points` that `flags` marks, as their bit patterns (exact matches).
+pub fn flagged(points: &[DVec3], flags: &[bool]) -> std::collections::HashSet<[u64; 3]> {
+    points
+        .iter()
+        .zip(flags)
+        .filter(|(_, &f)| f)
+        .map(|(p, _)| p.to_array().map(f64::to_bits))
+        .collect()
 }
 
 /// Neighbours within the radius that put a point on a sheet (see [`off_surface`]).

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use glam::DVec3;
 use spectral_remesh::TriMesh;
@@ -164,4 +165,17 @@ pub fn grid_box_counts(lo: DVec3, hi: DVec3, counts: [usize; 3]) -> TriMesh {
     let mut mesh = TriMesh::new(positions, triangles);
     mesh.weld_identical_positions();
     mesh
+}
+
+/// The run failed with `code` and printed exactly one line on stderr, `remesh: error: …`, that
+/// contains every one of `mentions` and no panic.
+pub fn assert_one_line_error(o: &Output, code: i32, mentions: &[&str]) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(code), "stderr: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    assert!(err.starts_with("remesh: error: "), "{err}");
+    for m in mentions {
+        assert!(err.contains(m), "{err:?} does not mention {m:?}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
 }
