@@ -61,3 +61,14 @@ fn fuzz_regression_a_long_crease_at_a_tiny_sigma_p_filled_the_memory() {
     let dir = tempfile::tempdir().unwrap();
     small_meshes::assert_remesh_is_sound(data, dir.path());
 }
+
+/// Found by the remesh fuzz target (issue 36's run): an open box corner whose other faces are
+/// slivers at one point. The buried-point test's BVH held two faces, numbered 0 and 2; parry's
+/// builder assumes two leaves are numbered 0 and 1 and panicked ("key not present", issue 36's
+/// item 1 by another road). BVHs are built through `geometry::bvh::bvh_of` now.
+#[test]
+fn fuzz_regression_a_bvh_of_two_faces_not_numbered_0_and_1_panicked() {
+    let data = include_bytes!("fuzz/remesh-two-leaf-bvh.bin");
+    let dir = tempfile::tempdir().unwrap();
+    small_meshes::assert_remesh_is_sound(data, dir.path());
+}

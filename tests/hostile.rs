@@ -89,6 +89,35 @@ fn a_zero_area_first_face_is_left_out_not_a_panic() {
     let input = write(dir.path(), "many.obj", many);
     let o = remesh(&[arg(&input), arg(&out), "--points", "200", "-q"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Two faces with area between zero-area ones: a BVH of two leaves numbered 0 and 2 (parry's
+    // builder assumed 0 and 1; found by the fuzz target).
+    let two = "v 0.00999969482421875 0.00999969482421875 0.00999969482421875\n\
+               v 1.008901672363281 0.5089016723632812 0.008901672363281293\n\
+               v 0.00843109130859375 1.0084310913085937 0.00843109130859375\n\
+               v 1.0084310913085937 0.00843292236328125 0.00890167236328133\n\
+               v 1.0089016723632813 0.5089016723632812 0.008901672363281293\n\
+               v 1.0089016723632813 1.0089016723632813 0.008431091308593716\n\
+               v 0.00999969482421875 0.5084310913085938 0.00843109130859375\n\
+               v 0.00999969482421875 0.5084310913085938 0.00843109130859375\n\
+               v 0.00999969482421875 0.5084310913085938 0.00843109130859375\n\
+               v 0.00999969482421875 0.5084310913085938 0.00843109130859375\n\
+               f 1 4 5\n\
+               f 1 5 2\n\
+               f 2 5 6\n\
+               f 2 6 3\n\
+               f 2 7 8\n\
+               f 2 9 10\n";
+    let input = write(dir.path(), "two.obj", two);
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "161",
+        "--seed",
+        "1",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 /// Item 2: `--report` naming the input or the output is refused before any work, and both

@@ -5,6 +5,7 @@
 //! A public namespace of its own (`spectral_remesh::geometry::triangle_q`, ...): these are small
 //! building blocks under the pipeline's stages, not stages, and read best with the prefix.
 
+pub(crate) mod bvh;
 pub(crate) mod morton;
 pub(crate) mod plane;
 pub(crate) mod self_intersection;

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use parry3d_f64::partitioning::Bvh;
 use rayon::prelude::*;
 
 use super::triangle::is_degenerate_face;
@@ -19,7 +19,7 @@ pub(crate) fn overlapping_box_pairs(boxes: &[(usize, Aabb)]) -> Vec<[u32; 2]> {
     if boxes.len() < 2 {
         return Vec::new();
     }
-    let bvh = Bvh::from_iter(BvhBuildStrategy::Binned, boxes.iter().copied());
+    let bvh = crate::geometry::bvh::bvh_of(boxes.iter().copied());
     let mut pairs: Vec<[u32; 2]> = bvh
         .traverse_bvtt_single_tree_parallel::<false>()
         .into_par_iter()
@@ -196,7 +196,7 @@ impl CrossingRegions {
             .enumerate()
             .map(|(i, (lo, hi))| (i, Aabb::new(lo - loosen, hi + loosen)));
         CrossingRegions {
-            bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
+            bvh: crate::geometry::bvh::bvh_of(boxes),
             count: pairs.len() + touching.len(),
         }
     }
@@ -293,7 +293,7 @@ mod tests {
     fn the_early_stopping_test_agrees_with_the_count() {
         let has = |m: &crate::mesh::TriMesh| {
             let boxes = face_boxes(&m.positions, &m.triangles);
-            let bvh = Bvh::from_iter(BvhBuildStrategy::Binned, boxes.iter().copied());
+            let bvh = crate::geometry::bvh::bvh_of(boxes.iter().copied());
             has_intersecting_pair(&bvh, &boxes, &m.positions, &m.triangles)
         };
         let mut sphere = uv_sphere(1.0, 12, 24);

@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 use parry3d_f64::bounding_volume::BoundingVolume;
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use parry3d_f64::partitioning::Bvh;
 
 use super::edit::EditMesh;
 use crate::geometry::self_intersection::triangle_aabb;
@@ -34,7 +34,7 @@ impl CrossingGuard {
             .zip(&slots)
             .map(|(&t, &f)| (f as usize, triangle_aabb(m.corners(t))));
         CrossingGuard {
-            bvh: Bvh::from_iter(BvhBuildStrategy::Binned, boxes),
+            bvh: crate::geometry::bvh::bvh_of(boxes),
             near: near.max(0.0),
         }
     }

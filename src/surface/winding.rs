@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use parry3d_f64::partitioning::Bvh;
 use parry3d_f64::query::{Ray, RayCast};
 use rayon::prelude::*;
 
@@ -58,7 +58,7 @@ impl<'a> RayWinding<'a> {
     /// or a non-finite corner are left out: [`face_boxes`]).
     pub fn new(mesh: &'a TriMesh) -> Self {
         let boxes = face_boxes(&mesh.positions, &mesh.triangles);
-        let bvh = Bvh::from_iter(BvhBuildStrategy::Binned, boxes.iter().copied());
+        let bvh = crate::geometry::bvh::bvh_of(boxes.iter().copied());
         // Only the counted faces' corners are read: the others may have an index out of range.
         let mut counted = vec![false; mesh.triangles.len()];
         let mut normals = vec![DVec3::ZERO; mesh.triangles.len()];
