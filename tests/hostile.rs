@@ -58,6 +58,25 @@ fn assert_quality_agrees(mesh: &Path, report: &serde_json::Value) {
     }
 }
 
+/// `remesh INPUT OUTPUT ARGS -q --report` expected to succeed; `remesh quality` of the written
+/// file agrees with the report ([`assert_quality_agrees`]), which is returned.
+fn remesh_checked(input: &Path, output: &Path, args: &[&str]) -> serde_json::Value {
+    let report = output.with_extension("report.json");
+    let o = remesh(
+        &[
+            &[arg(input), arg(output)][..],
+            args,
+            &["-q", "--report", arg(&report)],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_quality_agrees(output, &r);
+    r
+}
+
 /// No temporary file of a write is left in `dir`.
 fn assert_no_temporaries(dir: &Path) {
     let left: Vec<_> = std::fs::read_dir(dir)
@@ -78,8 +97,7 @@ fn a_zero_area_first_face_is_left_out_not_a_panic() {
         "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n",
     );
     let out = dir.path().join("o.obj");
-    let o = remesh(&[arg(&input), arg(&out), "--points", "200", "-q"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    remesh_checked(&input, &out, &["--points", "200"]);
     let (mesh, _) = spectral_remesh::read_mesh(&out).unwrap();
     assert!(mesh.face_count() > 0);
     // The same face many times over, first.
@@ -87,8 +105,7 @@ fn a_zero_area_first_face_is_left_out_not_a_panic() {
     many.push_str(&"f 1 2 3\n".repeat(10_000));
     many.push_str("f 1 2 4\n");
     let input = write(dir.path(), "many.obj", many);
-    let o = remesh(&[arg(&input), arg(&out), "--points", "200", "-q"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    remesh_checked(&input, &out, &["--points", "200"]);
     // Two faces with area between zero-area ones: a BVH of two leaves numbered 0 and 2 (parry's
     // builder assumed 0 and 1; found by the fuzz target).
     let two = "v 0.00999969482421875 0.00999969482421875 0.00999969482421875\n\
@@ -108,16 +125,7 @@ fn a_zero_area_first_face_is_left_out_not_a_panic() {
                f 2 7 8\n\
                f 2 9 10\n";
     let input = write(dir.path(), "two.obj", two);
-    let o = remesh(&[
-        arg(&input),
-        arg(&out),
-        "--points",
-        "161",
-        "--seed",
-        "1",
-        "-q",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    remesh_checked(&input, &out, &["--points", "161", "--seed", "1"]);
 }
 
 /// Item 2: `--report` naming the input or the output is refused before any work, and both
@@ -265,16 +273,7 @@ fn sweep_counts_have_upper_bounds() {
     assert_error(&o, 2, &["--resample", "1000000000"]);
     assert!(!simplified.exists());
     // The bound itself is taken.
-    let o = remesh(&[
-        arg(&input),
-        arg(&out),
-        "--points",
-        "300",
-        "--smooth",
-        "1000",
-        "-q",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    remesh_checked(&input, &out, &["--points", "300", "--smooth", "1000"]);
 }
 
 /// Item 12: negative and fractional numbers reach each option's own one-line check, or a
@@ -398,8 +397,7 @@ fn bytes_after_a_binary_body_are_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let input = sphere(dir.path());
     let ply = dir.path().join("m.ply");
-    let o = remesh(&[arg(&input), arg(&ply), "--points", "200", "-q"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    remesh_checked(&input, &ply, &["--points", "200"]);
     let mut bytes = std::fs::read(&ply).unwrap();
     bytes.extend_from_slice(b"GARBAGE");
     let garbage = write(dir.path(), "garbage.ply", &bytes);
