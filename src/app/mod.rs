@@ -130,7 +130,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         if !to_stdout {
             others.push((job.output.as_path(), "the output mesh"));
         }
-        check_report_path(report, &others)?;
+        report_clash(report, &others)?;
     }
     // Every file the job writes is opened (as a temporary beside it) before the work: a path
     // that cannot be written is an error now, not after the run.
@@ -676,7 +676,6 @@ fn write_output(
         outputs.written.set(true);
         Ok(())
     } else {
-        use std::io::Write;
         let mut stdout = std::io::stdout().lock();
         stdout
             .write_all(&bytes)
@@ -1171,14 +1170,21 @@ pub fn write_report(path: &Path, report: &QualityReport) -> Result<()> {
 /// file under any name, or the same name in the same folder); [`Error::Write`] naming `report`
 /// when it is a directory or a special file, or its folder is missing or not writable.
 pub fn check_report_path(report: &Path, others: &[(&Path, &str)]) -> Result<()> {
-    if let Some((_, what)) = others.iter().find(|(p, _)| same_target(report, p)) {
-        return Err(Error::InvalidParameter {
-            name: "--report",
-            message: format!("{} is {what}; choose another report path", report.display()),
-        });
-    }
+    report_clash(report, others)?;
     // Creating the temporary file (removed when dropped) is the test of the folder.
     AtomicFile::create(report).map(drop)
+}
+
+/// [`check_report_path`] without the test of the folder ([`run_remesh`] creates the report's
+/// temporary file itself).
+fn report_clash(report: &Path, others: &[(&Path, &str)]) -> Result<()> {
+    match others.iter().find(|(p, _)| same_target(report, p)) {
+        Some((_, what)) => Err(Error::InvalidParameter {
+            name: "--report",
+            message: format!("{} is {what}; choose another report path", report.display()),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Runs `job`, turning a panic (a bug) into an [`Error::Internal`] with stage `panic`, the

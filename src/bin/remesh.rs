@@ -588,18 +588,14 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // One line whatever a file name holds: control characters (a newline) escaped.
-            let message: String = e
-                .to_string()
-                .chars()
-                .flat_map(|c| {
-                    let escaped: Vec<char> = if c.is_control() {
-                        c.escape_default().collect()
-                    } else {
-                        vec![c]
-                    };
-                    escaped
-                })
-                .collect();
+            let mut message = String::new();
+            for c in e.to_string().chars() {
+                if c.is_control() {
+                    message.extend(c.escape_default());
+                } else {
+                    message.push(c);
+                }
+            }
             eprintln!("remesh: error: {message}");
             ExitCode::from(e.exit_code() as u8)
         }

@@ -573,11 +573,12 @@ pub fn simplify_progressive(
     })
 }
 
-/// Bucket `b`'s points in `dir` as written (model units, in file order).
-fn read_bucket(dir: &Path, b: usize) -> Result<Vec<Point>> {
+/// Bucket `b`'s points in `dir` as written (model units, in file order), the first `limit`.
+fn read_bucket(dir: &Path, b: usize, limit: usize) -> Result<Vec<Point>> {
     let mut bytes = Vec::new();
+    let most = limit.saturating_mul(RECORD_BYTES) as u64;
     File::open(dir.join(format!("{b}.bin")))
-        .and_then(|f| BufReader::new(f).read_to_end(&mut bytes))
+        .and_then(|f| BufReader::new(f).take(most).read_to_end(&mut bytes))
         .map_err(|e| Error::io(dir, e))?;
     Ok(bytes
         .chunks_exact(RECORD_BYTES)
@@ -712,9 +713,8 @@ impl Buckets {
         let mut keep = None;
         let mut far_points = 0;
         if total >= FAR_MIN_POINTS {
-            let reference: Vec<DVec3> = read_bucket(dir.path(), 0)?
+            let reference: Vec<DVec3> = read_bucket(dir.path(), 0, FAR_REFERENCE_POINTS)?
                 .into_iter()
-                .take(FAR_REFERENCE_POINTS)
                 .map(|p| p.position)
                 .collect();
             let candidates: Vec<DVec3> = extremes.lists.iter().flatten().map(|&(_, p)| p).collect();
@@ -722,7 +722,7 @@ impl Buckets {
             keep = extremes.box_without(|p| far_set.contains(&p.to_array().map(f64::to_bits)));
             if let Some(b) = keep {
                 for k in 0..count {
-                    far_points += read_bucket(dir.path(), k)?
+                    far_points += read_bucket(dir.path(), k, usize::MAX)?
                         .iter()
                         .filter(|p| !b.contains(p.position))
                         .count() as u64;
@@ -785,7 +785,7 @@ impl Buckets {
 
     /// Bucket `b`'s points in bbox-100 units, shuffled.
     fn load(&self, b: usize, rng: &mut ChaCha8Rng) -> Result<Vec<Point>> {
-        let mut pts: Vec<Point> = read_bucket(self.dir.path(), b)?
+        let mut pts: Vec<Point> = read_bucket(self.dir.path(), b, usize::MAX)?
             .into_iter()
             .filter(|p| self.keep.is_none_or(|k| k.contains(p.position)))
             .map(|p| Point {
