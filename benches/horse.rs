@@ -15,11 +15,11 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use spectral_remesh::{
-    linear_scan, read_mesh, run_remesh, surface_candidates, triangulate, validate_input, Density,
-    Kernel, LinearScanParams, RemeshJob, RemeshParams, SampleSet, TriangulateParams,
-    SAMPLES_PER_SIGMA2,
+use spectral_remesh::internal::{
+    linear_scan, surface_candidates, triangulate, validate_input, Kernel, LinearScanParams,
+    SampleSet, TriangulateParams, SAMPLES_PER_SIGMA2,
 };
+use spectral_remesh::{read_mesh, run_remesh, Density, RemeshJob, RemeshParams};
 
 /// Output vertices, as the harness remeshes the horse.
 const POINTS: usize = 8600;

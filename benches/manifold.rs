@@ -22,9 +22,10 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use glam::DVec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use spectral_remesh::internal::{Kernel, LinearScanParams, LinearScanner};
 use spectral_remesh::{
-    resample_manifold, sample_manifold, DataProjection, Kernel, LinearScanParams, LinearScanner,
-    ManifoldResampleParams, ManifoldSampleParams, PointSet,
+    resample_manifold, sample_manifold, DataProjection, ManifoldResampleParams,
+    ManifoldSampleParams, PointSet,
 };
 
 fn sphere(n: usize) -> Vec<DVec3> {

@@ -9,9 +9,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DQuat, DVec3};
-use spectral_remesh::{
-    check_invariants, surface_distance_with, topology, triangle_quality, MeshSurface, TriMesh,
-};
+use spectral_remesh::internal::{surface_distance_with, triangle_quality, MeshSurface};
+use spectral_remesh::{check_invariants, topology, TriMesh};
 
 #[path = "../tests/common/mod.rs"]
 mod common;

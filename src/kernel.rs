@@ -21,7 +21,7 @@ use glam::DVec3;
 use crate::error::{Error, Result};
 
 /// A positive definite kernel with k(x, x) = 1 on points already mapped to kernel space: what
-/// the spectral measure (eq. 9, [`spectral_measure`](crate::spectral_measure)) and its
+/// the spectral measure (eq. 9, [`spectral_measure`](crate::internal::spectral_measure)) and its
 /// evaluation by eq. 10 need of a kernel. The measure's code is written once over this trait;
 /// [`Kernel`] (surfaces in R^3, x = [p/sigma_p, n/sigma_n] in R^6) and [`GaussianKernel`]
 /// (point sets in R^d, x in R^K) implement it.

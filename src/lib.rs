@@ -7,7 +7,9 @@
 //! # The pipeline
 //!
 //! [`remesh`] runs the whole of it on a mesh in memory; [`run_remesh`] adds reading, writing and
-//! the report, as the `remesh` command line does. Each stage is also public on its own:
+//! the report, as the `remesh` command line does. The stages, each a module of the crate
+//! (ARCHITECTURE.md draws the map; they are reachable for the crate's own tools through the
+//! hidden module `internal`, which may change without notice):
 //!
 //! ```text
 //! read_mesh                      OBJ, PLY, glTF, STL, OFF → TriMesh (model units)
@@ -41,9 +43,10 @@
 //! write_mesh, write_report       back to model units, written atomically
 //! ```
 //!
-//! Point sets take a second path: [`PointReader`] → [`simplify_out_of_core`] (the randomized
-//! linear scan in buckets, Sec. 6.4) → [`PlyPointWriter`], with [`estimate_normals`] for inputs
-//! without normals and the [`Rimls`] surface to resample on.
+//! Point sets take a second path: [`remesh_points`] meshes a scan (out of core, on the RIMLS
+//! surface of its points), [`simplify_out_of_core`] subsamples one with the randomized linear
+//! scan in buckets (Sec. 6.4), and [`sample_manifold`] and [`resample_manifold`] sample point sets
+//! near a manifold of any dimension in R^d.
 //!
 //! # Example
 //!
@@ -98,10 +101,10 @@
 //! # Units
 //!
 //! Meshes are read and written in their own (model) units; the pipeline works in bbox-100 units
-//! (the input scaled so that its bounding box's longest side is 100, [`Normalization`]). Lengths
+//! (the input scaled so that its bounding box's longest side is 100, `Normalization`). Lengths
 //! given relative to the kernel width sigma_p say so in their name (`*_sigma_p`); kernel-space
 //! quantities (a support radius of 2.5, the ascent's step) are in kernel units, x =
-//! [p/sigma_p, n/sigma_n] ([`Kernel`]).
+//! [p/sigma_p, n/sigma_n] (the `Kernel`).
 //!
 //! # References
 //!
@@ -116,9 +119,11 @@ mod app;
 mod check;
 mod disjoint_sets;
 mod error;
+#[doc(hidden)]
 pub mod geometry;
 mod io;
 mod kernel;
+#[doc(hidden)]
 pub mod manifold;
 mod measure;
 mod mesh;
@@ -132,129 +137,175 @@ mod surface;
 mod timing;
 mod triangulate;
 
+// The public API: the calls a user makes. Everything else (the stages one by one, their
+// parameters and constants) is in the hidden module `internal`, for the binary, the Python
+// module, the experiments crate, the tests and the benchmarks.
+
 // Errors: one enum for the whole crate.
 pub use error::{Error, Result};
-
-// Reading and writing meshes (OBJ, PLY, glTF, STL, OFF), atomically.
-pub use io::{
-    read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, MeshFormat, ReadStats,
-};
-
-// The meshes: the indexed triangle mesh, its normalization to bbox 100, its consistent
-// orientation, and the editable directed-edge mesh with its local operators.
-pub use mesh::edit::{EditError, EditMesh, EditViolation, SlotPolicy};
-pub use mesh::{orient_consistently, Aabb, FaceCleanup, Normalization, OrientStats, TriMesh};
-
-// The pipeline in one call.
-pub use pipeline::{
-    remesh, validate_input, Density, FeatureStats, RemeshOutput, RemeshParams,
-    BOUNDARY_SPACING_PER_SIGMA, FIT_ITERATIONS, MAX_POINTS, SAMPLES_PER_SIGMA2,
-};
+// Meshes: reading and writing (OBJ, PLY, glTF, STL, OFF), atomically.
+pub use io::{read_mesh, write_mesh, MeshFormat, ReadStats};
+pub use mesh::TriMesh;
+// The pipeline in one call, and the jobs of the command line (files in, files and report out).
+pub use app::{remesh_mesh, run_remesh, RemeshJob, RemeshOptions, RemeshedMesh};
+pub use pipeline::{remesh, Density, FeatureStats, RemeshOutput, RemeshParams};
 pub use timing::Stage;
-
-// The input surface: closest points, projection, and the test for its self-buried parts.
-pub use surface::winding::BuriedTest;
-
-// The local feature size of the input (shrinking medial balls), for a graded kernel width.
-pub use surface::local_feature_size::{
-    local_feature_size, LfsParams, LocalFeatureSize, MAX_LFS_SAMPLES,
-};
-// Sharp features of the input: crease edges, curves and corners.
-pub use sampling::crease_band::{CreaseBand, CREASE_BAND_PER_SPACING};
-pub use surface::curvature::{
-    Curvature, CurvatureParams, CurvatureWidths, CAD_CHORD_ERROR, CURVATURE_GRADATION,
-    CURVATURE_MAX_BEND_DEG,
-};
-pub use surface::features::{
-    detect_features, long_curve_share, FeatureCurve, FeatureDetection, FeatureParams, Features,
-    AUTO_FEATURE_MIN_SHARE, CAD_FEATURE_ANGLE_DEG, LONG_CURVE_SPACINGS,
-};
-pub use surface::{MeshSurface, Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
-
-// Sampling stages: candidates and boundary samples, the linear scan (and the sigma_p search for
-// a count), the gradient ascent.
-pub use sampling::boundary::{boundary_curves, sample_boundary, BoundaryCurve, BoundarySamples};
-pub use sampling::candidates::surface_candidates;
-pub use sampling::gradient_ascent::{
-    gradient_ascent, gradient_ascent_graded, GradientAscentParams, GradientAscentResult,
-};
-pub use sampling::grading::{GradedRegion, Grading, GradingParams, GradingStats, MAX_GAP_LOOPS};
-pub use sampling::linear_scan::{
-    linear_scan, linear_scan_graded, LinearScanParams, LinearScanResult, LinearScanner,
-};
-pub use sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
-pub use sampling::WidthField;
-
-// Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
-// optimization against the input, the separation of crossing faces.
-pub use geometry::self_intersection::CrossingRegions;
-pub use geometry::triangle::AngleBounds;
-pub use triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
-pub use triangulate::optimize::{
-    optimize, FacesLeft, MendStats, OptimizeParams, OptimizeStats, SmoothStats, SMOOTH_ITERATIONS,
-};
-pub use triangulate::stray_shells::StrayShells;
-pub use triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
-pub use triangulate::untangle::{untangle, UntangleParams, UntangleStats};
-pub use triangulate::{
-    assemble, triangulate, triangulate_restricted, vote_triangles, AssemblyParams, AssemblyStats,
-    FaceSource, RefineParams, RestrictedDelaunayParams, RestrictedDelaunayStats, SampleSet,
-    TangentDelaunayParams, TriangulateParams, TriangulationMethod, VotedTriangle,
-};
-
-// The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).
-pub use kernel::{GaussianKernel, Kernel, KernelPoint, UnitKernel, SUPPORT_RADIUS};
-pub use measure::{
-    measure_and_gradient, measure_and_gradient_graded, projection_coefficients, spectral_measure,
-    IncrementalInverse, Measure, MeasureWorkspace, Push, DEFAULT_EPSILON,
-};
-
-// kd-trees: over fixed 3D points (neighbourhoods of the measure), and over points of R^K.
-pub use spatial::{DynamicKdTree, StaticKdTree, StaticTree};
-
+// The report on any mesh: Table 1's triangle measures, Metro-style distances, topology,
+// invariants.
+pub use app::{quality_mesh, run_quality};
+pub use check::{check_invariants, topology, Topology, Violation};
+pub use report::{QualityReport, SurfaceDistance, TriangleQuality};
+// Point sets: a scan to a mesh, and the out-of-core linear scan.
+pub use app::remesh_point_set;
+pub use point_pipeline::{remesh_points, PointRemeshOutput, PointRemeshParams};
+pub use points::out_of_core::{simplify_out_of_core, OutOfCoreParams, OutOfCoreResult};
 // Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.
 pub use manifold::{
-    estimate_dimension, resample_manifold, sample_manifold, DataProjection, ManifoldProjection,
-    ManifoldResampleParams, ManifoldSampleParams, ManifoldSampling, PointSet, MANIFOLD_ASCENT_STEP,
+    resample_manifold, sample_manifold, DataProjection, ManifoldProjection, ManifoldResampleParams,
+    ManifoldSampleParams, ManifoldSampling, PointSet,
 };
 
-// Checks of a mesh: invariants (typed violations), topology, self-intersections, the distance
-// from creases to the output's edges.
-pub use check::{
-    check_invariants, crease_distance, self_intersections, surface_topology, topology,
-    topology_changes, CreaseDistance, SelfIntersections, Topology, TopologyChange, Violation,
-};
+/// The crate's internals: every stage on its own, with its parameters and constants, for the
+/// `remesh` binary, the Python module, the experiments crate, the tests and the benchmarks. Not
+/// part of the public API: it may change without notice.
+#[doc(hidden)]
+pub mod internal {
+    // Errors: one enum for the whole crate.
+    pub use crate::error::{Error, Result};
 
-// The quality report: Table 1's triangle measures, Metro-style distances, stage times.
-pub use report::{
-    surface_distance, surface_distance_with, surface_samples, triangle_quality, PointSetDistance,
-    QualityReport, StageTime, SurfaceDistance, TriangleQuality,
-};
+    // Reading and writing meshes (OBJ, PLY, glTF, STL, OFF), atomically.
+    pub use crate::io::{
+        read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, MeshFormat,
+        ReadStats,
+    };
 
-// Point sets: streaming reading and writing, points drawn from a mesh, normal estimation, the
-// out-of-core linear scan, the RIMLS surface.
-pub use points::generate::{
-    surface_points, surface_points_with, write_surface_points, NormalField,
-};
-pub use points::normals::{estimate_normals, NormalOrientation};
-pub use points::out_of_core::{
-    simplify_out_of_core, simplify_progressive, OutOfCoreParams, OutOfCoreResult, ProgressiveResult,
-};
-pub use points::outliers::OutlierFilter;
-pub use points::rimls::{Rimls, RimlsParams, RimlsProjection};
+    // The meshes: the indexed triangle mesh, its normalization to bbox 100, its consistent
+    // orientation, and the editable directed-edge mesh with its local operators.
+    pub use crate::mesh::edit::{EditError, EditMesh, EditViolation, SlotPolicy};
+    pub use crate::mesh::{
+        orient_consistently, Aabb, FaceCleanup, Normalization, OrientStats, TriMesh,
+    };
 
-// Point sets in, meshes out (issue 19).
-pub use point_pipeline::{
-    is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams,
-    DOMAIN_GAP_SIGMA_P, MAX_SCANS, OPEN_GAP_SIGMA_P, RIMLS_POINTS_PER_SAMPLE,
-};
-pub use points::{PlyPointWriter, Point, PointReader};
+    // The pipeline in one call.
+    pub use crate::pipeline::{
+        remesh, validate_input, Density, FeatureStats, RemeshOutput, RemeshParams,
+        BOUNDARY_SPACING_PER_SIGMA, FIT_ITERATIONS, MAX_POINTS, SAMPLES_PER_SIGMA2,
+    };
+    pub use crate::timing::Stage;
 
-// The jobs of the `remesh` command line: files in, files and report out.
-pub use app::{
-    catch_panics, check_report_path, estimate_remesh_bytes, memory_limit, parse_bytes,
-    physical_memory, quality_mesh, remesh_mesh, remesh_point_set, run_points, run_quality,
-    run_remesh, run_simplify, write_report, PointsJob, RemeshJob, RemeshOptions, RemeshedMesh,
-    SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary, DISTANCE_SAMPLES,
-    MAX_SURFACE_POINTS, STDOUT,
-};
+    // The input surface: closest points, projection, and the test for its self-buried parts.
+    pub use crate::surface::winding::BuriedTest;
+
+    // The local feature size of the input (shrinking medial balls), for a graded kernel width.
+    pub use crate::surface::local_feature_size::{
+        local_feature_size, LfsParams, LocalFeatureSize, MAX_LFS_SAMPLES,
+    };
+    // Sharp features of the input: crease edges, curves and corners.
+    pub use crate::sampling::crease_band::{CreaseBand, CREASE_BAND_PER_SPACING};
+    pub use crate::surface::curvature::{
+        Curvature, CurvatureParams, CurvatureWidths, CAD_CHORD_ERROR, CURVATURE_GRADATION,
+        CURVATURE_MAX_BEND_DEG,
+    };
+    pub use crate::surface::features::{
+        detect_features, long_curve_share, FeatureCurve, FeatureDetection, FeatureParams, Features,
+        AUTO_FEATURE_MIN_SHARE, CAD_FEATURE_ANGLE_DEG, LONG_CURVE_SPACINGS,
+    };
+    pub use crate::surface::{MeshSurface, Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
+
+    // Sampling stages: candidates and boundary samples, the linear scan (and the sigma_p search for
+    // a count), the gradient ascent.
+    pub use crate::sampling::boundary::{
+        boundary_curves, sample_boundary, BoundaryCurve, BoundarySamples,
+    };
+    pub use crate::sampling::gradient_ascent::{
+        gradient_ascent, gradient_ascent_graded, GradientAscentParams, GradientAscentResult,
+    };
+    pub use crate::sampling::grading::{
+        GradedRegion, Grading, GradingParams, GradingStats, MAX_GAP_LOOPS,
+    };
+    pub use crate::sampling::linear_scan::{
+        linear_scan, linear_scan_graded, LinearScanParams, LinearScanResult, LinearScanner,
+    };
+    pub use crate::sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
+    pub use crate::sampling::WidthField;
+    pub use crate::surface::candidates::surface_candidates;
+
+    // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
+    // optimization against the input, the separation of crossing faces.
+    pub use crate::geometry::self_intersection::CrossingRegions;
+    pub use crate::geometry::triangle::AngleBounds;
+    pub use crate::triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
+    pub use crate::triangulate::optimize::{
+        optimize, FacesLeft, MendStats, OptimizeParams, OptimizeStats, SmoothStats,
+        SMOOTH_ITERATIONS,
+    };
+    pub use crate::triangulate::stray_shells::StrayShells;
+    pub use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
+    pub use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
+    pub use crate::triangulate::{
+        assemble, triangulate, triangulate_restricted, vote_triangles, AssemblyParams,
+        AssemblyStats, FaceSource, RefineParams, RestrictedDelaunayParams, RestrictedDelaunayStats,
+        SampleSet, TangentDelaunayParams, TriangulateParams, TriangulationMethod, VotedTriangle,
+    };
+
+    // The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).
+    pub use crate::kernel::{GaussianKernel, Kernel, KernelPoint, UnitKernel, SUPPORT_RADIUS};
+    pub use crate::measure::{
+        measure_and_gradient, measure_and_gradient_graded, projection_coefficients,
+        spectral_measure, IncrementalInverse, Measure, MeasureWorkspace, Push, DEFAULT_EPSILON,
+    };
+
+    // kd-trees: over fixed 3D points (neighbourhoods of the measure), and over points of R^K.
+    pub use crate::spatial::{DynamicKdTree, StaticKdTree, StaticTree};
+
+    // Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.
+    pub use crate::manifold::{
+        estimate_dimension, resample_manifold, sample_manifold, DataProjection, ManifoldProjection,
+        ManifoldResampleParams, ManifoldSampleParams, ManifoldSampling, PointSet,
+        MANIFOLD_ASCENT_STEP,
+    };
+
+    // Checks of a mesh: invariants (typed violations), topology, self-intersections, the distance
+    // from creases to the output's edges.
+    pub use crate::check::{
+        check_invariants, crease_distance, self_intersections, surface_topology, topology,
+        topology_changes, CreaseDistance, SelfIntersections, Topology, TopologyChange, Violation,
+    };
+
+    // The quality report: Table 1's triangle measures, Metro-style distances, stage times.
+    pub use crate::report::{
+        surface_distance, surface_distance_with, surface_samples, triangle_quality,
+        PointSetDistance, QualityReport, StageTime, SurfaceDistance, TriangleQuality,
+    };
+
+    // Point sets: streaming reading and writing, points drawn from a mesh, normal estimation, the
+    // out-of-core linear scan, the RIMLS surface.
+    pub use crate::points::generate::{
+        surface_points, surface_points_with, write_surface_points, NormalField,
+    };
+    pub use crate::points::normals::{estimate_normals, NormalOrientation};
+    pub use crate::points::out_of_core::{
+        simplify_out_of_core, simplify_progressive, OutOfCoreParams, OutOfCoreResult,
+        ProgressiveResult,
+    };
+    pub use crate::points::outliers::OutlierFilter;
+    pub use crate::points::rimls::{Rimls, RimlsParams, RimlsProjection};
+
+    // Point sets in, meshes out (issue 19).
+    pub use crate::point_pipeline::{
+        is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams,
+        DOMAIN_GAP_SIGMA_P, MAX_SCANS, OPEN_GAP_SIGMA_P, RIMLS_POINTS_PER_SAMPLE,
+    };
+    pub use crate::points::{PlyPointWriter, Point, PointReader};
+
+    // The jobs of the `remesh` command line: files in, files and report out.
+    pub use crate::app::{
+        catch_panics, check_report_path, estimate_remesh_bytes, memory_limit, parse_bytes,
+        physical_memory, quality_mesh, remesh_mesh, remesh_point_set, run_points, run_quality,
+        run_remesh, run_simplify, write_report, PointsJob, RemeshJob, RemeshOptions, RemeshedMesh,
+        SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary, DISTANCE_SAMPLES,
+        MAX_SURFACE_POINTS, STDOUT,
+    };
+    pub use crate::geometry::{intersecting_pairs, triangle_angles_deg};
+    pub use crate::manifold::MAX_KERNEL_DIMENSION;
+}

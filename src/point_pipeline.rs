@@ -1,13 +1,14 @@
-//! The remeshing pipeline for a point set (a scan): out-of-core linear scan of the points →
-//! outlier filter → RIMLS surface of the points → samples projected onto it → gradient ascent on
-//! it → tangent-plane umbrellas → local optimization and fit against it → untangle → outward
-//! orientation → model units. The paper's Figure 1 path (Sec. 6.1, 6.2 and 7).
+//! The remeshing pipeline for a point set (a scan): out-of-core linear scan of the points → outlier
+//! filter → RIMLS surface of the points → samples projected onto it → gradient ascent on it →
+//! tangent-plane umbrellas → local optimization and fit against it → untangle → outward orientation
+//! → model units. The paper's Figure 1 path (Sec. 6.1, 6.2 and 7).
 //!
-//! The mesh pipeline ([`crate::pipeline`]) has an input surface to project onto, measure
-//! against and take boundaries, creases and local feature size from; here the surface is the
-//! RIMLS surface ([`Rimls`](crate::Rimls), Öztireli, Guennebaud, Gross 2009) of a uniformly random subset of
-//! the points (the first bucket of the out-of-core scan) and the samples, with the sampling's
-//! sigma_p and sigma_n, so memory stays bounded by the output and one bucket, not by the input.
+//! The mesh pipeline ([`crate::pipeline`]) has an input surface to project onto, measure against
+//! and take boundaries, creases and local feature size from; here the surface is the RIMLS surface
+//! ([`Rimls`](crate::internal::Rimls), Öztireli, Guennebaud, Gross 2009) of a uniformly random
+//! subset of the points (the first bucket of the out-of-core scan) and the samples, with the
+//! sampling's sigma_p and sigma_n, so memory stays bounded by the output and one bucket, not by the
+//! input.
 
 use std::path::{Path, PathBuf};
 
@@ -16,8 +17,9 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
-use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
-use crate::pipeline::{Density, RemeshParams, STRAY_SHELL_VERTICES};
+use crate::mesh::{Normalization, OrientStats, TriMesh};
+use crate::pipeline::finish::{finish, Finishing, StrayRule};
+use crate::pipeline::{Density, RemeshParams};
 use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{rimls_of, OutOfCoreParams, RimlsSupport, ScannedInput};
 use crate::points::rimls::Rimls;
@@ -28,8 +30,8 @@ use crate::surface::features::FeatureDetection;
 use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
-use crate::triangulate::optimize::{optimize, OptimizeStats};
-use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
+use crate::triangulate::optimize::OptimizeStats;
+use crate::triangulate::stray_shells::StrayShells;
 use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
@@ -129,8 +131,8 @@ pub struct PointRemeshParams {
     pub temp_dir: Option<PathBuf>,
     /// How normals are oriented for a point set without them (a viewpoint in model units).
     pub orientation: NormalOrientation,
-    /// Whether isolated points are dropped ([`OutlierFilter`](crate::points::outliers::OutlierFilter);
-    /// default true).
+    /// Whether isolated points are dropped
+    /// ([`OutlierFilter`](crate::points::outliers::OutlierFilter); default true).
     pub drop_outliers: bool,
 }
 
@@ -200,25 +202,25 @@ pub struct PointRemeshOutput {
 }
 
 /// Remeshes the point set in the file `input` (PLY without faces, or XYZ/CSV text; see
-/// [`PointReader`](crate::points::PointReader)), with or without normals, out of core.
-/// `on_stage` is called with each stage name as it starts.
+/// [`PointReader`](crate::points::PointReader)), with or without normals, out of core. `on_stage`
+/// is called with each stage name as it starts.
 ///
-/// With a target count, the count of the samples once projected onto the surface decides: when
-/// it is off by more than `count_tolerance`, sigma_p is corrected and the buckets scanned again
-/// (up to [`MAX_SCANS`] scans). There is no least-squares fit of the output to the surface
-/// (measured on horse: no closer, at twice the run time). Closed shells of at most 8 vertices
+/// With a target count, the count of the samples once projected onto the surface decides: when it
+/// is off by more than `count_tolerance`, sigma_p is corrected and the buckets scanned again (up to
+/// [`MAX_SCANS`] scans). There is no least-squares fit of the output to the surface (no closer, at
+/// twice the run time: `docs/decisions/point-set-no-fit.md`). Closed shells of at most 8 vertices
 /// and 4 sigma_p across are left out, the largest part always kept.
 ///
-/// Memory: the output, the first bucket of the input (`params.bucket_points` points), and the
-/// RIMLS surface of `RIMLS_POINTS_PER_SAMPLE` points per sample; not the input.
+/// Memory: the output, the first bucket of the input (`params.bucket_points` points), and the RIMLS
+/// surface of `RIMLS_POINTS_PER_SAMPLE` points per sample; not the input.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming the option for a density other than a count or sigma_p
 /// (`--points`), grading (`--lfs-factor`), curvature (`--chord-error`), a crease angle
-/// (`--feature-angle`) or a finite sigma_n (`--sigma-n`) on points without normals; the
-/// errors of reading the points ([`PointReader`](crate::points::PointReader)), naming the
-/// file; [`Error::InvalidMesh`] for an empty set, one with no extent, or one of which nothing
-/// could be triangulated.
+/// (`--feature-angle`) or a finite sigma_n (`--sigma-n`) on points without normals; the errors of
+/// reading the points ([`PointReader`](crate::points::PointReader)), naming the file;
+/// [`Error::InvalidMesh`] for an empty set, one with no extent, or one of which nothing could be
+/// triangulated.
 pub fn remesh_points(
     input: &Path,
     params: &PointRemeshParams,
@@ -417,54 +419,35 @@ pub fn remesh_points(
     let (untangle_umbrellas, _) = untangle(&mut mesh, &no_fixed, sigma_p, &untangle_params, None);
     timer.lap("triangulate");
 
-    on_stage("optimize");
-    let optimize_stats = match &rp.optimize {
-        Some(op) => {
-            let fixed = vec![false; mesh.positions.len()];
-            optimize(
-                &mut mesh,
-                &domain,
-                &cover_points,
-                &fixed,
-                &[],
-                None,
-                None,
-                sigma_p,
-                op,
-            )
-            .0
-        }
-        None => OptimizeStats::default(),
+    // No least-squares fit to the RIMLS surface (`fit_iterations` is not used: see
+    // docs/decisions/point-set-no-fit.md). A tiny closed shell (a few samples closing into a
+    // tetrahedron where a tip is thinner than the spacing) is no part of the surface: a real
+    // part 4 sigma_p across would have tens of samples. The largest part always stays.
+    let stray = |shell: &[DVec3]| {
+        let (lo, hi) = shell.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        lo.distance(hi) <= 4.0 * sigma_p
     };
-    let dropped_samples = mesh.remove_unreferenced_vertices();
-    timer.lap("optimize");
-    // No least-squares fit to the RIMLS surface (`fit_iterations` is not used): measured on
-    // horse 1M -> 10k, seeds 1-3, Hausdorff to horse.obj 1.16, 0.73, 0.57 with it and 1.07,
-    // 0.77, 0.60 without, at 1.8 times the run time (each of its moves is a RIMLS projection).
-    let fixed = vec![false; mesh.positions.len()];
-    on_stage("untangle");
-    let (untangle_stats, _) = untangle(&mut mesh, &fixed, sigma_p, &untangle_params, None);
-    // No face of no area is written.
-    crate::triangulate::degenerate::mend_degenerate_faces(&mut mesh, &fixed);
-    let collapsed = mesh.remove_unreferenced_vertices();
-    // A tiny closed shell (a few samples closing into a tetrahedron where a tip is thinner than
-    // the spacing) is no part of the surface: a real part 4 sigma_p across would have tens of
-    // samples. The largest part always stays.
-    let mut sources = vec![crate::triangulate::FaceSource::Refined; mesh.triangles.len()];
-    let stray_shells =
-        remove_stray_shells(&mut mesh, &mut sources, 1, STRAY_SHELL_VERTICES, |shell| {
-            let (lo, hi) = shell.iter().fold(
-                (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-                |(lo, hi), &p| (lo.min(p), hi.max(p)),
-            );
-            lo.distance(hi) <= 4.0 * sigma_p
-        });
-    if stray_shells.shells > 0 {
-        mesh.remove_unreferenced_vertices();
-    }
+    let finishing = Finishing {
+        surface: &domain,
+        cover_points: &cover_points,
+        fixed: 0,
+        protected: &[],
+        boundary: None,
+        input_crossings: None,
+        sigma_p,
+        optimize: rp.optimize.as_ref(),
+        fit_iterations: 0,
+        untangle: untangle_params,
+        stray: Some(StrayRule {
+            keep: 1,
+            stray: &stray,
+        }),
+    };
     // The points' normals point outward (given, or oriented so): so does the output.
-    let output_orientation = orient_consistently(&mut mesh, true);
-    timer.lap("untangle");
+    let finished = finish(&mut mesh, &mut sources, &finishing, on_stage, &mut timer);
     Ok(PointRemeshOutput {
         mesh: normalization.invert_mesh(&mesh),
         mesh_normalized: mesh,
@@ -481,12 +464,12 @@ pub fn remesh_points(
         gradient_ascent: ga,
         assembly,
         unsupported,
-        optimize: optimize_stats,
+        optimize: finished.optimize,
         untangle_umbrellas,
-        untangle: untangle_stats,
-        dropped_samples: dropped_samples + collapsed,
-        stray_shells,
-        output_orientation,
+        untangle: finished.untangle,
+        dropped_samples: finished.dropped_samples + finished.later_dropped,
+        stray_shells: finished.stray_shells,
+        output_orientation: finished.orientation,
         scan_seconds: scan.seconds,
         stages: timer.take_stages(),
     })

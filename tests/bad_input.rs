@@ -1,7 +1,7 @@
 //! Issue 6: the table of bad and awkward inputs, each run through the `remesh` binary with its
 //! expected outcome. Either a correct result (exit 0, an output whose invariants hold) or a
-//! one-line error naming the file and the problem, with the exit code of its kind: 2 usage,
-//! 3 input, 4 output, 1 internal. Never a panic, a hang, a half-written or clobbered file.
+//! one-line error naming the file and the problem, with the exit code of its kind: 2 usage, 3
+//! input, 4 output, 1 internal. Never a panic, a hang, a half-written or clobbered file.
 //!
 //! | case | outcome |
 //! |---|---|
@@ -12,7 +12,8 @@
 //! | face index out of range | input error |
 //! | negative (relative) OBJ indices | result, identical to the positive-index file's |
 //! | quads and n-gons | result, closed genus 0 |
-//! | concave polygons (an L-shaped prism with 6-gon caps), OBJ and PLY | read without overlap; result closed genus 0, no "passes through itself" note |
+//! | concave polygons (an L-shaped prism with 6-gon caps), OBJ and PLY | read without overlap;
+//! result closed genus 0, no "passes through itself" note |
 //! | degenerate and zero-area faces | result, closed genus 0 |
 //! | duplicate vertices and duplicate faces | result, closed genus 0 |
 //! | non-manifold edges and vertices | result, manifold |
@@ -26,17 +27,23 @@
 //! | `--points` 5000 on a single triangle | result within 1%, one boundary loop |
 //! | output in a missing directory, or under a file | output error, nothing written |
 //! | output path equal to the input path | usage error, input untouched |
-//! | `--sigma-p` too small for memory (issue 14) | usage error naming the smallest it takes, at once |
-//! | `--points` or `--sigma-p` giving no triangle (issue 14) | usage error, nothing written (not an empty file) |
+//! | `--sigma-p` too small for memory (issue 14) | usage error naming the smallest it takes, at
+//! once |
+//! | `--points` or `--sigma-p` giving no triangle (issue 14) | usage error, nothing written (not an
+//! empty file) |
 //! | an unsupported output extension (issue 14) | usage error before any work |
 //! | `remesh points` or `simplify` to a non-.ply output (issue 14) | usage error, nothing written |
 //! | `quality --ref` of a reference without area (issue 14) | input error naming the reference |
 //! | glTF nodes listed as a child twice or by two parents (issue 14) | input error, at once |
 //! | `remesh points --count` above 10^9 (issue 14) | usage error, nothing written |
-//! | a model at UTM coordinates written as .ply, .glb, .gltf (issue 14) | the file as written is faithful |
-//! | a truncated point file for `simplify` (issue 14) | input error giving the points read and promised |
-//! | subnormal coordinates, a model scaled by 1e-310 (issue 14) | result in the input's units and place, with a note; glTF output a usage error |
-//! | an internal failure (a panic) | internal error, one line (injected in `app::catch_panics`'s unit test; the binary runs every job through it) |
+//! | a model at UTM coordinates written as .ply, .glb, .gltf (issue 14) | the file as written is
+//! faithful |
+//! | a truncated point file for `simplify` (issue 14) | input error giving the points read and
+//! promised |
+//! | subnormal coordinates, a model scaled by 1e-310 (issue 14) | result in the input's units and
+//! place, with a note; glTF output a usage error |
+//! | an internal failure (a panic) | internal error, one line (injected in `app::catch_panics`'s
+//! unit test; the binary runs every job through it) |
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -45,9 +52,7 @@ use glam::DVec3;
 use serde_json::Value;
 
 fn shared(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(name)
+    common::model(name)
 }
 
 fn remesh(args: &[&str]) -> Output {
@@ -155,21 +160,21 @@ fn write(dir: &Path, name: &str, content: impl AsRef<[u8]>) -> PathBuf {
 fn unreadable_inputs_are_one_line_input_errors() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out.obj");
-    let horse_ply = std::fs::read(shared("horse.ply")).unwrap();
+    let spot_ply = std::fs::read(common::spot_ply(dir.path())).unwrap();
     let spot_glb = std::fs::read(shared("spot.glb")).unwrap();
     let cases: Vec<(PathBuf, &str)> = vec![
         (write(dir.path(), "empty.obj", ""), "empty"),
         (write(dir.path(), "empty.ply", ""), "empty"),
         (write(dir.path(), "empty.glb", ""), "empty"),
         (
-            write(dir.path(), "cut.ply", &horse_ply[..horse_ply.len() / 2]),
+            write(dir.path(), "cut.ply", &spot_ply[..spot_ply.len() / 2]),
             "cut.ply",
         ),
         (
             write(dir.path(), "cut.glb", &spot_glb[..spot_glb.len() / 2]),
             "cut.glb",
         ),
-        (write(dir.path(), "ply-inside.obj", &horse_ply), "PLY"),
+        (write(dir.path(), "ply-inside.obj", &spot_ply), "PLY"),
         (
             write(
                 dir.path(),
@@ -1057,7 +1062,8 @@ fn l_prism() -> (Vec<[f64; 3]>, Vec<Vec<usize>>) {
 
 #[test]
 fn concave_polygon_caps_are_triangulated_without_overlap() {
-    use spectral_remesh::{check_invariants, read_mesh, self_intersections, topology};
+    use spectral_remesh::internal::self_intersections;
+    use spectral_remesh::{check_invariants, read_mesh, topology};
     let dir = tempfile::tempdir().unwrap();
     let (p, f) = l_prism();
     let as_obj = write(dir.path(), "l.obj", obj(&p, &f, false));
@@ -1329,7 +1335,7 @@ fn simplify_keeps_utm_coordinates() {
         "-q",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let mut reader = spectral_remesh::PointReader::open(&out).unwrap();
+    let mut reader = spectral_remesh::internal::PointReader::open(&out).unwrap();
     let mut chunk = Vec::new();
     let mut seen = 0;
     while reader.read_chunk(&mut chunk, 4096).unwrap() > 0 {

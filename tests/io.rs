@@ -7,8 +7,10 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use spectral_remesh::{read_mesh, write_mesh, Error, MeshFormat, ReadStats, TriMesh};
 
+mod common;
+
 fn model(name: &str) -> PathBuf {
-    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/")).join(name)
+    common::model(name)
 }
 
 fn read(name: &str) -> (TriMesh, ReadStats) {
@@ -111,7 +113,8 @@ fn assert_same_mesh_within(a: &TriMesh, b: &TriMesh, rel_tol: f64) {
 // The shared models
 
 #[test]
-fn horse_obj_and_ply_are_the_same_mesh() {
+#[ignore = "needs ../shared: .ci/run runs it"]
+fn shared_horse_obj_and_ply_are_the_same_mesh() {
     let (obj, so) = assert_counts("horse.obj", 48_485, 96_966);
     let (ply, sp) = assert_counts("horse.ply", 48_485, 96_966);
     assert_eq!(so.format, MeshFormat::Obj);
@@ -135,7 +138,8 @@ fn horse_obj_and_ply_are_the_same_mesh() {
 }
 
 #[test]
-fn stanford_bunny_drops_its_unreferenced_vertices() {
+#[ignore = "needs ../shared: .ci/run runs it"]
+fn shared_stanford_bunny_drops_its_unreferenced_vertices() {
     let (_, s) = assert_counts("stanford-bunny.obj", 34_834, 69_451);
     assert_eq!(s.vertices_read, 35_947);
     assert_eq!(s.unreferenced_vertices_removed, 1_113);
@@ -144,7 +148,8 @@ fn stanford_bunny_drops_its_unreferenced_vertices() {
 }
 
 #[test]
-fn fandisk_cow_counts() {
+#[ignore = "needs ../shared: .ci/run runs it"]
+fn shared_fandisk_cow_counts() {
     let (_, s) = assert_counts("fandisk.obj", 6_475, 12_946);
     assert_eq!((s.vertices_read, s.faces_read), (6_475, 12_946));
     let (_, s) = assert_counts("cow.obj", 2_903, 5_804);
@@ -942,13 +947,19 @@ fn empty_files_are_errors() {
 #[test]
 fn content_that_does_not_match_the_extension_is_named() {
     let dir = tempfile::tempdir().unwrap();
+    let ply = common::spot_ply(dir.path());
     let copy = |from: &str, to: &str| {
         let path = dir.path().join(to);
-        fs::copy(model(from), &path).unwrap();
+        let from = if from == "spot.ply" {
+            ply.clone()
+        } else {
+            model(from)
+        };
+        fs::copy(from, &path).unwrap();
         path
     };
     for (from, to, says) in [
-        ("horse.ply", "ply-content.obj", "the content is PLY"),
+        ("spot.ply", "ply-content.obj", "the content is PLY"),
         ("spot.glb", "glb-content.obj", "the content is binary glTF"),
         ("spot.glb", "glb-content.ply", "the content is binary glTF"),
         ("spot.obj", "obj-content.ply", "not a PLY file"),
@@ -1003,10 +1014,10 @@ fn bad_obj_content() {
 fn bad_ply_content() {
     let dir = tempfile::tempdir().unwrap();
     // A truncated binary PLY.
-    let horse = fs::read(model("horse.ply")).unwrap();
-    for cut in [10, 200, 400, horse.len() / 2, horse.len() - 1] {
+    let ply = fs::read(common::spot_ply(dir.path())).unwrap();
+    for cut in [10, 200, 400, ply.len() / 2, ply.len() - 1] {
         let path = dir.path().join(format!("cut{cut}.ply"));
-        fs::write(&path, &horse[..cut]).unwrap();
+        fs::write(&path, &ply[..cut]).unwrap();
         assert!(matches!(expect_err(&path), Error::Parse { .. }));
     }
     let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\

@@ -75,7 +75,7 @@ const HAUSDORFF_FACTOR: f64 = 2.0;
 #[test]
 fn spot_with_a_reversed_region_remeshes_like_clean_spot() {
     let dir = tempfile::tempdir().unwrap();
-    let (clean, _) = read_mesh(&common::shared("spot.obj")).unwrap();
+    let (clean, _) = read_mesh(&common::model("spot.obj")).unwrap();
     let mut reversed = clean.clone();
     let centre = clean.positions[0];
     let count = reverse_within(&mut reversed, centre, 0.4);

@@ -11,10 +11,10 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use spectral_remesh::internal::{is_point_set, write_surface_points};
 use spectral_remesh::{
-    check_invariants, is_point_set, remesh_point_set, remesh_points, run_remesh, topology,
-    write_mesh, write_surface_points, Density, Error, PointRemeshOutput, PointRemeshParams,
-    RemeshJob, RemeshParams, TriMesh,
+    check_invariants, remesh_point_set, remesh_points, run_remesh, topology, write_mesh, Density,
+    Error, PointRemeshOutput, PointRemeshParams, RemeshJob, RemeshParams, TriMesh,
 };
 
 /// A torus around the z axis (radii `big` and `small`), `n` × `m` quads split in two, outward.
@@ -126,7 +126,7 @@ fn torus_points_without_normals_keep_the_genus() {
     let input = dir.path().join("torus.ply");
     write_surface_points(&mesh, 80_000, 5, &input).unwrap();
     // The same points as XYZ text without normals.
-    let mut reader = spectral_remesh::PointReader::open(&input).unwrap();
+    let mut reader = spectral_remesh::internal::PointReader::open(&input).unwrap();
     let mut pts = Vec::new();
     reader.read_chunk(&mut pts, 1 << 20).unwrap();
     let xyz = dir.path().join("torus.xyz");

@@ -47,7 +47,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
-use spectral_remesh::{Error, Result, Rimls, TriMesh};
+use spectral_remesh::internal::Rimls;
+use spectral_remesh::{Error, Result, TriMesh};
 
 /// An implicit function f: R³ → R whose zero set is a surface, defined (`Some`) near it and
 /// possibly undefined (`None`) elsewhere. Positive on the outside by this crate's convention.

@@ -1,7 +1,7 @@
 //! Surface reconstruction from an oriented point set: the RIMLS surface of the points
-//! ([`spectral_remesh::Rimls`]) triangulated by marching cubes ([`crate::marching_cubes`]) on a
-//! grid much finer than the kernel, the "densely triangulated implicit function" the paper
-//! measures reconstructions on (Sec. 7.2).
+//! ([`spectral_remesh::internal::Rimls`]) triangulated by marching cubes
+//! ([`crate::marching_cubes`]) on a grid much finer than the kernel, the "densely triangulated
+//! implicit function" the paper measures reconstructions on (Sec. 7.2).
 
 use std::time::Instant;
 
@@ -9,7 +9,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::marching_cubes::{marching_cubes, MarchingCubesParams};
-use spectral_remesh::{Error, Result, Rimls, RimlsParams, StaticTree, TriMesh};
+use spectral_remesh::internal::{Rimls, RimlsParams, StaticTree};
+use spectral_remesh::{Error, Result, TriMesh};
 
 /// The grid cell of a reconstruction, in units of σ_p: 0.5 (cell = σ_p/2). The RIMLS surface
 /// varies on the scale of σ_p, so cells of σ_p/2 resolve it. Measured on horse (475k surface

@@ -12,7 +12,7 @@
 //!    resampling"); its count is the target of the others;
 //! 4. each subset's RIMLS surface with the same σ_p, σ_n on the same grid, compared with the
 //!    all-points surface by the Metro-style two-sided distance
-//!    ([`spectral_remesh::surface_distance`]: RMS and Hausdorff, bbox-100 units);
+//!    ([`spectral_remesh::internal::surface_distance`]: RMS and Hausdorff, bbox-100 units);
 //! 5. unless [`ReconstructionEvalParams::weighted`] is off, each subset again with the weights of
 //!    the points it dropped as RIMLS masses ([`representation_weights`], Sec. 5: a dropped
 //!    point's weight moves to the kept points that span its φ), the same rule for every
@@ -53,11 +53,11 @@ use crate::subsample::{
     linear_scan_subsample, poisson_disk_subsample_to_count, random_subsample,
     representation_weights, voxel_grid_subsample_to_count, RepresentationParams, Subsampler,
 };
-use spectral_remesh::{
-    read_mesh, surface_distance_with, surface_points_with, topology, write_mesh, Error, Kernel,
-    LinearScanParams, MeshSurface, NormalField, Normalization, PlyPointWriter, Point, Result,
-    SurfaceDistance, TargetCountParams, TriMesh,
+use spectral_remesh::internal::{
+    surface_distance_with, surface_points_with, Kernel, LinearScanParams, MeshSurface, NormalField,
+    Normalization, PlyPointWriter, Point, TargetCountParams,
 };
+use spectral_remesh::{read_mesh, topology, write_mesh, Error, Result, SurfaceDistance, TriMesh};
 
 /// Where the input points come from.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

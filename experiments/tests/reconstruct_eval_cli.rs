@@ -6,10 +6,16 @@ use std::process::Command;
 
 use serde_json::Value;
 
+/// `data/NAME` of the checkout when it has the model, else the shared model beside the checkout
+/// (only the tests marked `#[ignore = "needs ../shared"]` read those).
 fn shared(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data")
-        .join(name)
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let own = root.join("data").join(name);
+    if own.is_file() {
+        own
+    } else {
+        root.join("../shared/data").join(name)
+    }
 }
 
 fn float(v: &Value, path: &[&str]) -> f64 {

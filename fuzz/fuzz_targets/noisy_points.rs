@@ -4,10 +4,10 @@
 //! triangulation's guarantees.
 
 use glam::DVec3;
-use spectral_remesh::{
-    check_invariants, triangulate, untangle, EditMesh, SampleSet, SlotPolicy, TriMesh,
-    TriangulateParams, UntangleParams, Violation,
+use spectral_remesh::internal::{
+    triangulate, untangle, EditMesh, SampleSet, SlotPolicy, TriangulateParams, UntangleParams,
 };
+use spectral_remesh::{check_invariants, TriMesh, Violation};
 
 /// Numbers in [0, 1) from the bytes, two bytes each (0x5a once they run out).
 struct Bytes<'a>(&'a [u8], usize);

@@ -391,10 +391,10 @@ fn quality<'py>(
 /// machine's physical memory and the process's limits (the command line's default).
 fn memory_limit(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<u64>> {
     let Some(value) = value else {
-        return Ok(spectral::memory_limit());
+        return Ok(spectral::internal::memory_limit());
     };
     if let Ok(text) = value.extract::<String>() {
-        return spectral::parse_bytes(&text)
+        return spectral::internal::parse_bytes(&text)
             .map(Some)
             .map_err(|e| PyValueError::new_err(format!("invalid parameter max_memory: {e}")));
     }
@@ -720,7 +720,7 @@ fn point3(value: &Bound<'_, PyAny>) -> PyResult<DVec3> {
 }
 
 /// The largest space dimension d of a point set (the library's kernel space, K = d).
-const MAX_DIM: usize = spectral::manifold::MAX_KERNEL_DIMENSION;
+const MAX_DIM: usize = spectral::internal::MAX_KERNEL_DIMENSION;
 
 /// `value` as a numpy array (`numpy.asarray(value)`).
 fn asarray<'py>(

@@ -1,7 +1,6 @@
 """Tests of the spectral_remesh Python module against the `remesh` command line.
 
-Needs the models in ../shared/data beside the repository (fails without them) and the
-`remesh` binary: $REMESH_BIN, or built here with `cargo build --release --workspace --bin
+Reads data/spot.obj (part of the checkout) and needs the `remesh` binary: $REMESH_BIN, or built here with `cargo build --release --workspace --bin
 remesh` (with --workspace the features resolve as in CI's `cargo test --release --workspace`,
 so after it the build is a no-op).
 """
@@ -18,7 +17,7 @@ import pytest
 import spectral_remesh as sr
 
 REPO = Path(__file__).resolve().parents[2]
-DATA = REPO.parent / "shared" / "data"
+DATA = REPO / "data"
 STUBS = REPO / "python" / "spectral_remesh.pyi"
 
 
@@ -26,7 +25,7 @@ STUBS = REPO / "python" / "spectral_remesh.pyi"
 def spot_path():
     path = DATA / "spot.obj"
     if not path.is_file():
-        pytest.fail(f"{path} is missing: the tests need ../shared/data beside the repository")
+        pytest.fail(f"{path} is missing: it is part of the checkout")
     return path
 
 

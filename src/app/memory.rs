@@ -1,28 +1,14 @@
 //! The memory budget of a `remesh` job: its peak resident memory estimated from the input's
 //! size and the output's, checked against a limit before the work starts.
 //!
-//! The estimate is a measured upper bound, not a count of allocations: peak RSS
-//! (`/usr/bin/time -v`, release build, 2026-11) of these jobs, and the model above each:
-//!
-//! | job | input faces | output points | peak RSS | model |
-//! |---|---|---|---|---|
-//! | spot → 2000 | 5,856 | 2,000 | 12 MB | 24 MB |
-//! | spot → 50,000 | 5,856 | 50,000 | 122 MB | 235 MB |
-//! | beetle → 3000 | 2,053 | 3,000 | 13 MB | 25 MB |
-//! | horse → 2000 | 96,966 | 2,000 | 74 MB | 92 MB |
-//! | horse → 2000, with the distance | 96,966 | 2,000 | 95 MB | 126 MB |
-//! | horse → 100,000 | 96,966 | 100,000 | 288 MB | 523 MB |
-//! | a 200k-face horse → 10,000 | 199,996 | 10,000 | 149 MB | 204 MB |
-//! | a 1,280-face sphere → 100,000 | 1,280 | 100,000 | 352 MB | 451 MB |
-//! | a 1,280-face sphere → 300,000 | 1,280 | 300,000 | 1,160 MB | 1,331 MB |
-//! | a 1,280-face sphere → 1,000,000 | 1,280 | 1,000,000 | 4,024 MB | 4,411 MB |
-//!
-//! The per-point cost is the candidate pool (10 candidates per output point), the samples, the
-//! kd-trees, the restricted Delaunay triangulation's refined copy of the input and the output
-//! mesh with its checks; the per-face cost is the input mesh, its BVH and its normalized copy.
-//! Upsampling a coarse input costs the most per point (3.4 KB at 100,000 points, 3.9 KB at a
-//! million, growing slowly with the count: the sphere rows) and sets the constant; downsampling
-//! costs less (horse → 100,000: 2.0 KB a point), where the estimate is loose.
+//! The estimate is a measured upper bound, not a count of allocations: peak RSS of jobs from
+//! 2,000 to 1,000,000 output points on inputs of 1,280 to 200,000 faces, each below its
+//! estimate (the table and its commands: `docs/decisions/memory-estimate.md`). The per-point
+//! cost is the candidate pool (10 candidates per output point), the samples, the kd-trees, the
+//! restricted Delaunay triangulation's refined copy of the input and the output mesh with its
+//! checks; the per-face cost is the input mesh, its BVH and its normalized copy. Upsampling a
+//! coarse input costs the most per point and sets the constant; downsampling costs less, where
+//! the estimate is loose.
 
 use std::path::Path;
 
@@ -34,7 +20,7 @@ pub const BASE_BYTES: u64 = 10 << 20;
 /// queries, the boundary and winding structures).
 pub const BYTES_PER_INPUT_FACE: u64 = 750;
 /// Bytes per output point (10 candidates each, the samples, kd-trees, triangulation, the output
-/// mesh and its checks), set by upsampling a coarse input (see the module's table).
+/// mesh and its checks), set by upsampling a coarse input (see the module's doc).
 pub const BYTES_PER_OUTPUT_POINT: u64 = 4_400;
 /// Bytes the report's distance measurement adds (200,000 samples a side and their queries).
 pub const DISTANCE_BYTES: u64 = 32 << 20;

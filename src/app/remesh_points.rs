@@ -8,10 +8,12 @@ use std::sync::Mutex;
 
 use glam::DVec3;
 
-use super::{
-    check_and_write, count_note, dropped_note, holes_note, insert_kernel_extras, memory, with_path,
-    RemeshJob, RemeshedMesh, DISTANCE_SAMPLES,
-};
+use super::files::with_path;
+use super::job::{RemeshJob, RemeshedMesh};
+use super::memory;
+use super::notes::{count_note, dropped_note, holes_note};
+use super::output::{check_and_write, insert_kernel_extras};
+use super::DISTANCE_SAMPLES;
 use crate::error::{Error, Result};
 use crate::io::{as_written, MeshFormat};
 use crate::mesh::TriMesh;

@@ -97,7 +97,7 @@ pub enum SimplifyDetail {
 /// [`Error::InvalidParameter`] for `--points 0` or a finite sigma_n on an input without normals;
 /// reading and writing errors naming the file.
 pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
-    super::require_ply_output(&job.output)?;
+    super::points::require_ply_output(&job.output)?;
     if job.density == SimplifyDensity::Points(0) {
         return Err(Error::InvalidParameter {
             name: "--points",

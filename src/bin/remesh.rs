@@ -8,11 +8,11 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use spectral_remesh::{
+use spectral_remesh::internal::{
     catch_panics, check_report_path, memory_limit, parse_bytes, remove_temporaries, run_points,
-    run_quality, run_remesh, run_simplify, write_report, Error, MeshFormat, PointsJob, RemeshJob,
-    RemeshOptions, SimplifyDensity, SimplifyJob, STDOUT,
+    run_simplify, write_report, PointsJob, SimplifyDensity, SimplifyJob, STDOUT,
 };
+use spectral_remesh::{run_quality, run_remesh, Error, MeshFormat, RemeshJob, RemeshOptions};
 
 const EXAMPLES: &str = "\
 Examples:
@@ -51,9 +51,9 @@ struct Cli {
     #[arg(required = true)]
     output: Option<PathBuf>,
 
-    /// The format written to standard output (OUTPUT -): obj (the default), ply, gltf, glb, stl
-    /// or off. The binary ones (ply, glb, stl) only when asked for, and never to a terminal. With a file,
-    /// the format is the extension's, and --format must agree with it.
+    /// The format written to standard output (OUTPUT -): obj (the default), ply, gltf, glb, stl or
+    /// off. The binary ones (ply, glb, stl) only when asked for, and never to a terminal. With a
+    /// file, the format is the extension's, and --format must agree with it.
     #[arg(long, value_enum, value_name = "FORMAT")]
     format: Option<OutputFormat>,
 
@@ -90,17 +90,17 @@ struct Cli {
     /// No least-squares vertex placement: the vertices stay on the input, as in the paper. By
     /// default each vertex (not on a boundary or a crease) moves off the input along its normal
     /// so the faces straddle the surface instead of lying under it as chords (the sag's mean,
-    /// about 2/3 of its peak): RMS distance about a third lower on curved parts (horse at 8600:
-    /// 0.038 to 0.024), angles kept within --min-angle and --max-angle.
+    /// about 2/3 of its peak): RMS distance about a third lower on curved parts, angles kept
+    /// within --min-angle and --max-angle.
     #[arg(long)]
     no_fit: bool,
 
     /// Iterations of the finishing relaxation: vertices move towards where their triangles
-    /// would be equilateral, on the input, with valence flips (horse at 8600: Qave 0.903 without,
-    /// 0.941 after 10). 0 turns it off (the triangulated samples as the paper leaves them).
+    /// would be equilateral, on the input, with valence flips (Qave about 0.90 without, 0.94
+    /// after 10). 0 turns it off (the triangulated samples as the paper leaves them).
     #[arg(
         long,
-        default_value_t = spectral_remesh::SMOOTH_ITERATIONS,
+        default_value_t = spectral_remesh::internal::SMOOTH_ITERATIONS,
         value_name = "N",
         value_parser = whole::<usize>
     )]

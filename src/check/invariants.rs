@@ -9,7 +9,7 @@ use std::fmt;
 use serde::Serialize;
 
 use super::self_intersection::{self_intersections, SelfIntersections};
-use super::topology::{analyze, Analysis, Topology};
+use crate::mesh::topology::{analyze, Analysis, Topology};
 use crate::mesh::TriMesh;
 
 /// One violated invariant: how many elements break it (`count`) and the first of them (lowest

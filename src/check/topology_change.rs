@@ -10,8 +10,8 @@ use std::fmt;
 
 use serde::Serialize;
 
-use super::topology::{topology, Topology};
 use crate::geometry::triangle::is_degenerate_face;
+use crate::mesh::topology::{topology, Topology};
 use crate::mesh::TriMesh;
 
 /// One count of [`Topology`] that differs between an input and its remesh. Serialized with a

@@ -17,8 +17,8 @@ pub const DEGENERATE_AREA_TOLERANCE: f64 = 1e-12;
 /// nothing to the projection (Sec. 6.1 of the paper). Dimensionless (k(x, x) = 1).
 pub const SINGULAR_TOLERANCE: f64 = 1e-9;
 
-/// How far in front of the surface a point is tested for being buried inside the input's own
-/// solid ([`BuriedTest`](crate::BuriedTest)), bbox-100 units: far below any sampling spacing,
+/// How far in front of the surface a point is tested for being buried inside the input's own solid
+/// ([`BuriedTest`](crate::internal::BuriedTest)), bbox-100 units: far below any sampling spacing,
 /// far above rounding.
 pub const BURIED_OFFSET: f64 = 1e-3;
 

@@ -1,27 +1,28 @@
 //! Point sets near a manifold of any dimension, in R^d: the linear scan (Algorithm 1) and the
 //! gradient ascent (eq. 11) on the paper's kernel, for curves, surfaces, volumes and
 //! higher-dimensional manifolds alike (the paper's abstract and Sec. 3: "the analysis and
-//! algorithms are general and can be applied for simplifying and resampling point clouds lying
-//! near a manifold of arbitrary dimension").
+//! algorithms are general and can be applied for simplifying and resampling point clouds lying near
+//! a manifold of arbitrary dimension").
 //!
-//! A point p of R^d with a unit normal n (optional) is mapped to x = [p/sigma_p, n/sigma_n] in
-//! R^K, K = 2d (K = d with positions only, sigma_n = infinity), and two points meet with the
-//! Gaussian k(x, y) = exp(-|x - y|²) ([`GaussianKernel`](crate::GaussianKernel)). The spectral measure is the
-//! crate's one implementation ([`spectral_measure`](crate::spectral_measure), generic over the
-//! kernel); the kd-trees are kiddo's in K dimensions ([`StaticKdTree`],
-//! [`DynamicKdTree`](crate::DynamicKdTree)). Every routine is written once over the const
+//! A point p of R^d with a unit normal n (optional) is mapped to x = [p/sigma_p, n/sigma_n] in R^K,
+//! K = 2d (K = d with positions only, sigma_n = infinity), and two points meet with the Gaussian
+//! k(x, y) = exp(-|x - y|²) ([`GaussianKernel`](crate::internal::GaussianKernel)). The spectral
+//! measure is the crate's one implementation
+//! ([`spectral_measure`](crate::internal::spectral_measure), generic over the kernel); the kd-trees
+//! are kiddo's in K dimensions ([`StaticKdTree`],
+//! [`DynamicKdTree`](crate::internal::DynamicKdTree)). Every routine is written once over the const
 //! dimension K and instantiated for K = 1 to [`MAX_KERNEL_DIMENSION`]: d up to 16 with positions
 //! only, up to 8 with normals.
 //!
-//! - `linear_scan.rs`: Algorithm 1 over the points in a seeded random order, and the search for
-//!   the sigma_p that gives a count.
+//! - `linear_scan.rs`: Algorithm 1 over the points in a seeded random order, and the search for the
+//!   sigma_p that gives a count.
 //! - `gradient_ascent.rs`: eq. 11 on the samples, each move projected onto the manifold by a
 //!   [`ManifoldProjection`].
 //! - `projection.rs`: the projection onto the point set itself (local principal components).
 //! - `dimension.rs`: the manifold's dimension estimated from the points (Levina and Bickel 2004).
 //!
-//! Units: positions and sigma_p in the point set's own units (no rescaling: a point set in R^d
-//! has no bounding-box convention of its own); sigma_n dimensionless.
+//! Units: positions and sigma_p in the point set's own units (no rescaling: a point set in R^d has
+//! no bounding-box convention of its own); sigma_n dimensionless.
 
 mod dimension;
 mod gradient_ascent;
@@ -38,11 +39,9 @@ pub use dimension::{estimate_dimension, DIMENSION_NEIGHBOURS};
 pub use projection::{DataProjection, ManifoldProjection, PROJECTION_ITERATIONS};
 
 /// The step of eq. 11 in kernel units for point sets in R^d (the surface sampler's is 0.55,
-/// [`GradientAscentParams::step`], measured on meshes). A curve is stiffer: on 200 samples of a
-/// circle, 10 sweeps after the linear scan, seeds 1–5 (`tests/manifold_sampling.rs`), the worst
-/// gap ratio is 1.52 at 0.55, 1.29 at 0.45, 1.31 at 0.38, and 0.8 oscillates (1.8–1.9); on 1000
-/// samples of the Clifford torus the worst ρ is 0.836 at 0.55, 0.829 at 0.45, 0.824 at 0.35, 0.77
-/// at 0.7; at 0.45 the Swiss roll's is 0.877 (0.885 at 0.55) and the 3-sphere's 0.807 (0.814).
+/// [`GradientAscentParams::step`], measured on meshes). A curve is stiffer than a surface: the
+/// step is the one measured on a circle, the Clifford torus, a Swiss roll and the 3-sphere
+/// (`tests/manifold_sampling.rs`); the figures are in `docs/decisions/manifold-ascent-step.md`.
 pub const MANIFOLD_ASCENT_STEP: f64 = 0.45;
 
 /// The largest kernel-space dimension K = d (positions only) or 2d (with normals) the sampler

@@ -8,6 +8,7 @@ pub(crate) mod crossing_guard;
 pub mod edit;
 mod orient;
 pub mod sheets;
+pub mod topology;
 mod trimesh;
 
 pub use orient::{orient_consistently, OrientStats};

@@ -5,8 +5,8 @@
 //! closed sheet its own copy of the vertices of the non-manifold edges it shares with another
 //! part, so that a walk over the mesh's vertices (the restricted Voronoi cells' growth) stays
 //! on one part. Open sheets that meet at an edge (a scan's fins on its body) are one surface
-//! and stay joined: split apart, a sheet with a few samples came out in pieces (beetle: the
-//! Hausdorff distance doubled).
+//! and stay joined: split apart, a sheet with a few samples came out in pieces (see
+//! `docs/decisions/restricted-delaunay-default.md`).
 
 use super::TriMesh;
 

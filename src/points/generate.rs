@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use super::stream::{PlyPointWriter, Point};
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
-use crate::sampling::surface_sampler::{AreaSample, AreaSampler};
+use crate::surface::area_sampler::{AreaSample, AreaSampler};
 
 /// Points drawn per chunk (bounds the memory of [`write_surface_points`]).
 const CHUNK: usize = 1 << 20;

@@ -3,23 +3,21 @@
 //!
 //! The two passes are described on [`simplify_out_of_core`].
 
-use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::DVec3;
-use rand::seq::SliceRandom;
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+use super::buckets::Buckets;
 use super::normals::{estimate_normals, NormalOrientation};
-use super::outliers::{far_isolated, flagged, off_surface, OutlierFilter};
+use super::outliers::{off_surface, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
-use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
+use super::stream::Point;
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
-use crate::mesh::{Aabb, Normalization};
+use crate::mesh::Normalization;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentParams};
 use crate::sampling::linear_scan::{LinearScanParams, LinearScanner};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
@@ -90,28 +88,29 @@ pub struct OutOfCoreResult {
     pub seconds: [f64; 4],
 }
 
-/// Simplifies the point set in the file `input` (PLY or XYZ/CSV, see [`PointReader`]) out of
-/// core: memory bounded by the output set plus a fixed buffer, not by the input. Peak memory:
-/// the output set, two buckets, and a 1 MiB write buffer per bucket.
+/// Simplifies the point set in the file `input` (PLY or XYZ/CSV, see
+/// [`PointReader`](crate::internal::PointReader)) out of core: memory bounded by the output set
+/// plus a fixed buffer, not by the input. Peak memory: the output set, two buckets, and a 1 MiB
+/// write buffer per bucket.
 ///
 /// Two passes over the data:
 /// 1. The input is streamed once: its bounding box is taken (for the bbox-100 frame of Sec. 7) and
-///    every point goes to one of `B` temporary bucket files chosen at random (a bucket shuffle:
-///    the visit order is random without the input ever being in memory).
-/// 2. Each bucket in turn is loaded (about `bucket_points` points), shuffled, and streamed
-///    through the linear scan, whose output set O lives in one dynamic kd-tree.
+///    every point goes to one of `B` temporary bucket files chosen at random (a bucket shuffle: the
+///    visit order is random without the input ever being in memory).
+/// 2. Each bucket in turn is loaded (about `bucket_points` points), shuffled, and streamed through
+///    the linear scan, whose output set O lives in one dynamic kd-tree.
 ///
 /// With `--points N` the sigma_p is found first on the first bucket alone: a uniformly random
 /// subset as dense as the output needs gives the same count (the count depends on sigma_p and the
 /// surface, not on the input's density).
 ///
-/// The samples always have unit normals: for an input without them, normals are estimated on
-/// the output (PCA over 10 neighbours, oriented by `params.orientation`). With
-/// `params.resample = K > 0` the samples then move by K sweeps of gradient ascent on the
-/// spectral measure (Sec. 6.2), each move projected onto the RIMLS surface (same sigma_p and
-/// sigma_n) of the samples and the first bucket's points, a uniformly random subset of the input,
-/// so memory stays bounded by a bucket (up to 3 of its points per sample are used, see
-/// `RIMLS_POINTS_PER_SAMPLE`). Their normals are then the RIMLS surface's.
+/// The samples always have unit normals: for an input without them, normals are estimated on the
+/// output (PCA over 10 neighbours, oriented by `params.orientation`). With `params.resample = K >
+/// 0` the samples then move by K sweeps of gradient ascent on the spectral measure (Sec. 6.2), each
+/// move projected onto the RIMLS surface (same sigma_p and sigma_n) of the samples and the first
+/// bucket's points, a uniformly random subset of the input, so memory stays bounded by a bucket (up
+/// to 3 of its points per sample are used, see `RIMLS_POINTS_PER_SAMPLE`). Their normals are then
+/// the RIMLS surface's.
 ///
 /// # Errors
 /// Errors of the PLY reader (naming the file); [`Error::InvalidMesh`] for an empty input or one
@@ -238,7 +237,12 @@ impl ScannedInput {
     ) -> Result<Self> {
         let t0 = Instant::now();
         let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-        let buckets = Buckets::write(input, params, &mut rng)?;
+        let buckets = Buckets::write(
+            input,
+            params.bucket_points,
+            params.temp_dir.as_deref(),
+            &mut rng,
+        )?;
         let t1 = Instant::now();
         // sigma_p: given, or searched on a scaled-down problem (see `search_sigma_p`).
         let mut filter = None;
@@ -333,10 +337,8 @@ fn estimate_sample_normals(points: &mut [Point], orientation: NormalOrientation)
 }
 
 /// Points per sample in the point set whose RIMLS surface the resampling projects onto: the
-/// samples and a random subset of the input. Measured on horse at 8600 from 1M points, 10 sweeps:
-/// with 1, 2, 4 points per sample the resampling takes 0.9, 1.7, 3.0 s and gives a normalized
-/// Poisson-disk radius (min/mean NN distance) of 0.728, 0.746, 0.755 and the same mean distance
-/// to the mesh (0.061 bbox-100 units); the whole 1M-point input takes 136 s (0.732, 0.058).
+/// samples and a random subset of the input, measured against 1 and 2 per sample and against the
+/// whole input (see `docs/decisions/simplify-resample.md`).
 const RIMLS_POINTS_PER_SAMPLE: usize = 4;
 
 /// Gradient-ascent resampling of `samples` (bbox-100 units) projected onto the RIMLS surface of
@@ -527,7 +529,12 @@ pub fn simplify_progressive(
     sigma_p.dedup();
     let t0 = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-    let buckets = Buckets::write(input, params, &mut rng)?;
+    let buckets = Buckets::write(
+        input,
+        params.bucket_points,
+        params.temp_dir.as_deref(),
+        &mut rng,
+    )?;
     let mut seconds = vec![t0.elapsed().as_secs_f64()];
     let norm = buckets.normalization;
     // P_l in bbox-100 units (for the next level's O) and in the input's units (the output).
@@ -571,231 +578,6 @@ pub fn simplify_progressive(
         normalization: norm,
         seconds,
     })
-}
-
-/// Bucket `b`'s points in `dir` as written (model units, in file order), the first `limit`.
-fn read_bucket(dir: &Path, b: usize, limit: usize) -> Result<Vec<Point>> {
-    let mut bytes = Vec::new();
-    let most = limit.saturating_mul(RECORD_BYTES) as u64;
-    File::open(dir.join(format!("{b}.bin")))
-        .and_then(|f| BufReader::new(f).take(most).read_to_end(&mut bytes))
-        .map_err(|e| Error::io(dir, e))?;
-    Ok(bytes
-        .chunks_exact(RECORD_BYTES)
-        .map(decode_record)
-        .collect())
-}
-
-/// Points of the first bucket the far-isolation test compares with (see [`far_isolated`]).
-const FAR_REFERENCE_POINTS: usize = 1 << 16;
-
-/// The most bucket files of one run: open files and their write buffers are bounded whatever
-/// the input's size (512 files of 2^20 points hold 2^29 points; larger inputs get larger buckets).
-const MAX_BUCKETS: u64 = 512;
-
-/// The input, bucket-shuffled into temporary files (pass 1 of [`simplify_out_of_core`]).
-struct Buckets {
-    dir: tempfile::TempDir,
-    /// The folder on the list an interrupted run removes.
-    _registered: crate::io::temporaries::Registered,
-    /// Number of bucket files.
-    count: usize,
-    /// Points kept (read, less the far isolated ones).
-    total: u64,
-    had_normals: bool,
-    normalization: Normalization,
-    /// The box (model units) of the points kept, when far isolated points were left out
-    /// ([`far_isolated`]): points outside it are not loaded.
-    keep: Option<Aabb>,
-    /// Far isolated points left out.
-    far_points: u64,
-}
-
-/// Points with the most extreme coordinate along each of the six axis directions, the most
-/// extreme first: the candidates of [`far_isolated`].
-struct Extremes {
-    lists: [Vec<(f64, DVec3)>; 6],
-}
-
-impl Extremes {
-    /// How many points each direction keeps.
-    const PER_DIRECTION: usize = 16;
-
-    fn new() -> Self {
-        Extremes {
-            lists: Default::default(),
-        }
-    }
-
-    fn offer(&mut self, p: DVec3) {
-        for (d, list) in self.lists.iter_mut().enumerate() {
-            let v = if d % 2 == 0 { p[d / 2] } else { -p[d / 2] };
-            if list.len() < Self::PER_DIRECTION || list.last().is_some_and(|&(w, _)| v > w) {
-                let at = list.partition_point(|&(w, _)| w >= v);
-                list.insert(at, (v, p));
-                list.truncate(Self::PER_DIRECTION);
-            }
-        }
-    }
-
-    /// The box of the points without those `far` says are far isolated: on each side, the
-    /// most extreme candidate that is not far. `None` when no candidate is far, or when every
-    /// candidate of some direction is (too many far points to tell the box).
-    fn box_without(&self, far: impl Fn(DVec3) -> bool) -> Option<Aabb> {
-        let mut any = false;
-        let mut bound = [0.0f64; 6];
-        for (d, list) in self.lists.iter().enumerate() {
-            any |= list.iter().any(|&(_, p)| far(p));
-            let &(v, _) = list.iter().find(|&&(_, p)| !far(p))?;
-            bound[d] = if d % 2 == 0 { v } else { -v };
-        }
-        any.then(|| Aabb {
-            min: DVec3::new(bound[1], bound[3], bound[5]),
-            max: DVec3::new(bound[0], bound[2], bound[4]),
-        })
-    }
-}
-
-/// Far isolated points are looked for in point sets of at least this many points (in a
-/// handful of points every point is far from the others).
-const FAR_MIN_POINTS: u64 = 1000;
-
-impl Buckets {
-    /// Streams `input` once: its bounding box, and every point to a random bucket file.
-    fn write(input: &Path, params: &OutOfCoreParams, rng: &mut ChaCha8Rng) -> Result<Buckets> {
-        let mut reader = PointReader::open(input)?;
-        let total = reader.count();
-        if total == 0 {
-            return Err(Error::invalid_mesh(input, "the point set is empty"));
-        }
-        let had_normals = reader.has_normals();
-        // At most MAX_BUCKETS files open at once (beyond 2^29 points the buckets grow instead).
-        let count = total
-            .div_ceil(params.bucket_points.max(1) as u64)
-            .clamp(1, MAX_BUCKETS) as usize;
-        let dir = tempfile::Builder::new()
-            .prefix("remesh-buckets")
-            .tempdir_in(params.temp_dir.clone().unwrap_or_else(std::env::temp_dir))
-            .map_err(|e| Error::io(input, e))?;
-        // On the list from the start: an interrupt while bucketing removes it too.
-        let registered = crate::io::temporaries::register(dir.path());
-        let io_err = |e: std::io::Error| Error::io(dir.path(), e);
-        let mut writers: Vec<BufWriter<File>> = (0..count)
-            .map(|b| {
-                File::create(dir.path().join(format!("{b}.bin")))
-                    .map(|f| BufWriter::with_capacity(1 << 16, f))
-            })
-            .collect::<std::io::Result<_>>()
-            .map_err(io_err)?;
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        let mut extremes = Extremes::new();
-        let mut chunk = Vec::new();
-        let mut staged: Vec<Vec<u8>> = vec![Vec::new(); count];
-        while reader.read_chunk(&mut chunk, 1 << 16)? > 0 {
-            for p in &chunk {
-                lo = lo.min(p.position);
-                hi = hi.max(p.position);
-                extremes.offer(p.position);
-                encode_record(p, &mut staged[rng.random_range(0..count)]);
-            }
-            for (w, bytes) in writers.iter_mut().zip(staged.iter_mut()) {
-                w.write_all(bytes).map_err(io_err)?;
-                bytes.clear();
-            }
-        }
-        for w in &mut writers {
-            w.flush().map_err(io_err)?;
-        }
-        drop(writers);
-        // Far isolated points (a stray `0 0 0` in a scan at UTM coordinates) do not set the
-        // scale: they are left out, judged against a random subset of the points (the first
-        // bucket's).
-        let mut keep = None;
-        let mut far_points = 0;
-        if total >= FAR_MIN_POINTS {
-            let reference: Vec<DVec3> = read_bucket(dir.path(), 0, FAR_REFERENCE_POINTS)?
-                .into_iter()
-                .map(|p| p.position)
-                .collect();
-            let candidates: Vec<DVec3> = extremes.lists.iter().flatten().map(|&(_, p)| p).collect();
-            let far_set = flagged(&candidates, &far_isolated(&candidates, &reference));
-            keep = extremes.box_without(|p| far_set.contains(&p.to_array().map(f64::to_bits)));
-            if let Some(b) = keep {
-                for k in 0..count {
-                    far_points += read_bucket(dir.path(), k, usize::MAX)?
-                        .iter()
-                        .filter(|p| !b.contains(p.position))
-                        .count() as u64;
-                }
-            }
-        }
-        let bbox = keep.unwrap_or(Aabb { min: lo, max: hi });
-        let normalization = Normalization::for_bbox(&bbox).ok_or_else(|| {
-            Error::invalid_mesh(
-                input,
-                Normalization::refusal(&bbox).replacen(
-                    "the bounding box",
-                    "the points' bounding box",
-                    1,
-                ),
-            )
-        })?;
-        Ok(Buckets {
-            _registered: registered,
-            dir,
-            count,
-            total: total - far_points,
-            had_normals,
-            normalization,
-            keep,
-            far_points,
-        })
-    }
-
-    /// Calls `f` with each bucket's points in turn (bbox-100 units, shuffled), loading the next
-    /// bucket on another thread meanwhile. The shuffles draw from `rng` in bucket order.
-    fn for_each(&self, rng: &mut ChaCha8Rng, mut f: impl FnMut(Vec<Point>)) -> Result<()> {
-        std::thread::scope(|scope| {
-            let spawn = |b: usize, mut r: ChaCha8Rng| {
-                scope.spawn(move || {
-                    let pts = self.load(b, &mut r);
-                    (pts, r)
-                })
-            };
-            let mut next = Some(spawn(0, rng.clone()));
-            let mut b = 0;
-            while let Some(loader) = next.take() {
-                let (pts, r) = loader.join().map_err(|_| {
-                    Error::io(
-                        self.dir.path(),
-                        std::io::Error::other("a bucket loader panicked"),
-                    )
-                })?;
-                *rng = r;
-                let pts = pts?;
-                b += 1;
-                if b < self.count {
-                    next = Some(spawn(b, rng.clone()));
-                }
-                f(pts);
-            }
-            Ok(())
-        })
-    }
-
-    /// Bucket `b`'s points in bbox-100 units, shuffled.
-    fn load(&self, b: usize, rng: &mut ChaCha8Rng) -> Result<Vec<Point>> {
-        let mut pts: Vec<Point> = read_bucket(self.dir.path(), b, usize::MAX)?
-            .into_iter()
-            .filter(|p| self.keep.is_none_or(|k| k.contains(p.position)))
-            .map(|p| Point {
-                position: self.normalization.apply(p.position),
-                normal: p.normal,
-            })
-            .collect();
-        pts.shuffle(rng);
-        Ok(pts)
-    }
 }
 
 /// Points of the first bucket the outlier filter compares with (a random subset: the tests are

@@ -13,7 +13,7 @@ use crate::error::Result;
 use crate::geometry::morton::{morton_code, morton_scale};
 use crate::geometry::tolerance::SEARCH_BOUND_SLACK;
 use crate::mesh::TriMesh;
-use crate::sampling::surface_sampler::AreaSampler;
+use crate::surface::area_sampler::AreaSampler;
 use crate::surface::MeshSurface;
 
 /// Two-sided distance between two surfaces A and B, in the units of the meshes given (the

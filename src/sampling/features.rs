@@ -10,90 +10,24 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
-use crate::sampling::boundary::{
-    curve_length, curve_points, edge_lengths, points_along, width_steps, BoundaryCurve,
+use crate::sampling::curves::{
+    curve_length, curve_points, edge_lengths, graded_points, points_along, width_steps,
+    BoundaryCurve, FeaturePiece,
 };
 use crate::sampling::WidthField;
 use crate::surface::features::Features;
 
 /// The least distance between the samples of two feature curves, in units of the spacing
 /// (apart from a corner they share): where two kept curves would come closer, the shorter is
-/// left out, so curves meeting at a corner at less than about 50° are not both kept. Measured
-/// with `--feature-angle 60` at seeds 1–5: at 0.5, horse 8600 θmin 26.7 and bunny 9635 25.1
-/// at worst (creases round the tail and ear tips, whose samples make thin triangles among
-/// themselves); at 0.85, 28.6 and 33.0; fandisk, bracket and flange the same at both.
+/// left out, so curves meeting at a corner at less than about 50° are not both kept (closer
+/// curves' samples make thin triangles among themselves: `docs/decisions/
+/// feature-curve-separation.md`).
 pub const CURVE_SAMPLE_GAP: f64 = 0.85;
 
 /// The smallest angle (degrees) between two creases leaving a corner that the sampling grades
 /// towards (see [`feature_pieces`]); at a smaller one the shorter crease is left out, as it would
 /// take too many samples (about 1 / angle) to follow both.
 pub const MIN_GRADED_CORNER_DEG: f64 = 8.0;
-
-/// A feature curve to sample: the curve, and at each end where it leaves a corner at a small
-/// angle to another kept curve, the arc lengths from that end (bbox-100 units, decreasing) of
-/// the samples graded towards the corner (see [`feature_pieces`]); empty where the samples are
-/// even up to the end.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FeaturePiece {
-    /// The crease, as a curve with a face per edge.
-    pub curve: BoundaryCurve,
-    /// Per end (start, end): the graded samples' distances along the curve from that end, the
-    /// first the farthest (where the even spacing starts).
-    pub graded: [Vec<f64>; 2],
-}
-
-impl FeaturePiece {
-    /// The arc lengths from the start (units of the mesh) of the samples of a piece of length
-    /// `total` with graded ends at `spacing`: 0, the start's graded samples, even steps as close
-    /// to `spacing` as a whole number allows in between, the end's graded samples, `total`.
-    /// Only for open curves with a graded end.
-    pub(crate) fn arcs(&self, total: f64, spacing: f64) -> Vec<f64> {
-        let r0 = self.graded[0].first().copied().unwrap_or(0.0);
-        let r1 = self.graded[1].first().copied().unwrap_or(0.0);
-        let middle = (total - r0 - r1).max(0.0);
-        let steps = (middle / spacing).round().max(1.0) as usize;
-        self.with_graded_ends(
-            total,
-            (1..steps).map(|k| r0 + middle * k as f64 / steps as f64),
-        )
-    }
-
-    /// [`FeaturePiece::arcs`] with the even steps between the graded ends taken in a measure
-    /// along the curve (edge `k` has length `lengths[k]` and measure `measures[k]`, in units of
-    /// length): as many steps as `spacing` fits into the middle part's measure, equal in it.
-    pub(crate) fn arcs_in_measure(
-        &self,
-        lengths: &[f64],
-        measures: &[f64],
-        spacing: f64,
-    ) -> Vec<f64> {
-        let total: f64 = lengths.iter().sum();
-        let r0 = self.graded[0].first().copied().unwrap_or(0.0);
-        let r1 = self.graded[1].first().copied().unwrap_or(0.0);
-        let m0 = convert(lengths, measures, r0, true);
-        let m1 = convert(lengths, measures, (total - r1).max(r0), true);
-        let steps = ((m1 - m0) / spacing).round().max(1.0) as usize;
-        self.with_graded_ends(
-            total,
-            (1..steps).map(|k| {
-                let m = m0 + (m1 - m0) * k as f64 / steps as f64;
-                convert(lengths, measures, m, false)
-            }),
-        )
-    }
-
-    /// The arc lengths of a piece of length `total`: 0, the start's graded samples, the
-    /// `middle` ones, the end's graded samples, `total` (coincident ones once).
-    fn with_graded_ends(&self, total: f64, middle: impl Iterator<Item = f64>) -> Vec<f64> {
-        let mut out = vec![0.0];
-        out.extend(self.graded[0].iter().rev().copied());
-        out.extend(middle);
-        out.extend(self.graded[1].iter().map(|&r| total - r));
-        out.push(total);
-        out.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * total.max(1.0));
-        out
-    }
-}
 
 /// The distances from a corner (decreasing, the first `reach`) of the samples graded towards a
 /// corner where two creases meet at `angle` (radians): the gap between the creases at distance
@@ -232,60 +166,6 @@ fn crowded_only_at_ends(clear: &[bool], closed: bool) -> bool {
         return false;
     };
     (first..=last).all(|k| clear[k])
-}
-
-/// The points of a feature piece with graded ends ([`FeaturePiece::arcs`]), corners exact. With
-/// a `width` field the even steps between the graded ends follow it (equal steps of ∫ ds / w,
-/// the width taken at the curve's vertices, linear in between, as on the other curves); the
-/// graded distances stay as they are (they were set at the corner's width).
-pub(crate) fn graded_points(
-    mesh: &TriMesh,
-    piece: &FeaturePiece,
-    spacing: f64,
-    width: Option<WidthField>,
-) -> Vec<(DVec3, usize)> {
-    let lengths = edge_lengths(mesh, &piece.curve);
-    let total: f64 = lengths.iter().sum();
-    let arcs = match width {
-        None => piece.arcs(total, spacing),
-        Some(w) => {
-            let nv = piece.curve.vertices.len();
-            let pos = |k: usize| mesh.positions[piece.curve.vertices[k % nv] as usize];
-            let measures: Vec<f64> = (0..lengths.len())
-                .map(|k| width_steps(w, pos(k), pos(k + 1)))
-                .collect();
-            piece.arcs_in_measure(&lengths, &measures, spacing)
-        }
-    };
-    let mut points = points_along(mesh, &piece.curve, &lengths, arcs);
-    let (last, nv) = (points.len() - 1, piece.curve.vertices.len());
-    points[0].0 = mesh.positions[piece.curve.vertices[0] as usize];
-    points[last].0 = mesh.positions[piece.curve.vertices[nv - 1] as usize];
-    points
-}
-
-/// Along a curve of edge `lengths` whose edges have `measures`, the measure at arc length `t`
-/// (`to_measure`) or the arc length at measure `m` (`!to_measure`), linear within an edge.
-fn convert(lengths: &[f64], measures: &[f64], x: f64, to_measure: bool) -> f64 {
-    let (from, to) = if to_measure {
-        (lengths, measures)
-    } else {
-        (measures, lengths)
-    };
-    let (mut a, mut b) = (0.0, 0.0);
-    for k in 0..from.len() {
-        if a + from[k] >= x || k + 1 == from.len() {
-            let u = if from[k] > 0.0 {
-                ((x - a) / from[k]).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            return b + u * to[k];
-        }
-        a += from[k];
-        b += to[k];
-    }
-    0.0
 }
 
 /// The feature curves of `features` worth sampling at `spacing` (bbox-100 units), as curves with
@@ -597,7 +477,8 @@ pub fn split_at(curves: &[BoundaryCurve], at: &FxHashSet<u32>) -> Vec<BoundaryCu
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::boundary::{boundary_curves, sample_curves_and_features};
+    use crate::sampling::boundary::boundary_curves;
+    use crate::sampling::curves::sample_curves_and_features;
     use crate::surface::features::{detect_features, FeatureParams};
     use glam::DVec3;
 

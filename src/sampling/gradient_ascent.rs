@@ -30,11 +30,9 @@ thread_local! {
 pub struct GradientAscentParams {
     /// Number of sweeps over all samples (default 10, Sec. 6.3).
     pub iterations: usize,
-    /// Step of eq. 11, x ← x + step ∇s(x), in kernel units (default 0.55; eq. 11 prints 0.5).
-    /// Measured on horse at 8600 points, 10 sweeps, seeds 1–4: step 0.5 gives Qave
-    /// 0.898–0.900 and θmin,ave 52.5–52.6; 0.55 gives Qave 0.901–0.903 and θmin,ave 52.7–52.8;
-    /// 0.6 gives 0.904–0.906 and 52.9–53.0 but, on seed 1, a worse worst triangle; 1.0 and
-    /// above oscillate (Qave 0.886 at 1.0, 0.870 at 1.5).
+    /// Step of eq. 11, x ← x + step ∇s(x), in kernel units (default 0.55; eq. 11 prints 0.5):
+    /// a little better triangles than 0.5, while 0.6 gave a worse worst triangle and 1.0 and
+    /// above oscillate (`docs/decisions/gradient-ascent-step.md`).
     pub step: f64,
     /// Largest move of one sample in one sweep, in units of sigma_p (default 0.25): a guard
     /// against a sample jumping across a thin part of the model.
@@ -45,13 +43,13 @@ pub struct GradientAscentParams {
     /// (Sec. 6.2; default true). Runs of consecutive samples in that order of which no two are
     /// neighbours are moved in parallel, with the same result. When false, all samples move at
     /// once from the positions at the start of the sweep, in parallel; that form needs a smaller
-    /// step (0.25) to converge and converges more slowly (horse at 8600, 10 sweeps: θmin,ave
-    /// 50.5 against 52.6).
+    /// step (0.25) to converge and converges more slowly
+    /// (`docs/decisions/gradient-ascent-order.md`).
     pub sequential: bool,
     /// Halvings of a step that would lower s (with the neighbours held fixed) before it is taken
-    /// anyway (default 0: every step is taken, as in eq. 11). Measured on horse at 8600: no
-    /// effect at step 0.5 (every step already raises s), Qave +0.0015 at step 0.75, at twice the
-    /// cost of the sweep.
+    /// anyway (default 0: every step is taken, as in eq. 11): at the default step every step
+    /// already raises s, and at larger ones the gain was small for twice the cost of a sweep
+    /// (`docs/decisions/gradient-ascent-step.md`).
     pub backtracking: usize,
 }
 
@@ -81,19 +79,20 @@ pub struct GradientAscentResult {
 }
 
 /// Moves each of `samples[fixed..]` along the gradient of its spectral measure (eq. 11) and
-/// projects it onto `surface` (see [`Projection`]), for `params.iterations` sweeps. `samples[..fixed]`
-/// (for example samples on the input's boundary curves) act as neighbours but do not move.
+/// projects it onto `surface` (see [`Projection`]), for `params.iterations` sweeps.
+/// `samples[..fixed]` (for example samples on the input's boundary curves) act as neighbours but do
+/// not move.
 ///
-/// Neighbourhoods are found once with a kd-tree and kept for all sweeps (Sec. 6.3). By default
-/// each sweep visits the samples one at a time in a seeded random order, each move seeing the
-/// ones before it (Sec. 6.2; a run of consecutive samples none of which is another's neighbour
-/// moves in parallel, which changes nothing); with `sequential = false` all moves of a sweep are computed in
+/// Neighbourhoods are found once with a kd-tree and kept for all sweeps (Sec. 6.3). By default each
+/// sweep visits the samples one at a time in a seeded random order, each move seeing the ones
+/// before it (Sec. 6.2; a run of consecutive samples none of which is another's neighbour moves in
+/// parallel, which changes nothing); with `sequential = false` all moves of a sweep are computed in
 /// parallel from the positions at its start. Either way the result depends only on `seed` (the
 /// caller's seed of every random choice: `RemeshParams::seed` in the pipeline).
 ///
 /// The gradient is taken with respect to the position part of x with the sample's normal held
-/// fixed; the projection then gives the new position and the normal of the input triangle it
-/// lands on. Units: positions in bbox-100 units.
+/// fixed; the projection then gives the new position and the normal of the input triangle it lands
+/// on. Units: positions in bbox-100 units.
 pub fn gradient_ascent<S: Projection + ?Sized>(
     kernel: &Kernel,
     surface: &S,
@@ -341,7 +340,7 @@ fn move_one<S: Projection + ?Sized>(
 mod tests {
     use super::*;
     use crate::mesh::test_meshes;
-    use crate::sampling::candidates::surface_candidates;
+    use crate::surface::candidates::surface_candidates;
     use crate::surface::MeshSurface;
     use rand::seq::SliceRandom;
     use rand::SeedableRng;

@@ -14,8 +14,8 @@ use glam::DVec3;
 use crate::disjoint_sets::Dsu;
 use crate::error::Result;
 use crate::mesh::{Normalization, TriMesh};
-use crate::pipeline::SAMPLES_PER_SIGMA2;
 use crate::sampling::boundary::BoundaryCurve;
+use crate::sampling::spacing::SAMPLES_PER_SIGMA2;
 use crate::spatial::StaticTree;
 use crate::surface::local_feature_size::{local_feature_size, LfsParams, LocalFeatureSize};
 

@@ -169,7 +169,8 @@ impl LinearScanner {
         self.insert_graded(position, normal, 1.0);
     }
 
-    /// [`LinearScanner::insert`] with the point's relative kernel width (see [`Kernel`](crate::Kernel)).
+    /// [`LinearScanner::insert`] with the point's relative kernel width (see
+    /// [`Kernel`](crate::internal::Kernel)).
     pub fn insert_graded(&mut self, position: DVec3, normal: DVec3, width: f64) {
         let x = self.kernel.embed_graded(position, normal, width);
         self.graded |= width != 1.0;
@@ -183,7 +184,8 @@ impl LinearScanner {
         self.offer_graded(position, normal, 1.0)
     }
 
-    /// [`LinearScanner::offer`] with the point's relative kernel width (see [`Kernel`](crate::Kernel)).
+    /// [`LinearScanner::offer`] with the point's relative kernel width (see
+    /// [`Kernel`](crate::internal::Kernel)).
     pub fn offer_graded(&mut self, position: DVec3, normal: DVec3, width: f64) -> bool {
         self.graded |= width != 1.0;
         let kernel = &self.kernel;
@@ -455,9 +457,9 @@ pub fn linear_scan(
 }
 
 /// [`linear_scan`] with a graded kernel: each point's relative width (see
-/// [`Kernel`](crate::Kernel)), `candidate_widths[k]` for `candidates[k]` and `width(position)`
-/// for the initial samples (`None`: 1 everywhere, the same as [`linear_scan`]). The candidates'
-/// widths are taken by the caller, once for the evaluations that share them.
+/// [`Kernel`](crate::internal::Kernel)), `candidate_widths[k]` for `candidates[k]` and
+/// `width(position)` for the initial samples (`None`: 1 everywhere, the same as [`linear_scan`]).
+/// The candidates' widths are taken by the caller, once for the evaluations that share them.
 pub fn linear_scan_graded(
     kernel: &Kernel,
     candidates: &[SurfaceSample],

@@ -3,15 +3,15 @@
 //! the sigma_p that yields a target count.
 
 pub mod boundary;
-pub mod candidates;
 pub mod crease_band;
+pub mod curves;
 pub mod features;
 pub mod gradient_ascent;
 pub mod grading;
 pub mod linear_scan;
-pub mod surface_sampler;
+pub mod spacing;
 pub mod target_count;
 
 /// A field of relative kernel widths w(p) in (0, 1] over positions (bbox-100 units): a graded
-/// kernel's sigma_p(p) = w(p) · sigma_p (see [`Kernel`](crate::Kernel)).
+/// kernel's sigma_p(p) = w(p) · sigma_p (see [`Kernel`](crate::internal::Kernel)).
 pub type WidthField<'a> = &'a (dyn Fn(glam::DVec3) -> f64 + Sync);

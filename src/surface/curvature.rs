@@ -44,10 +44,10 @@ pub struct Curvature {
 }
 
 impl Curvature {
-    /// The curvature of the faces of `surface`'s mesh (1 / mesh units), the edges in `creases` (`[a, b]` with
-    /// `a < b`; the pipeline passes none, see [`CURVATURE_MAX_BEND_DEG`]) and the edges bending
-    /// by [`CURVATURE_MAX_BEND_DEG`] or more left out. Edges with other than two faces, or a face
-    /// of zero area, give no curvature.
+    /// The curvature of the faces of `surface`'s mesh (1 / mesh units), the edges in `creases`
+    /// (`[a, b]` with `a < b`; the pipeline passes none, see [`CURVATURE_MAX_BEND_DEG`]) and the
+    /// edges bending by [`CURVATURE_MAX_BEND_DEG`] or more left out. Edges with other than two
+    /// faces, or a face of zero area, give no curvature.
     pub fn new(surface: &MeshSurface, creases: &[[u32; 2]]) -> Self {
         let mesh = surface.mesh();
         let creases: FxHashSet<[u32; 2]> = creases.iter().copied().collect();
@@ -172,7 +172,7 @@ pub struct CurvatureParams {
 }
 
 /// The chord error (fraction of sigma_p) measured for CAD parts: fandisk, bracket and flange at
-/// their counts, with `--feature-angle 20` (see ARCHITECTURE.md).
+/// their counts, with `--feature-angle 20` (see `docs/decisions/chord-error-cad.md`).
 pub const CAD_CHORD_ERROR: f64 = 0.003;
 
 impl Default for CurvatureParams {

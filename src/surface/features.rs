@@ -2,11 +2,12 @@
 //!
 //! A feature edge is an interior edge of two faces whose normals differ by at least the feature
 //! angle, and still do at the sampling's scale: the surface within `scale` of the edge, on either
-//! side of it, has mean normals that differ by the feature angle too. The second test is what tells a crease of a part (fandisk, a CSG flange) from the
-//! folds and spikes a scan leaves at the scale of its own triangles (horse, bunny), which are
-//! sharp between two faces but smooth a sample spacing away. Feature edges are chained into
-//! curves that end at corners: vertices where one, three or more feature edges meet, where a
-//! feature curve meets the boundary, or where a curve turns by the feature angle or more.
+//! side of it, has mean normals that differ by the feature angle too. The second test is what tells
+//! a crease of a part (fandisk, a CSG flange) from the folds and spikes a scan leaves at the scale
+//! of its own triangles (horse, bunny), which are sharp between two faces but smooth a sample
+//! spacing away. Feature edges are chained into curves that end at corners: vertices where one,
+//! three or more feature edges meet, where a feature curve meets the boundary, or where a curve
+//! turns by the feature angle or more.
 //!
 //! # References
 //! The dihedral-angle test is the one of MeshLab's and CGAL's feature detection
@@ -27,11 +28,9 @@ pub enum FeatureDetection {
     /// Detection at [`CAD_FEATURE_ANGLE_DEG`], the creases kept when they are a part's: when at
     /// least [`AUTO_FEATURE_MIN_SHARE`] of their length lies in curves at least
     /// [`LONG_CURVE_SPACINGS`] sample spacings long ([`long_curve_share`]). The creases of a
-    /// CAD part run from corner to corner (fandisk 0.98, bracket and flange 1.00, a cube 1.00);
-    /// a scan's folds are sharp at its own scale in short pieces (horse 0.10, bunny 0.11, cow
-    /// 0.29, spot 0.43, beetle 0.57; pymeshlab's airplane 0.67 and bone 0.52), and sampled as
-    /// creases they leave poor triangles (horse at 20°: θmin 13.7 against 35) and no closer
-    /// surface. The default.
+    /// CAD part run from corner to corner; a scan's folds are sharp at its own scale in short
+    /// pieces, and sampled as creases they leave poor triangles and no closer surface (the shares
+    /// and figures: `docs/decisions/feature-angle-auto.md`). The default.
     #[default]
     Auto,
     /// Detection at this feature angle (degrees; 180 or more: off), every crease kept.
@@ -75,14 +74,10 @@ pub fn long_curve_share(features: &Features, positions: &[DVec3], spacing: f64) 
     long / total
 }
 
-/// The feature angle (degrees) measured for CAD parts. Fandisk 6000 at seeds 1–5: Hausdorff
-/// 0.15–0.19 at 20, 0.23–0.26 at 25, 0.24–0.28 at 30 and 0.39–0.42 at 55, as its crease that
-/// fades from 64° to 20° is followed further; its cylinders' 22° facets are the input's own
-/// edges and are kept where they lie a spacing apart (RMS 0.008 at 20, 0.014 at 25). Below 20,
-/// its 18–19° blend line comes in bits shorter than the spacing and nothing improves. Parts not
-/// tuned on are the same or better at 20 than at 55: a turned shaft with a 45° chamfer (3000:
-/// Hausdorff 0.55 → 0.09), a hex nut, an L-shaped block, a washer and a hexagonal prism
-/// (every edge kept, with its coordinates rounded to `f32` too); bracket and flange alike.
+/// The feature angle (degrees) measured for CAD parts: on fandisk the Hausdorff distance falls
+/// from 55° down to 20°, as a crease that fades is followed further, and below 20° nothing
+/// improves; parts not tuned on are the same or better at 20° than at 55° (the figures:
+/// `docs/decisions/feature-angle-20.md`).
 pub const CAD_FEATURE_ANGLE_DEG: f64 = 20.0;
 
 /// Parameters of [`detect_features`].
@@ -249,9 +244,9 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     }
 }
 
-/// The faces of `mesh` and each face's neighbour across each of its edges (`tri[k]`–`tri[k + 1]`): the other face of
-/// an edge with exactly two faces, [`FaceAdjacency::NONE`] across a boundary or non-manifold
-/// edge; and whether that edge is a dihedral candidate. Built once, so the patches of
+/// The faces of `mesh` and each face's neighbour across each of its edges (`tri[k]`–`tri[k + 1]`):
+/// the other face of an edge with exactly two faces, [`FaceAdjacency::NONE`] across a boundary or
+/// non-manifold edge; and whether that edge is a dihedral candidate. Built once, so the patches of
 /// [`sharp_at_scale`] are walked by index instead of by hashing each edge.
 struct FaceAdjacency<'a> {
     mesh: &'a TriMesh,
@@ -344,10 +339,10 @@ impl PatchScratch {
 const PATCH_FACES: usize = 1024;
 
 /// Whether the surface within `scale` of edge `e`'s midpoint still bends by the feature angle
-/// (`cos_bound` its cosine) across the edge: the area-weighted normals of the faces on either
-/// side at least the angle apart. The patch is grown from the edge's two faces across edges to
-/// faces whose centroids are within `scale` (over `adjacency`), never across a dihedral
-/// candidate when `barriers` is set: so near a corner where creases meet, each side is the smooth sheet beside the
+/// (`cos_bound` its cosine) across the edge: the area-weighted normals of the faces on either side
+/// at least the angle apart. The patch is grown from the edge's two faces across edges to faces
+/// whose centroids are within `scale` (over `adjacency`), never across a dihedral candidate when
+/// `barriers` is set: so near a corner where creases meet, each side is the smooth sheet beside the
 /// edge and not a sheet beyond another crease. Each face of the patch counts on the side of the
 /// edge it lies on (the half of the patch nearer one of the two faces' half-planes). True when
 /// `scale` is 0.

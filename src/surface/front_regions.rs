@@ -35,7 +35,7 @@ use glam::DVec3;
 use parry3d_f64::bounding_volume::Aabb;
 use rayon::prelude::*;
 
-use super::winding::RayWinding;
+use super::winding_number::RayWinding;
 use crate::disjoint_sets::Dsu;
 use crate::geometry::tolerance::BURIED_OFFSET;
 use crate::geometry::triangle_intersection::{orient, segment_meets_triangle, triangles_intersect};

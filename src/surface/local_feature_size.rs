@@ -7,8 +7,8 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
-use crate::sampling::candidates::surface_candidates;
 use crate::spatial::StaticTree;
+use crate::surface::candidates::surface_candidates;
 use crate::surface::MeshSurface;
 
 /// Parameters of [`local_feature_size`].

@@ -1,5 +1,7 @@
 //! The input surface the samples live on, and projection onto it.
 
+pub mod area_sampler;
+pub mod candidates;
 pub mod curvature;
 pub mod feature_lines;
 pub mod features;
@@ -7,6 +9,7 @@ pub(crate) mod front_regions;
 pub mod local_feature_size;
 pub mod mesh_projection;
 pub mod winding;
+pub mod winding_number;
 
 pub use mesh_projection::{MeshSurface, SurfacePoint};
 
@@ -26,7 +29,7 @@ pub struct SurfaceSample {
 
 /// A surface samples are projected onto after each gradient-ascent move (Sec. 6.2): the input
 /// mesh ([`MeshSurface`], closest point) or the RIMLS surface of a point set
-/// ([`Rimls`](crate::Rimls), Newton projection).
+/// ([`Rimls`](crate::internal::Rimls), Newton projection).
 pub trait Projection: Sync {
     /// The projection of `p` (bbox-100 units) with the surface's unit normal there and, on a
     /// mesh, the triangle it lies on (0 elsewhere); `None` when `p` cannot be projected.

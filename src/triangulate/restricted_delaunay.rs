@@ -31,17 +31,13 @@ use crate::surface::MeshSurface;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RestrictedDelaunayParams {
     /// Longest edge of the refined input, as a fraction of the sample spacing (default 0.5:
-    /// about 15 refined vertices per cell; 0.3 and 0.6 gave the same topology and Qave within
-    /// 0.0003 on horse, cow and bunny).
+    /// about 15 refined vertices per cell; finer and coarser settings changed no topology, see
+    /// `docs/decisions/restricted-delaunay-default.md`).
     pub resolution: f64,
-    /// The most vertices the refinement adds per sample (default 200; horse at 8600 takes 11,
-    /// the CAD parts' sliver tessellations more: bracket at 2000 and 4000 about 57, flange at
-    /// 2000 and 6000 about 113–127): beyond, `restricted_delaunay` gives up and the umbrellas
-    /// connect the samples (a degenerate sliver, whose bisection makes ever thinner slivers).
-    /// At 40 the CAD parts took the umbrellas: bracket 2000 seed 1 split in two with 8
-    /// crossing pairs, the cylinder of radius 0.1 kept 472 of 2000 vertices in 58 pieces; at
-    /// 200 both are whole and clean, flange 6000 takes 2.0 s instead of 1.4 s and 161 MB
-    /// instead of 63 MB.
+    /// The most vertices the refinement adds per sample (default 200, room for the CAD parts'
+    /// sliver tessellations): beyond, `restricted_delaunay` gives up and the umbrellas connect
+    /// the samples (a degenerate sliver, whose bisection makes ever thinner slivers). The
+    /// figures behind 200: `docs/decisions/restricted-delaunay-default.md`.
     pub max_added_per_sample: usize,
 }
 

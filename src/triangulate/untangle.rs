@@ -36,11 +36,11 @@ pub struct UntangleParams {
     /// mesh passes through itself or its parts meet (the [`CrossingRegions`] given to
     /// [`untangle`]) a crossing is the input's, and collapses would eat the part.
     pub max_collapses: usize,
-    /// Faces nearer than this count as crossing (bbox-100 units, not σ_p; at most a tenth of
-    /// the margin is used): faces that would share a point once the mesh is written, whose
-    /// coordinates are rounded
-    /// ([`Normalization::written_rounding`](crate::Normalization::written_rounding)). Default 0:
-    /// the exact test alone.
+    /// Faces nearer than this count as crossing (bbox-100 units, not σ_p; at most a tenth of the
+    /// margin is used): faces that would share a point once the mesh is written, whose coordinates
+    /// are rounded
+    /// ([`Normalization::written_rounding`](crate::internal::Normalization::written_rounding)).
+    /// Default 0: the exact test alone.
     pub near: f64,
 }
 

@@ -7,18 +7,30 @@ use std::process::Output;
 use glam::DVec3;
 use spectral_remesh::TriMesh;
 
-/// The path of a shared test model (`../shared/data/NAME` beside the checkout); a missing one
-/// fails the test that needs it, with its path.
-pub fn shared(name: &str) -> PathBuf {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(name);
+/// The path of a test model: `data/NAME` when the checkout has it (spot, beetle), else the
+/// shared model `../shared/data/NAME` beside the checkout, which only the tests marked
+/// `#[ignore = "needs ../shared"]` read; a missing one fails the test, with its path.
+pub fn model(name: &str) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let own = root.join("data").join(name);
+    if own.is_file() {
+        return own;
+    }
+    let p = root.join("../shared/data").join(name);
     assert!(
         p.is_file(),
         "{} is missing: this test needs the shared models beside the checkout",
         p.display()
     );
     p
+}
+
+/// data/spot.obj written as binary PLY into `dir` (`spot.ply`), as `remesh` writes PLY.
+pub fn spot_ply(dir: &Path) -> PathBuf {
+    let (spot, _) = spectral_remesh::read_mesh(&model("spot.obj")).unwrap();
+    let path = dir.join("spot.ply");
+    spectral_remesh::write_mesh(&path, &spot).unwrap();
+    path
 }
 
 /// Flips every face whose normal points towards the origin (for convex meshes around it).

@@ -11,7 +11,8 @@ use spectral_experiments::reconstruction_eval::{
     evaluate_model, PointSource, ReconstructionEvalParams,
 };
 use spectral_experiments::subsample::Subsampler;
-use spectral_remesh::{Error, NormalField};
+use spectral_remesh::internal::NormalField;
+use spectral_remesh::Error;
 
 const EXAMPLES: &str = "\
 Examples:
@@ -141,7 +142,7 @@ enum Command {
 
 /// Writes a JSON report atomically (a temporary file beside it, then a rename).
 fn write_report(path: &Path, json: &str) -> Result<(), Error> {
-    spectral_remesh::write_atomically(path, |w| w.write_all(json.as_bytes()))
+    spectral_remesh::internal::write_atomically(path, |w| w.write_all(json.as_bytes()))
 }
 
 /// Writes to standard output. A reader that went away (`... | head`) is not an error: the

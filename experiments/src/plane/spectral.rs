@@ -33,11 +33,11 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::torus::{delta, periodic_images, wrap, TorusGrid};
-use spectral_remesh::{
-    find_sigma_p, measure_and_gradient, spectral_measure, Error, Kernel, KernelPoint,
-    LinearScanParams, LinearScanner, MeasureWorkspace, Result, TargetCountParams, DEFAULT_EPSILON,
-    SUPPORT_RADIUS,
+use spectral_remesh::internal::{
+    find_sigma_p, measure_and_gradient, spectral_measure, Kernel, KernelPoint, LinearScanParams,
+    LinearScanner, MeasureWorkspace, TargetCountParams, DEFAULT_EPSILON, SUPPORT_RADIUS,
 };
+use spectral_remesh::{Error, Result};
 
 /// The largest support radius (2.5 sigma, in units of the square's side) the torus samplers
 /// accept: up to 1/4, two neighbours of a point are at most 1/2 apart, so the distance between

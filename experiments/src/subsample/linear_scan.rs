@@ -5,7 +5,7 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use spectral_remesh::{Kernel, LinearScanParams, LinearScanner};
+use spectral_remesh::internal::{Kernel, LinearScanParams, LinearScanner};
 
 /// Algorithm 1 (Sec. 6.1) over `positions` (bbox-100 units) with unit `normals` (same length):
 /// the points are visited in a random order (seeded) and kept when s(x) > epsilon against the

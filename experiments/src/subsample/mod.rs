@@ -7,7 +7,7 @@
 //!
 //! Every subsampler returns indices into the input (the kept points keep their normals) and is
 //! deterministic for its seed. The baselines with a size parameter search it for a target count
-//! ([`spectral_remesh::find_sigma_p`], the same log-log secant search that finds
+//! ([`spectral_remesh::internal::find_sigma_p`], the same log-log secant search that finds
 //! the linear scan's sigma_p).
 
 pub mod linear_scan;

@@ -6,7 +6,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
 
-use spectral_remesh::{find_sigma_p, TargetCountParams, TargetCountResult};
+use spectral_remesh::internal::{find_sigma_p, TargetCountParams, TargetCountResult};
 
 /// Visits `positions` (any units; `radius` in the same) in a random order (seeded) and keeps a
 /// point when no kept point lies closer than `radius` (Euclidean distance): a maximal Poisson-

@@ -3,7 +3,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use spectral_remesh::{find_sigma_p, TargetCountParams, TargetCountResult};
+use spectral_remesh::internal::{find_sigma_p, TargetCountParams, TargetCountResult};
 
 /// Clusters `positions` (any units; `voxel` in the same) by the cubic voxel of side `voxel` they
 /// fall in (the grid anchored at the points' bounding-box minimum minus `offset · voxel`, each

@@ -4,10 +4,10 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use spectral_remesh::{
-    projection_coefficients, Error, Kernel, KernelPoint, MeasureWorkspace, Result, StaticTree,
-    SUPPORT_RADIUS,
+use spectral_remesh::internal::{
+    projection_coefficients, Kernel, KernelPoint, MeasureWorkspace, StaticTree, SUPPORT_RADIUS,
 };
+use spectral_remesh::{Error, Result};
 
 /// Parameters of [`representation_weights`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,7 +65,7 @@ const CHUNK: usize = 1 << 14;
 /// ([`RepresentationWeights::clamped`]). An input point with no kept point within the support
 /// gives its weight to the nearest kept point ([`RepresentationWeights::unsupported`]).
 ///
-/// Reconstructing with these weights as masses ([`spectral_remesh::Rimls::with_masses`])
+/// Reconstructing with these weights as masses ([`spectral_remesh::internal::Rimls::with_masses`])
 /// makes the subset's RIMLS surface follow the all-points one where the subset's density
 /// differs from the input's (the linear scan's adaptive sampling with a finite σ_n keeps more
 /// points where the normals turn; uniform weights over-count them there).
@@ -203,7 +203,7 @@ mod tests {
     use crate::subsample::linear_scan_subsample;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-    use spectral_remesh::LinearScanParams;
+    use spectral_remesh::internal::LinearScanParams;
 
     /// A `side × side` square grid of spacing `h` in the plane z = 0, normals up.
     fn plane(side: usize, h: f64) -> (Vec<DVec3>, Vec<DVec3>) {

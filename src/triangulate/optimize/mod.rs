@@ -32,8 +32,8 @@ use relax::{flip_poor, relax_poor};
 use smooth::smooth;
 pub use smooth::SmoothStats;
 
-/// The iterations of the tangential relaxation with valence flips by default: horse at 8600
-/// (seed 1) reaches Qave 0.942 after 5 and 0.944 after 10, from 0.903 without.
+/// The iterations of the tangential relaxation with valence flips by default (the measured
+/// choice: `docs/decisions/finishing-relaxation.md`).
 pub const SMOOTH_ITERATIONS: usize = 10;
 
 /// Parameters of [`optimize`].
@@ -332,9 +332,8 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// below the bound), keeps the mesh within `collapse_offset_sigma_p` · sigma_p of the surface
 /// and makes no crossing (exact test against the faces near it).
 ///
-/// Everything else stays as the sampler and the tangent-plane Delaunay left it. On horse at 8600
-/// about 16 points are covered and 600 of the 8600 vertices move (most by a fraction of the
-/// spacing).
+/// Everything else stays as the sampler and the triangulation left it (how much moves on a scan:
+/// `docs/decisions/optimize-cover.md`).
 #[allow(clippy::too_many_arguments)] // the mesh, the input and its creases and boundary, the limits
 pub fn optimize<S: SurfaceQuery + ?Sized>(
     mesh: &mut TriMesh,

@@ -22,10 +22,11 @@ use super::*;
 
 /// The smallest angle a valence flip may leave in its two faces, unless the faces it replaces
 /// had a smaller one, degrees: a flip towards valence 6 that makes a sliver would only be
-/// undone (measured on horse at 8600: Qave 0.937 without valence flips, 0.944 with them).
+/// undone (what the valence flips add: `docs/decisions/finishing-relaxation.md`).
 const VALENCE_FLIP_MIN_ANGLE_DEG: f64 = 20.0;
 
-/// What the finishing relaxation (`optimize`'s first step, [`OptimizeParams::smooth_iterations`]) did.
+/// What the finishing relaxation (`optimize`'s first step, [`OptimizeParams::smooth_iterations`])
+/// did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 pub struct SmoothStats {
     /// Valence flips.

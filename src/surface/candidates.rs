@@ -10,7 +10,7 @@ use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::surface_sampler::{point_in_triangle, random_barycentric};
+use super::area_sampler::{point_in_triangle, random_barycentric};
 use crate::mesh::TriMesh;
 use crate::surface::SurfaceSample;
 

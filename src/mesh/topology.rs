@@ -15,22 +15,22 @@ use crate::mesh::TriMesh;
 ///
 /// Definitions:
 /// - `vertices` (V): distinct vertex indices used by at least one face (an out-of-range index
-///   counts too; [`check_invariants`](super::check_invariants) reports it). Vertices no face uses are *not* counted here
-///   but in `unreferenced_vertices`.
+///   counts too; [`check_invariants`](crate::check::check_invariants) reports it). Vertices no face
+///   uses are *not* counted here but in `unreferenced_vertices`.
 /// - `faces` (F): all triangles, including degenerate and duplicate ones.
 /// - `edges` (E): distinct undirected vertex pairs `{i, j}`, `i ≠ j`, that are a side of some face.
-///   Each face side with two different indices is one *incidence* of its edge; a side `(i, i)` of
-///   a face with a repeated index is not an edge (so `[a, a, b]` gives two incidences of `{a, b}`).
+///   Each face side with two different indices is one *incidence* of its edge; a side `(i, i)` of a
+///   face with a repeated index is not an edge (so `[a, a, b]` gives two incidences of `{a, b}`).
 /// - `boundary_edges`: edges with exactly 1 incidence.
 /// - `non_manifold_edges`: edges with 3 or more incidences.
 /// - `non_manifold_vertices`: referenced vertices whose incident faces do not form a single fan.
-///   Precisely: at vertex v, two faces containing v are *fan-adjacent* when they share an edge
-///   `{v, w}` (whatever that edge's number of incidences); v is non-manifold when the graph of
-///   its incident faces under fan-adjacency has 2 or more connected components. This flags the
-///   "bowtie" (two cones touching at the tip); a vertex on a non-manifold edge is flagged only if
-///   its fans are split in this sense (three triangles sharing an edge make one fan at each end).
-/// - `components`: connected components of the faces, two faces being connected when they share
-///   a *vertex* (not only an edge) — the topological components of the surface. Two tetrahedra
+///   Precisely: at vertex v, two faces containing v are *fan-adjacent* when they share an edge `{v,
+///   w}` (whatever that edge's number of incidences); v is non-manifold when the graph of its
+///   incident faces under fan-adjacency has 2 or more connected components. This flags the "bowtie"
+///   (two cones touching at the tip); a vertex on a non-manifold edge is flagged only if its fans
+///   are split in this sense (three triangles sharing an edge make one fan at each end).
+/// - `components`: connected components of the faces, two faces being connected when they share a
+///   *vertex* (not only an edge) — the topological components of the surface. Two tetrahedra
 ///   touching at one vertex are 1 component. Unreferenced vertices form no component.
 /// - `euler_characteristic` χ = V − E + F with the V, E, F above (referenced vertices only).
 /// - `boundary_loops`: connected components of the graph formed by the boundary edges and their
@@ -40,22 +40,23 @@ use crate::mesh::TriMesh;
 /// - `genus`: the total genus `g = (2·components − χ − boundary_loops) / 2` (summed over
 ///   components; for a single closed component `g = (2 − χ)/2`). It is `Some` only where the
 ///   formula holds: there is at least one face, every face has three distinct in-range indices,
-///   there are no duplicate faces (so the faces form a simplicial complex), no non-manifold edge
-///   or vertex, the surface is orientable (faces can be flipped so that every interior edge is
-///   traversed in opposite directions — a mesh with a few flipped faces still has a genus), and
-///   the numerator comes out even and non-negative. Otherwise `None`.
+///   there are no duplicate faces (so the faces form a simplicial complex), no non-manifold edge or
+///   vertex, the surface is orientable (faces can be flipped so that every interior edge is
+///   traversed in opposite directions — a mesh with a few flipped faces still has a genus), and the
+///   numerator comes out even and non-negative. Otherwise `None`.
 /// - `degenerate_faces`: faces that repeat a vertex index or have zero area
-///   ([`is_degenerate_face`](crate::geometry::triangle::is_degenerate_face): `|(b-a)×(c-a)| <= 1e-12 · h²`).
+///   ([`is_degenerate_face`](crate::geometry::triangle::is_degenerate_face): `|(b-a)×(c-a)| <=
+///   1e-12 · h²`).
 /// - `duplicate_faces`: faces whose sorted index triple equals that of an earlier face (same
 ///   vertices in any order and either orientation); the first occurrence is not counted.
 /// - `unreferenced_vertices`: entries of `positions` that no face uses.
 /// - `inconsistent_orientation_edges`: edges with exactly 2 incidences whose two faces traverse
-///   them in the same direction (a consistently oriented manifold traverses each interior edge
-///   once each way). One flipped face in a closed mesh gives 3.
+///   them in the same direction (a consistently oriented manifold traverses each interior edge once
+///   each way). One flipped face in a closed mesh gives 3.
 ///
-/// Source: standard combinatorial topology of simplicial surfaces (Euler–Poincaré formula
-/// χ = 2c − 2g − b for orientable compact surfaces); see e.g. Botsch, Kobbelt, Pauly, Alliez,
-/// Lévy, *Polygon Mesh Processing*, 2010, Ch. 1.
+/// Source: standard combinatorial topology of simplicial surfaces (Euler–Poincaré formula χ = 2c −
+/// 2g − b for orientable compact surfaces); see e.g. Botsch, Kobbelt, Pauly, Alliez, Lévy, *Polygon
+/// Mesh Processing*, 2010, Ch. 1.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Topology {
     /// V: vertices referenced by at least one face.
@@ -91,7 +92,7 @@ pub struct Topology {
 impl Topology {
     /// Edge- and vertex-manifold: no non-manifold edge and no non-manifold vertex (boundaries
     /// allowed). Says nothing about orientation, degenerate or duplicate faces; see
-    /// [`check_invariants`](super::check_invariants) for the full list.
+    /// [`check_invariants`](crate::check::check_invariants) for the full list.
     pub fn is_manifold(&self) -> bool {
         self.non_manifold_edges == 0 && self.non_manifold_vertices == 0
     }
@@ -109,22 +110,23 @@ pub fn topology(mesh: &TriMesh) -> Topology {
     analyze(mesh).topology
 }
 
-/// Everything [`topology`] and [`check_invariants`](super::check_invariants) need, with the first offender of each kind.
-pub(super) struct Analysis {
-    pub(super) topology: Topology,
-    pub(super) out_of_range_faces: usize,
-    pub(super) first_out_of_range: Option<(usize, u32)>,
-    pub(super) non_finite_vertices: usize,
-    pub(super) first_non_finite: Option<usize>,
-    pub(super) first_degenerate: Option<usize>,
-    pub(super) first_duplicate: Option<(usize, usize)>,
-    pub(super) first_non_manifold_edge: Option<([u32; 2], usize)>,
-    pub(super) first_non_manifold_vertex: Option<u32>,
-    pub(super) first_unreferenced: Option<usize>,
-    pub(super) first_inconsistent: Option<([u32; 2], [u32; 2])>,
+/// Everything [`topology`] and [`check_invariants`](crate::check::check_invariants) need, with the
+/// first offender of each kind.
+pub(crate) struct Analysis {
+    pub(crate) topology: Topology,
+    pub(crate) out_of_range_faces: usize,
+    pub(crate) first_out_of_range: Option<(usize, u32)>,
+    pub(crate) non_finite_vertices: usize,
+    pub(crate) first_non_finite: Option<usize>,
+    pub(crate) first_degenerate: Option<usize>,
+    pub(crate) first_duplicate: Option<(usize, usize)>,
+    pub(crate) first_non_manifold_edge: Option<([u32; 2], usize)>,
+    pub(crate) first_non_manifold_vertex: Option<u32>,
+    pub(crate) first_unreferenced: Option<usize>,
+    pub(crate) first_inconsistent: Option<([u32; 2], [u32; 2])>,
 }
 
-pub(super) fn analyze(mesh: &TriMesh) -> Analysis {
+pub(crate) fn analyze(mesh: &TriMesh) -> Analysis {
     let npos = mesh.positions.len();
     let faces = mesh.triangles.len();
 

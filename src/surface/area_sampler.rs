@@ -5,7 +5,7 @@
 //!
 //! Every area-uniform draw of the crate goes through here: the dense point sets of
 //! `points::generate` (`remesh points`, the reconstruction experiment's inputs) draw faces with
-//! [`AreaSampler`]; the linear scan's candidate pool (`sampling::candidates`) is stratified per
+//! [`AreaSampler`]; the linear scan's candidate pool (`surface::candidates`) is stratified per
 //! face instead and draws only the point in the face with [`random_barycentric`].
 //!
 //! # References

@@ -1,0 +1,181 @@
+//! The notes of the report: what the pipeline did that a user should know, one line each.
+
+use crate::mesh::OrientStats;
+
+/// The report's note when the output's vertex count is more than 1% off the target.
+pub(super) fn count_note(notes: &mut Vec<String>, target: Option<usize>, vertices: usize) {
+    if let Some(n) = target {
+        if (vertices as f64 - n as f64).abs() > 0.01 * n as f64 {
+            notes.push(format!(
+                "target not reached: {vertices} vertices for --points {n} (more than 1% off)"
+            ));
+        }
+    }
+}
+
+/// The report's note on samples that ended in no triangle.
+pub(super) fn dropped_note(dropped: usize) -> String {
+    format!("{dropped} samples ended in no triangle and were left out")
+}
+
+/// The report's note on holes of the triangulation left open.
+pub(super) fn holes_note(holes: usize) -> String {
+    format!("{holes} holes of the triangulation could not be closed")
+}
+
+/// The report's notes on orienting the input and the output ([`OrientStats`]): how many input
+/// faces were reversed and why, a non-orientable input said plainly, and an inward-facing
+/// closed input whose output was turned outward.
+pub(super) fn orientation_notes(
+    input: &OrientStats,
+    output: &OrientStats,
+    input_faces: usize,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    if input.non_orientable_components > 0 {
+        notes.push(format!(
+            "the input is non-orientable ({} part(s), {} faces, like a Möbius strip): the \
+             output is an oriented surface, so it cannot have the input's topology there; {} \
+             faces were reversed so that the input is consistently oriented everywhere but \
+             across a seam of {} edges; the output is cut open there (a Möbius strip comes \
+             out as a twisted disc, χ 1 instead of 0, whose two sides of the cut can touch or \
+             cross)",
+            input.non_orientable_components,
+            input.non_orientable_faces,
+            input.faces_flipped,
+            input.seam_edges
+        ));
+    } else if input.inconsistent_edges > 0 {
+        notes.push(format!(
+            "the input was not consistently oriented ({} edges ran the same way in both their \
+             faces): {} of its {input_faces} faces were reversed so that every edge between two \
+             faces runs once each way (each part keeps the orientation of its larger area)",
+            input.inconsistent_edges, input.faces_flipped,
+        ));
+    }
+    match output.components_turned_outward {
+        0 => {}
+        1 => notes.push(
+            "the input faced inward (negative signed volume): the output, closed, was turned \
+             outward"
+                .to_string(),
+        ),
+        k => notes.push(format!(
+            "the input faced inward (negative signed volume): {k} closed parts of the output \
+             were turned outward"
+        )),
+    }
+    notes
+}
+
+/// The report's notes on the grading by the local feature size: how many samples it moved to a
+/// finer spacing and where, and the parts too thin for the count.
+pub(super) fn grading_notes(
+    g: &crate::sampling::grading::GradingStats,
+    vertices: usize,
+) -> Vec<String> {
+    let bbox = |r: &crate::sampling::grading::GradedRegion| {
+        format!(
+            "[{:.4}, {:.4}, {:.4}]-[{:.4}, {:.4}, {:.4}]",
+            r.min.x, r.min.y, r.min.z, r.max.x, r.max.y, r.max.z
+        )
+    };
+    let mut notes = Vec::new();
+    if g.graded_samples > 0 {
+        let shown: Vec<String> = g
+            .regions
+            .iter()
+            .take(3)
+            .map(|r| format!("{} in {}", r.samples, bbox(r)))
+            .collect();
+        notes.push(format!(
+            "local feature size: {} of {vertices} samples are spaced finer than sigma_p (down to \
+             {:.2} sigma_p) at thin parts, in {} regions (largest: {})",
+            g.graded_samples,
+            g.min_width,
+            g.regions.len(),
+            shown.join("; ")
+        ));
+    }
+    if g.unresolved_samples > 0 {
+        let shown: Vec<String> = g
+            .regions
+            .iter()
+            .filter(|r| r.unresolved > 0)
+            .take(3)
+            .map(|r| format!("{} in {}", r.unresolved, bbox(r)))
+            .collect();
+        let resolve = g.resolving_count.map_or(String::new(), |n| {
+            format!("; about --points {} would resolve them", round_up_2(n))
+        });
+        notes.push(format!(
+            "{} samples lie on parts thinner than this count can resolve (held at the finest \
+             spacing the grading allows, so the output there may split, fuse or lose a tip): \
+             {}{resolve}",
+            g.unresolved_samples,
+            shown.join("; ")
+        ));
+    }
+    notes
+}
+
+/// `n` rounded up to two significant digits (a count for a note).
+pub(super) fn round_up_2(n: f64) -> u64 {
+    if !(n.is_finite() && n > 0.0) {
+        return 0;
+    }
+    let scale = 10f64.powi((n.log10().floor() as i32 - 1).max(0));
+    ((n / scale).ceil() * scale) as u64
+}
+
+/// The report's line on the sharp features of a remesh: what was found, what the output keeps
+/// and how far the creases are from its edges, or why automatic detection left them out. None
+/// when detection was off or found nothing to leave out.
+pub(super) fn features_note(f: &crate::pipeline::FeatureStats) -> Option<String> {
+    if !(f.angle_deg < 180.0) {
+        return None;
+    }
+    if f.automatic == Some(false) {
+        if f.edges == 0 {
+            return None;
+        }
+        return Some(format!(
+            "sharp features (automatic, at {}°): {} crease edges in {} curves, {:.0}% of their \
+             length in curves of {} spacings or more: a scan's folds, not a part's creases, so \
+             they are sampled like the rest (--feature-angle {} keeps them)",
+            f.angle_deg,
+            f.edges,
+            f.curves,
+            100.0 * f.long_curve_share,
+            crate::surface::features::LONG_CURVE_SPACINGS,
+            f.angle_deg
+        ));
+    }
+    if f.edges == 0 {
+        return Some(format!(
+            "sharp features at {}°: no crease found",
+            f.angle_deg
+        ));
+    }
+    let kept = if f.kept_edges == f.sampled_edges {
+        format!(
+            "all {} crease edges of the samples are output edges",
+            f.sampled_edges
+        )
+    } else {
+        format!(
+            "{} of the samples' {} crease edges are output edges",
+            f.kept_edges, f.sampled_edges
+        )
+    };
+    let distance = f.crease_distance.as_ref().map_or(String::new(), |d| {
+        format!(
+            "; the creases are within {:.3} of the output's edges (bbox-100)",
+            d.max
+        )
+    });
+    Some(format!(
+        "sharp features at {}°: {} crease edges in {} curves ({} closed), {} corners; {kept}{distance}",
+        f.angle_deg, f.edges, f.curves, f.closed_curves, f.corners
+    ))
+}

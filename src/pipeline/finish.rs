@@ -1,0 +1,190 @@
+//! The finishing stage, shared by meshes and point sets: the triangulated samples optimized
+//! against the surface they came from (cover, collapse, flip, relax), fitted to it, faces that
+//! cross moved apart, faces of no area mended, stray shells left out, closed parts turned
+//! outward.
+
+use glam::DVec3;
+
+use crate::geometry::self_intersection::CrossingRegions;
+use crate::mesh::{orient_consistently, OrientStats, TriMesh};
+use crate::surface::feature_lines::FeatureLines;
+use crate::surface::SurfaceQuery;
+use crate::timing::StageTimer;
+use crate::triangulate::degenerate::{mend_degenerate_faces, DegenerateStats};
+use crate::triangulate::fit::{fit_to_surface, FitStats};
+use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
+use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
+use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
+use crate::triangulate::FaceSource;
+
+/// The most vertices of a shell [`remove_stray_shells`] removes: a few samples closing on
+/// themselves at a tip (4 make a tetrahedron), not a part of the surface.
+pub(crate) const STRAY_SHELL_VERTICES: usize = 8;
+
+/// The sources of the faces of an edited mesh: a face that is still face `f` of the mesh before
+/// (`origin`, as `EditMesh::into_parts` gives it) keeps `sources[f]`; a new or changed one is
+/// `Refined`.
+pub(crate) fn carried_sources(origin: &[Option<u32>], sources: &[FaceSource]) -> Vec<FaceSource> {
+    origin
+        .iter()
+        .map(|o| o.map_or(FaceSource::Refined, |f| sources[f as usize]))
+        .collect()
+}
+
+/// Which shells are stray: keep the largest `keep` parts, and of the others (at most
+/// [`STRAY_SHELL_VERTICES`] vertices) remove those the test says are stray.
+pub(crate) struct StrayRule<'a> {
+    pub keep: usize,
+    pub stray: &'a dyn Fn(&[DVec3]) -> bool,
+}
+
+/// What the finishing stage reads besides the mesh (bbox-100 units).
+pub(crate) struct Finishing<'a, S: SurfaceQuery + ?Sized> {
+    /// The surface the samples came from.
+    pub surface: &'a S,
+    /// Points of that surface the optimization keeps within its cover distance of the output.
+    pub cover_points: &'a [DVec3],
+    /// The first `fixed` vertices stay where they are (boundary and crease samples).
+    pub fixed: usize,
+    /// Edges the optimization keeps (the sampled creases).
+    pub protected: &'a [[u32; 2]],
+    /// The input's boundary curves, which boundary vertices slide along.
+    pub boundary: Option<&'a FeatureLines>,
+    /// Where the input crosses itself: the output's crossings there are left alone.
+    pub input_crossings: Option<&'a CrossingRegions>,
+    /// The kernel width the samples were placed at.
+    pub sigma_p: f64,
+    /// The local optimization (`None`: skipped).
+    pub optimize: Option<&'a OptimizeParams>,
+    /// Iterations of the least-squares fit (0: none).
+    pub fit_iterations: usize,
+    /// The separation of crossing faces.
+    pub untangle: UntangleParams,
+    /// Stray shells to leave out (`None`: all kept).
+    pub stray: Option<StrayRule<'a>>,
+}
+
+/// What the finishing stage did.
+pub(crate) struct Finished {
+    pub optimize: OptimizeStats,
+    /// Of the protected edges, those still edges after the optimization.
+    pub protected_kept: usize,
+    /// Vertices no face used after the optimization (samples dropped).
+    pub dropped_samples: usize,
+    /// Vertices removed after that (by untangle's collapses and the mending).
+    pub later_dropped: usize,
+    pub fit: Option<FitStats>,
+    pub untangle: UntangleStats,
+    pub degenerate: DegenerateStats,
+    pub stray_shells: StrayShells,
+    /// What orienting the output did (closed parts turned outward).
+    pub orientation: OrientStats,
+}
+
+/// Finishes `mesh` (its faces' sources carried along) as `f` says, in the stages "optimize" and
+/// "untangle".
+pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
+    mesh: &mut TriMesh,
+    face_sources: &mut Vec<FaceSource>,
+    f: &Finishing<S>,
+    on_stage: &(dyn Fn(&str) + Sync),
+    timer: &mut StageTimer,
+) -> Finished {
+    on_stage("optimize");
+    let fixed_prefix = |n: usize| -> Vec<bool> { (0..n).map(|i| i < f.fixed).collect() };
+    let optimize_stats = match f.optimize {
+        Some(op) => {
+            let (st, origin) = optimize(
+                mesh,
+                f.surface,
+                f.cover_points,
+                &fixed_prefix(mesh.positions.len()),
+                f.protected,
+                f.boundary,
+                f.input_crossings,
+                f.sigma_p,
+                op,
+            );
+            *face_sources = carried_sources(&origin, face_sources);
+            st
+        }
+        None => OptimizeStats::default(),
+    };
+    // Connectivity is final here but for the collapses of untangle's folds (where the output
+    // crosses itself where the input does not).
+    let protected_kept = edges_present(mesh, f.protected);
+    let dropped_samples = mesh.remove_unreferenced_vertices();
+    timer.lap("optimize");
+    on_stage("untangle");
+    let fixed = fixed_prefix(mesh.positions.len());
+    // The least-squares fit to the surface, before the separation of crossing faces (which then
+    // sees the final positions). It keeps the angles the last pass of optimize reached.
+    let fit = (f.fit_iterations > 0).then(|| {
+        fit_to_surface(
+            mesh,
+            f.surface,
+            &fixed,
+            f.fit_iterations,
+            f.optimize.map(OptimizeParams::angle_bounds),
+        )
+    });
+    // Faces that still cross (where the surface's sheets lie closer than the output's chords
+    // bend away from them) are moved apart.
+    let mut later_dropped = 0;
+    let (untangle_stats, origin) =
+        untangle(mesh, &fixed, f.sigma_p, &f.untangle, f.input_crossings);
+    if untangle_stats.collapses > 0 {
+        *face_sources = carried_sources(&origin, face_sources);
+        later_dropped += mesh.remove_unreferenced_vertices();
+    }
+    // No face of no area is written.
+    let (degenerate, origin) = mend_degenerate_faces(mesh, &fixed);
+    if let Some(origin) = origin {
+        *face_sources = carried_sources(&origin, face_sources);
+        later_dropped += mesh.remove_unreferenced_vertices();
+    }
+    // Tiny shells split off at tips too thin for the count (four samples closing into a
+    // tetrahedron) go when the output has more parts than it should.
+    let stray_shells = match &f.stray {
+        Some(rule) => remove_stray_shells(
+            mesh,
+            face_sources,
+            rule.keep,
+            STRAY_SHELL_VERTICES,
+            rule.stray,
+        ),
+        None => StrayShells::default(),
+    };
+    if stray_shells.shells > 0 {
+        mesh.remove_unreferenced_vertices();
+    }
+    // The output follows the surface's orientation: its closed parts are turned outward.
+    let orientation = orient_consistently(mesh, true);
+    timer.lap("untangle");
+    Finished {
+        optimize: optimize_stats,
+        protected_kept,
+        dropped_samples,
+        later_dropped,
+        fit,
+        untangle: untangle_stats,
+        degenerate,
+        stray_shells,
+        orientation,
+    }
+}
+
+/// How many of `edges` (vertex pairs, either direction) are edges of a face of `mesh`.
+pub(crate) fn edges_present(mesh: &TriMesh, edges: &[[u32; 2]]) -> usize {
+    let mut have: rustc_hash::FxHashSet<(u32, u32)> = rustc_hash::FxHashSet::default();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            have.insert((a.min(b), a.max(b)));
+        }
+    }
+    edges
+        .iter()
+        .filter(|e| have.contains(&(e[0].min(e[1]), e[0].max(e[1]))))
+        .count()
+}

@@ -1,0 +1,290 @@
+//! The remeshing pipeline, one stage per file: the input normalized to bbox 100, oriented and
+//! indexed, candidates drawn on it ([`input`]) → sharp features ([`features`]) → the sizing
+//! field ([`sizing`]) → the linear scan with the sigma_p search for a count ([`scan`]) → the
+//! gradient ascent ([`ascent`]) → the triangulation ([`triangulation`]) → the finishing stage
+//! shared with point sets ([`finish`]) → back to model units ([`output`]).
+
+mod ascent;
+mod features;
+pub(crate) mod finish;
+mod input;
+mod output;
+mod params;
+mod scan;
+mod sizing;
+mod triangulation;
+
+use crate::error::{Error, Result};
+use crate::geometry::self_intersection::CrossingRegions;
+use crate::mesh::{Normalization, TriMesh};
+use crate::sampling::spacing::sigma_p_for_count;
+use crate::surface::features::Features;
+use crate::timing::StageTimer;
+use crate::triangulate::untangle::UntangleParams;
+use ascent::{ascend, Ascended};
+use finish::{finish, Finished, Finishing, StrayRule};
+use input::{Candidates, InputIndex, NormalizedInput};
+use params::Target;
+use scan::{Scanned, Search};
+use sizing::Sizing;
+use triangulation::{triangulate_samples, Triangulated};
+
+pub use crate::sampling::spacing::{
+    expected_samples, BOUNDARY_SPACING_PER_SIGMA, SAMPLES_PER_SIGMA2,
+};
+pub use output::{FeatureStats, RemeshOutput};
+pub use params::{Density, RemeshParams, FIT_ITERATIONS, MAX_POINTS};
+
+/// Runs of the pipeline at most for one count: when the output's vertex count misses the target
+/// by more than the search tolerance (the triangulation may set a few samples aside, at parts
+/// thinner than the sampling), the search runs again once, for a target raised by the
+/// shortfall: the retry's miss is how closely the count can be aimed on this input, and a
+/// second retry aims no closer, at the cost of a third run.
+const MAX_ATTEMPTS: usize = 2;
+
+/// Checks `mesh` and returns its normalization to bbox 100.
+///
+/// # Errors
+/// [`Error::InvalidMesh`] for no faces, an index out of range, a non-finite coordinate, or a
+/// bounding box of zero size or one too small or too large to scale to bbox 100 (the message
+/// gives its size).
+pub fn validate_input(mesh: &TriMesh) -> Result<Normalization> {
+    if mesh.triangles.is_empty() {
+        return Err(Error::invalid_mesh("", "the mesh has no faces"));
+    }
+    mesh.check_geometry()?;
+    let bbox = mesh
+        .bbox()
+        .ok_or_else(|| Error::invalid_mesh("", "the mesh has no vertices"))?;
+    Normalization::for_bbox(&bbox)
+        .ok_or_else(|| Error::invalid_mesh("", Normalization::refusal(&bbox)))
+}
+
+/// Remeshes `input` (model units): samples its surface with the spectral sampler and
+/// triangulates the samples. `on_stage` is called with each stage's name as it starts (for
+/// progress display).
+///
+/// # Errors
+/// [`Error::InvalidMesh`] for an unusable input (see [`validate_input`]);
+/// [`Error::InvalidParameter`] for a density or sigma out of range, or a density that gives no
+/// triangle.
+pub fn remesh(
+    input: &TriMesh,
+    params: &RemeshParams,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<RemeshOutput> {
+    let mut timer = StageTimer::new();
+    let normalization = validate_input(input)?;
+    let target = Target::of(params, input)?;
+    on_stage("normalize");
+    let (input, as_read) = NormalizedInput::new(input, normalization)?;
+    let pool_size = input.pool_size(target, params)?;
+    let index = InputIndex::new(&input.mesh, 2 * pool_size + input.mesh.positions.len())?;
+    timer.lap("normalize");
+
+    on_stage("candidates");
+    let candidates = Candidates::draw(as_read, &input, &index, pool_size, params.seed);
+    timer.lap("candidates");
+
+    // The search's first sigma_p (the given one for a sigma_p).
+    let first_sigma_p = match target {
+        Target::Points(n) => sigma_p_for_count(input.area, input.boundary_length, n as f64),
+        Target::SigmaP(s) => s,
+    };
+    on_stage("features");
+    let (features, feature_stats) =
+        features::sharp_features(&input, &index.surface, first_sigma_p, params.features);
+    timer.lap("features");
+    let sizing = Sizing::new(
+        &input,
+        &index.surface,
+        first_sigma_p,
+        params,
+        on_stage,
+        &mut timer,
+    )?;
+
+    let mut search = Search {
+        goal: target.count().unwrap_or(0),
+        start: first_sigma_p,
+        sigma_ref: first_sigma_p,
+        history: Vec::new(),
+    };
+    let mut attempt = 1;
+    let (run, reached) = loop {
+        let stages = (&input, &index, &candidates, &features, &sizing);
+        let run = run_once(target, &mut search, stages, params, on_stage, &mut timer)?;
+        search.history.extend(run.scanned.history.iter().copied());
+        match next_goal(target, attempt, &run, search.goal, params.count_tolerance) {
+            Next::Done { reached } => break (run, reached),
+            Next::Again { goal } => {
+                search.start = run.scanned.sigma_p * (search.goal as f64 / goal as f64).sqrt();
+                search.goal = goal;
+                attempt += 1;
+            }
+        }
+    };
+    let InputIndex {
+        crossing_pairs,
+        junction_faces,
+        ..
+    } = index;
+    let found = (&features, feature_stats, &sizing, search.sigma_ref);
+    let record = (crossing_pairs, junction_faces, &candidates, found);
+    let output = output::assemble(input, record, run, target, reached, search.history, timer);
+    if output.mesh.triangles.is_empty() {
+        // Too few samples for any triangle to form (a handful of points on a closed surface, or
+        // sigma_p as large as the model): nothing to write.
+        let (name, what) = target.named(target.count().unwrap_or(0));
+        return Err(Error::InvalidParameter {
+            name,
+            message: format!(
+                "{what} gave {} samples and no triangle on this surface; ask for more points \
+                 (a smaller sigma_p)",
+                output.samples
+            ),
+        });
+    }
+    Ok(output)
+}
+
+/// One run of the stages that depend on sigma_p.
+struct Run<'s> {
+    scanned: Scanned<'s>,
+    ascended: Ascended,
+    triangulated: Triangulated,
+    finished: Finished,
+}
+
+/// What the stages before the sigma_p search made: the input, its index, the candidates, the
+/// features and the sizing field.
+type Prepared<'a, 's> = (
+    &'a NormalizedInput,
+    &'a InputIndex<'a>,
+    &'a Candidates,
+    &'a Features,
+    &'s Sizing,
+);
+
+/// The linear scan for `search`'s goal, the gradient ascent, the triangulation and the
+/// finishing stage.
+fn run_once<'s>(
+    target: Target,
+    search: &mut Search,
+    (input, index, candidates, features, sizing): Prepared<'_, 's>,
+    params: &RemeshParams,
+    on_stage: &(dyn Fn(&str) + Sync),
+    timer: &mut StageTimer,
+) -> Result<Run<'s>> {
+    on_stage("linear scan");
+    let mut scanned = scan::scan(target, search, input, features, candidates, sizing, params)?;
+    timer.lap("linear scan");
+
+    on_stage("gradient ascent");
+    let ascended = ascend(&mut scanned, index, params)?;
+    timer.lap("gradient ascent");
+
+    on_stage("triangulate");
+    let (sigma_p, curves) = (scanned.sigma_p, &scanned.scan);
+    let (boundary_edges, feature_edges) = (&curves.boundary_edges, &curves.feature_edges);
+    let mut triangulated = triangulate_samples(
+        &ascended.samples,
+        sigma_p,
+        boundary_edges,
+        feature_edges,
+        index,
+        params,
+    );
+    timer.lap("triangulate");
+
+    // Where the input's faces cross or its parts meet: an output face within a spacing of there
+    // is there.
+    let input_crossings = (!index.crossing_pairs.is_empty() || !index.junction_faces.is_empty())
+        .then(|| {
+            let m = &input.mesh;
+            let (pairs, junctions) = (&index.crossing_pairs, &index.junction_faces);
+            CrossingRegions::new(&m.positions, &m.triangles, pairs, junctions, sigma_p)
+        });
+    // With grading, tiny closed shells at tips too thin for the count go when the output has
+    // more parts than the input.
+    let sigma_ref = scanned.widths.sigma_ref;
+    let stray = |shell: &[glam::DVec3]| {
+        let (lo, hi) = shell.iter().fold(
+            (
+                glam::DVec3::splat(f64::INFINITY),
+                glam::DVec3::splat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        lo.distance(hi) <= 4.0 * sigma_p
+            || sizing
+                .grading
+                .as_ref()
+                .is_some_and(|g| shell.iter().all(|&p| g.width(p, sigma_ref) < 1.0))
+    };
+    let finishing = Finishing {
+        surface: &index.surface,
+        cover_points: &candidates.cover_points,
+        fixed: ascended.boundary_count,
+        protected: feature_edges,
+        boundary: input.boundary_lines.as_ref(),
+        input_crossings: input_crossings.as_ref(),
+        sigma_p,
+        optimize: params.optimize.as_ref(),
+        fit_iterations: params.fit_iterations,
+        // Faces that would touch once written in model units are separated too.
+        untangle: UntangleParams {
+            near: params
+                .untangle
+                .near
+                .max(input.normalization.written_rounding()),
+            ..params.untangle
+        },
+        stray: sizing.grading.as_ref().map(|_| StrayRule {
+            keep: sizing.input_components,
+            stray: &stray,
+        }),
+    };
+    let (mesh, sources) = (&mut triangulated.mesh, &mut triangulated.face_sources);
+    let finished = finish(mesh, sources, &finishing, on_stage, timer);
+    Ok(Run {
+        scanned,
+        ascended,
+        triangulated,
+        finished,
+    })
+}
+
+/// What follows a run.
+enum Next {
+    /// The output: `reached` whether the count came within 1% of the target (for a sigma_p,
+    /// whether the scan reached it).
+    Done { reached: bool },
+    /// Another attempt for `goal` samples.
+    Again { goal: usize },
+}
+
+/// After attempt number `attempt` (aimed at `goal` samples) of a run for `target`: done, or
+/// another attempt for the goal raised by the miss (see [`MAX_ATTEMPTS`]).
+fn next_goal(target: Target, attempt: usize, run: &Run, goal: usize, tolerance: f64) -> Next {
+    let Target::Points(n) = target else {
+        return Next::Done {
+            reached: run.scanned.target_reached,
+        };
+    };
+    let miss = n as f64 - run.triangulated.mesh.vertex_count() as f64;
+    // A raised target helps only where the sampler reached its own: a count the search could
+    // not reach is not reached by asking for more.
+    let done = attempt >= MAX_ATTEMPTS
+        || miss.abs() <= tolerance * n as f64
+        || (run.finished.dropped_samples == 0 && miss.abs() <= 0.01 * n as f64)
+        || !run.scanned.target_reached;
+    if done {
+        return Next::Done {
+            reached: miss.abs() <= 0.01 * n as f64,
+        };
+    }
+    Next::Again {
+        goal: ((goal as f64 + miss).round() as usize).max(4),
+    }
+}

@@ -1,0 +1,116 @@
+//! The sizing field of one run: the kernel width relative to sigma_p at each point, the
+//! smallest of the grading by thickness (local feature size), the grading by curvature and the
+//! grading towards crease corners; 1 everywhere when none is on.
+
+use glam::DVec3;
+
+use super::input::NormalizedInput;
+use super::RemeshParams;
+use crate::error::Result;
+use crate::sampling::features::{corner_width, GradedCorner};
+use crate::sampling::grading::Grading;
+use crate::surface::curvature::{Curvature, CurvatureParams, CurvatureWidths};
+use crate::surface::{MeshSurface, SurfaceSample};
+use crate::timing::StageTimer;
+
+/// The most points the local feature size is estimated at for the grading (their spacing is
+/// about the expected samples' otherwise).
+const MAX_GRADING_POINTS: f64 = 200_000.0;
+
+/// The gradings a run asks for, estimated once on the input.
+pub(super) struct Sizing {
+    /// By thickness (`None` when off).
+    pub grading: Option<Grading>,
+    /// By curvature (`None` when off).
+    pub curvature: Option<(Curvature, CurvatureParams)>,
+    /// The input's component count, which the stray-shell pass (grading only) brings the output
+    /// back to (0 without grading).
+    pub input_components: usize,
+}
+
+impl Sizing {
+    /// The gradings `params` ask for on `input`, for a search that starts at `first_sigma_p`.
+    ///
+    /// # Errors
+    /// Those of [`Grading::new`].
+    pub(super) fn new(
+        input: &NormalizedInput,
+        surface: &MeshSurface,
+        first_sigma_p: f64,
+        params: &RemeshParams,
+        on_stage: &(dyn Fn(&str) + Sync),
+        timer: &mut StageTimer,
+    ) -> Result<Self> {
+        let curvature = params.curvature.map(|p| (Curvature::new(surface, &[]), p));
+        // The local feature size, for the grading of the kernel width: estimated up to a few
+        // times the largest width the search is expected to try (a part thicker than that is not
+        // graded).
+        let grading = match params.grading {
+            Some(g) => {
+                on_stage("local feature size");
+                let cap = 1.5 * first_sigma_p / g.lfs_factor;
+                // Estimate points every first_sigma_p (about one per expected sample), at most
+                // MAX_GRADING_POINTS of them.
+                let spacing = first_sigma_p.max((input.area / MAX_GRADING_POINTS).sqrt());
+                let grading = Grading::new(&input.mesh, &input.curves, g, cap, spacing)?;
+                timer.lap("local feature size");
+                Some(grading)
+            }
+            None => None,
+        };
+        let input_components = grading.as_ref().map_or(0, |_| {
+            crate::mesh::topology::topology(&input.mesh).components
+        });
+        Ok(Sizing {
+            grading,
+            curvature,
+            input_components,
+        })
+    }
+
+    /// The width field for the global `sigma_ref`, the curvature's taken at the candidates
+    /// `pool`.
+    pub(super) fn widths_at(&self, pool: &[SurfaceSample], sigma_ref: f64) -> Widths<'_> {
+        Widths {
+            grading: self.grading.as_ref(),
+            curvature: self
+                .curvature
+                .as_ref()
+                .map(|(c, p)| CurvatureWidths::new(c, pool, sigma_ref, p.chord_error, p.min_width)),
+            sigma_ref,
+        }
+    }
+}
+
+/// The kernel width field of one remesh round: the grading by thickness and the grading by
+/// curvature, for the global `sigma_ref`, the smaller of the two.
+pub(super) struct Widths<'a> {
+    pub grading: Option<&'a Grading>,
+    pub curvature: Option<CurvatureWidths>,
+    pub sigma_ref: f64,
+}
+
+impl Widths<'_> {
+    /// Whether any grading is on.
+    pub(super) fn active(&self) -> bool {
+        self.grading.is_some() || self.curvature.is_some()
+    }
+
+    /// The relative width at `p` (1 with no grading).
+    pub(super) fn width(&self, p: DVec3) -> f64 {
+        let mut w: f64 = 1.0;
+        if let Some(g) = self.grading {
+            w = w.min(g.width(p, self.sigma_ref));
+        }
+        if let Some(c) = &self.curvature {
+            w = w.min(c.width(p));
+        }
+        w
+    }
+
+    /// [`Widths::width`] lowered around graded `corners` ([`corner_width`] at the creases'
+    /// `spacing`).
+    pub(super) fn at(&self, p: DVec3, corners: &[GradedCorner], spacing: f64) -> f64 {
+        self.width(p).min(corner_width(corners, p, spacing))
+    }
+}

@@ -1,0 +1,323 @@
+use super::*;
+use crate::mesh::test_meshes::grid;
+
+/// The smallest angle of the live faces, degrees.
+fn theta_min(m: &Mesh) -> f64 {
+    m.live_faces()
+        .0
+        .into_iter()
+        .map(|t| min_angle(m, t))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A flat `n × n` grid of unit squares as the mesh to mend (every face labelled with its
+/// index) and as the surface.
+fn flat(n: usize) -> (TriMesh, MeshSurface) {
+    let g = grid(n, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+    let surface = MeshSurface::new(&g).unwrap();
+    (g, surface)
+}
+
+fn limits() -> Limits {
+    Limits::new(&OptimizeParams::default(), 1.0)
+}
+
+#[test]
+fn the_faces_left_out_of_bounds_are_counted_by_where_they_are() {
+    // A 6 × 6 grid of unit squares (45°, 45°, 90°: in bounds) with an interior vertex pulled
+    // most of the way to a neighbour (its faces out of bounds), then a boundary one.
+    let (g, _) = flat(6);
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    let none = |_: [u32; 3]| false;
+    assert_eq!(faces_left(&m, &limits(), none), FacesLeft::default());
+    let v = 3 * 7 + 3;
+    let p = m.position(v);
+    m.relocate_vertex(v, p + DVec3::new(0.8, 0.0, 0.0)).unwrap();
+    let left = faces_left(&m, &limits(), none);
+    assert!(left.total > 0);
+    assert_eq!((left.at_creases, left.on_boundary), (0, 0));
+    assert_eq!(
+        faces_left(&m, &limits(), |_| true).at_input_crossings,
+        left.total
+    );
+    m.protect_edge(v, v + 1);
+    assert_eq!(faces_left(&m, &limits(), none).at_creases, left.total);
+    let b = 3 * 7;
+    let q = m.position(b);
+    m.relocate_vertex(b, q + DVec3::new(0.8, 0.0, 0.0)).unwrap();
+    let more = faces_left(&m, &limits(), none);
+    assert!(more.on_boundary > 0);
+    assert_eq!(more.total, more.at_creases + more.on_boundary);
+}
+
+#[test]
+fn a_vertex_of_three_faces_near_an_edge_is_collapsed_away() {
+    // (Horse at 2000, seed 4: a vertex of three faces with a 137° angle, 17.6° beside it.)
+    // One grid triangle split at a point near the middle of its long edge.
+    let (g, surface) = flat(6);
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    let f = g.triangles.iter().position(|&t| t == [14, 15, 22]).unwrap() as u32;
+    let [a, _, c] = m.corners([14, 15, 22]);
+    let v = m.add_vertex(a.lerp(c, 0.5) + DVec3::new(0.12, -0.12, 0.0));
+    m.split_face(f, v, None).unwrap();
+    let before = theta_min(&m);
+    assert!(before < 20.0, "{before}");
+    let fixed = vec![false; m.vertex_count()];
+    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    assert!(made.ops >= 1);
+    assert_eq!(m.degree(v), 0, "the vertex is gone");
+    assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
+    assert_eq!(m.sanity_check(), Ok(()));
+}
+
+#[test]
+fn a_sliver_on_a_short_fixed_boundary_edge_is_mended_and_the_boundary_stays() {
+    // (Bunny's small hole: two boundary samples 0.4 spacings apart, the interior vertex
+    // across them a whole spacing away.) A boundary vertex of the grid moved along the
+    // boundary towards its neighbour; the boundary is fixed.
+    let (mut g, surface) = flat(6);
+    g.positions[3] = DVec3::new(2.6, 0.0, 0.0);
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    let fixed: Vec<bool> = (0..m.vertex_count() as u32)
+        .map(|v| m.is_boundary_vertex(v))
+        .collect();
+    let before = theta_min(&m);
+    assert!(before < 25.0, "{before}");
+    let boundary: Vec<DVec3> = (0..m.vertex_count())
+        .filter(|&v| fixed[v])
+        .map(|v| m.position(v as u32))
+        .collect();
+    mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    assert!(theta_min(&m) >= 25.0, "{before} -> {}", theta_min(&m));
+    let after: Vec<DVec3> = (0..m.vertex_count())
+        .filter(|&v| fixed[v])
+        .map(|v| m.position(v as u32))
+        .collect();
+    assert_eq!(boundary, after);
+    assert!(m.positions().iter().all(|p| p.z == 0.0));
+    assert_eq!(m.sanity_check(), Ok(()));
+}
+
+#[test]
+fn a_mesh_without_small_angles_is_left_alone() {
+    let (g, surface) = flat(4);
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    let fixed = vec![false; m.vertex_count()];
+    assert_eq!(
+        mend_faces(&mut m, &surface, None, None, &fixed, &limits()).ops,
+        0
+    );
+    assert_eq!(m.to_trimesh(), g);
+}
+
+/// Two parallel 6 × 6 grids 0.2 apart: (the input surface, the mesh with vertex `poke` of
+/// the upper grid pushed to z = -0.3, through the lower grid).
+fn poked_sheets() -> (MeshSurface, TriMesh, usize) {
+    let a = grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+    let b = grid(6, |i, j| DVec3::new(i as f64 + 0.3, j as f64 + 0.4, 0.2));
+    let mut both = a.clone();
+    let off = both.positions.len() as u32;
+    both.positions.extend(b.positions.iter().copied());
+    both.triangles
+        .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+    let surface = MeshSurface::new(&both).unwrap();
+    let poke = off as usize + 3 * 7 + 3;
+    both.positions[poke].z = -0.3;
+    (surface, both, poke)
+}
+
+#[test]
+fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
+    let (surface, mesh, poke) = poked_sheets();
+    assert!(!intersecting_pairs(&mesh.positions, &mesh.triangles).is_empty());
+    let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+    let fixed = vec![false; m.vertex_count()];
+    // sigma_p 4: the pass may move the mesh by up to 1 off the surface, more than the poke.
+    let wide = Limits::new(&OptimizeParams::default(), 4.0);
+    let made = mend_faces(&mut m, &surface, None, None, &fixed, &wide);
+    assert!(made.ops >= 1);
+    let out = m.to_trimesh();
+    let pairs = intersecting_pairs(&out.positions, &out.triangles);
+    assert!(pairs.is_empty(), "{pairs:?}");
+    assert!(
+        m.position(poke as u32).z > 0.0,
+        "{}",
+        m.position(poke as u32)
+    );
+    assert!(theta_min(&m) >= 30.0, "{}", theta_min(&m));
+    assert_eq!(m.sanity_check(), Ok(()));
+    // Without moves that far (sigma_p 1: 0.25), nothing is made that would cross.
+    let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+    mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    let out = m.to_trimesh();
+    assert!(
+        intersecting_pairs(&out.positions, &out.triangles).len()
+            <= intersecting_pairs(&mesh.positions, &mesh.triangles).len()
+    );
+    assert_eq!(m.sanity_check(), Ok(()));
+}
+
+#[test]
+fn the_crossing_guard_sees_faces_near_and_faces_changed() {
+    // Two parallel grids 0.2 apart.
+    let (both, off) = crate::mesh::test_meshes::stacked_grids(4);
+    assert!(intersecting_pairs(&both.positions, &both.triangles).is_empty());
+    let mut m: Mesh = EditMesh::from_trimesh(&both, Some, SlotPolicy::Reuse);
+    let mut guard = CrossingGuard::new(&m);
+    // The faces around an upper vertex, were it pushed through the lower grid.
+    let v = off + 2 * 5 + 2;
+    let slots = m.faces_around(v).to_vec();
+    let faces: Vec<[u32; 3]> = slots.iter().map(|&f| face(&m, f)).collect();
+    assert!(!guard.crosses(&m, &faces, &slots));
+    let p = m.position(v);
+    m.relocate_vertex(v, p - DVec3::new(0.0, 0.0, 0.5)).unwrap();
+    assert!(guard.crosses(&m, &faces, &slots));
+    // Moved back, and recorded: a lower face moved up through them is seen crossing them
+    // at their updated leaves.
+    m.relocate_vertex(v, p).unwrap();
+    guard.changed(&m, &slots);
+    assert!(!guard.crosses(&m, &faces, &slots));
+    let u = 2 * 5 + 2;
+    let lower = m.faces_around(u).to_vec();
+    let lower_faces: Vec<[u32; 3]> = lower.iter().map(|&f| face(&m, f)).collect();
+    m.relocate_vertex(u, m.position(u) + DVec3::new(0.0, 0.0, 0.5))
+        .unwrap();
+    guard.changed(&m, &lower);
+    assert!(guard.crosses(&m, &lower_faces, &lower));
+    assert!(!guard.crosses(&m, &lower_faces, &[lower.clone(), slots.clone()].concat()));
+}
+
+/// The largest angle of the live faces, degrees.
+fn theta_max(m: &Mesh) -> f64 {
+    m.live_faces()
+        .0
+        .into_iter()
+        .map(|t| {
+            let [a, b, c] = m.corners(t);
+            let angle = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p).to_degrees();
+            angle(a, b, c).max(angle(b, c, a)).max(angle(c, a, b))
+        })
+        .fold(0.0, f64::max)
+}
+
+/// A fan of six faces round a fixed vertex c at the origin, its ring a unit hexagon with one
+/// corner v pulled in to `inset` of the way: the boundary turns by more than 180° at v, whose
+/// two faces share that angle (103° each at 0.3).
+fn fan_with_a_reflex_corner(inset: f64) -> (TriMesh, u32) {
+    let mut positions = vec![DVec3::ZERO];
+    for k in 0..6 {
+        let a = k as f64 * std::f64::consts::FRAC_PI_3;
+        let r = if k == 0 { inset } else { 1.0 };
+        positions.push(DVec3::new(r * a.cos(), r * a.sin(), 0.0));
+    }
+    let triangles = (0..6).map(|k| [0, 1 + k, 1 + (k + 1) % 6]).collect();
+    (TriMesh::new(positions, triangles), 1)
+}
+
+#[test]
+fn a_reflex_boundary_corner_with_two_faces_gets_its_edge_split() {
+    let (g, v) = fan_with_a_reflex_corner(0.3);
+    let surface = MeshSurface::new(&g).unwrap();
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    assert!(theta_max(&m) > 102.0, "{}", theta_max(&m));
+    // The corner is on the boundary, the centre fixed (a covering vertex), and the corner's
+    // neighbours on the boundary have two faces each (no collapse): no flip, collapse or move
+    // mends the corner's faces, whose angles at it add up to 206°.
+    let fixed = vec![true; m.vertex_count()];
+    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    assert!(made.ops >= 1);
+    assert!(m.vertex_count() > 7, "no vertex added");
+    assert!(m.degree(v) >= 3, "the corner has {} faces", m.degree(v));
+    assert!(theta_max(&m) <= 100.0, "{}", theta_max(&m));
+    assert!(theta_min(&m) >= 35.0, "{}", theta_min(&m));
+    assert_eq!(m.sanity_check(), Ok(()));
+}
+
+#[test]
+fn a_boundary_vertex_slides_along_the_boundary_to_mend_its_face() {
+    // A strip along a straight boundary (y = 0): boundary vertices at x = 0, 0.12 and 1, and
+    // above them two fixed vertices; the face on the short boundary edge has a small angle.
+    let positions = vec![
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(0.12, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 0.9, 0.0),
+        DVec3::new(1.0, 0.9, 0.0),
+    ];
+    let triangles = vec![[0, 1, 3], [1, 4, 3], [1, 2, 4]];
+    let g = TriMesh::new(positions, triangles);
+    let surface = MeshSurface::new(&g).unwrap();
+    let boundary =
+        FeatureLines::new(&g.positions, [[0, 1], [1, 2], [2, 4], [4, 3], [3, 0]]).unwrap();
+    let fixed = vec![true; 5];
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    let before = theta_min(&m);
+    assert!(before < 10.0, "{before}");
+    // Without the boundary's lines, vertex 1 stays and nothing mends the face.
+    mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    assert_eq!(m.position(1), DVec3::new(0.12, 0.0, 0.0));
+    let made = mend_faces(&mut m, &surface, Some(&boundary), None, &fixed, &limits());
+    assert!(made.ops >= 1);
+    let p = m.position(1);
+    assert!(p.y.abs() < 1e-12 && p.x > 0.12 && p.x < 1.0, "{p}");
+    assert!(
+        theta_min(&m) > before + 10.0,
+        "{before} -> {}",
+        theta_min(&m)
+    );
+    assert_eq!(m.sanity_check(), Ok(()));
+}
+
+#[test]
+fn the_compass_search_finds_the_best_angle_position_of_a_ring() {
+    // An interior vertex of a flat grid whose ring is distorted: the centroid of the ring
+    // is not where the smallest angle score of its faces is largest.
+    let g = grid(6, |i, j| {
+        let (x, y) = (i as f64, j as f64);
+        match (i, j) {
+            (4, 3) => DVec3::new(x + 0.45, y - 0.2, 0.0),
+            (2, 2) => DVec3::new(x - 0.1, y + 0.35, 0.0),
+            (3, 4) => DVec3::new(x + 0.3, y + 0.25, 0.0),
+            _ => DVec3::new(x, y, 0.0),
+        }
+    });
+    let surface = MeshSurface::new(&grid(6, |i, j| DVec3::new(i as f64, j as f64, 0.0))).unwrap();
+    let m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    let params = limits();
+    let v = 3 * 7 + 3;
+    let ring: Vec<[DVec3; 2]> = m
+        .faces_around(v)
+        .iter()
+        .map(|&f| {
+            let t = starting_at(face(&m, f), v);
+            [m.position(t[1]), m.position(t[2])]
+        })
+        .collect();
+    let ring_score = |p: DVec3| ring_score(&ring, p, &params.angle_bounds());
+    // The best score by brute force over a fine grid of positions around the vertex.
+    let old = m.position(v);
+    let mut brute = f64::NEG_INFINITY;
+    for i in -200..=200 {
+        for j in -200..=200 {
+            let p = old + DVec3::new(i as f64, j as f64, 0.0) * 0.004;
+            brute = brute.max(ring_score(p));
+        }
+    }
+    let centroid = m
+        .ring(v)
+        .iter()
+        .map(|&u| m.position(u))
+        .fold(DVec3::ZERO, |a, b| a + b)
+        / m.ring(v).len() as f64;
+    let found = best_angle_position(&m, &surface, v, &params).expect("a better position");
+    let (at_found, at_centroid) = (ring_score(found), ring_score(centroid));
+    assert!(
+        at_found >= brute - 0.5,
+        "compass {at_found} against the best {brute}"
+    );
+    assert!(
+        at_found > at_centroid + 1.0,
+        "compass {at_found}, centroid {at_centroid}"
+    );
+    assert!(found.z.abs() < 1e-12);
+}
