@@ -60,7 +60,9 @@ pub enum Error {
     /// A parameter is out of its valid range.
     #[error("invalid parameter {name}: {message}")]
     InvalidParameter {
-        /// The parameter's name as the command line spells it (`--points`, `--sigma-p`, ...).
+        /// The parameter's name as the library and the Python module spell it (`points`,
+        /// `sigma_p`, ...; the field of `RemeshOptions`), which the command line shows as its
+        /// flag (`--points`, `--sigma-p`). A message names other parameters in backticks.
         name: &'static str,
         /// What is wrong.
         message: String,

@@ -112,7 +112,7 @@ impl Kernel {
     pub fn new(sigma_p: f64, sigma_n: f64) -> Result<Self> {
         if !(sigma_p.is_finite() && sigma_p > 0.0) {
             return Err(Error::InvalidParameter {
-                name: "--sigma-p",
+                name: "sigma_p",
                 message: format!(
                     "must be a positive number, got {}",
                     crate::error::shown(sigma_p)
@@ -121,7 +121,7 @@ impl Kernel {
         }
         if sigma_n.is_nan() || sigma_n <= 0.0 {
             return Err(Error::InvalidParameter {
-                name: "--sigma-n",
+                name: "sigma_n",
                 message: format!(
                     "must be positive (or infinite), got {}",
                     crate::error::shown(sigma_n)

@@ -239,28 +239,28 @@ pub fn remesh_points(
         Density::SigmaP(s) => (None, s),
         Density::InputVertices => {
             return Err(Error::InvalidParameter {
-                name: "--points",
+                name: "points",
                 message: format!(
-                    "{} is a point set: give the output's vertex count with --points N (or \
-                     its sigma_p with --sigma-p)",
+                    "{} is a point set: give the output's vertex count with `points` (or \
+                     its sigma_p with `sigma_p`)",
                     input.display()
                 ),
             })
         }
     };
     if rp.grading.is_some() {
-        return Err(refuse("--lfs-factor", "grading by local feature size"));
+        return Err(refuse("lfs_factor", "grading by local feature size"));
     }
     if rp.curvature.is_some() {
-        return Err(refuse("--chord-error", "grading by curvature"));
+        return Err(refuse("chord_error", "grading by curvature"));
     }
     if matches!(rp.features, FeatureDetection::Angle(_)) {
-        return Err(refuse("--feature-angle", "sharp-feature detection"));
+        return Err(refuse("feature_angle", "sharp-feature detection"));
     }
     // (Opening a text file counts its points: only when sigma_n needs the answer.)
     if rp.sigma_n.is_finite() && !crate::points::PointReader::open(input)?.has_normals() {
         return Err(Error::InvalidParameter {
-            name: "--sigma-n",
+            name: "sigma_n",
             message: format!("{} has no normals; sigma_n needs them", input.display()),
         });
     }

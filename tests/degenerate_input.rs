@@ -177,7 +177,7 @@ fn sigma_p_too_small_for_the_boundary_curves_is_a_usage_error() {
     };
     match remesh(&sliver(1e-7), &params, &|_| {}) {
         Err(Error::InvalidParameter { name, message }) => {
-            assert_eq!(name, "--sigma-p");
+            assert_eq!(name, "sigma_p");
             assert!(message.contains("smallest sigma_p"), "{message}");
         }
         Err(e) => panic!("wrong error: {e}"),

@@ -269,7 +269,7 @@ fn a_point_set_needs_a_count() {
     };
     match remesh_points(&input, &p, &|_| {}) {
         Err(Error::InvalidParameter { name, message }) => {
-            assert_eq!(name, "--points");
+            assert_eq!(name, "points");
             assert!(message.contains("sphere.ply"), "{message}");
         }
         other => panic!("{other:?}"),

@@ -618,18 +618,18 @@ fn remesh<'py>(
     let defaults = RemeshOptions::default();
     let seed = u64::try_from(seed).map_err(|_| {
         PyValueError::new_err(format!(
-            "invalid parameter --seed: must be an integer from 0 to 2^64 - 1, got {seed}"
+            "invalid parameter seed: must be an integer from 0 to 2^64 - 1, got {seed}"
         ))
     })?;
     let options = RemeshOptions {
-        points: points.map(|n| count("--points", n)).transpose()?,
+        points: points.map(|n| count("points", n)).transpose()?,
         sigma_p,
         sigma_n,
         lfs_factor: lfs_factor.unwrap_or(defaults.lfs_factor),
         chord_error: chord_error.unwrap_or(defaults.chord_error),
         no_fit: !fit,
         smooth: smooth
-            .map(|n| count("--smooth", n))
+            .map(|n| count("smooth", n))
             .transpose()?
             .unwrap_or(defaults.smooth),
         min_angle: min_angle.unwrap_or(defaults.min_angle),
@@ -638,7 +638,7 @@ fn remesh<'py>(
         no_features: !features,
         triangulation: triangulation.unwrap_or(defaults.triangulation),
         iterations: iterations
-            .map(|n| count("--iterations", n))
+            .map(|n| count("iterations", n))
             .transpose()?
             .unwrap_or(defaults.iterations),
         seed,

@@ -85,7 +85,7 @@ def test_point_set_refusals_are_value_errors():
         sr.remesh(points, normals=zero, points=100)
     with pytest.raises(ValueError, match="input points"):
         sr.remesh(points)
-    with pytest.raises(ValueError, match="lfs-factor"):
+    with pytest.raises(ValueError, match="lfs_factor"):
         sr.remesh(points, points=100, lfs_factor=0.75)
     with pytest.raises(ValueError, match=r"shape \(n, 3\)"):
         sr.remesh(points[:, :2], points=100)

@@ -35,10 +35,10 @@ pub(super) fn output_format(output: &Path, format: Option<MeshFormat>) -> Result
     })?;
     match format {
         Some(f) if f != by_extension => Err(Error::InvalidParameter {
-            name: "--format",
+            name: "format",
             message: format!(
-                "--format {} contradicts the extension of {}; the format of a file is its \
-                 extension's (--format chooses the format of standard output, -)",
+                "`format` {} contradicts the extension of {}; the format of a file is its \
+                 extension's (`format` chooses the format of standard output, -)",
                 f.extension(),
                 output.display()
             ),
@@ -119,7 +119,7 @@ pub fn check_report_path(report: &Path, others: &[(&Path, &str)]) -> Result<()> 
 pub(super) fn report_clash(report: &Path, others: &[(&Path, &str)]) -> Result<()> {
     match others.iter().find(|(p, _)| same_target(report, p)) {
         Some((_, what)) => Err(Error::InvalidParameter {
-            name: "--report",
+            name: "report",
             message: format!("{} is {what}; choose another report path", report.display()),
         }),
         None => Ok(()),

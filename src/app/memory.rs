@@ -139,10 +139,10 @@ pub fn check_input_size(path: &Path, limit: u64) -> Result<()> {
     };
     if meta.len() > limit {
         return Err(Error::InvalidParameter {
-            name: "--max-memory",
+            name: "max_memory",
             message: format!(
                 "{}: a file of {} cannot be remeshed within the limit of {} (its faces take \
-                 several times their file size in memory); raise --max-memory",
+                 several times their file size in memory); raise `max_memory`",
                 path.display(),
                 format_bytes(meta.len()),
                 format_bytes(limit)
@@ -166,10 +166,10 @@ pub fn check_remesh_budget(
     let need = estimate_remesh_bytes(input_faces, output_points, measure_distance);
     if need > limit {
         return Err(Error::InvalidParameter {
-            name: "--max-memory",
+            name: "max_memory",
             message: format!(
                 "remeshing {input_faces} input faces to about {output_points:.0} points needs \
-                 about {}, more than the limit of {}; ask for fewer points or raise --max-memory",
+                 about {}, more than the limit of {}; ask for fewer points or raise `max_memory`",
                 format_bytes(need),
                 format_bytes(limit)
             ),
@@ -242,6 +242,6 @@ mod tests {
         assert_eq!(estimate_remesh_bytes(u64::MAX, 1e300, true), u64::MAX);
         assert!(check_remesh_budget(1000, 1000.0, false, small).is_ok());
         let e = check_remesh_budget(1000, 1000.0, false, small - 1).unwrap_err();
-        assert!(e.to_string().contains("--max-memory"), "{e}");
+        assert!(e.to_string().contains("`max_memory`"), "{e}");
     }
 }

@@ -92,7 +92,7 @@ mod tests {
         assert_eq!(catch_panics(|| Ok(3)).unwrap(), 3);
         let e = catch_panics::<()>(|| {
             Err(Error::InvalidParameter {
-                name: "--points",
+                name: "points",
                 message: "x".into(),
             })
         })

@@ -88,8 +88,8 @@ impl RemeshOptions {
         let density = match (self.points, self.sigma_p) {
             (Some(_), Some(_)) => {
                 return Err(Error::InvalidParameter {
-                    name: "--points",
-                    message: "give --points or --sigma-p, not both".into(),
+                    name: "points",
+                    message: "give `points` or `sigma_p`, not both".into(),
                 })
             }
             (Some(n), None) => Density::Points(n),
@@ -101,7 +101,7 @@ impl RemeshOptions {
             seed: self.seed,
             ..Default::default()
         };
-        for (name, value) in [("--iterations", self.iterations), ("--smooth", self.smooth)] {
+        for (name, value) in [("iterations", self.iterations), ("smooth", self.smooth)] {
             if value > MAX_SWEEPS {
                 return Err(Error::InvalidParameter {
                     name,
@@ -112,7 +112,7 @@ impl RemeshOptions {
         params.gradient_ascent.iterations = self.iterations;
         if !(self.lfs_factor.is_finite() && self.lfs_factor >= 0.0) {
             return Err(Error::InvalidParameter {
-                name: "--lfs-factor",
+                name: "lfs_factor",
                 message: format!(
                     "must be a number >= 0, got {}",
                     crate::error::shown(self.lfs_factor)
@@ -122,8 +122,8 @@ impl RemeshOptions {
         params.features = match self.feature_angle {
             Some(_) if self.no_features => {
                 return Err(Error::InvalidParameter {
-                    name: "--feature-angle",
-                    message: "give --feature-angle or --no-features, not both".into(),
+                    name: "feature_angle",
+                    message: "give `feature_angle` or `no_features`, not both".into(),
                 })
             }
             _ if self.no_features => FeatureDetection::Off,
@@ -131,7 +131,7 @@ impl RemeshOptions {
             Some(a) if (0.0..=180.0).contains(&a) => FeatureDetection::Angle(a),
             Some(a) => {
                 return Err(Error::InvalidParameter {
-                    name: "--feature-angle",
+                    name: "feature_angle",
                     message: format!("must be an angle from 0 to 180 degrees, got {a}"),
                 })
             }
@@ -141,7 +141,7 @@ impl RemeshOptions {
             "restricted" => TriangulationMethod::RestrictedDelaunay(Default::default()),
             other => {
                 return Err(Error::InvalidParameter {
-                    name: "--triangulation",
+                    name: "triangulation",
                     message: format!("must be umbrellas or restricted, got {other}"),
                 })
             }
@@ -152,7 +152,7 @@ impl RemeshOptions {
         });
         if !(self.chord_error.is_finite() && self.chord_error >= 0.0) {
             return Err(Error::InvalidParameter {
-                name: "--chord-error",
+                name: "chord_error",
                 message: format!(
                     "must be a number >= 0, got {}",
                     crate::error::shown(self.chord_error)
@@ -162,7 +162,7 @@ impl RemeshOptions {
         params.fit_iterations = if self.no_fit { 0 } else { FIT_ITERATIONS };
         if !(self.min_angle >= 0.0 && self.min_angle < 60.0) {
             return Err(Error::InvalidParameter {
-                name: "--min-angle",
+                name: "min_angle",
                 message: format!(
                     "must be an angle from 0 to 60 degrees, got {}",
                     self.min_angle
@@ -171,7 +171,7 @@ impl RemeshOptions {
         }
         if !(self.max_angle > 60.0 && self.max_angle <= 180.0) {
             return Err(Error::InvalidParameter {
-                name: "--max-angle",
+                name: "max_angle",
                 message: format!(
                     "must be an angle above 60 and up to 180 degrees, got {}",
                     self.max_angle
@@ -209,10 +209,7 @@ mod tests {
         };
         assert!(matches!(
             both.params(),
-            Err(Error::InvalidParameter {
-                name: "--points",
-                ..
-            })
+            Err(Error::InvalidParameter { name: "points", .. })
         ));
         let features = RemeshOptions {
             feature_angle: Some(30.0),
@@ -222,7 +219,7 @@ mod tests {
         assert!(matches!(
             features.params(),
             Err(Error::InvalidParameter {
-                name: "--feature-angle",
+                name: "feature_angle",
                 ..
             })
         ));

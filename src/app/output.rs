@@ -114,7 +114,7 @@ pub(super) fn refuse_if_strict(job: &RemeshJob, report: &mut QualityReport) -> R
         return Err(Error::Internal {
             stage: "invariant check",
             message: format!(
-                "{}; {} was not written (--strict)",
+                "{}; {} was not written (`strict`)",
                 refusals.join("; "),
                 job.output.display()
             ),

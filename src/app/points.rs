@@ -32,7 +32,7 @@ pub fn run_points(job: &PointsJob) -> Result<()> {
     require_ply_output(&job.output)?;
     if job.count > MAX_SURFACE_POINTS {
         return Err(Error::InvalidParameter {
-            name: "--count",
+            name: "count",
             message: format!(
                 "{} points is more than the {MAX_SURFACE_POINTS} `remesh points` writes (about \
                  24 bytes each on disk)",

@@ -60,7 +60,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         use std::io::IsTerminal;
         if std::io::stdout().is_terminal() {
             return Err(Error::InvalidParameter {
-                name: "--format",
+                name: "format",
                 message: format!(
                     "standard output is a terminal, and {} is a binary format; redirect it to a \
                      file or a pipe",

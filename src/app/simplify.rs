@@ -100,13 +100,13 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
     super::points::require_ply_output(&job.output)?;
     if job.density == SimplifyDensity::Points(0) {
         return Err(Error::InvalidParameter {
-            name: "--points",
+            name: "points",
             message: "must be at least 1".into(),
         });
     }
     if job.resample > super::options::MAX_SWEEPS {
         return Err(Error::InvalidParameter {
-            name: "--resample",
+            name: "resample",
             message: format!(
                 "must be at most {}, got {}",
                 super::options::MAX_SWEEPS,
@@ -117,7 +117,7 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
     let t = Instant::now();
     if job.sigma_n.is_some_and(f64::is_finite) && !PointReader::open(&job.input)?.has_normals() {
         return Err(Error::InvalidParameter {
-            name: "--sigma-n",
+            name: "sigma_n",
             message: format!("{} has no normals; sigma_n needs them", job.input.display()),
         });
     }

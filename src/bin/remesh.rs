@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::internal::{
     catch_panics, check_report_path, memory_limit, parse_bytes, remove_temporaries, run_points,
@@ -355,7 +355,7 @@ fn config(mut cli: Cli) -> Result<Config, Error> {
                 (_, _, Some(l)) => SimplifyDensity::Levels(l),
                 _ => {
                     return Err(Error::InvalidParameter {
-                        name: "--points",
+                        name: "points",
                         message: "give --points N, --sigma-p S or --levels S1,S2,...".into(),
                     })
                 }
@@ -409,7 +409,7 @@ fn config(mut cli: Cli) -> Result<Config, Error> {
             if json {
                 if job.output.as_os_str() == STDOUT {
                     return Err(Error::InvalidParameter {
-                        name: "--report",
+                        name: "report",
                         message: "- (standard output) is where the mesh goes (OUTPUT -); give \
                                   the report a file"
                             .into(),
@@ -589,7 +589,7 @@ fn main() -> ExitCode {
         Err(e) => {
             // One line whatever a file name holds: control characters (a newline) escaped.
             let mut message = String::new();
-            for c in e.to_string().chars() {
+            for c in command_line_text(&e).chars() {
                 if c.is_control() {
                     message.extend(c.escape_default());
                 } else {
@@ -600,6 +600,52 @@ fn main() -> ExitCode {
             ExitCode::from(e.exit_code() as u8)
         }
     }
+}
+
+/// An error as the command line says it: the library names parameters as they are spelled in
+/// Rust and Python (`sigma_p`), the command line by their flags (`--sigma-p`): the parameter of an
+/// [`Error::InvalidParameter`], and each parameter its message names in backticks, becomes the
+/// flag of that name when the command line has one.
+fn command_line_text(e: &Error) -> String {
+    let cli = Cli::command();
+    let flags: Vec<String> = cli
+        .get_arguments()
+        .chain(cli.get_subcommands().flat_map(|s| s.get_arguments()))
+        .filter_map(|a| a.get_long().map(str::to_string))
+        .collect();
+    let flag = |name: &str| {
+        let long = name.replace('_', "-");
+        let plain = name.chars().all(|c| c.is_ascii_lowercase() || c == '_');
+        (plain && flags.contains(&long)).then(|| format!("--{long}"))
+    };
+    let text = match e {
+        Error::InvalidParameter { name, message } => {
+            let name = flag(name).unwrap_or_else(|| name.to_string());
+            format!("invalid parameter {name}: {message}")
+        }
+        _ => e.to_string(),
+    };
+    let mut out = String::new();
+    let mut rest = text.as_str();
+    while let Some(i) = rest.find('`') {
+        out.push_str(&rest[..i]);
+        let after = &rest[i + 1..];
+        match after
+            .find('`')
+            .and_then(|j| flag(&after[..j]).map(|f| (j, f)))
+        {
+            Some((j, f)) => {
+                out.push_str(&f);
+                rest = &after[j + 1..];
+            }
+            None => {
+                out.push('`');
+                rest = after;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
 }
 
 #[cfg(test)]
@@ -667,5 +713,31 @@ mod tests {
         ]);
         let o = remesh_options(&cli);
         assert_eq!((o.sigma_p, o.no_features), (Some(2.0), true));
+    }
+
+    /// Parameters named as in Rust and Python reach the user as flags, in the error's name and
+    /// in backticks in its message; other names and backticked words stay.
+    #[test]
+    fn errors_name_flags_on_the_command_line() {
+        let e = Error::InvalidParameter {
+            name: "sigma_p",
+            message: "give `points` or `sigma_p`, not both; `no_features`, `vertex`".into(),
+        };
+        assert_eq!(
+            command_line_text(&e),
+            "invalid parameter --sigma-p: give --points or --sigma-p, not both; --no-features, \
+             `vertex`"
+        );
+        let e = Error::InvalidParameter {
+            name: "OUTPUT",
+            message: "x".into(),
+        };
+        assert_eq!(command_line_text(&e), "invalid parameter OUTPUT: x");
+        // `count` is a flag of a subcommand (remesh points --count).
+        let e = Error::InvalidParameter {
+            name: "count",
+            message: "x".into(),
+        };
+        assert_eq!(command_line_text(&e), "invalid parameter --count: x");
     }
 }

@@ -398,7 +398,7 @@ fn check_widths(points: &PointSet, sigma_p: f64, sigma_n: f64) -> Result<()> {
     // The kernel's own checks, the parameters named as this module's callers name them.
     crate::kernel::Kernel::new(sigma_p, sigma_n).map_err(|e| match e {
         Error::InvalidParameter { name, message } => Error::InvalidParameter {
-            name: if name == "--sigma-p" {
+            name: if name == "sigma_p" {
                 "sigma_p"
             } else {
                 "sigma_n"

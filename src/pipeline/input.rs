@@ -113,7 +113,7 @@ impl NormalizedInput {
                 let b = boundary_length / BOUNDARY_SPACING_PER_SIGMA;
                 let smallest = (b + (b * b + 4.0 * n * a).sqrt()) / (2.0 * n);
                 return Err(Error::InvalidParameter {
-                    name: "--sigma-p",
+                    name: "sigma_p",
                     message: format!(
                         "sigma_p {} would give {} samples on this surface, more than the \
                          {MAX_POINTS} this remesher holds in memory; the smallest sigma_p it \

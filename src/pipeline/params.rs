@@ -123,13 +123,13 @@ impl Target {
         match target {
             Target::Points(n) if n < 4 => {
                 return Err(Error::InvalidParameter {
-                    name: "--points",
+                    name: "points",
                     message: format!("at least 4 points are needed for a closed surface, got {n}"),
                 })
             }
             Target::Points(n) if n > MAX_POINTS => {
                 return Err(Error::InvalidParameter {
-                    name: "--points",
+                    name: "points",
                     message: format!(
                         "{n} is more than the {MAX_POINTS} points this remesher holds in memory; \
                          for larger point sets use `remesh simplify`"
@@ -138,7 +138,7 @@ impl Target {
             }
             Target::SigmaP(s) if !(s.is_finite() && s > 0.0) => {
                 return Err(Error::InvalidParameter {
-                    name: "--sigma-p",
+                    name: "sigma_p",
                     message: format!("must be a positive number, got {}", crate::error::shown(s)),
                 })
             }
@@ -160,8 +160,8 @@ impl Target {
     /// The parameter and the value asked, for an error message: with a count, `goal` points.
     pub(super) fn named(self, goal: usize) -> (&'static str, String) {
         match self {
-            Target::Points(_) => ("--points", format!("{goal} points")),
-            Target::SigmaP(s) => ("--sigma-p", format!("sigma_p {s}")),
+            Target::Points(_) => ("points", format!("{goal} points")),
+            Target::SigmaP(s) => ("sigma_p", format!("sigma_p {s}")),
         }
     }
 }

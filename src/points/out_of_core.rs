@@ -512,7 +512,7 @@ pub fn simplify_progressive(
     params: &OutOfCoreParams,
 ) -> Result<ProgressiveResult> {
     let invalid = |message: String| Error::InvalidParameter {
-        name: "--levels",
+        name: "levels",
         message,
     };
     if sigma_ps.is_empty() || sigma_ps.len() > 255 {
