@@ -17,7 +17,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use spectral_remesh::internal::{
     linear_scan, surface_candidates, triangulate, validate_input, Kernel, LinearScanParams,
-    SampleSet, TriangulateParams, SAMPLES_PER_SIGMA2,
+    SampleSet, TriangulateParams, Uniform, SAMPLES_PER_SIGMA2,
 };
 use spectral_remesh::{read_mesh, run_remesh, Density, RemeshJob, RemeshParams};
 
@@ -72,10 +72,10 @@ fn stages(c: &mut Criterion) {
     let kernel = Kernel::new(sigma_p, f64::INFINITY).expect("a valid kernel");
     let params = LinearScanParams::default();
     c.bench_function("horse/linear scan", |b| {
-        b.iter(|| linear_scan(&kernel, &candidates, &[], &params))
+        b.iter(|| linear_scan(&kernel, &candidates, None, &[], &Uniform, &params))
     });
 
-    let samples = linear_scan(&kernel, &candidates, &[], &params).samples;
+    let samples = linear_scan(&kernel, &candidates, None, &[], &Uniform, &params).samples;
     let positions: Vec<_> = samples.iter().map(|s| s.position).collect();
     let normals: Vec<_> = samples.iter().map(|s| s.normal).collect();
     let set = SampleSet {

@@ -218,16 +218,16 @@ pub mod internal {
         boundary_curves, sample_boundary, BoundaryCurve, BoundarySamples,
     };
     pub use crate::sampling::gradient_ascent::{
-        gradient_ascent, gradient_ascent_graded, GradientAscentParams, GradientAscentResult,
+        gradient_ascent, GradientAscentParams, GradientAscentResult,
     };
     pub use crate::sampling::grading::{
         GradedRegion, Grading, GradingParams, GradingStats, MAX_GAP_LOOPS,
     };
     pub use crate::sampling::linear_scan::{
-        linear_scan, linear_scan_graded, LinearScanParams, LinearScanResult, LinearScanner,
+        linear_scan, LinearScanParams, LinearScanResult, LinearScanner,
     };
+    pub use crate::sampling::sizing::{SizingField, Smallest, Uniform};
     pub use crate::sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
-    pub use crate::sampling::WidthField;
     pub use crate::surface::candidates::surface_candidates;
 
     // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
@@ -251,8 +251,8 @@ pub mod internal {
     // The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).
     pub use crate::kernel::{GaussianKernel, Kernel, KernelPoint, UnitKernel, SUPPORT_RADIUS};
     pub use crate::measure::{
-        measure_and_gradient, measure_and_gradient_graded, projection_coefficients,
-        spectral_measure, IncrementalInverse, Measure, MeasureWorkspace, Push, DEFAULT_EPSILON,
+        measure_and_gradient, projection_coefficients, spectral_measure, IncrementalInverse,
+        Measure, MeasureWorkspace, Push, DEFAULT_EPSILON,
     };
 
     // kd-trees: over fixed 3D points (neighbourhoods of the measure), and over points of R^K.

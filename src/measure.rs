@@ -253,19 +253,11 @@ pub fn spectral_measure<K: UnitKernel>(
 /// row by row in the same nearest-first order as eq. 10: the squared pivot of row n+1 is exactly
 /// g_n^-1, so skipping rows whose squared pivot is below [`SINGULAR_TOLERANCE`] skips the same
 /// neighbours as eq. 10 does.
-pub fn measure_and_gradient(
-    kernel: &Kernel,
-    x: &KernelPoint,
-    neighbors: &[KernelPoint],
-    ws: &mut MeasureWorkspace,
-) -> (f64, [f64; 3]) {
-    measure_and_gradient_graded(kernel, x, [0.0; 3], neighbors, ws)
-}
-
-/// [`measure_and_gradient`] for a graded kernel (see [`Kernel`](crate::internal::Kernel)): x's
-/// width w follows a width field whose gradient at x, in kernel units (d w / d(p / sigma_p)), is
-/// `width_gradient`; the gradient returned is that of s(x) with x's width moving with it. The
-/// neighbours keep their widths.
+///
+/// For a graded kernel (see [`Kernel`](crate::internal::Kernel)), x's width w follows a sizing
+/// field whose gradient at x, in kernel units (d w / d(p / sigma_p)), is `width_gradient`; the
+/// gradient returned is that of s(x) with x's width moving with it. The neighbours keep their
+/// widths.
 ///
 /// With log k_i = 3/2 (log w + log w_i - log s_i²) - |p - p_i|² / s_i² - |Δn|², s_i² = (w² + w_i²)
 /// / 2 (positions in kernel units):
@@ -273,9 +265,9 @@ pub fn measure_and_gradient(
 /// ∇k_i = k_i [-2 (p - p_i) / s_i² + (3/2 (1/w - w/s_i²) + |p - p_i|² w / s_i⁴) ∇w], ∇s = -2 Σ_i
 /// α_i ∇k_i;
 ///
-/// with every width 1 and ∇w = 0 this is the formula of [`measure_and_gradient`] (and the same
-/// arithmetic, so the same bits).
-pub fn measure_and_gradient_graded(
+/// with every width 1 and ∇w = 0 this is the formula above (and the same arithmetic, so the same
+/// bits).
+pub fn measure_and_gradient(
     kernel: &Kernel,
     x: &KernelPoint,
     width_gradient: [f64; 3],

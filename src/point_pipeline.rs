@@ -26,6 +26,7 @@ use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::linear_scan::LinearScanner;
+use crate::sampling::sizing::Uniform;
 use crate::surface::features::FeatureDetection;
 use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
@@ -370,6 +371,8 @@ pub fn remesh_points(
         &domain,
         &mut moving,
         0,
+        &Uniform,
+        None,
         &rp.gradient_ascent,
         rp.seed,
     );

@@ -232,7 +232,7 @@ fn cholesky_measure_matches_block_inversion() {
         let pts = slab_points(&k, 25, &mut rng);
         let x = k.embed(DVec3::new(0.1, -0.2, 0.05), DVec3::Z);
         let s_eq10 = spectral_measure(&k, &x, pts.clone(), -1.0, &mut ws).s;
-        let (s_chol, _) = measure_and_gradient(&k, &x, &pts, &mut ws);
+        let (s_chol, _) = measure_and_gradient(&k, &x, [0.0; 3], &pts, &mut ws);
         assert!((s_eq10 - s_chol).abs() < 1e-9, "{s_eq10} vs {s_chol}");
     }
 }
@@ -291,7 +291,7 @@ fn gradient_matches_finite_differences_of_the_measure() {
             0.0,
         );
         let x = k.embed(p0, DVec3::Z);
-        let (_, g) = measure_and_gradient(&k, &x, &pts, &mut ws);
+        let (_, g) = measure_and_gradient(&k, &x, [0.0; 3], &pts, &mut ws);
         let h = 1e-6;
         for (c, &gc) in g.iter().enumerate() {
             let mut xp = x;
@@ -426,7 +426,7 @@ fn graded_gradient_matches_finite_differences_along_the_width_field() {
             x
         };
         let x = at(p0);
-        let (_, g) = measure_and_gradient_graded(&k, &x, width_field(p0).1, &pts, &mut ws);
+        let (_, g) = measure_and_gradient(&k, &x, width_field(p0).1, &pts, &mut ws);
         let h = 1e-6;
         for (c, &gc) in g.iter().enumerate() {
             let mut d = DVec3::ZERO;
@@ -448,12 +448,13 @@ fn unit_widths_give_the_paper_kernel_bit_for_bit() {
     let mut rng = ChaCha8Rng::seed_from_u64(15);
     let mut ws = MeasureWorkspace::new();
     let pts = slab_points(&k, 20, &mut rng);
-    let x = k.embed_graded(DVec3::new(0.2, 0.1, 0.0), DVec3::Z, 1.0);
-    let plain = measure_and_gradient(&k, &x, &pts, &mut ws);
-    let graded = measure_and_gradient_graded(&k, &x, [0.0; 3], &pts, &mut ws);
+    let (p, n) = (DVec3::new(0.2, 0.1, 0.0), DVec3::Z);
+    let plain = measure_and_gradient(&k, &k.embed(p, n), [0.0; 3], &pts, &mut ws);
+    let x = k.embed_graded(p, n, 1.0);
+    let graded = measure_and_gradient(&k, &x, [0.0; 3], &pts, &mut ws);
     assert_eq!(plain, graded);
     // And a width below 1 changes it: the grading is not ignored.
     let mut y = x;
     y.width = 0.5;
-    assert_ne!(measure_and_gradient(&k, &y, &pts, &mut ws), plain);
+    assert_ne!(measure_and_gradient(&k, &y, [0.0; 3], &pts, &mut ws), plain);
 }

@@ -9,9 +9,9 @@ use super::RemeshParams;
 use crate::error::Result;
 use crate::kernel::Kernel;
 use crate::sampling::crease_band::CreaseBand;
-use crate::sampling::gradient_ascent::{gradient_ascent_graded, GradientAscentResult};
+use crate::sampling::features::Corners;
+use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::spacing::FEATURE_SPACING_PER_SIGMA;
-use crate::sampling::WidthField;
 use crate::surface::SurfaceSample;
 
 /// The samples after the gradient ascent.
@@ -49,8 +49,11 @@ pub(super) fn ascend(
     let before_ascent = index.buried_test.as_ref().map(|_| samples.clone());
     let feature_spacing = FEATURE_SPACING_PER_SIGMA * sigma_p;
     let (widths, corners) = (&scanned.widths, &scan.corners);
-    let width_field = (widths.active() || !corners.is_empty())
-        .then_some(|p: DVec3| widths.at(p, corners, feature_spacing));
+    let corner_term = Corners {
+        corners,
+        spacing: feature_spacing,
+    };
+    let field = widths.with_corners(&corner_term);
     // Surface samples keep out of a band along the sampled creases.
     let band = {
         let positions: Vec<DVec3> = samples[..boundary_count]
@@ -64,12 +67,12 @@ pub(super) fn ascend(
             0.05 * feature_spacing,
         )
     };
-    let record = gradient_ascent_graded(
+    let record = gradient_ascent(
         &kernel,
         &index.surface,
         &mut samples,
         boundary_count,
-        width_field.as_ref().map(|f| f as WidthField),
+        &field,
         band.as_ref(),
         &params.gradient_ascent,
         params.seed,

@@ -4,7 +4,6 @@
 
 use std::borrow::Cow;
 
-use glam::DVec3;
 use rayon::prelude::*;
 
 use super::input::{Candidates, NormalizedInput};
@@ -14,11 +13,11 @@ use super::{RemeshParams, MAX_POINTS};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
 use crate::sampling::curves::{boundary_sample_count, sample_curves_and_features};
-use crate::sampling::features::{corner_width, feature_pieces, graded_corners, GradedCorner};
-use crate::sampling::linear_scan::{linear_scan, linear_scan_graded, LinearScanResult};
+use crate::sampling::features::{feature_pieces, graded_corners, Corners, GradedCorner};
+use crate::sampling::linear_scan::{linear_scan, LinearScanResult};
+use crate::sampling::sizing::{SizingField, Uniform};
 use crate::sampling::spacing::{BOUNDARY_SPACING_PER_SIGMA, FEATURE_SPACING_PER_SIGMA};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
-use crate::sampling::WidthField;
 use crate::surface::curvature::CurvatureWidths;
 use crate::surface::features::Features;
 
@@ -92,13 +91,13 @@ impl ScanInputs<'_> {
         }
         // The boundary curves, cut where creases end on them, and the creases long enough to
         // take samples at their spacing.
-        let width = widths.active().then_some(|p: DVec3| widths.width(p));
+        let field = widths.field();
         let (boundary_pieces, feature_curves) = feature_pieces(
             normalized,
             &self.input.curves,
             self.features,
             feature_spacing,
-            width.as_ref().map(|f| f as WidthField),
+            &field,
         );
         let boundary_count = boundary_sample_count(normalized, &boundary_pieces, spacing)
             + boundary_sample_count(
@@ -112,18 +111,20 @@ impl ScanInputs<'_> {
         // Around a corner that creases are graded towards, the other curves and the surface
         // samples are graded too (corner_width).
         let corners = graded_corners(normalized, &feature_curves, feature_spacing);
-        let graded = widths.active() || !corners.is_empty();
-        let w = |p: DVec3| widths.at(p, &corners, feature_spacing);
-        let field: Option<WidthField> = graded.then_some(&w);
+        let corner_term = Corners {
+            corners: &corners,
+            spacing: feature_spacing,
+        };
+        let field = widths.with_corners(&corner_term);
         let b = sample_curves_and_features(
             normalized,
             &boundary_pieces,
             &feature_curves,
             spacing,
             feature_spacing,
-            field,
+            &field,
         );
-        let r = if graded {
+        let r = if !field.is_uniform() {
             // The candidates' widths: the round's, lowered around the graded corners.
             let pool_w: Option<Cow<[f64]>> = if corners.is_empty() {
                 pool_widths.map(Cow::Borrowed)
@@ -133,25 +134,30 @@ impl ScanInputs<'_> {
                         .par_iter()
                         .enumerate()
                         .map(|(i, c)| {
-                            pool_widths.map_or(1.0, |pw| pw[i]).min(corner_width(
-                                &corners,
-                                c.position,
-                                feature_spacing,
-                            ))
+                            pool_widths
+                                .map_or(1.0, |pw| pw[i])
+                                .min(corner_term.width(c.position))
                         })
                         .collect(),
                 ))
             };
-            linear_scan_graded(
+            linear_scan(
                 &kernel,
                 self.pool,
                 pool_w.as_deref(),
                 &b.samples,
-                field,
+                &field,
                 &params.linear_scan,
             )
         } else {
-            linear_scan(&kernel, self.pool, &b.samples, &params.linear_scan)
+            linear_scan(
+                &kernel,
+                self.pool,
+                None,
+                &b.samples,
+                &Uniform,
+                &params.linear_scan,
+            )
         };
         let count = r.samples.len();
         let scan = CurveScan {
@@ -205,12 +211,14 @@ pub(super) fn scan<'s>(
         boundary_limit,
     };
     // The candidates' widths for one sigma_ref, taken once for a round's evaluations.
-    let pool_widths =
-        |w: &Widths| -> Vec<f64> { pool.par_iter().map(|c| w.width(c.position)).collect() };
+    let pool_widths = |w: &Widths| -> Vec<f64> {
+        let field = w.field();
+        pool.par_iter().map(|c| field.width(c.position)).collect()
+    };
     let (sigma_p, target_reached, history, value, widths) = match target {
         Target::SigmaP(s) => {
             let w = sizing.widths_at(pool, s);
-            let pool_w = w.active().then(|| pool_widths(&w));
+            let pool_w = (!w.field().is_uniform()).then(|| pool_widths(&w));
             let (count, value) = inputs.at(s, &w, pool_w.as_deref())?;
             (s, true, vec![(s, count)], value, w)
         }
@@ -224,7 +232,7 @@ pub(super) fn scan<'s>(
             let mut round = 0;
             loop {
                 let w = sizing.widths_at(pool, search.sigma_ref);
-                let pool_w = w.active().then(|| pool_widths(&w));
+                let pool_w = (!w.field().is_uniform()).then(|| pool_widths(&w));
                 let mut failure = None;
                 let r = find_sigma_p(&count_search, round_start, |s| {
                     match inputs.at(s, &w, pool_w.as_deref()) {

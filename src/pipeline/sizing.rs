@@ -2,13 +2,12 @@
 //! smallest of the grading by thickness (local feature size), the grading by curvature and the
 //! grading towards crease corners; 1 everywhere when none is on.
 
-use glam::DVec3;
-
 use super::input::NormalizedInput;
 use super::RemeshParams;
 use crate::error::Result;
-use crate::sampling::features::{corner_width, GradedCorner};
-use crate::sampling::grading::Grading;
+use crate::sampling::features::Corners;
+use crate::sampling::grading::{Grading, Thickness};
+use crate::sampling::sizing::{SizingField, Smallest};
 use crate::surface::curvature::{Curvature, CurvatureParams, CurvatureWidths};
 use crate::surface::{MeshSurface, SurfaceSample};
 use crate::timing::StageTimer;
@@ -72,7 +71,10 @@ impl Sizing {
     /// `pool`.
     pub(super) fn widths_at(&self, pool: &[SurfaceSample], sigma_ref: f64) -> Widths<'_> {
         Widths {
-            grading: self.grading.as_ref(),
+            thickness: self
+                .grading
+                .as_ref()
+                .map(|grading| Thickness { grading, sigma_ref }),
             curvature: self
                 .curvature
                 .as_ref()
@@ -82,35 +84,31 @@ impl Sizing {
     }
 }
 
-/// The kernel width field of one remesh round: the grading by thickness and the grading by
-/// curvature, for the global `sigma_ref`, the smaller of the two.
+/// The sizing terms of one remesh round: the grading by thickness and the grading by curvature,
+/// for the global `sigma_ref`.
 pub(super) struct Widths<'a> {
-    pub grading: Option<&'a Grading>,
+    pub thickness: Option<Thickness<'a>>,
     pub curvature: Option<CurvatureWidths>,
     pub sigma_ref: f64,
 }
 
 impl Widths<'_> {
-    /// Whether any grading is on.
-    pub(super) fn active(&self) -> bool {
-        self.grading.is_some() || self.curvature.is_some()
-    }
-
-    /// The relative width at `p` (1 with no grading).
-    pub(super) fn width(&self, p: DVec3) -> f64 {
-        let mut w: f64 = 1.0;
-        if let Some(g) = self.grading {
-            w = w.min(g.width(p, self.sigma_ref));
+    /// The sizing field: the smallest of the terms on (uniform with none).
+    pub(super) fn field(&self) -> Smallest<'_> {
+        let mut terms: Vec<&dyn SizingField> = Vec::new();
+        if let Some(t) = &self.thickness {
+            terms.push(t);
         }
         if let Some(c) = &self.curvature {
-            w = w.min(c.width(p));
+            terms.push(c);
         }
-        w
+        Smallest(terms)
     }
 
-    /// [`Widths::width`] lowered around graded `corners` ([`corner_width`] at the creases'
-    /// `spacing`).
-    pub(super) fn at(&self, p: DVec3, corners: &[GradedCorner], spacing: f64) -> f64 {
-        self.width(p).min(corner_width(corners, p, spacing))
+    /// [`Widths::field`] lowered around the corners creases are graded towards.
+    pub(super) fn with_corners<'b>(&'b self, corners: &'b Corners<'b>) -> Smallest<'b> {
+        let mut field = self.field();
+        field.0.push(corners);
+        field
     }
 }

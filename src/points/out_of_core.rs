@@ -20,6 +20,7 @@ use crate::kernel::Kernel;
 use crate::mesh::Normalization;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentParams};
 use crate::sampling::linear_scan::{LinearScanParams, LinearScanner};
+use crate::sampling::sizing::Uniform;
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::surface::SurfaceSample;
 
@@ -376,7 +377,16 @@ fn resample_on_rimls(
     };
     // Each move's projection gives the surface's normal there (a sample the projection never
     // moved keeps its own).
-    gradient_ascent(kernel, &rimls, &mut moving, 0, &ascent, params.seed);
+    gradient_ascent(
+        kernel,
+        &rimls,
+        &mut moving,
+        0,
+        &Uniform,
+        None,
+        &ascent,
+        params.seed,
+    );
     for (p, m) in samples.iter_mut().zip(&moving) {
         p.position = m.position;
         p.normal = m.normal;

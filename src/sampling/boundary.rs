@@ -11,6 +11,7 @@ use rustc_hash::FxHashMap;
 use crate::mesh::TriMesh;
 use crate::sampling::curves::sample_curves;
 pub use crate::sampling::curves::{BoundaryCurve, BoundarySamples};
+use crate::sampling::sizing::Uniform;
 
 /// The boundary curves of `mesh`: chains of edges that belong to exactly one triangle.
 /// Deterministic (ordered by the lowest vertex index each curve starts from).
@@ -101,7 +102,7 @@ pub fn boundary_curves(mesh: &TriMesh) -> Vec<BoundaryCurve> {
 /// `spacing` (bbox-100 units) as a whole number of steps allows: a closed loop gets at least 3,
 /// and the ends of open chains are shared between the chains that meet there.
 pub fn sample_boundary(mesh: &TriMesh, curves: &[BoundaryCurve], spacing: f64) -> BoundarySamples {
-    sample_curves(mesh, curves, &[], spacing, spacing, 1.0, None)
+    sample_curves(mesh, curves, &[], spacing, spacing, 1.0, &Uniform)
 }
 
 #[cfg(test)]

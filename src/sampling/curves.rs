@@ -7,7 +7,7 @@ use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 use crate::mesh::TriMesh;
-use crate::sampling::WidthField;
+use crate::sampling::sizing::{SizingField, Uniform};
 use crate::surface::SurfaceSample;
 
 /// One boundary curve of a mesh: input vertex indices in order, the surface on the left (the
@@ -101,12 +101,13 @@ pub fn sample_curves_and_features(
     features: &[FeaturePiece],
     spacing: f64,
     feature_spacing: f64,
-    width: Option<WidthField>,
+    field: &dyn SizingField,
 ) -> BoundarySamples {
     let scale = feature_spacing / spacing;
-    match width {
-        None => sample_curves(mesh, curves, features, spacing, spacing, scale, None),
-        Some(_) => sample_curves(mesh, curves, features, 1.0, spacing, scale, width),
+    if field.is_uniform() {
+        sample_curves(mesh, curves, features, spacing, spacing, scale, &Uniform)
+    } else {
+        sample_curves(mesh, curves, features, 1.0, spacing, scale, field)
     }
 }
 
@@ -176,8 +177,8 @@ pub(crate) fn points_along(
 
 /// The length of the edge a–b in a width field, ∫ ds / w by the trapezoid rule (the width
 /// taken at both ends, at least 1e-6): the steps it takes at a spacing of 1 where w is 1.
-pub(crate) fn width_steps(width: WidthField, a: DVec3, b: DVec3) -> f64 {
-    0.5 * a.distance(b) * (1.0 / width(a).max(1e-6) + 1.0 / width(b).max(1e-6))
+pub(crate) fn width_steps(field: &dyn SizingField, a: DVec3, b: DVec3) -> f64 {
+    0.5 * a.distance(b) * (1.0 / field.width(a).max(1e-6) + 1.0 / field.width(b).max(1e-6))
 }
 
 /// The samples of every curve ([`curve_points`]), one shared sample where open curves meet;
@@ -190,8 +191,9 @@ pub(crate) fn sample_curves(
     unit: f64,
     spacing: f64,
     feature_scale: f64,
-    width: Option<WidthField>,
+    field: &dyn SizingField,
 ) -> BoundarySamples {
+    let width = (!field.is_uniform()).then_some(field);
     // Per edge: its length, or with a width field its steps (the trapezoid rule in 1/w, in
     // units of one step of `spacing`).
     let measure = |a: DVec3, b: DVec3| match width {
@@ -208,7 +210,7 @@ pub(crate) fn sample_curves(
         let nv = curve.vertices.len();
         let points = match feature {
             Some(f) if f.graded.iter().any(|g| !g.is_empty()) => {
-                graded_points(mesh, f, spacing * feature_scale, width)
+                graded_points(mesh, f, spacing * feature_scale, field)
             }
             Some(_) => curve_points(mesh, curve, unit * feature_scale, measure),
             None => curve_points(mesh, curve, unit, measure),
@@ -332,8 +334,9 @@ pub(crate) fn graded_points(
     mesh: &TriMesh,
     piece: &FeaturePiece,
     spacing: f64,
-    width: Option<WidthField>,
+    field: &dyn SizingField,
 ) -> Vec<(DVec3, usize)> {
+    let width = (!field.is_uniform()).then_some(field);
     let lengths = edge_lengths(mesh, &piece.curve);
     let total: f64 = lengths.iter().sum();
     let arcs = match width {

@@ -14,7 +14,7 @@ use crate::sampling::curves::{
     curve_length, curve_points, edge_lengths, graded_points, points_along, width_steps,
     BoundaryCurve, FeaturePiece,
 };
-use crate::sampling::WidthField;
+use crate::sampling::sizing::SizingField;
 use crate::surface::features::Features;
 
 /// The least distance between the samples of two feature curves, in units of the spacing
@@ -190,9 +190,10 @@ pub fn feature_pieces(
     curves: &[BoundaryCurve],
     features: &Features,
     spacing: f64,
-    width: Option<WidthField>,
+    field: &dyn SizingField,
 ) -> (Vec<BoundaryCurve>, Vec<FeaturePiece>) {
-    let w = |p: DVec3| width.map_or(1.0, |f| f(p).max(1e-6));
+    let width = (!field.is_uniform()).then_some(field);
+    let w = |p: DVec3| width.map_or(1.0, |f| f.width(p).max(1e-6));
     if features.curves.is_empty() {
         return (curves.to_vec(), Vec::new());
     }
@@ -274,7 +275,7 @@ pub fn feature_pieces(
                 }),
             }
         } else {
-            graded_points(mesh, piece, spacing, width)
+            graded_points(mesh, piece, spacing, field)
         }
     };
     let place = |placed: &mut FxHashMap<[i64; 3], Vec<Placed>>,
@@ -474,11 +475,29 @@ pub fn split_at(curves: &[BoundaryCurve], at: &FxHashSet<u32>) -> Vec<BoundaryCu
     out
 }
 
+/// The grading towards the corners creases are graded towards ([`corner_width`] at the creases'
+/// `spacing`, bbox-100 units); 1 everywhere without corners.
+pub struct Corners<'a> {
+    pub corners: &'a [GradedCorner],
+    pub spacing: f64,
+}
+
+impl SizingField for Corners<'_> {
+    fn width(&self, p: DVec3) -> f64 {
+        corner_width(self.corners, p, self.spacing)
+    }
+
+    fn is_uniform(&self) -> bool {
+        self.corners.is_empty()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::sampling::boundary::boundary_curves;
     use crate::sampling::curves::sample_curves_and_features;
+    use crate::sampling::sizing::Uniform;
     use crate::surface::features::{detect_features, FeatureParams};
     use glam::DVec3;
 
@@ -514,14 +533,14 @@ mod tests {
         assert_eq!(features.curves[0].vertices, crease);
         let curves = boundary_curves(&mesh);
         assert_eq!(curves.len(), 1);
-        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 0.1, None);
+        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 0.1, &Uniform);
         assert_eq!(
             boundary.len(),
             2,
             "the loop is cut at the crease's two ends"
         );
         assert_eq!(feature.len(), 1);
-        let b = sample_curves_and_features(&mesh, &boundary, &feature, 0.1, 0.1, None);
+        let b = sample_curves_and_features(&mesh, &boundary, &feature, 0.1, 0.1, &Uniform);
         // 10 steps along the crease (length 1), its ends shared with the boundary.
         assert_eq!(b.feature_edges.len(), 10);
         for e in &b.feature_edges {
@@ -550,7 +569,7 @@ mod tests {
         assert_eq!(on_crease_only, 9);
         assert!(degree.iter().all(|&d| d == 0 || d == 2));
         // A crease shorter than the spacing is left out, and the loop stays whole.
-        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 1.5, None);
+        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 1.5, &Uniform);
         assert!(feature.is_empty());
         assert_eq!(boundary, curves);
     }
@@ -577,7 +596,7 @@ mod tests {
             corners: vec![at(0, 30), at(60, 30), at(60, 50)],
         };
         let spacing = 2.0;
-        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing, None);
+        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing, &Uniform);
         assert_eq!(pieces.len(), 2, "both creases are kept");
         let angle = (1.0f64 / 3.0).atan();
         let expected = graded_distances(angle, spacing, f64::INFINITY);
@@ -597,7 +616,7 @@ mod tests {
         for w in expected.windows(2) {
             assert!((w[0] / w[1] - (1.0 + g)).abs() < 1e-12);
         }
-        let b = sample_curves_and_features(&mesh, &[], &pieces, spacing, spacing, None);
+        let b = sample_curves_and_features(&mesh, &[], &pieces, spacing, spacing, &Uniform);
         // One shared corner sample; samples at equal distances from it on both creases.
         let corner = DVec3::new(0.0, 30.0, 0.0);
         let dist = |s: &crate::surface::SurfaceSample| s.position.distance(corner);
@@ -643,7 +662,7 @@ mod tests {
             curves: vec![features.curves[0].clone()],
             ..features.clone()
         };
-        let (_, pieces) = feature_pieces(&mesh, &[], &alone, spacing, None);
+        let (_, pieces) = feature_pieces(&mesh, &[], &alone, spacing, &Uniform);
         assert!(pieces[0].graded.iter().all(|g| g.is_empty()));
     }
 }

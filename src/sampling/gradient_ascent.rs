@@ -4,11 +4,9 @@
 use rayon::prelude::*;
 
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
-#[cfg(doc)]
-use crate::measure::measure_and_gradient_graded;
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
 use crate::sampling::crease_band::CreaseBand;
-use crate::sampling::WidthField;
+use crate::sampling::sizing::SizingField;
 use crate::spatial::StaticTree;
 use crate::surface::Projection;
 use crate::surface::SurfaceSample;
@@ -93,40 +91,34 @@ pub struct GradientAscentResult {
 /// The gradient is taken with respect to the position part of x with the sample's normal held
 /// fixed; the projection then gives the new position and the normal of the input triangle it lands
 /// on. Units: positions in bbox-100 units.
+///
+/// The kernel is graded by the sizing `field`: each sample's width is its value at the sample's
+/// position, taken again after each of its moves ([`Uniform`](crate::sampling::sizing::Uniform):
+/// one sigma_p, eq. 11 as printed). The field is treated as locally constant (the pipeline's is
+/// piecewise constant, so its gradient is zero almost everywhere): the step is that of
+/// [`measure_and_gradient`] with ∇w = 0, scaled by w² (the gradient of s grows as 1/w where the
+/// kernel is w times narrower, and a step should be w times shorter), and the largest move is
+/// `max_move_sigma_p` · w · sigma_p. With a `band` (the sampled sharp-feature curves), a move into
+/// it towards a feature curve is not taken ([`CreaseBand::refuses`]), so no sample reaches or
+/// crosses a crease.
+#[allow(clippy::too_many_arguments)] // the field and the band beside eq. 11's inputs
 pub fn gradient_ascent<S: Projection + ?Sized>(
     kernel: &Kernel,
     surface: &S,
     samples: &mut [SurfaceSample],
     fixed: usize,
-    params: &GradientAscentParams,
-    seed: u64,
-) -> GradientAscentResult {
-    gradient_ascent_graded(kernel, surface, samples, fixed, None, None, params, seed)
-}
-
-/// [`gradient_ascent`] with a graded kernel: each sample's width is `width(position)`, taken
-/// again after each of its moves. The field is treated as locally constant (the pipeline's is
-/// piecewise constant, so its gradient is zero almost everywhere): the step is that of
-/// [`measure_and_gradient_graded`] with ∇w = 0, scaled by w² (the gradient of s grows as 1/w
-/// where the kernel is w times narrower, and a step should be w times shorter), and the
-/// largest move is `max_move_sigma_p` · w · sigma_p. With a `band` (the sampled sharp-feature
-/// curves), a move into it towards a feature curve is not taken ([`CreaseBand::refuses`]), so no
-/// sample reaches or crosses a crease. With `width` and `band` `None` (or a width of 1
-/// everywhere) this is [`gradient_ascent`] exactly.
-#[allow(clippy::too_many_arguments)] // the two optional fields (width, band) beside eq. 11's inputs
-pub fn gradient_ascent_graded<S: Projection + ?Sized>(
-    kernel: &Kernel,
-    surface: &S,
-    samples: &mut [SurfaceSample],
-    fixed: usize,
-    width: Option<WidthField>,
+    field: &dyn SizingField,
     band: Option<&CreaseBand>,
     params: &GradientAscentParams,
     seed: u64,
 ) -> GradientAscentResult {
-    let embed = |s: &SurfaceSample| match width {
-        Some(w) => kernel.embed_graded(s.position, s.normal, w(s.position)),
-        None => kernel.embed(s.position, s.normal),
+    let uniform = field.is_uniform();
+    let embed = |s: &SurfaceSample| {
+        if uniform {
+            kernel.embed(s.position, s.normal)
+        } else {
+            kernel.embed_graded(s.position, s.normal, field.width(s.position))
+        }
     };
     let n = samples.len();
     let fixed = fixed.min(n);
@@ -304,7 +296,7 @@ fn move_one<S: Projection + ?Sized>(
     near.sort_by(|a, b| a.0.total_cmp(&b.0));
     sorted.clear();
     sorted.extend(near.iter().map(|p| p.1));
-    let (s, g) = measure_and_gradient(kernel, &x, sorted, ws);
+    let (s, g) = measure_and_gradient(kernel, &x, [0.0; 3], sorted, ws);
     // Kernel units to position units: Δp = sigma_p · step · w² · ∇_x s (w = 1: eq. 11).
     let w = x.width;
     let mut delta = glam::DVec3::new(g[0], g[1], g[2]) * (params.step * sigma_p * w * w);
@@ -340,6 +332,7 @@ fn move_one<S: Projection + ?Sized>(
 mod tests {
     use super::*;
     use crate::mesh::test_meshes;
+    use crate::sampling::sizing::Uniform;
     use crate::surface::candidates::surface_candidates;
     use crate::surface::MeshSurface;
     use rand::seq::SliceRandom;
@@ -406,7 +399,18 @@ mod tests {
                 .build()
                 .unwrap();
             let mut samples = start.clone();
-            pool.install(|| gradient_ascent(&kernel, &surface, &mut samples, 0, &params, 5));
+            pool.install(|| {
+                gradient_ascent(
+                    &kernel,
+                    &surface,
+                    &mut samples,
+                    0,
+                    &Uniform,
+                    None,
+                    &params,
+                    5,
+                )
+            });
             assert!(
                 samples
                     .iter()

@@ -15,6 +15,7 @@ use crate::disjoint_sets::Dsu;
 use crate::error::Result;
 use crate::mesh::{Normalization, TriMesh};
 use crate::sampling::boundary::BoundaryCurve;
+use crate::sampling::sizing::SizingField;
 use crate::sampling::spacing::SAMPLES_PER_SIGMA2;
 use crate::spatial::StaticTree;
 use crate::surface::local_feature_size::{local_feature_size, LfsParams, LocalFeatureSize};
@@ -338,4 +339,17 @@ fn median_filtered(lfs: &LocalFeatureSize, k: usize) -> Vec<f64> {
             },
         )
         .collect()
+}
+
+/// The grading by thickness: `min(1, c · lfs(p) / sigma_ref)` ([`Grading::width`]) for the global
+/// `sigma_ref` (bbox-100 units).
+pub struct Thickness<'a> {
+    pub grading: &'a Grading,
+    pub sigma_ref: f64,
+}
+
+impl SizingField for Thickness<'_> {
+    fn width(&self, p: DVec3) -> f64 {
+        self.grading.width(p, self.sigma_ref)
+    }
 }

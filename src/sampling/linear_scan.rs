@@ -3,7 +3,7 @@
 use crate::geometry::morton::morton_code;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{spectral_measure, MeasureWorkspace, DEFAULT_EPSILON};
-use crate::sampling::WidthField;
+use crate::sampling::sizing::SizingField;
 use crate::spatial::DynamicTree;
 use crate::surface::SurfaceSample;
 use glam::DVec3;
@@ -441,6 +441,11 @@ fn full_measure(
 /// epsilon, or when it has no neighbour in O. `initial` samples (for example samples placed on the
 /// input's boundary curves) start O.
 ///
+/// The kernel is graded by the sizing `field` (each point's relative width, see
+/// [`Kernel`](crate::internal::Kernel); [`Uniform`](crate::sampling::sizing::Uniform): one
+/// sigma_p, as in the paper). `candidate_widths[k]`, when given, is the field at `candidates[k]`
+/// (the caller takes them once for the scans that share them); else they are taken here.
+///
 /// Neighbours are the points of O within `support_radius` in kernel space, taken nearest first;
 /// the evaluation stops as soon as s <= epsilon (Sec. 6.1). O is kept in a dynamic kd-tree over
 /// positions: a point within r in kernel space is within r sigma_p in position.
@@ -450,28 +455,28 @@ fn full_measure(
 pub fn linear_scan(
     kernel: &Kernel,
     candidates: &[SurfaceSample],
-    initial: &[SurfaceSample],
-    params: &LinearScanParams,
-) -> LinearScanResult {
-    linear_scan_graded(kernel, candidates, None, initial, None, params)
-}
-
-/// [`linear_scan`] with a graded kernel: each point's relative width (see
-/// [`Kernel`](crate::internal::Kernel)), `candidate_widths[k]` for `candidates[k]` and
-/// `width(position)` for the initial samples (`None`: 1 everywhere, the same as [`linear_scan`]).
-/// The candidates' widths are taken by the caller, once for the evaluations that share them.
-pub fn linear_scan_graded(
-    kernel: &Kernel,
-    candidates: &[SurfaceSample],
     candidate_widths: Option<&[f64]>,
     initial: &[SurfaceSample],
-    width: Option<WidthField>,
+    field: &dyn SizingField,
     params: &LinearScanParams,
 ) -> LinearScanResult {
+    let uniform = field.is_uniform();
+    let taken: Option<Vec<f64>> = (!uniform && candidate_widths.is_none()).then(|| {
+        candidates
+            .par_iter()
+            .map(|c| field.width(c.position))
+            .collect()
+    });
+    let candidate_widths = candidate_widths.or(taken.as_deref());
     let mut samples: Vec<SurfaceSample> = Vec::with_capacity(initial.len() + candidates.len() / 8);
     let mut scanner = LinearScanner::new(kernel, params);
     for s in initial {
-        scanner.insert_graded(s.position, s.normal, width.map_or(1.0, |w| w(s.position)));
+        let w = if uniform {
+            1.0
+        } else {
+            field.width(s.position)
+        };
+        scanner.insert_graded(s.position, s.normal, w);
         samples.push(*s);
     }
     let batch: Vec<(DVec3, DVec3)> = candidates.iter().map(|c| (c.position, c.normal)).collect();

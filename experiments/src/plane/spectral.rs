@@ -217,7 +217,7 @@ pub fn torus_gradient_ascent(
         for &i in &order {
             let p = points[i as usize];
             gather(&kernel, &grid, points, p, i, r, &mut near, &mut nb);
-            let (s, g) = measure_and_gradient(&kernel, &origin, &nb, &mut ws);
+            let (s, g) = measure_and_gradient(&kernel, &origin, [0.0; 3], &nb, &mut ws);
             let boost = params
                 .small_s_boost
                 .map_or(1.0, |s_ref| (s_ref / s.max(1e-12)).clamp(1.0, 1000.0));

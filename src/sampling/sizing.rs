@@ -1,0 +1,131 @@
+//! The sizing field: the kernel width at a point relative to sigma_p, w(p) in (0, 1], so that a
+//! graded kernel's width is w(p) · sigma_p (see `Kernel`). One field is read by every stage that
+//! places samples: the curve samples (`sampling::curves`, `sampling::features`), the linear scan
+//! and the gradient ascent. Its terms are the paper's single sigma_p ([`Uniform`]), the grading
+//! by thickness (`grading::Thickness`, the local feature size), the grading by
+//! curvature (`CurvatureWidths`) and the grading towards crease corners (`features::Corners`); a run's field is the
+//! smallest of the terms it asks for ([`Smallest`]).
+
+use glam::DVec3;
+
+use crate::surface::curvature::CurvatureWidths;
+
+/// A field of relative kernel widths over positions (bbox-100 units).
+pub trait SizingField: Sync {
+    /// The relative width at `p`, in (0, 1].
+    fn width(&self, p: DVec3) -> f64;
+
+    /// Whether the field is 1 everywhere by construction: the stages then take the paper's
+    /// single sigma_p (the same samples as a graded field of 1 everywhere, at less cost).
+    fn is_uniform(&self) -> bool {
+        false
+    }
+}
+
+/// One sigma_p everywhere, as in the paper.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Uniform;
+
+impl SizingField for Uniform {
+    fn width(&self, _: DVec3) -> f64 {
+        1.0
+    }
+
+    fn is_uniform(&self) -> bool {
+        true
+    }
+}
+
+/// The grading by curvature (the widths taken at points, the nearest one's at p).
+impl SizingField for CurvatureWidths {
+    fn width(&self, p: DVec3) -> f64 {
+        CurvatureWidths::width(self, p)
+    }
+}
+
+/// The smallest of `terms` (1 where none is smaller): uniform when every term is.
+pub struct Smallest<'a>(pub Vec<&'a dyn SizingField>);
+
+impl SizingField for Smallest<'_> {
+    fn width(&self, p: DVec3) -> f64 {
+        self.0
+            .iter()
+            .filter(|t| !t.is_uniform())
+            .fold(1.0, |w, t| w.min(t.width(p)))
+    }
+
+    fn is_uniform(&self) -> bool {
+        self.0.iter().all(|t| t.is_uniform())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Half;
+    impl SizingField for Half {
+        fn width(&self, p: DVec3) -> f64 {
+            if p.x > 0.0 {
+                0.5
+            } else {
+                1.0
+            }
+        }
+    }
+
+    #[test]
+    fn the_smallest_term_sets_the_width() {
+        let corners = crate::sampling::features::Corners {
+            corners: &[],
+            spacing: 1.0,
+        };
+        assert!(Smallest(vec![]).is_uniform());
+        assert!(Smallest(vec![&Uniform, &corners]).is_uniform());
+        let field = Smallest(vec![&Uniform, &Half, &corners]);
+        assert!(!field.is_uniform());
+        assert_eq!(field.width(DVec3::X), 0.5);
+        assert_eq!(field.width(-DVec3::X), 1.0);
+    }
+
+    /// A field of 1 everywhere that does not say so takes the graded path of the scan and the
+    /// ascent; [`Uniform`] takes the paper's: the same samples, bit for bit (the uniform path is
+    /// only faster). And a field below 1 somewhere changes them.
+    #[test]
+    fn the_uniform_path_is_the_graded_path_at_width_1() {
+        use crate::kernel::Kernel;
+        use crate::mesh::test_meshes;
+        use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentParams};
+        use crate::sampling::linear_scan::{linear_scan, LinearScanParams};
+        use crate::surface::candidates::surface_candidates;
+        use crate::surface::MeshSurface;
+
+        struct One;
+        impl SizingField for One {
+            fn width(&self, _: DVec3) -> f64 {
+                1.0
+            }
+        }
+        let mesh = test_meshes::uv_sphere(10.0, 24, 48);
+        let surface = MeshSurface::new(&mesh).unwrap();
+        let kernel = Kernel::new(2.0, 0.9).unwrap();
+        let pool = surface_candidates(&mesh, 3000, 4);
+        let (initial, pool) = pool.split_at(20);
+        let params = LinearScanParams::default();
+        let scan =
+            |field: &dyn SizingField| linear_scan(&kernel, pool, None, initial, field, &params);
+        let (uniform, one, half) = (scan(&Uniform), scan(&One), scan(&Half));
+        assert_eq!(uniform.samples, one.samples);
+        assert_ne!(uniform.samples.len(), half.samples.len());
+        let ascend = |field: &dyn SizingField| {
+            let mut samples = uniform.samples.clone();
+            let p = GradientAscentParams::default();
+            gradient_ascent(&kernel, &surface, &mut samples, 20, field, None, &p, 7);
+            samples
+        };
+        let moved = ascend(&Uniform);
+        assert_ne!(moved, uniform.samples);
+        assert_eq!(moved, ascend(&One));
+        assert_ne!(moved, ascend(&Half));
+    }
+}
