@@ -159,6 +159,7 @@ pub use report::{QualityReport, SurfaceDistance, TriangleQuality};
 pub use app::remesh_point_set;
 pub use point_pipeline::{remesh_points, PointRemeshOutput, PointRemeshParams};
 pub use points::out_of_core::{simplify_out_of_core, OutOfCoreParams, OutOfCoreResult};
+pub use points::stream::PointSource;
 // Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.
 pub use manifold::{
     resample_manifold, sample_manifold, DataProjection, ManifoldProjection, ManifoldResampleParams,

@@ -24,6 +24,7 @@ use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{rimls_of, OutOfCoreParams, RimlsSupport, ScannedInput};
 use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
+use crate::points::stream::PointSource;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::linear_scan::LinearScanner;
 use crate::sampling::sizing::Uniform;
@@ -202,9 +203,10 @@ pub struct PointRemeshOutput {
     pub stages: Vec<Stage>,
 }
 
-/// Remeshes the point set in the file `input` (PLY without faces, or XYZ/CSV text; see
-/// [`PointReader`](crate::points::PointReader)), with or without normals, out of core. `on_stage`
-/// is called with each stage name as it starts.
+/// Remeshes the point set `input`: a file (PLY without faces, or XYZ/CSV text; see
+/// [`PointReader`](crate::internal::PointReader)) or points in memory
+/// ([`PointSource::memory`]), with or without normals, out of core. `on_stage` is called with each
+/// stage name as it starts.
 ///
 /// With a target count, the count of the samples once projected onto the surface decides: when it
 /// is off by more than `count_tolerance`, sigma_p is corrected and the buckets scanned again (up to
@@ -216,17 +218,18 @@ pub struct PointRemeshOutput {
 /// surface of `RIMLS_POINTS_PER_SAMPLE` points per sample; not the input.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] naming the option for a density other than a count or sigma_p
-/// (`--points`), grading (`--lfs-factor`), curvature (`--chord-error`), a crease angle
-/// (`--feature-angle`) or a finite sigma_n (`--sigma-n`) on points without normals; the errors of
-/// reading the points ([`PointReader`](crate::points::PointReader)), naming the file;
+/// [`Error::InvalidParameter`] naming the parameter for a density other than a count or sigma_p
+/// (`points`), grading (`lfs_factor`), curvature (`chord_error`), a crease angle
+/// (`feature_angle`) or a finite sigma_n (`sigma_n`) on points without normals; the errors of
+/// reading the points ([`PointReader`](crate::internal::PointReader)), naming the file;
 /// [`Error::InvalidMesh`] for an empty set, one with no extent, or one of which nothing could be
 /// triangulated.
 pub fn remesh_points(
-    input: &Path,
+    source: &PointSource,
     params: &PointRemeshParams,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<PointRemeshOutput> {
+    let input = source.name();
     let rp = &params.remesh;
     let refuse = |name: &'static str, what: &str| Error::InvalidParameter {
         name,
@@ -259,7 +262,7 @@ pub fn remesh_points(
         return Err(refuse("feature_angle", "sharp-feature detection"));
     }
     // (Opening a text file counts its points: only when sigma_n needs the answer.)
-    if rp.sigma_n.is_finite() && !crate::points::PointReader::open(input)?.has_normals() {
+    if rp.sigma_n.is_finite() && !source.open()?.has_normals() {
         return Err(Error::InvalidParameter {
             name: "sigma_n",
             message: format!("{} has no normals; sigma_n needs them", input.display()),
@@ -279,7 +282,7 @@ pub fn remesh_points(
         resample: 0,
         orientation: params.orientation,
     };
-    let mut source = ScannedInput::open(input, &scan_params, params.drop_outliers)?;
+    let mut source = ScannedInput::open(source, &scan_params, params.drop_outliers)?;
     let mut sigma_p = source.sigma_p;
     let mut scans = 0;
     let (scan, kernel, rimls, samples, mut moving, unprojected_samples, rescan_rejected) = loop {

@@ -14,7 +14,7 @@ use rand_chacha::ChaCha8Rng;
 use spectral_remesh::internal::{is_point_set, write_surface_points};
 use spectral_remesh::{
     check_invariants, remesh_point_set, remesh_points, run_remesh, topology, write_mesh, Density,
-    Error, PointRemeshOutput, PointRemeshParams, RemeshJob, RemeshParams, TriMesh,
+    Error, PointRemeshOutput, PointRemeshParams, PointSource, RemeshJob, RemeshParams, TriMesh,
 };
 
 /// A torus around the z axis (radii `big` and `small`), `n` × `m` quads split in two, outward.
@@ -103,12 +103,49 @@ fn worst_off(mesh: &TriMesh, distance: impl Fn(DVec3) -> f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Points in memory are read as the same points in a file: the same mesh, bit for bit, with
+/// normals and without.
+#[test]
+fn a_point_source_in_memory_reads_as_its_file() {
+    use spectral_remesh::internal::PointReader;
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere.ply");
+    write_surface_points(&common::icosphere(3), 20_000, 5, &input).unwrap();
+    let mut reader = PointReader::open(&input).unwrap();
+    let mut points = Vec::new();
+    let mut chunk = Vec::new();
+    while reader.read_chunk(&mut chunk, 4096).unwrap() > 0 {
+        points.extend_from_slice(&chunk);
+    }
+    let positions: Vec<_> = points.iter().map(|p| p.position).collect();
+    let normals: Vec<_> = points.iter().map(|p| p.normal).collect();
+    let from_file = remesh_points(&PointSource::File(input), &params(600, 2), &|_| {}).unwrap();
+    let memory = PointSource::memory("sphere points", &positions, Some(&normals));
+    let from_memory = remesh_points(&memory, &params(600, 2), &|_| {}).unwrap();
+    assert_eq!(from_file.mesh, from_memory.mesh);
+    assert!(from_file.had_normals && from_memory.had_normals);
+    // Without normals: estimated the same way as from a text file of the same positions (each
+    // written in the shortest form that reads back to the same number).
+    let xyz = dir.path().join("sphere.xyz");
+    let text: String = positions
+        .iter()
+        .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
+        .collect();
+    std::fs::write(&xyz, text).unwrap();
+    let from_text = remesh_points(&PointSource::File(xyz), &params(600, 2), &|_| {}).unwrap();
+    let bare = PointSource::memory("sphere points", &positions, None);
+    let from_bare = remesh_points(&bare, &params(600, 2), &|_| {}).unwrap();
+    assert!(!from_text.had_normals && !from_bare.had_normals);
+    assert_eq!(from_text.mesh, from_bare.mesh);
+    assert_ne!(from_bare.mesh, from_memory.mesh);
+}
+
 #[test]
 fn sphere_points_with_normals_become_a_closed_sphere() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("sphere.ply");
     write_surface_points(&common::icosphere(5), 60_000, 3, &input).unwrap();
-    let out = remesh_points(&input, &params(1500, 1), &|_| {}).unwrap();
+    let out = remesh_points(&PointSource::File(input.clone()), &params(1500, 1), &|_| {}).unwrap();
     assert!(out.had_normals);
     assert_closed(&out, 0, 1500);
     // On the sphere: the RIMLS bias sigma_p^2 / (2R) is 0.2% of R at this count.
@@ -133,7 +170,12 @@ fn torus_points_without_normals_keep_the_genus() {
     let positions: Vec<DVec3> = pts.iter().map(|p| p.position).collect();
     write_xyz(&xyz, &positions, None);
     for seed in 1..=2 {
-        let out = remesh_points(&xyz, &params(2000, seed), &|_| {}).unwrap();
+        let out = remesh_points(
+            &PointSource::File(xyz.clone()),
+            &params(2000, seed),
+            &|_| {},
+        )
+        .unwrap();
         assert!(!out.had_normals);
         assert_closed(&out, 1, 2000);
         let off = worst_off(&out.mesh, |p| {
@@ -172,7 +214,7 @@ fn noise_and_outliers_still_give_the_closed_surface() {
     }
     let input = dir.path().join("noisy.xyz");
     write_xyz(&input, &points, None);
-    let out = remesh_points(&input, &params(1500, 1), &|_| {}).unwrap();
+    let out = remesh_points(&PointSource::File(input.clone()), &params(1500, 1), &|_| {}).unwrap();
     assert!(
         out.outliers_removed >= 900,
         "{} outliers removed",
@@ -206,7 +248,12 @@ fn an_open_patch_keeps_its_boundary_and_its_hole() {
     let input = dir.path().join("patch.xyz");
     write_xyz(&input, &points, Some(&normals));
     for seed in 1..=2 {
-        let out = remesh_points(&input, &params(1500, seed), &|_| {}).unwrap();
+        let out = remesh_points(
+            &PointSource::File(input.clone()),
+            &params(1500, seed),
+            &|_| {},
+        )
+        .unwrap();
         let t = topology(&out.mesh);
         assert!(t.is_manifold(), "seed {seed}: {t:?}");
         assert_eq!(t.components, 1, "seed {seed}: {t:?}");
@@ -238,7 +285,7 @@ fn many_buckets_give_the_same_guarantees_as_one() {
     write_surface_points(&common::icosphere(5), 60_000, 9, &input).unwrap();
     for bucket_points in [1 << 20, 7_000] {
         let out = remesh_points(
-            &input,
+            &PointSource::File(input.clone()),
             &PointRemeshParams {
                 bucket_points,
                 temp_dir: Some(dir.path().to_path_buf()),
@@ -267,7 +314,7 @@ fn a_point_set_needs_a_count() {
         },
         ..PointRemeshParams::default()
     };
-    match remesh_points(&input, &p, &|_| {}) {
+    match remesh_points(&PointSource::File(input.clone()), &p, &|_| {}) {
         Err(Error::InvalidParameter { name, message }) => {
             assert_eq!(name, "points");
             assert!(message.contains("sphere.ply"), "{message}");

@@ -392,7 +392,7 @@ fn a_viewpoint_in_model_units_orients_the_normals_towards_it() {
         out.samples.len()
     );
     let remeshed = spectral_remesh::remesh_points(
-        &input,
+        &spectral_remesh::PointSource::File(input.clone()),
         &spectral_remesh::PointRemeshParams {
             remesh: spectral_remesh::RemeshParams {
                 density: spectral_remesh::Density::Points(500),

@@ -22,6 +22,7 @@ use crate::mesh::TriMesh;
 use crate::pipeline::{
     expected_samples, remesh, validate_input, Density, RemeshParams, MAX_POINTS,
 };
+use crate::points::stream::PointSource;
 use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
 use crate::triangulate::TriangulationMethod;
@@ -98,7 +99,13 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
     };
     let write = |mesh: &TriMesh| write_output(job, format, mesh, &outputs);
     let report = if job.as_points || crate::point_pipeline::is_point_set(&job.input)? {
-        remesh_points::run(job, format, &write, on_stage)?
+        remesh_points::run(
+            job,
+            &PointSource::File(job.input.clone()),
+            format,
+            &write,
+            on_stage,
+        )?
     } else {
         if let Some(limit) = job.max_memory {
             memory::check_input_size(&job.input, limit)?;

@@ -2,8 +2,7 @@
 //! report as for a mesh, and the distances measured against the input points themselves; and
 //! [`remesh_point_set`], the same job on points held in memory.
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Mutex;
 
 use glam::DVec3;
@@ -21,7 +20,7 @@ use crate::pipeline::RemeshParams;
 use crate::pipeline::{Density, MAX_POINTS};
 use crate::point_pipeline::{remesh_points, PointRemeshParams};
 use crate::points::normals::NormalOrientation;
-use crate::points::PointReader;
+use crate::points::stream::PointSource;
 use crate::report::{PointSetDistance, QualityReport};
 use crate::surface::MeshSurface;
 use crate::timing::Clock;
@@ -33,6 +32,7 @@ const DISTANCE_CHUNK: usize = 1 << 20;
 /// `write` takes the output mesh (model units).
 pub(super) fn run(
     job: &RemeshJob,
+    source: &PointSource,
     format: MeshFormat,
     write: &dyn Fn(&TriMesh) -> Result<()>,
     on_stage: &(dyn Fn(&str) + Sync),
@@ -50,7 +50,7 @@ pub(super) fn run(
             memory::check_remesh_budget(0, n as f64, job.measure_distance, limit)?;
         }
     }
-    let out = remesh_points(&job.input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
+    let out = remesh_points(source, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
 
     on_stage("check");
     let t = Clock::start();
@@ -80,7 +80,7 @@ pub(super) fn run(
         let surface = MeshSurface::new(checked)?;
         let mut distance =
             PointSetDistance::new(checked, &surface, DISTANCE_SAMPLES, job.params.seed);
-        let mut reader = PointReader::open(&job.input)?;
+        let mut reader = source.open()?;
         let mut chunk = Vec::new();
         let mut positions: Vec<DVec3> = Vec::new();
         while reader.read_chunk(&mut chunk, DISTANCE_CHUNK)? > 0 {
@@ -238,18 +238,9 @@ pub fn remesh_point_set(
         }
     }
     on_stage("read");
-    let dir = tempfile::tempdir().map_err(|e| Error::Io {
-        path: std::env::temp_dir(),
-        source: e,
-    })?;
-    let input = dir.path().join(if normals.is_some() {
-        "points.xyzn"
-    } else {
-        "points.xyz"
-    });
-    write_text_points(&input, points, normals)?;
+    let source = PointSource::memory(INPUT_POINTS, points, normals);
     let job = RemeshJob::in_memory(
-        input.clone(),
+        PathBuf::from(INPUT_POINTS),
         params,
         measure_distance,
         strict,
@@ -259,14 +250,14 @@ pub fn remesh_point_set(
     let handed = Mutex::new(None);
     let report = run(
         &job,
+        &source,
         MeshFormat::Ply,
         &|mesh| {
             *handed.lock().unwrap_or_else(|e| e.into_inner()) = Some(mesh.clone());
             Ok(())
         },
         on_stage,
-    )
-    .map_err(|e| rename_input(e, &input))?;
+    )?;
     let mesh = handed
         .into_inner()
         .unwrap_or_else(|e| e.into_inner())
@@ -275,66 +266,4 @@ pub fn remesh_point_set(
             message: "the point-set pipeline handed over no mesh".into(),
         })?;
     Ok(RemeshedMesh { mesh, report })
-}
-
-/// `points` (and `normals`) as a text point file at `path`, one point per line, each value in
-/// the shortest form that reads back to the same `f64`.
-fn write_text_points(path: &Path, points: &[DVec3], normals: Option<&[DVec3]>) -> Result<()> {
-    let io = |e: std::io::Error| Error::Io {
-        path: path.to_path_buf(),
-        source: e,
-    };
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
-    for (i, p) in points.iter().enumerate() {
-        match normals {
-            Some(n) => writeln!(
-                w,
-                "{} {} {} {} {} {}",
-                p.x, p.y, p.z, n[i].x, n[i].y, n[i].z
-            ),
-            None => writeln!(w, "{} {} {}", p.x, p.y, p.z),
-        }
-        .map_err(io)?;
-    }
-    w.flush().map_err(io)
-}
-
-/// `e` with the temporary file `input` named as [`INPUT_POINTS`].
-fn rename_input(e: Error, input: &Path) -> Error {
-    let text = input.display().to_string();
-    let rename = |path: PathBuf| {
-        if path == input {
-            PathBuf::from(INPUT_POINTS)
-        } else {
-            path
-        }
-    };
-    match e {
-        Error::Io { path, source } => Error::Io {
-            path: rename(path),
-            source,
-        },
-        Error::Parse {
-            path,
-            line,
-            message,
-        } => Error::Parse {
-            path: rename(path),
-            line,
-            message: message.replace(&text, INPUT_POINTS),
-        },
-        Error::InvalidMesh { path, message } => Error::InvalidMesh {
-            path: rename(path),
-            message: message.replace(&text, INPUT_POINTS),
-        },
-        Error::InvalidParameter { name, message } => Error::InvalidParameter {
-            name,
-            message: message.replace(&text, INPUT_POINTS),
-        },
-        Error::Internal { stage, message } => Error::Internal {
-            stage,
-            message: message.replace(&text, INPUT_POINTS),
-        },
-        other => other,
-    }
 }

@@ -12,7 +12,7 @@ use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
 use super::outliers::{far_isolated, flagged};
-use super::stream::{decode_record, encode_record, Point, PointReader, RECORD_BYTES};
+use super::stream::{decode_record, encode_record, Point, PointSource, RECORD_BYTES};
 use crate::error::{Error, Result};
 use crate::mesh::{Aabb, Normalization};
 
@@ -104,14 +104,15 @@ impl Extremes {
 const FAR_MIN_POINTS: u64 = 1000;
 
 impl Buckets {
-    /// Streams `input` once: its bounding box, and every point to a random bucket file.
+    /// Streams `source` once: its bounding box, and every point to a random bucket file.
     pub(crate) fn write(
-        input: &Path,
+        source: &PointSource,
         bucket_points: usize,
         temp_dir: Option<&Path>,
         rng: &mut ChaCha8Rng,
     ) -> Result<Buckets> {
-        let mut reader = PointReader::open(input)?;
+        let input = source.name();
+        let mut reader = source.open()?;
         let total = reader.count();
         if total == 0 {
             return Err(Error::invalid_mesh(input, "the point set is empty"));

@@ -14,7 +14,7 @@ use super::buckets::Buckets;
 use super::normals::{estimate_normals, NormalOrientation};
 use super::outliers::{off_surface, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
-use super::stream::Point;
+use super::stream::{Point, PointSource};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
 use crate::mesh::Normalization;
@@ -123,7 +123,8 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
     } else {
         0
     };
-    let scan = scan_out_of_core(input, params, false, support_per_sample)?;
+    let source = PointSource::File(input.to_path_buf());
+    let scan = scan_out_of_core(&source, params, false, support_per_sample)?;
     let t3 = Instant::now();
     let ScanOutput {
         mut samples,
@@ -203,7 +204,7 @@ pub(crate) struct ScanOutput {
 /// Passes 1 and 2 of [`simplify_out_of_core`] ([`ScannedInput::open`] and
 /// [`ScannedInput::scan`] at the sigma_p found or given).
 pub(crate) fn scan_out_of_core(
-    input: &Path,
+    input: &PointSource,
     params: &OutOfCoreParams,
     drop_outliers: bool,
     support_per_sample: usize,
@@ -232,7 +233,7 @@ impl ScannedInput {
     /// scan's samples and support (so isolated points neither raise the count the search sees
     /// nor become samples).
     pub(crate) fn open(
-        input: &Path,
+        input: &PointSource,
         params: &OutOfCoreParams,
         drop_outliers: bool,
     ) -> Result<Self> {
@@ -540,7 +541,7 @@ pub fn simplify_progressive(
     let t0 = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let buckets = Buckets::write(
-        input,
+        &PointSource::File(input.to_path_buf()),
         params.bucket_points,
         params.temp_dir.as_deref(),
         &mut rng,
