@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 use crate::kernel::GaussianKernel;
 use crate::measure::{solve_alpha, MeasureWorkspace};
 use crate::sampling::gradient_ascent::GradientAscentResult;
+use crate::sampling::sweep::{Batches, MAX_BATCH};
 use crate::spatial::StaticKdTree;
 
 /// One thread's buffers for [`step`]: the measure's workspace, the neighbours with their squared
@@ -23,9 +24,6 @@ type Scratch<const K: usize> = (
     Vec<(f64, [f64; K])>,
     Vec<[f64; K]>,
 );
-
-/// The most samples moved together (and projected in one call) by a sweep.
-const MAX_BATCH: usize = 64;
 
 /// The parameters checked against the samples (see [`super::resample_manifold`]'s errors).
 pub(super) fn check_params(
@@ -159,8 +157,7 @@ fn resample_in_batches<const K: usize>(
     };
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(params.seed);
     let mut order: Vec<usize> = (0..n).collect();
-    let mut batch_of = vec![0u64; n];
-    let mut batch_id = 0u64;
+    let mut batches = Batches::new(n, max_batch);
     let (mut moved, mut moved_normals) = (Vec::new(), Vec::new());
     for _ in 0..params.iterations {
         // Neighbourhoods found again at each sweep's start. Sec. 6.3 keeps them for all sweeps
@@ -171,96 +168,89 @@ fn resample_in_batches<const K: usize>(
         let lists = neighbour_lists::<K>(&embedded, d, params.support_radius);
         order.shuffle(&mut rng);
         let (mut total_move, mut total_s, mut min_s) = (0.0, 0.0, f64::INFINITY);
-        let mut start = 0;
-        while start < n {
-            // Consecutive samples of which no two are neighbours: their moves read only
-            // samples outside the batch, so together they equal one at a time.
-            batch_id += 1;
-            let mut end = start;
-            while end < n && end - start < max_batch {
-                let i = order[end];
-                if lists[i].iter().any(|&j| batch_of[j as usize] == batch_id) {
-                    break;
-                }
-                batch_of[i] = batch_id;
-                end += 1;
-            }
-            let members = &order[start..end];
-            let steps: Vec<([f64; K], f64)> = members
-                .par_iter()
-                .map_init(
-                    || (MeasureWorkspace::new(), Vec::new(), Vec::new()),
-                    |(ws, near, sorted): &mut Scratch<K>, &i| {
-                        let x = embedded[i];
-                        near.clear();
-                        for &j in &lists[i] {
-                            let y = embedded[j as usize];
-                            let d2 = GaussianKernel::<K>::dist2(&x, &y);
-                            if d2 <= r2 {
-                                near.push((d2, y));
+        // Batches of consecutive samples of which no two are neighbours (`sampling::sweep`):
+        // their moves read only samples outside the batch, so together they equal one at a time
+        // (and a batch is projected in one call).
+        batches.sweep(
+            &order,
+            |i| lists[i].as_slice(),
+            |members| {
+                let steps: Vec<([f64; K], f64)> = members
+                    .par_iter()
+                    .map_init(
+                        || (MeasureWorkspace::new(), Vec::new(), Vec::new()),
+                        |(ws, near, sorted): &mut Scratch<K>, &i| {
+                            let x = embedded[i];
+                            near.clear();
+                            for &j in &lists[i] {
+                                let y = embedded[j as usize];
+                                let d2 = GaussianKernel::<K>::dist2(&x, &y);
+                                if d2 <= r2 {
+                                    near.push((d2, y));
+                                }
                             }
-                        }
-                        near.sort_by(|a, b| a.0.total_cmp(&b.0));
-                        sorted.clear();
-                        sorted.extend(near.iter().map(|p| p.1));
-                        step(&x, sorted, d, params, ws)
-                    },
-                )
-                .collect();
-            moved.clear();
-            for (&i, (delta, _)) in members.iter().zip(&steps) {
-                moved.extend((0..d).map(|c| positions[i * d + c] + sigma_p * delta[c]));
-            }
-            moved_normals.clear();
-            if let Some(nrm) = &normals {
-                for &i in members {
-                    moved_normals.extend_from_slice(&nrm[i * d..(i + 1) * d]);
+                            near.sort_by(|a, b| a.0.total_cmp(&b.0));
+                            sorted.clear();
+                            sorted.extend(near.iter().map(|p| p.1));
+                            step(&x, sorted, d, params, ws)
+                        },
+                    )
+                    .collect();
+                moved.clear();
+                for (&i, (delta, _)) in members.iter().zip(&steps) {
+                    moved.extend((0..d).map(|c| positions[i * d + c] + sigma_p * delta[c]));
                 }
-            }
-            let with_normals = normals.is_some().then_some(&mut moved_normals[..]);
-            projection.project(&mut moved, with_normals)?;
-            for (k, (&i, (_, s))) in members.iter().zip(&steps).enumerate() {
-                let p = &moved[k * d..(k + 1) * d];
-                if let Some(c) = p.iter().position(|c| !c.is_finite()) {
-                    return Err(Error::InvalidParameter {
-                        name: "project",
-                        message: format!(
-                            "the projection gave sample {i} a coordinate that is not finite \
-                             (column {c})"
-                        ),
-                    });
+                moved_normals.clear();
+                if let Some(nrm) = &normals {
+                    for &i in members {
+                        moved_normals.extend_from_slice(&nrm[i * d..(i + 1) * d]);
+                    }
                 }
-                let dist = p
-                    .iter()
-                    .zip(&positions[i * d..(i + 1) * d])
-                    .map(|(a, b)| (a - b) * (a - b))
-                    .sum::<f64>()
-                    .sqrt();
-                positions[i * d..(i + 1) * d].copy_from_slice(p);
-                if let Some(nrm) = &mut normals {
-                    let m = &mut moved_normals[k * d..(k + 1) * d];
-                    let len = m.iter().map(|c| c * c).sum::<f64>().sqrt();
-                    if !(len.is_finite() && len > 0.0) {
+                let with_normals = normals.is_some().then_some(&mut moved_normals[..]);
+                projection.project(&mut moved, with_normals)?;
+                for (k, (&i, (_, s))) in members.iter().zip(&steps).enumerate() {
+                    let p = &moved[k * d..(k + 1) * d];
+                    if let Some(c) = p.iter().position(|c| !c.is_finite()) {
                         return Err(Error::InvalidParameter {
                             name: "project",
                             message: format!(
-                                "the projection gave sample {i} a normal with no direction"
+                                "the projection gave sample {i} a coordinate that is not finite \
+                             (column {c})"
                             ),
                         });
                     }
-                    m.iter_mut().for_each(|c| *c /= len);
-                    nrm[i * d..(i + 1) * d].copy_from_slice(m);
+                    let dist = p
+                        .iter()
+                        .zip(&positions[i * d..(i + 1) * d])
+                        .map(|(a, b)| (a - b) * (a - b))
+                        .sum::<f64>()
+                        .sqrt();
+                    positions[i * d..(i + 1) * d].copy_from_slice(p);
+                    if let Some(nrm) = &mut normals {
+                        let m = &mut moved_normals[k * d..(k + 1) * d];
+                        let len = m.iter().map(|c| c * c).sum::<f64>().sqrt();
+                        if !(len.is_finite() && len > 0.0) {
+                            return Err(Error::InvalidParameter {
+                                name: "project",
+                                message: format!(
+                                    "the projection gave sample {i} a normal with no direction"
+                                ),
+                            });
+                        }
+                        m.iter_mut().for_each(|c| *c /= len);
+                        nrm[i * d..(i + 1) * d].copy_from_slice(m);
+                    }
+                    embedded[i] = embed_one(
+                        &positions[i * d..(i + 1) * d],
+                        normals.as_deref().map(|nrm| &nrm[i * d..(i + 1) * d]),
+                    );
+                    total_move += dist;
+                    total_s += s;
+                    min_s = f64::min(min_s, *s);
                 }
-                embedded[i] = embed_one(
-                    &positions[i * d..(i + 1) * d],
-                    normals.as_deref().map(|nrm| &nrm[i * d..(i + 1) * d]),
-                );
-                total_move += dist;
-                total_s += s;
-                min_s = f64::min(min_s, *s);
-            }
-            start = end;
-        }
+                Ok(())
+            },
+        )?;
         let m = n.max(1) as f64;
         result.mean_move.push(total_move / m);
         result.mean_s.push(total_s / m);

@@ -7,12 +7,10 @@ use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
 use crate::sampling::crease_band::CreaseBand;
 use crate::sampling::sizing::SizingField;
+use crate::sampling::sweep::{Batches, MAX_BATCH};
 use crate::spatial::StaticTree;
 use crate::surface::Projection;
 use crate::surface::SurfaceSample;
-
-/// The most samples moved in parallel at once by the sequential sweep.
-const MAX_BATCH: usize = 64;
 
 /// Type of one thread's buffers for [`move_one`].
 type Scratch = (MeasureWorkspace, Vec<(f64, KernelPoint)>, Vec<KernelPoint>);
@@ -138,31 +136,14 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let mut order: Vec<usize> = (fixed..n).collect();
         let mut embedded: Vec<KernelPoint> = samples.iter().map(embed).collect();
-        // The batch each sample was last put in (0: none yet).
-        let mut batch = vec![0u64; n];
-        let mut batch_id = 0u64;
+        let mut batches = Batches::new(n, MAX_BATCH);
         for _ in 0..params.iterations {
             order.shuffle(&mut rng);
             let (mut total_move, mut total_s, mut min_s) = (0.0, 0.0, f64::INFINITY);
             // The samples are taken in `order`, in batches of consecutive ones of which no two
-            // are neighbours: a batch's moves read only samples outside it, so they are
-            // computed in parallel with the same result as one at a time.
-            let mut start = 0;
-            while start < order.len() {
-                batch_id += 1;
-                let mut end = start;
-                while end < order.len() && end - start < MAX_BATCH {
-                    let i = order[end];
-                    if lists[i - fixed]
-                        .iter()
-                        .any(|&j| batch[j as usize] == batch_id)
-                    {
-                        break;
-                    }
-                    batch[i] = batch_id;
-                    end += 1;
-                }
-                let members = &order[start..end];
+            // are neighbours (`sampling::sweep`).
+            let neighbours = |i: usize| lists[i - fixed].as_slice();
+            let sweep = batches.sweep(&order, neighbours, |members| {
                 let moves: Vec<(SurfaceSample, f64, f64)> = members
                     .par_iter()
                     .map(|&i| {
@@ -190,7 +171,10 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
                     total_s += s;
                     min_s = f64::min(min_s, s);
                 }
-                start = end;
+                Ok::<(), std::convert::Infallible>(())
+            });
+            if let Err(never) = sweep {
+                match never {}
             }
             let m = order.len().max(1) as f64;
             result.mean_move.push(total_move / m);

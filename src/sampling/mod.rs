@@ -11,4 +11,5 @@ pub mod grading;
 pub mod linear_scan;
 pub mod sizing;
 pub mod spacing;
+pub(crate) mod sweep;
 pub mod target_count;
