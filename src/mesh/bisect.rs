@@ -6,6 +6,7 @@
 //! edges.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use std::collections::VecDeque;
 
 use super::TriMesh;
@@ -121,10 +122,17 @@ fn link(next: &mut [u32], ring: &[u32]) {
 }
 
 /// Splits edges of `mesh` at their midpoints, each face's longest first, until every edge is
-/// at most `max_length` long (units of the mesh). `None` when that takes more than `max_splits`
-/// splits (each adds one vertex; slivers, whose bisection makes ever thinner slivers, can take
-/// far more than their area suggests). Deterministic: the same input gives the same output.
-pub fn bisect_to_length(mesh: &TriMesh, max_length: f64, max_splits: usize) -> Option<Refined> {
+/// at most `max_length` long (units of the mesh), or with a `scale` (a relative length in
+/// (0, 1] over positions) at most `max_length` times the smallest scale at the corners of its
+/// face. `None` when that takes more than `max_splits` splits (each adds one vertex; slivers,
+/// whose bisection makes ever thinner slivers, can take far more than their area suggests).
+/// Deterministic: the same input gives the same output.
+pub fn bisect_to_length(
+    mesh: &TriMesh,
+    max_length: f64,
+    scale: Option<&(dyn Fn(DVec3) -> f64 + Sync)>,
+    max_splits: usize,
+) -> Option<Refined> {
     let mut positions = mesh.positions.clone();
     let mut triangles = mesh.triangles.clone();
     let mut parent: Vec<u32> = (0..triangles.len() as u32).collect();
@@ -154,6 +162,11 @@ pub fn bisect_to_length(mesh: &TriMesh, max_length: f64, max_splits: usize) -> O
         }
         (best, best_d)
     };
+    // The scale at each vertex (squared), taken once per vertex.
+    let mut scale2: Vec<f64> = match scale {
+        Some(s) => positions.par_iter().map(|&p| s(p).powi(2)).collect(),
+        None => Vec::new(),
+    };
     let mut queue: VecDeque<u32> = (0..triangles.len() as u32).collect();
     let mut splits = 0;
     let (mut around, mut at_a, mut at_b) = (Vec::new(), Vec::new(), Vec::new());
@@ -163,6 +176,10 @@ pub fn bisect_to_length(mesh: &TriMesh, max_length: f64, max_splits: usize) -> O
             continue;
         }
         let (k, d2) = longest(&positions, t);
+        let limit2 = match scale {
+            None => limit2,
+            Some(_) => limit2 * t.iter().map(|&v| scale2[v as usize]).fold(1.0, f64::min),
+        };
         if d2 <= limit2 || !d2.is_finite() {
             continue;
         }
@@ -174,6 +191,9 @@ pub fn bisect_to_length(mesh: &TriMesh, max_length: f64, max_splits: usize) -> O
         let (a, b) = (t[k], t[(k + 1) % 3]);
         let m = positions.len() as u32;
         positions.push(0.5 * (positions[a as usize] + positions[b as usize]));
+        if let Some(s) = scale {
+            scale2.push(s(positions[m as usize]).powi(2));
+        }
         splits += 1;
         at_a.clear();
         at_b.clear();
@@ -224,10 +244,36 @@ mod tests {
             .fold(0.0, f64::max)
     }
 
+    /// With a scale, each edge is at most the length times the smallest scale at its face's
+    /// corners: finer where the scale is small, as coarse as without it where it is 1.
+    #[test]
+    fn a_scale_refines_where_it_is_small() {
+        let mesh = test_meshes::uv_sphere(10.0, 6, 8);
+        let half = |p: DVec3| if p.x > 0.0 { 0.5 } else { 1.0 };
+        let r = bisect_to_length(&mesh, 2.0, Some(&half), usize::MAX).unwrap();
+        let plain = bisect_to_length(&mesh, 2.0, None, usize::MAX).unwrap();
+        assert!(r.positions.len() > plain.positions.len());
+        for t in &r.triangles {
+            let smallest = t
+                .iter()
+                .map(|&v| half(r.positions[v as usize]))
+                .fold(1.0, f64::min);
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                assert!(r.positions[a].distance(r.positions[b]) <= 2.0 * smallest + 1e-12);
+            }
+        }
+        // A scale of 1 everywhere is no scale.
+        let one = |_: DVec3| 1.0;
+        let same = bisect_to_length(&mesh, 2.0, Some(&one), usize::MAX).unwrap();
+        assert_eq!(same.positions, plain.positions);
+        assert_eq!(same.triangles, plain.triangles);
+    }
+
     #[test]
     fn refines_below_the_length_and_keeps_the_surface() {
         let mesh = test_meshes::uv_sphere(10.0, 6, 8);
-        let r = bisect_to_length(&mesh, 1.0, usize::MAX).unwrap();
+        let r = bisect_to_length(&mesh, 1.0, None, usize::MAX).unwrap();
         assert!(max_edge(&r) <= 1.0 + 1e-12);
         let before = TriMesh::new(mesh.positions.clone(), mesh.triangles.clone());
         let after = TriMesh::new(r.positions.clone(), r.triangles.clone());
@@ -251,13 +297,13 @@ mod tests {
     #[test]
     fn the_split_budget_is_kept() {
         let mesh = test_meshes::uv_sphere(10.0, 6, 8);
-        assert!(bisect_to_length(&mesh, 1.0, 100).is_none());
+        assert!(bisect_to_length(&mesh, 1.0, None, 100).is_none());
     }
 
     #[test]
     fn a_mesh_already_fine_is_unchanged() {
         let mesh = test_meshes::uv_sphere(1.0, 6, 8);
-        let r = bisect_to_length(&mesh, 10.0, 0).unwrap();
+        let r = bisect_to_length(&mesh, 10.0, None, 0).unwrap();
         assert_eq!(r.positions, mesh.positions);
         assert_eq!(r.triangles, mesh.triangles);
     }

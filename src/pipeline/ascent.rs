@@ -9,7 +9,6 @@ use super::RemeshParams;
 use crate::error::Result;
 use crate::kernel::Kernel;
 use crate::sampling::crease_band::CreaseBand;
-use crate::sampling::features::Corners;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::spacing::FEATURE_SPACING_PER_SIGMA;
 use crate::surface::SurfaceSample;
@@ -43,17 +42,13 @@ pub(super) fn ascend(
 ) -> Result<Ascended> {
     let sigma_p = scanned.sigma_p;
     let kernel = Kernel::new(sigma_p, params.sigma_n)?;
-    let scan = &mut scanned.scan;
-    let mut samples = std::mem::take(&mut scan.result.samples);
+    let mut samples = std::mem::take(&mut scanned.scan.result.samples);
+    let (scanned, feature_spacing) = (&*scanned, FEATURE_SPACING_PER_SIGMA * sigma_p);
+    let scan = &scanned.scan;
     let boundary_count = scan.result.initial;
     let before_ascent = index.buried_test.as_ref().map(|_| samples.clone());
-    let feature_spacing = FEATURE_SPACING_PER_SIGMA * sigma_p;
-    let (widths, corners) = (&scanned.widths, &scan.corners);
-    let corner_term = Corners {
-        corners,
-        spacing: feature_spacing,
-    };
-    let field = widths.with_corners(&corner_term);
+    let corner_term = scanned.corner_term();
+    let field = scanned.widths.with_corners(&corner_term);
     // Surface samples keep out of a band along the sampled creases.
     let band = {
         let positions: Vec<DVec3> = samples[..boundary_count]

@@ -187,14 +187,11 @@ fn run_once<'s>(
     on_stage("triangulate");
     let (sigma_p, curves) = (scanned.sigma_p, &scanned.scan);
     let (boundary_edges, feature_edges) = (&curves.boundary_edges, &curves.feature_edges);
-    let mut triangulated = triangulate_samples(
-        &ascended.samples,
-        sigma_p,
-        boundary_edges,
-        feature_edges,
-        index,
-        params,
-    );
+    let corners = scanned.corner_term();
+    let field = scanned.widths.with_corners(&corners);
+    let edges = (boundary_edges.as_slice(), feature_edges.as_slice());
+    let samples = &ascended.samples;
+    let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, params);
     timer.lap("triangulate");
 
     // Where the input's faces cross or its parts meet: an output face within a spacing of there

@@ -54,6 +54,16 @@ pub(super) struct Scanned<'s> {
     pub widths: Widths<'s>,
 }
 
+impl Scanned<'_> {
+    /// The grading towards the corners the creases are graded towards, at the creases' spacing.
+    pub(super) fn corner_term(&self) -> Corners<'_> {
+        Corners {
+            corners: &self.scan.corners,
+            spacing: FEATURE_SPACING_PER_SIGMA * self.sigma_p,
+        }
+    }
+}
+
 /// What one evaluation of the scan reads.
 struct ScanInputs<'a> {
     input: &'a NormalizedInput,

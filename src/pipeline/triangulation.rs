@@ -10,6 +10,7 @@ use super::RemeshParams;
 use crate::geometry::tolerance::ON_SURFACE_RELATIVE;
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
+use crate::sampling::sizing::SizingField;
 use crate::sampling::spacing::SAMPLES_PER_SIGMA2;
 use crate::surface::SurfaceSample;
 use crate::triangulate::recover::{close_slits, flip_crease_slivers, recover_edges, RecoverStats};
@@ -33,13 +34,13 @@ pub(super) struct Triangulated {
     pub recovery: RecoverStats,
 }
 
-/// Triangulates `samples` (on the input, spaced about `sigma_p`) with their curve edges
-/// (`boundary_edges`, `feature_edges`: vertex pairs).
+/// Triangulates `samples` (on the input, spaced about `sigma_p` times the sizing `field`) with
+/// their curve edges (`boundary_edges`, `feature_edges`: vertex pairs).
 pub(super) fn triangulate_samples(
     samples: &[SurfaceSample],
     sigma_p: f64,
-    boundary_edges: &[[u32; 2]],
-    feature_edges: &[[u32; 2]],
+    field: &dyn SizingField,
+    (boundary_edges, feature_edges): (&[[u32; 2]], &[[u32; 2]]),
     index: &InputIndex,
     params: &RemeshParams,
 ) -> Triangulated {
@@ -73,7 +74,15 @@ pub(super) fn triangulate_samples(
             // area; on boundary curves one per sigma_p or closer).
             let spacing = sigma_p / SAMPLES_PER_SIGMA2.sqrt();
             let sheets = &index.sheets;
-            triangulate_restricted(&set, surface, sheets, spacing, &params.triangulate, &rd)
+            triangulate_restricted(
+                &set,
+                surface,
+                sheets,
+                spacing,
+                field,
+                &params.triangulate,
+                &rd,
+            )
         }
     };
     let (faces, mut face_sources, mut assembly, restricted_delaunay) = match restricted {

@@ -20,6 +20,7 @@ pub use restricted_delaunay::{RestrictedDelaunayParams, RestrictedDelaunayStats}
 pub use tangent_delaunay::{vote_triangles, SampleSet, TangentDelaunayParams, VotedTriangle};
 
 use crate::mesh::sheets::Sheets;
+use crate::sampling::sizing::SizingField;
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
@@ -75,14 +76,20 @@ pub fn triangulate_restricted(
     surface: &MeshSurface,
     sheets: &Sheets,
     spacing: f64,
+    field: &dyn SizingField,
     params: &TriangulateParams,
     rd: &RestrictedDelaunayParams,
 ) -> Option<Restricted> {
     let mut rd_stats = None;
     let (faces, sources, stats) = on_distinct(set, |s| {
-        let Some((voted, st)) =
-            restricted_delaunay::restricted_delaunay(surface, sheets, s.positions, spacing, rd)
-        else {
+        let Some((voted, st)) = restricted_delaunay::restricted_delaunay(
+            surface,
+            sheets,
+            s.positions,
+            spacing,
+            field,
+            rd,
+        ) else {
             return (Vec::new(), Vec::new(), AssemblyStats::default());
         };
         rd_stats = Some(st);

@@ -24,6 +24,7 @@ use std::collections::BinaryHeap;
 use super::tangent_delaunay::VotedTriangle;
 use crate::mesh::bisect::bisect_to_length;
 use crate::mesh::sheets::Sheets;
+use crate::sampling::sizing::SizingField;
 use crate::spatial::StaticTree;
 use crate::surface::MeshSurface;
 
@@ -73,6 +74,7 @@ pub fn restricted_delaunay(
     sheets: &Sheets,
     positions: &[DVec3],
     spacing: f64,
+    field: &dyn SizingField,
     params: &RestrictedDelaunayParams,
 ) -> Option<(Vec<VotedTriangle>, RestrictedDelaunayStats)> {
     let budget = params
@@ -83,9 +85,13 @@ pub fn restricted_delaunay(
     // part's triangles join only its own samples.
     let split = sheets.split(surface.mesh());
     let sheet = &sheets.part;
+    // The input refined to a fraction of the local spacing: the sizing field's where the
+    // samples are graded.
+    let width = |p: DVec3| field.width(p);
     let refined = bisect_to_length(
         split.as_ref().unwrap_or(surface.mesh()),
         params.resolution * spacing,
+        (!field.is_uniform()).then_some(&width as &(dyn Fn(DVec3) -> f64 + Sync)),
         budget,
     )?;
     let n = refined.positions.len();
@@ -279,6 +285,7 @@ mod tests {
     use super::*;
     use crate::mesh::test_meshes;
     use crate::mesh::TriMesh;
+    use crate::sampling::sizing::Uniform;
     use crate::triangulate::{triangulate, triangulate_restricted, SampleSet, TriangulateParams};
 
     /// Samples of a plate `w × w × t` (t far below the spacing 1): a grid on the top and the
@@ -338,6 +345,7 @@ mod tests {
                 surface,
                 &Sheets::new(surface.mesh()),
                 1.0,
+                &Uniform,
                 &params,
                 &RestrictedDelaunayParams::default(),
             )
@@ -389,9 +397,15 @@ mod tests {
             normals: &normals,
             boundary_edges: &[],
         };
-        let (voted, stats) =
-            restricted_delaunay(&surface, &sheets, &positions, spacing, &Default::default())
-                .unwrap();
+        let (voted, stats) = restricted_delaunay(
+            &surface,
+            &sheets,
+            &positions,
+            spacing,
+            &Uniform,
+            &Default::default(),
+        )
+        .unwrap();
         assert_eq!(stats.empty_cells, 0);
         // On a sphere the dual alone is the whole triangulation: 2V - 4 faces.
         assert_eq!(voted.len(), 2 * 300 - 4);
@@ -400,6 +414,7 @@ mod tests {
             &surface,
             &sheets,
             spacing,
+            &Uniform,
             &TriangulateParams::default(),
             &Default::default(),
         )
