@@ -159,7 +159,7 @@ pub use report::{QualityReport, SurfaceDistance, TriangleQuality};
 pub use app::remesh_point_set;
 pub use point_pipeline::{remesh_points, PointRemeshOutput, PointRemeshParams};
 pub use points::out_of_core::{simplify_out_of_core, OutOfCoreParams, OutOfCoreResult};
-pub use points::stream::PointSource;
+pub use points::source::PointSource;
 // Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.
 pub use manifold::{
     resample_manifold, sample_manifold, DataProjection, ManifoldProjection, ManifoldResampleParams,
@@ -297,6 +297,7 @@ pub mod internal {
         is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams,
         DOMAIN_GAP_SIGMA_P, MAX_SCANS, OPEN_GAP_SIGMA_P, RIMLS_POINTS_PER_SAMPLE,
     };
+    pub use crate::points::source::ReadPoints;
     pub use crate::points::{PlyPointWriter, Point, PointReader};
 
     // The jobs of the `remesh` command line: files in, files and report out.

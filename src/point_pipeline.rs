@@ -24,7 +24,7 @@ use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{rimls_of, OutOfCoreParams, RimlsSupport, ScannedInput};
 use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
-use crate::points::stream::PointSource;
+use crate::points::source::PointSource;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::linear_scan::LinearScanner;
 use crate::sampling::sizing::Uniform;

@@ -22,7 +22,7 @@ use crate::mesh::TriMesh;
 use crate::pipeline::{
     expected_samples, remesh, validate_input, Density, RemeshParams, MAX_POINTS,
 };
-use crate::points::stream::PointSource;
+use crate::points::source::PointSource;
 use crate::report::{surface_distance_with, QualityReport};
 use crate::surface::MeshSurface;
 use crate::triangulate::TriangulationMethod;

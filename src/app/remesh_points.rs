@@ -20,7 +20,7 @@ use crate::pipeline::RemeshParams;
 use crate::pipeline::{Density, MAX_POINTS};
 use crate::point_pipeline::{remesh_points, PointRemeshParams};
 use crate::points::normals::NormalOrientation;
-use crate::points::stream::PointSource;
+use crate::points::source::PointSource;
 use crate::report::{PointSetDistance, QualityReport};
 use crate::surface::MeshSurface;
 use crate::timing::Clock;

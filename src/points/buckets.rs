@@ -12,7 +12,8 @@ use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
 use super::outliers::{far_isolated, flagged};
-use super::stream::{decode_record, encode_record, Point, PointSource, RECORD_BYTES};
+use super::source::PointSource;
+use super::stream::{decode_record, encode_record, Point, RECORD_BYTES};
 use crate::error::{Error, Result};
 use crate::mesh::{Aabb, Normalization};
 

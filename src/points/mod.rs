@@ -8,6 +8,7 @@ pub mod normals;
 pub mod out_of_core;
 pub mod outliers;
 pub mod rimls;
+pub mod source;
 pub mod stream;
 
 pub use stream::{PlyPointWriter, Point, PointReader};
