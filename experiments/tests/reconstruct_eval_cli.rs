@@ -1,22 +1,13 @@
 //! Runs `spectral-experiments reconstruct-eval` on a small case and checks its JSON report, the
 //! meshes it writes, and the usage error for an unknown method.
 
-use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde_json::Value;
 
-/// `data/NAME` of the checkout when it has the model, else the shared model beside the checkout
-/// (only the tests marked `#[ignore = "needs ../shared"]` read those).
-fn shared(name: &str) -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let own = root.join("data").join(name);
-    if own.is_file() {
-        own
-    } else {
-        root.join("../shared/data").join(name)
-    }
-}
+mod common;
+
+use common::model;
 
 fn float(v: &Value, path: &[&str]) -> f64 {
     let mut x = v;
@@ -42,7 +33,7 @@ fn reconstruct_eval_writes_json_and_meshes_and_refuses_an_unknown_method() {
             "--methods",
             "ours,random",
         ])
-        .arg(shared("spot.obj"))
+        .arg(model("spot.obj"))
         .arg("--json")
         .arg(&json)
         .arg("--meshes")
@@ -65,7 +56,7 @@ fn reconstruct_eval_writes_json_and_meshes_and_refuses_an_unknown_method() {
 
     let out = Command::new(env!("CARGO_BIN_EXE_spectral-experiments"))
         .args(["reconstruct-eval", "--methods", "ours,lloyd"])
-        .arg(shared("spot.obj"))
+        .arg(model("spot.obj"))
         .output()
         .expect("run spectral-experiments");
     assert_eq!(out.status.code(), Some(2));

@@ -1,7 +1,7 @@
 //! The reconstruction experiment (Sec. 7.2, Table 2) end to end on a small case: spot at one
 //! σ_p from a dense point set.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use spectral_experiments::reconstruction_eval::{
     evaluate_model, input_points, read_normalized_outward, PointSource, ReconstructionEvalParams,
@@ -9,17 +9,9 @@ use spectral_experiments::reconstruction_eval::{
 use spectral_experiments::subsample::Subsampler;
 use spectral_remesh::internal::NormalField;
 
-/// `data/NAME` of the checkout when it has the model, else the shared model beside the checkout
-/// (only the tests marked `#[ignore = "needs ../shared"]` read those).
-fn model(name: &str) -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let own = root.join("data").join(name);
-    if own.is_file() {
-        own
-    } else {
-        root.join("../shared/data").join(name)
-    }
-}
+mod common;
+
+use common::model;
 
 #[test]
 fn spot_pipeline_reconstructs_the_input_and_every_subsampler_hits_the_count() {
