@@ -221,14 +221,15 @@ pub(super) fn scan<'s>(
         boundary_limit,
     };
     // The candidates' widths for one sigma_ref, taken once for a round's evaluations.
-    let pool_widths = |w: &Widths| -> Vec<f64> {
+    // (None for a uniform field, which the scan takes as 1 everywhere.)
+    let pool_widths = |w: &Widths| -> Option<Vec<f64>> {
         let field = w.field();
-        pool.par_iter().map(|c| field.width(c.position)).collect()
+        (!field.is_uniform()).then(|| pool.par_iter().map(|c| field.width(c.position)).collect())
     };
     let (sigma_p, target_reached, history, value, widths) = match target {
         Target::SigmaP(s) => {
             let w = sizing.widths_at(pool, s);
-            let pool_w = (!w.field().is_uniform()).then(|| pool_widths(&w));
+            let pool_w = pool_widths(&w);
             let (count, value) = inputs.at(s, &w, pool_w.as_deref())?;
             (s, true, vec![(s, count)], value, w)
         }
@@ -242,7 +243,7 @@ pub(super) fn scan<'s>(
             let mut round = 0;
             loop {
                 let w = sizing.widths_at(pool, search.sigma_ref);
-                let pool_w = (!w.field().is_uniform()).then(|| pool_widths(&w));
+                let pool_w = pool_widths(&w);
                 let mut failure = None;
                 let r = find_sigma_p(&count_search, round_start, |s| {
                     match inputs.at(s, &w, pool_w.as_deref()) {

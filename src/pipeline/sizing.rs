@@ -95,20 +95,13 @@ pub(super) struct Widths<'a> {
 impl Widths<'_> {
     /// The sizing field: the smallest of the terms on (uniform with none).
     pub(super) fn field(&self) -> Smallest<'_> {
-        let mut terms: Vec<&dyn SizingField> = Vec::new();
-        if let Some(t) = &self.thickness {
-            terms.push(t);
-        }
-        if let Some(c) = &self.curvature {
-            terms.push(c);
-        }
-        Smallest(terms)
+        let thickness = self.thickness.as_ref().map(|t| t as &dyn SizingField);
+        let curvature = self.curvature.as_ref().map(|c| c as &dyn SizingField);
+        Smallest::new(thickness.into_iter().chain(curvature))
     }
 
     /// [`Widths::field`] lowered around the corners creases are graded towards.
     pub(super) fn with_corners<'b>(&'b self, corners: &'b Corners<'b>) -> Smallest<'b> {
-        let mut field = self.field();
-        field.0.push(corners);
-        field
+        self.field().with(corners)
     }
 }

@@ -30,7 +30,7 @@ impl PointSource {
     /// Points in memory: `positions` and, when given, their normals (made unit length, as a
     /// file's are), named `name` in messages.
     pub fn memory(name: &str, positions: &[DVec3], normals: Option<&[DVec3]>) -> PointSource {
-        let points: Vec<Point> = positions
+        let points: Arc<[Point]> = positions
             .iter()
             .enumerate()
             .map(|(i, &position)| Point {
@@ -40,7 +40,7 @@ impl PointSource {
             .collect();
         PointSource::Memory {
             name: PathBuf::from(name),
-            points: points.into(),
+            points,
             has_normals: normals.is_some(),
         }
     }

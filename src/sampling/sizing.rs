@@ -43,19 +43,32 @@ impl SizingField for CurvatureWidths {
     }
 }
 
-/// The smallest of `terms` (1 where none is smaller): uniform when every term is.
-pub struct Smallest<'a>(pub Vec<&'a dyn SizingField>);
+/// The smallest of its terms (1 where none is smaller): uniform when every term is. The terms
+/// that are uniform by construction are left out when it is made, not asked at every point.
+pub struct Smallest<'a>(Vec<&'a dyn SizingField>);
+
+impl<'a> Smallest<'a> {
+    /// The smallest of `terms`.
+    pub fn new(terms: impl IntoIterator<Item = &'a dyn SizingField>) -> Self {
+        Smallest(terms.into_iter().filter(|t| !t.is_uniform()).collect())
+    }
+
+    /// This field and `term`, the smaller.
+    pub fn with(mut self, term: &'a dyn SizingField) -> Self {
+        if !term.is_uniform() {
+            self.0.push(term);
+        }
+        self
+    }
+}
 
 impl SizingField for Smallest<'_> {
     fn width(&self, p: DVec3) -> f64 {
-        self.0
-            .iter()
-            .filter(|t| !t.is_uniform())
-            .fold(1.0, |w, t| w.min(t.width(p)))
+        self.0.iter().fold(1.0, |w, t| w.min(t.width(p)))
     }
 
     fn is_uniform(&self) -> bool {
-        self.0.iter().all(|t| t.is_uniform())
+        self.0.is_empty()
     }
 }
 
@@ -80,9 +93,9 @@ mod tests {
             corners: &[],
             spacing: 1.0,
         };
-        assert!(Smallest(vec![]).is_uniform());
-        assert!(Smallest(vec![&Uniform, &corners]).is_uniform());
-        let field = Smallest(vec![&Uniform, &Half, &corners]);
+        assert!(Smallest::new([]).is_uniform());
+        assert!(Smallest::new([&Uniform as &dyn SizingField, &corners]).is_uniform());
+        let field = Smallest::new([&Uniform as &dyn SizingField, &Half, &corners]);
         assert!(!field.is_uniform());
         assert_eq!(field.width(DVec3::X), 0.5);
         assert_eq!(field.width(-DVec3::X), 1.0);
