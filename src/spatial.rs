@@ -256,6 +256,17 @@ impl<const K: usize> StaticKdTree<K> {
         }
     }
 
+    /// Calls `visit(index, squared distance)` for the points within squared distance
+    /// `radius_2` of `q`, in no particular order, without collecting them.
+    pub fn visit_within(&self, q: &[f64; K], radius_2: f64, mut visit: impl FnMut(u32, f64)) {
+        if let Some(t) = &self.tree {
+            t.query(q)
+                .within::<SquaredEuclidean<f64>>(radius_2)
+                .unsorted()
+                .visit(|q| visit(q.item, q.distance));
+        }
+    }
+
     /// The nearest point to `q` as `(index, squared distance)`; `None` when the tree is empty.
     pub fn nearest(&self, q: &[f64; K]) -> Option<(u32, f64)> {
         let r = self
@@ -303,6 +314,12 @@ impl StaticTree {
     /// [`StaticTree::within`]), as `(index, squared distance)`.
     pub fn within_unsorted(&self, p: DVec3, radius_2: f64, out: &mut Vec<(u32, f64)>) {
         self.tree.within_unsorted(&arr(p), radius_2, out);
+    }
+
+    /// Calls `visit(index, squared distance)` for the points within squared distance
+    /// `radius_2` of `p`, in no particular order, without collecting them.
+    pub fn visit_within(&self, p: DVec3, radius_2: f64, visit: impl FnMut(u32, f64)) {
+        self.tree.visit_within(&arr(p), radius_2, visit);
     }
 
     /// The nearest point to `p` as `(index, squared distance)`; `None` when the tree is empty.

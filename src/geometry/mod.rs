@@ -6,6 +6,7 @@
 //! building blocks under the pipeline's stages, not stages, and read best with the prefix.
 
 pub(crate) mod bvh;
+pub(crate) mod closest_point_tree;
 pub(crate) mod morton;
 pub(crate) mod plane;
 pub(crate) mod self_intersection;

@@ -57,10 +57,7 @@ pub(super) struct Scanned<'s> {
 impl Scanned<'_> {
     /// The grading towards the corners the creases are graded towards, at the creases' spacing.
     pub(super) fn corner_term(&self) -> Corners<'_> {
-        Corners {
-            corners: &self.scan.corners,
-            spacing: FEATURE_SPACING_PER_SIGMA * self.sigma_p,
-        }
+        Corners::new(&self.scan.corners, FEATURE_SPACING_PER_SIGMA * self.sigma_p)
     }
 }
 
@@ -121,10 +118,7 @@ impl ScanInputs<'_> {
         // Around a corner that creases are graded towards, the other curves and the surface
         // samples are graded too (corner_width).
         let corners = graded_corners(normalized, &feature_curves, feature_spacing);
-        let corner_term = Corners {
-            corners: &corners,
-            spacing: feature_spacing,
-        };
+        let corner_term = Corners::new(&corners, feature_spacing);
         let field = widths.with_corners(&corner_term);
         let b = sample_curves_and_features(
             normalized,

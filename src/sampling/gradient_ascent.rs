@@ -289,12 +289,8 @@ fn move_one<S: Projection + ?Sized>(
     if len > max_move {
         delta *= max_move / len;
     }
-    // The old position is on the surface, so the closest point is within the move's length.
-    let project = |delta: glam::DVec3| {
-        surface
-            .project_near(old.position + delta, delta.length())
-            .unwrap_or(old)
-    };
+    // The old position is on the surface: the search starts from it.
+    let project = |delta: glam::DVec3| surface.project_from(old.position + delta, &old).unwrap_or(old);
     let mut moved = project(delta);
     for _ in 0..params.backtracking {
         // Keep the move only if it does not lower s (with the neighbours held where they are).

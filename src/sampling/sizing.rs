@@ -89,10 +89,7 @@ mod tests {
 
     #[test]
     fn the_smallest_term_sets_the_width() {
-        let corners = crate::sampling::features::Corners {
-            corners: &[],
-            spacing: 1.0,
-        };
+        let corners = crate::sampling::features::Corners::new(&[], 1.0);
         assert!(Smallest::new([]).is_uniform());
         assert!(Smallest::new([&Uniform as &dyn SizingField, &corners]).is_uniform());
         let field = Smallest::new([&Uniform as &dyn SizingField, &Half, &corners]);

@@ -1,14 +1,13 @@
-//! Closest-point projection onto a triangle mesh, through the bounding-volume hierarchy of
-//! `parry3d-f64`. Used to project gradient-ascent moves back onto the input surface (Sec. 6.2) and
+//! Closest-point projection onto a triangle mesh, through a bounding-volume hierarchy built for
+//! that query ([`ClosestPointTree`]), warm-started from the face of a previous answer where the
+//! caller has one. Used to project gradient-ascent moves back onto the input surface (Sec. 6.2) and
 //! to measure the distance between two surfaces (Hausdorff, RMS).
 
-use glam::DVec3;
-use parry3d_f64::query::PointQueryWithLocation;
-use parry3d_f64::shape::{TriMesh as ParryTriMesh, TrianglePointLocation};
-
 use crate::error::{Error, Result};
+use crate::geometry::closest_point_tree::ClosestPointTree;
 use crate::geometry::tolerance::SEARCH_BOUND_SLACK;
 use crate::mesh::TriMesh;
+use glam::DVec3;
 
 /// A point on the surface: where it is, on which triangle, with which barycentric coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,9 +28,7 @@ pub struct SurfacePoint {
 /// keeps its index in the source mesh.
 pub struct MeshSurface {
     mesh: TriMesh,
-    bvh: ParryTriMesh,
-    /// parry triangle index -> source face index.
-    face_of_part: Vec<u32>,
+    tree: ClosestPointTree,
     face_normals: Vec<DVec3>,
     vertex_normals: Vec<DVec3>,
 }
@@ -47,20 +44,18 @@ impl MeshSurface {
         let face_normals: Vec<DVec3> = (0..mesh.face_count())
             .map(|f| mesh.face_normal(f))
             .collect();
-        let face_of_part: Vec<u32> = (0..mesh.face_count() as u32)
-            .filter(|&f| face_normals[f as usize] != DVec3::ZERO)
-            .collect();
-        let indices: Vec<[u32; 3]> = face_of_part
-            .iter()
-            .map(|&f| mesh.triangles[f as usize])
-            .collect();
-        let bvh = ParryTriMesh::new(mesh.positions.clone(), indices)
-            .map_err(|e| Error::invalid_mesh("", format!("no triangle of non-zero area ({e})")))?;
+        let tree = ClosestPointTree::new(
+            (0..mesh.face_count() as u32)
+                .filter(|&f| face_normals[f as usize] != DVec3::ZERO)
+                .map(|f| (f, mesh.corners(f as usize))),
+        );
+        if tree.is_empty() {
+            return Err(Error::invalid_mesh("", "no triangle of non-zero area"));
+        }
         Ok(MeshSurface {
             vertex_normals: mesh.vertex_normals(),
             mesh: mesh.clone(),
-            bvh,
-            face_of_part,
+            tree,
             face_normals,
         })
     }
@@ -77,21 +72,26 @@ impl MeshSurface {
 
     /// The closest point of the surface to `p` if it is within `max_dist` of `p`.
     pub fn closest_point_within(&self, p: DVec3, max_dist: f64) -> Option<SurfacePoint> {
-        if !p.is_finite() {
-            return None;
-        }
-        let (proj, (part, location)) = self
-            .bvh
-            .project_local_point_and_get_location_with_max_dist(p, false, max_dist)?;
-        let barycentric = match location {
-            TrianglePointLocation::OnSolid => [1.0 / 3.0; 3],
-            loc => loc.barycentric_coordinates().unwrap_or([1.0 / 3.0; 3]),
-        };
+        self.search(p, max_dist, None)
+    }
+
+    /// [`MeshSurface::closest_point_within`] warm-started from face `start` (the face of a
+    /// previous answer near `p`): the search begins with that face's distance as its bound.
+    /// The same answer, up to the choice among faces at exactly equal distances (where `start`
+    /// is kept).
+    pub fn closest_point_from(&self, p: DVec3, start: u32, max_dist: f64) -> Option<SurfacePoint> {
+        self.search(p, max_dist, Some(start))
+    }
+
+    fn search(&self, p: DVec3, max_dist: f64, start: Option<u32>) -> Option<SurfacePoint> {
+        // Squared bound a hair above max_dist², so that a point exactly at max_dist is kept.
+        let bound = max_dist * max_dist * (1.0 + SEARCH_BOUND_SLACK);
+        let c = self.tree.closest(p, bound, start)?;
         Some(SurfacePoint {
-            position: proj.point,
-            face: self.face_of_part[part as usize],
-            barycentric,
-            distance: (proj.point - p).length(),
+            position: c.point,
+            face: c.id,
+            barycentric: c.barycentric,
+            distance: c.distance_squared.sqrt(),
         })
     }
 

@@ -42,6 +42,13 @@ pub trait Projection: Sync {
         let _ = bound;
         self.project(p)
     }
+
+    /// [`Projection::project`] for a point moved a little from `from` (a sample this surface
+    /// gave): the same answer, found faster where the surface can start its search from
+    /// `from` (on a mesh: from its triangle, [`MeshSurface::closest_point_from`]).
+    fn project_from(&self, p: DVec3, from: &SurfaceSample) -> Option<SurfaceSample> {
+        self.project_near(p, p.distance(from.position))
+    }
 }
 
 impl Projection for MeshSurface {
@@ -51,6 +58,11 @@ impl Projection for MeshSurface {
 
     fn project_near(&self, p: DVec3, bound: f64) -> Option<SurfaceSample> {
         self.closest_point_hinted(p, bound, f64::MAX)
+            .map(|sp| self.sample_at(&sp))
+    }
+
+    fn project_from(&self, p: DVec3, from: &SurfaceSample) -> Option<SurfaceSample> {
+        self.closest_point_from(p, from.face, f64::MAX)
             .map(|sp| self.sample_at(&sp))
     }
 }
@@ -91,6 +103,18 @@ pub trait SurfaceQuery: Sync {
     fn closest_point_to_midpoint(&self, a: DVec3, b: DVec3) -> Option<SurfacePoint> {
         self.closest_point_hinted(0.5 * (a + b), 0.5 * a.distance(b), f64::MAX)
     }
+
+    /// [`SurfaceQuery::closest_point_within`] for a point near `from` (a point this surface
+    /// returned): the same answer, found faster where the search can start from `from` (on a
+    /// mesh: from its triangle, [`MeshSurface::closest_point_from`]).
+    fn closest_point_near(
+        &self,
+        p: DVec3,
+        from: &SurfacePoint,
+        max_dist: f64,
+    ) -> Option<SurfacePoint> {
+        self.closest_point_hinted(p, p.distance(from.position), max_dist)
+    }
 }
 
 impl SurfaceQuery for MeshSurface {
@@ -116,6 +140,15 @@ impl SurfaceQuery for MeshSurface {
 
     fn closest_point_to_midpoint(&self, a: DVec3, b: DVec3) -> Option<SurfacePoint> {
         MeshSurface::closest_point_to_midpoint(self, a, b)
+    }
+
+    fn closest_point_near(
+        &self,
+        p: DVec3,
+        from: &SurfacePoint,
+        max_dist: f64,
+    ) -> Option<SurfacePoint> {
+        MeshSurface::closest_point_from(self, p, from.face, max_dist)
     }
 }
 

@@ -24,7 +24,7 @@ use serde::Serialize;
 use crate::geometry::self_intersection::{crossing_faces, undo_new_crossings};
 use crate::geometry::triangle::AngleBounds;
 use crate::mesh::TriMesh;
-use crate::surface::SurfaceQuery;
+use crate::surface::{SurfacePoint, SurfaceQuery};
 
 /// The largest total offset of a vertex, as a fraction of its shortest edge (a sag is κ h² / 8,
 /// under a twentieth of h where κ h < 0.4; a larger residual is another sheet or a tip, not a
@@ -61,7 +61,7 @@ const POINTS: [([f64; 3], f64); 6] = {
 type Contribution = [(f64, f64); 3];
 
 /// A face's points' closest points on the surface (`None` where none was found).
-type Closest = [Option<DVec3>; 6];
+type Closest = [Option<SurfacePoint>; 6];
 
 /// What [`fit_to_surface`] did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -131,21 +131,23 @@ pub fn fit_to_surface<S: SurfaceQuery + ?Sized>(
                 for (k, (b, weight)) in POINTS.into_iter().enumerate() {
                     let x = b[0] * p[0] + b[1] * p[1] + b[2] * p[2];
                     // The point's closest point within half the face's longest edge; searched
-                    // first within its distance to a point known to be on the surface (the last
-                    // iteration's answer, or the nearest corner where it started), which gives
-                    // the same answer when one lies within that and prunes most of the search.
-                    let near = found[f][k].map_or_else(
-                        || {
-                            t.iter()
+                    // from the last iteration's answer (on a mesh, starting at its triangle), or
+                    // first within the distance to the nearest corner where it started (a point
+                    // of the surface): the same answer, with most of the search pruned.
+                    let q = match &found[f][k] {
+                        Some(last) => surface.closest_point_near(x, last, 0.5 * reach),
+                        None => {
+                            let near = t
+                                .iter()
                                 .map(|&v| x.distance(start[v as usize]))
-                                .fold(f64::INFINITY, f64::min)
-                        },
-                        |q| x.distance(q),
-                    );
-                    let Some(q) = surface.closest_point_hinted(x, near, 0.5 * reach) else {
+                                .fold(f64::INFINITY, f64::min);
+                            surface.closest_point_hinted(x, near, 0.5 * reach)
+                        }
+                    };
+                    let Some(q) = q else {
                         continue;
                     };
-                    closest[k] = Some(q.position);
+                    closest[k] = Some(q);
                     // A point on another sheet (facing away: a thin part's other side) is not
                     // this face's sag.
                     if surface.piece_normal(&q).dot(normal) < FIT_MIN_NORMAL_COS {

@@ -59,25 +59,85 @@ pub(crate) fn max_min_candidate<L: Copy>(m: &EditMesh<L>, x: u32, y: u32) -> Opt
     })
 }
 
+/// Below this many edges [`max_min_flips`] runs sequentially: the parallel evaluation pays off
+/// on whole meshes, not on the few edges around a poor triangle.
+const PARALLEL_EDGES: usize = 512;
+
 /// Flips the edges `edges` (pairs of vertices), in order, that the max-min rule asks for
 /// ([`max_min_candidate`]) and `accept` allows (it sees the mesh and the flip before it is
 /// made), with [`EditMesh::flip_edge`]; new faces get `label`. Returns the number of flips.
-pub(crate) fn max_min_flips<L: Copy>(
+/// `accept` decides from the flip's four vertices alone ([`flip_in_order`]).
+pub(crate) fn max_min_flips<L: Copy + Send + Sync>(
     m: &mut EditMesh<L>,
     edges: &[(u32, u32)],
     label: L,
-    mut accept: impl FnMut(&EditMesh<L>, &FlipCandidate) -> bool,
+    accept: impl Fn(&EditMesh<L>, &FlipCandidate) -> bool + Sync,
 ) -> usize {
+    flip_in_order(m, edges, label, |m, x, y| {
+        max_min_candidate(m, x, y).is_some_and(|flip| accept(m, &flip))
+    })
+}
+
+/// Flips, in order, the edges of `edges` for which `decide` says yes on the mesh as it is when
+/// the pass reaches them; new faces get `label`. Returns the number of flips.
+///
+/// `decide` must answer from the edge's four vertices alone (the edge's ends and the apexes of
+/// its two faces: their positions, degrees and edges, and data no flip changes). Every edge is
+/// first decided in parallel on the mesh as it is, and the pass in order then takes that answer
+/// for each edge none of whose four vertices a flip earlier in the pass touched: a flip changes
+/// only the degrees of its own four vertices and the faces on the edges among them, so such an
+/// edge would be decided alike. The result is the sequential pass's, to the bit.
+pub(crate) fn flip_in_order<L: Copy + Send + Sync>(
+    m: &mut EditMesh<L>,
+    edges: &[(u32, u32)],
+    label: L,
+    decide: impl Fn(&EditMesh<L>, u32, u32) -> bool + Sync,
+) -> usize {
+    use rayon::prelude::*;
     let mut flips = 0;
-    for &(x, y) in edges {
-        let Some(flip) = max_min_candidate(m, x, y) else {
+    if edges.len() < PARALLEL_EDGES {
+        for &(x, y) in edges {
+            if decide(m, x, y) && m.flip_edge(x, y, label).is_ok() {
+                flips += 1;
+            }
+        }
+        return flips;
+    }
+    let first: Vec<([u32; 2], bool)> = {
+        let m = &*m;
+        edges
+            .par_iter()
+            .map(|&(x, y)| {
+                let apexes = quad(m, x, y).map_or([x, y], |[_, _, c, d]| [c, d]);
+                (apexes, decide(m, x, y))
+            })
+            .collect()
+    };
+    let mut touched = vec![false; m.vertex_count()];
+    for (&(x, y), &(apexes, yes)) in edges.iter().zip(&first) {
+        let stale = [x, y, apexes[0], apexes[1]]
+            .iter()
+            .any(|&v| touched.get(v as usize).copied().unwrap_or(true));
+        if !(if stale { decide(m, x, y) } else { yes }) {
             continue;
-        };
-        if accept(m, &flip) && m.flip_edge(x, y, label).is_ok() {
+        }
+        let [_, _, c, d] = quad(m, x, y).unwrap_or([x, y, x, y]);
+        if m.flip_edge(x, y, label).is_ok() {
             flips += 1;
+            for v in [x, y, c, d] {
+                touched[v as usize] = true;
+            }
         }
     }
     flips
+}
+
+/// The vertices `[x, y, c, d]` of the two faces on the interior edge `x`–`y` (`c` the apex of
+/// the face on `x`→`y`, `d` of the face on `y`→`x`), or `None` when it is not interior.
+pub(crate) fn quad<L: Copy>(m: &EditMesh<L>, x: u32, y: u32) -> Option<[u32; 4]> {
+    let c = starting_at(m.face(m.face_on(x, y)?)?, x)[2];
+    let d = starting_at(m.face(m.face_on(y, x)?)?, y)[2];
+    Some([x, y, c, d])
 }
 
 #[cfg(test)]
@@ -108,6 +168,48 @@ mod tests {
         assert_eq!(max_min_candidate(&m, 2, 3), None);
         assert_eq!(max_min_flips(&mut m, &[(2, 3)], (), |_, _| true), 0);
         assert_eq!(m.sanity_check(), Ok(()));
+    }
+
+    /// A jittered grid: most of its edges are not Delaunay, and flips chain into each other.
+    fn jittered(n: usize, seed: u64) -> EditMesh<()> {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let jitter: Vec<(f64, f64)> = (0..(n + 1) * (n + 1))
+            .map(|_| (rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3)))
+            .collect();
+        let mesh = crate::mesh::test_meshes::grid(n, |i, j| {
+            let (dx, dy) = jitter[i * (n + 1) + j];
+            glam::DVec3::new(i as f64 + dx, j as f64 + dy, 0.0)
+        });
+        EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse)
+    }
+
+    #[test]
+    fn the_parallel_pass_flips_what_the_sequential_pass_flips() {
+        for seed in 0..4 {
+            let mut parallel = jittered(30, seed);
+            let mut sequential = parallel.clone();
+            let mut edges: Vec<(u32, u32)> =
+                parallel.directed_edges().filter(|&(x, y)| x < y).collect();
+            edges.sort_unstable();
+            assert!(edges.len() >= PARALLEL_EDGES);
+            // A guard that reads the four vertices only (here: refuse flips whose new edge
+            // would run up and to the right of vertex 0's column, to make some refusals).
+            let accept = |m: &EditMesh<()>, f: &FlipCandidate| {
+                let [c, d] = [f.new[0][2], f.new[0][1]];
+                m.position(c).x + m.position(d).x > 1.5
+            };
+            let a = max_min_flips(&mut parallel, &edges, (), accept);
+            // One edge at a time: below PARALLEL_EDGES, so the plain sequential pass.
+            let b: usize = edges
+                .iter()
+                .map(|e| max_min_flips(&mut sequential, std::slice::from_ref(e), (), accept))
+                .sum();
+            assert!(a > 50, "{a} flips: the case should chain flips");
+            assert_eq!(a, b);
+            assert_eq!(parallel.live_faces(), sequential.live_faces());
+            assert_eq!(parallel.sanity_check(), Ok(()));
+        }
     }
 
     #[test]

@@ -61,7 +61,7 @@ pub(super) fn oriented_quality<L: Copy>(b: &EditMesh<L>, normals: &[DVec3], t: [
 /// agree with their corners' `normals` and the normals of both pairs of faces, old and new, are
 /// within `max_flip_dihedral_deg` (an old pair with a degenerate face may always be flipped
 /// away). New faces get `label`. Returns the number of flips.
-pub(super) fn flip_edges<L: Copy>(
+pub(super) fn flip_edges<L: Copy + Send + Sync>(
     b: &mut EditMesh<L>,
     normals: &[DVec3],
     params: &RefineParams,

@@ -17,6 +17,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::geometry::self_intersection::{crossing_faces, undo_new_crossings};
+use crate::surface::SurfacePoint;
+use crate::triangulate::flip::flip_in_order;
 
 use super::*;
 
@@ -53,16 +55,15 @@ fn valence_flips<S: SurfaceQuery + ?Sized>(
         .filter(|&(a, b)| a < b && m.face_on(b, a).is_some())
         .collect();
     edges.sort_unstable();
-    let mut flips = 0;
-    for (a, b) in edges {
+    let decide = |m: &Mesh, a: u32, b: u32| {
         let Ok((f1, f2, c, d)) = m.edge_faces(a, b) else {
-            continue;
+            return false;
         };
         if c == d || m.is_protected(a, b) || m.has_edge(c, d) || m.has_edge(d, c) {
-            continue;
+            return false;
         }
         if m.degree(a) <= 3 || m.degree(b) <= 3 {
-            continue;
+            return false;
         }
         let dev = |v: u32, delta: i64| {
             // A boundary vertex has one edge more than faces; its target is 4, inside 6.
@@ -76,29 +77,27 @@ fn valence_flips<S: SurfaceQuery + ?Sized>(
         let before = dev(a, 0) + dev(b, 0) + dev(c, 0) + dev(d, 0);
         let after = dev(a, -1) + dev(b, -1) + dev(c, 1) + dev(d, 1);
         if after >= before {
-            continue;
+            return false;
         }
         let (t1, t2) = (face(m, f1), face(m, f2));
         let (new1, new2) = ([a, d, c], [b, c, d]);
         let old_min = min_angle(m, t1).min(min_angle(m, t2));
         let new_min = min_angle(m, new1).min(min_angle(m, new2));
         if new_min < min_angle_deg.min(old_min) {
-            continue;
+            return false;
         }
         let (n1, n2) = (normal(m, new1), normal(m, new2));
         let mean_old = normal(m, t1) + normal(m, t2);
         if n1.dot(mean_old) <= 0.0 || n2.dot(mean_old) <= 0.0 || n1.dot(n2) < 0.5 {
-            continue;
+            return false;
         }
-        match surface.closest_point_to_midpoint(m.position(c), m.position(d)) {
-            Some(sp) if sp.distance <= params.max_offset => {}
-            _ => continue,
-        }
-        if m.flip_edge(a, b, None).is_ok() {
-            flips += 1;
-        }
-    }
-    flips
+        matches!(
+            surface.closest_point_to_midpoint(m.position(c), m.position(d)),
+            Some(sp) if sp.distance <= params.max_offset
+        )
+    };
+    // The decision reads the four vertices of the edge's faces alone.
+    flip_in_order(m, &edges, None, decide)
 }
 
 /// One relaxation step over the `movable` vertices. Each vertex's target is the area-weighted
@@ -117,11 +116,12 @@ fn relax<S: SurfaceQuery + ?Sized>(
     surface: &S,
     movable: &[bool],
     pins: &[DVec3],
+    last: &mut [Option<SurfacePoint>],
     params: &Limits,
 ) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let mesh = &*m;
-    let targets: Vec<(u32, DVec3)> = (0..mesh.vertex_count() as u32)
+    let targets: Vec<(u32, SurfacePoint, bool)> = (0..mesh.vertex_count() as u32)
         .into_par_iter()
         .filter(|&v| movable[v as usize] && mesh.faces_around(v).len() >= 3)
         .filter_map(|v| {
@@ -146,11 +146,23 @@ fn relax<S: SurfaceQuery + ?Sized>(
             }
             let mut d = weighted / area - old;
             d -= n * n.dot(d);
-            // The vertex lies on the surface: the target is within the move's length of it.
-            let sp = surface.closest_point_hinted(old + d, d.length(), 4.0 * params.max_offset)?;
-            (surface.smooth_normal(&sp).dot(n) >= 0.5).then_some((v, sp.position))
+            // The vertex lies on the surface: the target is within the move's length of it, and
+            // near the vertex's last target.
+            let (p, reach) = (old + d, 4.0 * params.max_offset);
+            let sp = match &last[v as usize] {
+                Some(from) => surface.closest_point_near(p, from, reach),
+                None => surface.closest_point_hinted(p, d.length(), reach),
+            }?;
+            Some((v, sp, surface.smooth_normal(&sp).dot(n) >= 0.5))
         })
         .collect();
+    for &(v, sp, _) in &targets {
+        last[v as usize] = Some(sp);
+    }
+    let targets = targets
+        .into_iter()
+        .filter(|t| t.2)
+        .map(|(v, sp, _)| (v, sp.position));
     let mut moves = 0;
     let mut old_normals: Vec<DVec3> = Vec::new();
     for (v, p) in targets {
@@ -204,10 +216,12 @@ pub(super) fn smooth<S: SurfaceQuery + ?Sized>(
     let boundary: Vec<bool> = (0..m.vertex_count() as u32)
         .map(|v| m.is_boundary_vertex(v))
         .collect();
+    // Each vertex's last target on the surface, where its next search starts.
+    let mut last = vec![None; m.vertex_count()];
     for _ in 0..iterations {
         stats.valence_flips +=
             valence_flips(m, surface, &boundary, params, VALENCE_FLIP_MIN_ANGLE_DEG);
-        stats.moves += relax(m, surface, &movable, &pins, params);
+        stats.moves += relax(m, surface, &movable, &pins, &mut last, params);
     }
     let mut positions = m.positions().to_vec();
     undo_new_crossings(&mut positions, &m.live_faces().0, &pins, &crossing_before);

@@ -1,0 +1,378 @@
+//! A bounding-volume hierarchy of triangles built for one question: the closest point of a
+//! triangle set to a query point, optionally warm-started from a triangle near the answer.
+//!
+//! Issue 38 measured parry's general BVH (`TriMesh::project_local_point_and_get_location`)
+//! at a quarter of a remesh's processor time: a best-first search over a binary heap, generic
+//! over shapes. Here the tree is a flat array of boxes with the triangles' corners stored in
+//! leaf order beside them, built once by median splits; a query is a depth-first walk, nearer
+//! child first, pruned by the squared distance to the best triangle found so far. A query that
+//! starts from a triangle (the face of the previous answer at a point that moved a little)
+//! begins with that triangle's distance as the bound, so the walk visits only the boxes that
+//! could hold something closer: the root-to-leaf paths near the point. The answer is the
+//! exact closest point either way (Ericson, *Real-Time Collision Detection*, 2005, Sec. 5.1.5,
+//! for the point-triangle test); a start only decides among triangles at exactly equal
+//! distances, where it keeps the start.
+
+use glam::DVec3;
+
+/// Triangles per leaf at most.
+const LEAF_SIZE: usize = 4;
+
+/// One box of the tree: a leaf holds `count > 0` triangles from `first` (leaf order); an inner
+/// node's two children are the nodes `first` and `first + 1`.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    lo: DVec3,
+    hi: DVec3,
+    first: u32,
+    count: u32,
+}
+
+/// The closest point of the tree's triangles to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Closest {
+    /// The caller's identifier of the triangle the point lies on.
+    pub id: u32,
+    /// The closest point (units of the triangles).
+    pub point: DVec3,
+    /// Its barycentric coordinates in that triangle's corners as given (sum 1).
+    pub barycentric: [f64; 3],
+    /// The squared distance from the query point to `point`.
+    pub distance_squared: f64,
+}
+
+/// A bounding-volume hierarchy of triangles for closest-point queries (see the module
+/// documentation). Built once; queries are `&self` and run from any number of threads.
+#[derive(Debug, Clone, Default)]
+pub struct ClosestPointTree {
+    nodes: Vec<Node>,
+    /// The triangles' corners in leaf order.
+    corners: Vec<[DVec3; 3]>,
+    /// Leaf order -> the caller's identifier.
+    ids: Vec<u32>,
+    /// The caller's identifier -> leaf order (`u32::MAX` for an identifier not given).
+    slot: Vec<u32>,
+}
+
+impl ClosestPointTree {
+    /// The tree of `triangles`, `(identifier, corners)`; identifiers are distinct and index
+    /// a table, so keep them small (face numbers). Triangles of zero area are accepted (their
+    /// closest point is still exact) but make no better answer than their neighbours.
+    pub fn new(triangles: impl IntoIterator<Item = (u32, [DVec3; 3])>) -> Self {
+        let mut items: Vec<(u32, [DVec3; 3], DVec3)> = triangles
+            .into_iter()
+            .map(|(id, t)| (id, t, (t[0] + t[1] + t[2]) / 3.0))
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * items.len() / LEAF_SIZE + 1);
+        if !items.is_empty() {
+            nodes.push(Node {
+                lo: DVec3::ZERO,
+                hi: DVec3::ZERO,
+                first: 0,
+                count: 0,
+            });
+            build(&mut nodes, 0, &mut items, 0);
+        }
+        let slot_len = items
+            .iter()
+            .map(|&(id, ..)| id as usize + 1)
+            .max()
+            .unwrap_or(0);
+        let mut slot = vec![u32::MAX; slot_len];
+        for (k, &(id, ..)) in items.iter().enumerate() {
+            slot[id as usize] = k as u32;
+        }
+        ClosestPointTree {
+            nodes,
+            corners: items.iter().map(|&(_, t, _)| t).collect(),
+            ids: items.iter().map(|&(id, ..)| id).collect(),
+            slot,
+        }
+    }
+
+    /// Whether the tree has no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.ids.is_empty()
+    }
+
+    /// The closest point of the triangles to `p` at a squared distance below
+    /// `max_distance_squared`, or `None` (no triangle that close, or `p` not finite). `start`,
+    /// when it names a triangle of the tree, is tried first and bounds the search: give the
+    /// triangle of a previous answer near `p`. The answer is the same with or without it, up to
+    /// the choice among triangles at exactly equal distances.
+    pub fn closest(
+        &self,
+        p: DVec3,
+        max_distance_squared: f64,
+        start: Option<u32>,
+    ) -> Option<Closest> {
+        if !p.is_finite() || self.nodes.is_empty() {
+            return None;
+        }
+        let mut best = max_distance_squared;
+        let mut found: Option<(usize, DVec3, [f64; 3])> = None;
+        if let Some(&k) = start.and_then(|id| self.slot.get(id as usize)) {
+            if k != u32::MAX {
+                let (q, bary) = closest_on_triangle(p, &self.corners[k as usize]);
+                let d = q.distance_squared(p);
+                if d < best {
+                    best = d;
+                    found = Some((k as usize, q, bary));
+                }
+            }
+        }
+        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        let root = box_distance_squared(p, &self.nodes[0]);
+        if root < best {
+            stack.push((0, root));
+        }
+        while let Some((n, d)) = stack.pop() {
+            if d >= best {
+                continue;
+            }
+            let node = self.nodes[n as usize];
+            if node.count > 0 {
+                let first = node.first as usize;
+                for k in first..first + node.count as usize {
+                    let (q, bary) = closest_on_triangle(p, &self.corners[k]);
+                    let d = q.distance_squared(p);
+                    if d < best {
+                        best = d;
+                        found = Some((k, q, bary));
+                    }
+                }
+            } else {
+                let (l, r) = (node.first, node.first + 1);
+                let dl = box_distance_squared(p, &self.nodes[l as usize]);
+                let dr = box_distance_squared(p, &self.nodes[r as usize]);
+                let ((near, dn), (far, df)) = if dl <= dr {
+                    ((l, dl), (r, dr))
+                } else {
+                    ((r, dr), (l, dl))
+                };
+                if df < best {
+                    stack.push((far, df));
+                }
+                if dn < best {
+                    stack.push((near, dn));
+                }
+            }
+        }
+        found.map(|(k, point, barycentric)| Closest {
+            id: self.ids[k],
+            point,
+            barycentric,
+            distance_squared: best,
+        })
+    }
+}
+
+/// Fills node `at` with the tree of `items` (which sit at leaf positions `offset..`), splitting
+/// at the median centroid along the longest side of the centroids' box.
+fn build(nodes: &mut Vec<Node>, at: usize, items: &mut [(u32, [DVec3; 3], DVec3)], offset: usize) {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    let (mut clo, mut chi) = (lo, hi);
+    for (_, t, c) in items.iter() {
+        for v in t {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        clo = clo.min(*c);
+        chi = chi.max(*c);
+    }
+    if items.len() <= LEAF_SIZE {
+        nodes[at] = Node {
+            lo,
+            hi,
+            first: offset as u32,
+            count: items.len() as u32,
+        };
+        return;
+    }
+    let extent = chi - clo;
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |a, b| {
+        a.2[axis].total_cmp(&b.2[axis]).then(a.0.cmp(&b.0))
+    });
+    let first = nodes.len();
+    nodes[at] = Node {
+        lo,
+        hi,
+        first: first as u32,
+        count: 0,
+    };
+    let blank = nodes[at];
+    nodes.push(blank);
+    nodes.push(blank);
+    let (left, right) = items.split_at_mut(mid);
+    build(nodes, first, left, offset);
+    build(nodes, first + 1, right, offset + mid);
+}
+
+/// Squared distance from `p` to the box of `node` (0 inside).
+#[inline]
+fn box_distance_squared(p: DVec3, node: &Node) -> f64 {
+    let d = (node.lo - p).max(p - node.hi).max(DVec3::ZERO);
+    d.length_squared()
+}
+
+/// The closest point of triangle `t` to `p` and its barycentric coordinates in `t`'s corners
+/// (Ericson 2005, Sec. 5.1.5: the Voronoi region of `p` among the corners, edges and face).
+#[inline]
+pub(crate) fn closest_on_triangle(p: DVec3, t: &[DVec3; 3]) -> (DVec3, [f64; 3]) {
+    let [a, b, c] = *t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, [1.0, 0.0, 0.0]);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, [0.0, 1.0, 0.0]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + v * ab, [1.0 - v, v, 0.0]);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, [0.0, 0.0, 1.0]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + w * ac, [1.0 - w, 0.0, w]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + w * (c - b), [0.0, 1.0 - w, w]);
+    }
+    let denom = va + vb + vc;
+    if !(denom > 0.0) {
+        // A triangle of zero area whose regions all missed (rounding): its nearest corner.
+        let k = (0..3)
+            .min_by(|&i, &j| {
+                t[i].distance_squared(p)
+                    .total_cmp(&t[j].distance_squared(p))
+            })
+            .unwrap_or(0);
+        let mut bary = [0.0; 3];
+        bary[k] = 1.0;
+        return (t[k], bary);
+    }
+    let (v, w) = (vb / denom, vc / denom);
+    (a + v * ab + w * ac, [1.0 - v - w, v, w])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    fn random_triangles(n: usize, seed: u64) -> Vec<(u32, [DVec3; 3])> {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut v = || {
+            DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+        };
+        (0..n)
+            .map(|i| {
+                let c = v();
+                let t = [c + 0.1 * v(), c + 0.1 * v(), c + 0.1 * v()];
+                // Identifiers with gaps, as a mesh's faces with zero-area ones left out.
+                (3 * i as u32 + 1, t)
+            })
+            .collect()
+    }
+
+    /// The brute-force answer: the least distance over all triangles.
+    fn brute(tris: &[(u32, [DVec3; 3])], p: DVec3) -> f64 {
+        tris.iter()
+            .map(|(_, t)| closest_on_triangle(p, t).0.distance_squared(p))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn agrees_with_brute_force_with_and_without_a_start() {
+        let tris = random_triangles(300, 3);
+        let tree = ClosestPointTree::new(tris.iter().copied());
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        for i in 0..500 {
+            let p = DVec3::new(
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+            );
+            let want = brute(&tris, p);
+            let start = Some(tris[i % tris.len()].0);
+            for s in [None, start, Some(2)] {
+                let c = tree.closest(p, f64::INFINITY, s).unwrap();
+                assert!(
+                    (c.distance_squared - want).abs() <= 1e-12 * (1.0 + want),
+                    "{p:?}: {} vs {want}",
+                    c.distance_squared
+                );
+                // The answer lies on the triangle it names, at its barycentric coordinates.
+                let t = tris.iter().find(|(id, _)| *id == c.id).unwrap().1;
+                let rebuilt =
+                    c.barycentric[0] * t[0] + c.barycentric[1] * t[1] + c.barycentric[2] * t[2];
+                assert!(rebuilt.distance(c.point) < 1e-12);
+                assert!((c.barycentric.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn a_bound_leaves_out_what_is_farther() {
+        let tris = random_triangles(50, 5);
+        let tree = ClosestPointTree::new(tris.iter().copied());
+        let p = DVec3::new(4.0, 0.0, 0.0);
+        let want = brute(&tris, p);
+        assert!(tree.closest(p, 0.99 * want, None).is_none());
+        assert!(tree.closest(p, 0.99 * want, Some(tris[0].0)).is_none());
+        assert!(tree.closest(p, 1.01 * want, None).is_some());
+        assert!(tree
+            .closest(DVec3::new(f64::NAN, 0.0, 0.0), f64::INFINITY, None)
+            .is_none());
+        assert!(ClosestPointTree::new([])
+            .closest(p, f64::INFINITY, None)
+            .is_none());
+    }
+
+    #[test]
+    fn regions_of_one_triangle() {
+        let t = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let cases = [
+            (DVec3::new(0.2, 0.3, 1.0), DVec3::new(0.2, 0.3, 0.0)),
+            (DVec3::new(-1.0, -1.0, 0.0), DVec3::ZERO),
+            (DVec3::new(2.0, -0.5, 0.0), DVec3::X),
+            (DVec3::new(0.5, -2.0, 0.3), DVec3::new(0.5, 0.0, 0.0)),
+            (DVec3::new(1.0, 1.0, 0.0), DVec3::new(0.5, 0.5, 0.0)),
+            (DVec3::new(-0.5, 0.5, 0.0), DVec3::new(0.0, 0.5, 0.0)),
+            (DVec3::new(-0.1, 3.0, 0.0), DVec3::Y),
+        ];
+        for (p, want) in cases {
+            let (q, b) = closest_on_triangle(p, &t);
+            assert!(q.distance(want) < 1e-15, "{p:?}: {q:?}");
+            assert!((b[0] * t[0] + b[1] * t[1] + b[2] * t[2]).distance(q) < 1e-15);
+        }
+        // A degenerate triangle (three points on a line) still gives its nearest point.
+        let line = [DVec3::ZERO, DVec3::X, 2.0 * DVec3::X];
+        let (q, _) = closest_on_triangle(DVec3::new(1.5, 1.0, 0.0), &line);
+        assert!(q.distance(DVec3::new(1.5, 0.0, 0.0)) < 1e-12);
+    }
+}
