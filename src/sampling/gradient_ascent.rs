@@ -290,7 +290,11 @@ fn move_one<S: Projection + ?Sized>(
         delta *= max_move / len;
     }
     // The old position is on the surface: the search starts from it.
-    let project = |delta: glam::DVec3| surface.project_from(old.position + delta, &old).unwrap_or(old);
+    let project = |delta: glam::DVec3| {
+        surface
+            .project_from(old.position + delta, &old)
+            .unwrap_or(old)
+    };
     let mut moved = project(delta);
     for _ in 0..params.backtracking {
         // Keep the move only if it does not lower s (with the neighbours held where they are).

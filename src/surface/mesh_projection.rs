@@ -208,6 +208,60 @@ mod tests {
     }
 
     #[test]
+    fn a_warm_start_gives_the_closest_point_also_across_a_thin_part() {
+        use rand::{RngExt, SeedableRng};
+        // Two bumpy sheets 0.02 apart (far below their edge length 1/12): a point near one is
+        // often closer to the other, which a search started on the first must still find.
+        let n = 12;
+        let sheet = |z: f64| {
+            crate::mesh::test_meshes::grid(n, move |i, j| {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                DVec3::new(x, y, z + 0.05 * (7.0 * x).sin() * (5.0 * y).cos())
+            })
+        };
+        let (a, b) = (sheet(0.0), sheet(0.02));
+        let offset = a.positions.len() as u32;
+        let mut positions = a.positions.clone();
+        positions.extend(&b.positions);
+        let mut triangles = a.triangles.clone();
+        triangles.extend(b.triangles.iter().map(|t| t.map(|v| v + offset)));
+        let mesh = TriMesh::new(positions, triangles);
+        let s = MeshSurface::new(&mesh).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for i in 0..2000 {
+            let mut r = |a: f64| rng.random_range(-a..a);
+            let anywhere = DVec3::new(0.5 + r(0.6), 0.5 + r(0.6), r(0.1));
+            // Every other point near the surface (as the pipeline's moves are), the others
+            // anywhere around it.
+            let p = match i % 2 {
+                0 => {
+                    let q = s.closest_point(anywhere).unwrap().position;
+                    q + 0.01 * DVec3::new(r(1.0), r(1.0), r(1.0))
+                }
+                _ => anywhere,
+            };
+            let want = s.closest_point(p).unwrap();
+            let near = s
+                .closest_point(p + DVec3::new(0.01, -0.01, 0.0))
+                .unwrap()
+                .face;
+            let arbitrary = (i * 7 % mesh.face_count()) as u32;
+            for start in [near, arbitrary] {
+                let got = s.closest_point_from(p, start, f64::MAX).unwrap();
+                assert!(
+                    (got.distance - want.distance).abs() < 1e-12,
+                    "{p:?} from {start}"
+                );
+                let [x, y, z] = mesh.corners(got.face as usize);
+                let b = got.barycentric;
+                assert!((b[0] * x + b[1] * y + b[2] * z).distance(got.position) < 1e-12);
+            }
+            // A bound below the distance finds nothing, warm or not.
+            assert!(s.closest_point_from(p, near, 0.5 * want.distance).is_none());
+        }
+    }
+
+    #[test]
     fn rejects_a_mesh_without_area() {
         let m = TriMesh::new(vec![DVec3::ZERO, DVec3::X, 2.0 * DVec3::X], vec![[0, 1, 2]]);
         assert!(MeshSurface::new(&m).is_err());
