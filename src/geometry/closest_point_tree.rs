@@ -90,6 +90,49 @@ impl ClosestPointTree {
         }
     }
 
+    /// Whether some triangle lies at a squared distance below `max_distance_squared` from `p`
+    /// (false for `p` not finite): the walk of [`ClosestPointTree::closest`], ended at the first
+    /// such triangle, which is usually in the first leaf it reaches.
+    pub fn any_within(&self, p: DVec3, max_distance_squared: f64) -> bool {
+        if !p.is_finite() || self.nodes.is_empty() {
+            return false;
+        }
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        if box_distance_squared(p, &self.nodes[0]) < max_distance_squared {
+            stack.push(0);
+        }
+        while let Some(n) = stack.pop() {
+            let node = self.nodes[n as usize];
+            if node.count > 0 {
+                let first = node.first as usize;
+                let hit = self.corners[first..first + node.count as usize]
+                    .iter()
+                    .any(|t| {
+                        closest_on_triangle(p, t).0.distance_squared(p) < max_distance_squared
+                    });
+                if hit {
+                    return true;
+                }
+            } else {
+                let (l, r) = (node.first, node.first + 1);
+                let dl = box_distance_squared(p, &self.nodes[l as usize]);
+                let dr = box_distance_squared(p, &self.nodes[r as usize]);
+                let ((near, dn), (far, df)) = if dl <= dr {
+                    ((l, dl), (r, dr))
+                } else {
+                    ((r, dr), (l, dl))
+                };
+                if df < max_distance_squared {
+                    stack.push(far);
+                }
+                if dn < max_distance_squared {
+                    stack.push(near);
+                }
+            }
+        }
+        false
+    }
+
     /// Whether the tree has no triangle.
     pub fn is_empty(&self) -> bool {
         self.ids.is_empty()
@@ -334,6 +377,31 @@ mod tests {
                 assert!((c.barycentric.iter().sum::<f64>() - 1.0).abs() < 1e-12);
             }
         }
+    }
+
+    #[test]
+    fn any_within_agrees_with_the_closest_distance() {
+        let tris = random_triangles(200, 4);
+        let tree = ClosestPointTree::new(tris.iter().copied());
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let (mut inside, mut outside) = (0, 0);
+        for _ in 0..2000 {
+            let p = DVec3::new(
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+            );
+            let r2: f64 = rng.random_range(0.0..0.05);
+            let want = brute(&tris, p) < r2;
+            assert_eq!(tree.any_within(p, r2), want, "{p:?} {r2}");
+            if want {
+                inside += 1;
+            } else {
+                outside += 1;
+            }
+        }
+        assert!(inside > 100 && outside > 100, "{inside} {outside}");
+        assert!(!tree.any_within(DVec3::new(f64::NAN, 0.0, 0.0), 1.0));
     }
 
     #[test]

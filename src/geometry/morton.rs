@@ -37,6 +37,30 @@ pub fn morton_scale(extent: f64) -> f64 {
     }
 }
 
+/// The indices of `points` in Morton (Z-curve) order over their bounding box, the points that
+/// are not finite last; ties in index order. Queries issued in this order keep a search
+/// structure's nodes in cache.
+pub fn morton_order(points: &[DVec3]) -> Vec<u32> {
+    let finite = || points.iter().filter(|p| p.is_finite());
+    let lo = finite().fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
+    let hi = finite().fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
+    let scale = morton_scale((hi - lo).max_element());
+    let mut order: Vec<(u64, u32)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let code = if p.is_finite() {
+                morton_code((*p - lo) * scale)
+            } else {
+                u64::MAX
+            };
+            (code, i as u32)
+        })
+        .collect();
+    order.sort_unstable();
+    order.into_iter().map(|(_, i)| i).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,6 +3,8 @@
 
 use glam::DVec3;
 
+use crate::geometry::morton::morton_order;
+
 use super::input::InputIndex;
 use super::scan::Scanned;
 use super::RemeshParams;
@@ -89,6 +91,21 @@ pub(super) fn ascend(
             }
         }
     }
+    // The surface samples in Morton order from here on: the triangulation's and the finishing
+    // stage's loops over vertices then walk the surface, which keeps the input's and the
+    // output's search structures in cache (they came in the scan's random order).
+    let order = morton_order(
+        &samples[boundary_count..]
+            .iter()
+            .map(|s| s.position)
+            .collect::<Vec<_>>(),
+    );
+    let surface: Vec<SurfaceSample> = order
+        .iter()
+        .map(|&i| samples[boundary_count + i as usize])
+        .collect();
+    samples.truncate(boundary_count);
+    samples.extend(surface);
     Ok(Ascended {
         samples,
         boundary_count,

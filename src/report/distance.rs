@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::Result;
-use crate::geometry::morton::{morton_code, morton_scale};
+use crate::geometry::morton::morton_order;
 use crate::geometry::tolerance::SEARCH_BOUND_SLACK;
 use crate::mesh::TriMesh;
 use crate::surface::area_sampler::AreaSampler;
@@ -106,29 +106,13 @@ const QUERY_CHUNK: usize = 512;
 /// prunes, it never changes the minimum found, and the chunking does not depend on the thread
 /// count, so the result is deterministic.
 fn distances_to(points: &[DVec3], surface: &MeshSurface) -> Vec<Option<f64>> {
-    let finite = || points.iter().filter(|p| p.is_finite());
-    let lo = finite().fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
-    let hi = finite().fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
-    let scale = morton_scale((hi - lo).max_element());
-    let mut order: Vec<(u64, u32)> = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let code = if p.is_finite() {
-                morton_code((*p - lo) * scale)
-            } else {
-                u64::MAX
-            };
-            (code, i as u32)
-        })
-        .collect();
-    order.sort_unstable();
+    let order = morton_order(points);
 
     let sorted: Vec<Option<f64>> = order
         .par_chunks(QUERY_CHUNK)
         .flat_map_iter(|chunk| {
             let mut previous: Option<DVec3> = None;
-            chunk.iter().map(move |&(_, i)| {
+            chunk.iter().map(move |&i| {
                 let p = points[i as usize];
                 let bounded = previous.and_then(|q| {
                     // Strictly above the answer (the search keeps only closer candidates).
@@ -142,7 +126,7 @@ fn distances_to(points: &[DVec3], surface: &MeshSurface) -> Vec<Option<f64>> {
         })
         .collect();
     let mut out = vec![None; points.len()];
-    for (&(_, i), d) in order.iter().zip(sorted) {
+    for (&i, d) in order.iter().zip(sorted) {
         out[i as usize] = d;
     }
     out

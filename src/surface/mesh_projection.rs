@@ -75,6 +75,14 @@ impl MeshSurface {
         self.search(p, max_dist, None)
     }
 
+    /// Whether the surface comes within `max_dist` of `p` (strictly closer, up to the search
+    /// slack): [`MeshSurface::closest_point_within`]`.is_some()`, ended at the first face close
+    /// enough instead of searching for the closest.
+    pub fn is_within(&self, p: DVec3, max_dist: f64) -> bool {
+        let bound = max_dist * max_dist * (1.0 + SEARCH_BOUND_SLACK);
+        self.tree.any_within(p, bound)
+    }
+
     /// [`MeshSurface::closest_point_within`] warm-started from face `start` (the face of a
     /// previous answer near `p`): the search begins with that face's distance as its bound.
     /// The same answer, up to the choice among faces at exactly equal distances (where `start`

@@ -242,16 +242,18 @@ fn lies_in(surface: &MeshSurface, f: u32, p: DVec3, tolerance: f64) -> bool {
     Triangle::new(a, b, c).distance_to_local_point(p, true) <= tolerance
 }
 
-/// Each vertex's neighbours in a triangle mesh, as rows of one array (compressed sparse rows;
-/// an edge of two faces is listed twice, which costs a second look in the search and nothing
-/// else).
+/// Each vertex's neighbours in a triangle mesh, as rows of one array (compressed sparse rows),
+/// each neighbour once (an interior edge is on two faces: offering a vertex twice the same
+/// sample at the same distance changes nothing in the search, so the second entry only cost a
+/// look).
 struct Rows {
     start: Vec<u32>,
     values: Vec<u32>,
 }
 
 impl Rows {
-    /// The neighbours of the vertices `0..n` in `triangles`: a counting sort of the edges.
+    /// The neighbours of the vertices `0..n` in `triangles`: a counting sort of the edges, then
+    /// each row sorted and its repeats dropped (in parallel).
     fn new(n: usize, triangles: &[[u32; 3]]) -> Self {
         let mut start = vec![0u32; n + 1];
         for t in triangles {
@@ -272,7 +274,42 @@ impl Rows {
                 fill[v] += 2;
             }
         }
-        Rows { start, values }
+        // Sort and deduplicate each row in place, then close the gaps.
+        let mut rows: Vec<&mut [u32]> = Vec::with_capacity(n);
+        let mut rest = values.as_mut_slice();
+        for v in 0..n {
+            let (row, tail) = rest.split_at_mut((start[v + 1] - start[v]) as usize);
+            rows.push(row);
+            rest = tail;
+        }
+        let kept: Vec<u32> = rows
+            .into_par_iter()
+            .map(|row| {
+                row.sort_unstable();
+                let mut k = 0;
+                for i in 0..row.len() {
+                    if i == 0 || row[i] != row[k - 1] {
+                        row[k] = row[i];
+                        k += 1;
+                    }
+                }
+                k as u32
+            })
+            .collect();
+        let mut write = 0usize;
+        let mut compact = vec![0u32; n + 1];
+        for v in 0..n {
+            let from = start[v] as usize;
+            let len = kept[v] as usize;
+            values.copy_within(from..from + len, write);
+            write += len;
+            compact[v + 1] = write as u32;
+        }
+        values.truncate(write);
+        Rows {
+            start: compact,
+            values,
+        }
     }
 
     fn row(&self, r: u32) -> &[u32] {

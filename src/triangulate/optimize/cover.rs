@@ -4,6 +4,8 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::geometry::morton::morton_order;
+
 use super::*;
 
 /// One round of covering: the points of `points` farther than `cover_distance` from the mesh,
@@ -25,21 +27,15 @@ pub(super) fn cover(
     // than the cover distance: a collapse moves the mesh by up to `collapse_offset` from a
     // surface point, relaxation by less.
     if watch.is_none() {
-        *watch = Some(
-            points
-                .par_iter()
-                .enumerate()
-                .filter(|(_, &p)| {
-                    output
-                        .closest_point_within(
-                            p,
-                            (params.cover_distance - params.collapse_offset).max(0.0),
-                        )
-                        .is_none()
-                })
-                .map(|(i, _)| i as u32)
-                .collect(),
-        );
+        // Asked in Morton order (the points are drawn in random order), which keeps the
+        // output's tree in cache; the answers are the same in any order.
+        let reach = (params.cover_distance - params.collapse_offset).max(0.0);
+        let mut far: Vec<u32> = morton_order(points)
+            .into_par_iter()
+            .filter(|&i| !output.is_within(points[i as usize], reach))
+            .collect();
+        far.sort_unstable();
+        *watch = Some(far);
     }
     let watched = watch.as_deref().unwrap_or_default();
     let mut far: Vec<(f64, usize, u32)> = watched
