@@ -18,6 +18,9 @@ use glam::DVec3;
 /// Triangles per leaf at most.
 const LEAF_SIZE: usize = 4;
 
+/// Entries of a query's stack: twice the depth of a tree of 2^32 triangles, with room to spare.
+const STACK: usize = 72;
+
 /// One box of the tree: a leaf holds `count > 0` triangles from `first` (leaf order); an inner
 /// node's two children are the nodes `first` and `first + 1`.
 #[derive(Debug, Clone, Copy)]
@@ -94,43 +97,7 @@ impl ClosestPointTree {
     /// (false for `p` not finite): the walk of [`ClosestPointTree::closest`], ended at the first
     /// such triangle, which is usually in the first leaf it reaches.
     pub fn any_within(&self, p: DVec3, max_distance_squared: f64) -> bool {
-        if !p.is_finite() || self.nodes.is_empty() {
-            return false;
-        }
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
-        if box_distance_squared(p, &self.nodes[0]) < max_distance_squared {
-            stack.push(0);
-        }
-        while let Some(n) = stack.pop() {
-            let node = self.nodes[n as usize];
-            if node.count > 0 {
-                let first = node.first as usize;
-                let hit = self.corners[first..first + node.count as usize]
-                    .iter()
-                    .any(|t| {
-                        closest_on_triangle(p, t).0.distance_squared(p) < max_distance_squared
-                    });
-                if hit {
-                    return true;
-                }
-            } else {
-                let (l, r) = (node.first, node.first + 1);
-                let dl = box_distance_squared(p, &self.nodes[l as usize]);
-                let dr = box_distance_squared(p, &self.nodes[r as usize]);
-                let ((near, dn), (far, df)) = if dl <= dr {
-                    ((l, dl), (r, dr))
-                } else {
-                    ((r, dr), (l, dl))
-                };
-                if df < max_distance_squared {
-                    stack.push(far);
-                }
-                if dn < max_distance_squared {
-                    stack.push(near);
-                }
-            }
-        }
-        false
+        self.walk(p, max_distance_squared, None, true).is_some()
     }
 
     /// Whether the tree has no triangle.
@@ -149,6 +116,19 @@ impl ClosestPointTree {
         max_distance_squared: f64,
         start: Option<u32>,
     ) -> Option<Closest> {
+        self.walk(p, max_distance_squared, start, false)
+    }
+
+    /// The depth-first walk of both queries: nearer child first, pruned by the best squared
+    /// distance so far (first `start`'s, when it names a triangle); with `first_hit`, it ends at
+    /// the first triangle below the bound.
+    fn walk(
+        &self,
+        p: DVec3,
+        max_distance_squared: f64,
+        start: Option<u32>,
+        first_hit: bool,
+    ) -> Option<Closest> {
         if !p.is_finite() || self.nodes.is_empty() {
             return None;
         }
@@ -164,12 +144,18 @@ impl ClosestPointTree {
                 }
             }
         }
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        // The stack grows by at most one entry per level, and median splits keep the depth
+        // below 32 for any u32 count of triangles.
+        let mut stack = [(0u32, 0.0f64); STACK];
+        let mut len = 0;
         let root = box_distance_squared(p, &self.nodes[0]);
         if root < best {
-            stack.push((0, root));
+            stack[0] = (0, root);
+            len = 1;
         }
-        while let Some((n, d)) = stack.pop() {
+        'walk: while len > 0 {
+            len -= 1;
+            let (n, d) = stack[len];
             if d >= best {
                 continue;
             }
@@ -182,6 +168,9 @@ impl ClosestPointTree {
                     if d < best {
                         best = d;
                         found = Some((k, q, bary));
+                        if first_hit {
+                            break 'walk;
+                        }
                     }
                 }
             } else {
@@ -193,11 +182,11 @@ impl ClosestPointTree {
                 } else {
                     ((r, dr), (l, dl))
                 };
-                if df < best {
-                    stack.push((far, df));
-                }
-                if dn < best {
-                    stack.push((near, dn));
+                for entry in [(far, df), (near, dn)] {
+                    if entry.1 < best {
+                        stack[len] = entry;
+                        len += 1;
+                    }
                 }
             }
         }
