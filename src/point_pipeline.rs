@@ -285,7 +285,7 @@ pub fn remesh_points(
     let mut source = ScannedInput::open(source, &scan_params, params.drop_outliers)?;
     let mut sigma_p = source.sigma_p;
     let mut scans = 0;
-    let (scan, kernel, rimls, samples, mut moving, unprojected_samples, rescan_rejected) = loop {
+    let (scan, kernel, rimls, samples, moving, unprojected_samples, rescan_rejected) = loop {
         scans += 1;
         let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE)?;
         let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
@@ -369,6 +369,13 @@ pub fn remesh_points(
     timer.lap("RIMLS surface");
 
     on_stage("gradient ascent");
+    // The samples in Morton order (they come in the scan's order): a move reads its
+    // neighbours' and the RIMLS points near it, and the later loops over vertices walk the
+    // surface instead of jumping across it.
+    let order = crate::geometry::morton::morton_order(
+        &moving.iter().map(|s| s.position).collect::<Vec<_>>(),
+    );
+    let mut moving: Vec<SurfaceSample> = order.iter().map(|&i| moving[i as usize]).collect();
     let ga = gradient_ascent(
         &kernel,
         &domain,

@@ -479,6 +479,11 @@ pub(crate) fn rimls_of(
             ));
         }
     }
+    // In Morton order: a RIMLS evaluation sums over a point's neighbours, which are then
+    // neighbours in memory too (the scan leaves them in its own order).
+    let order = crate::geometry::morton::morton_order(&positions);
+    let positions = order.iter().map(|&i| positions[i as usize]).collect();
+    let normals = order.iter().map(|&i| normals[i as usize]).collect();
     Rimls::new(positions, normals, params)
 }
 
