@@ -10,6 +10,7 @@ use parry3d_f64::partitioning::Bvh;
 
 use super::edit::EditMesh;
 use crate::geometry::self_intersection::triangle_aabb;
+use crate::geometry::triangle::is_degenerate_face;
 use crate::geometry::triangle_intersection::triangles_within;
 
 /// A BVH over the live faces of an edit mesh, by slot (see the module).
@@ -75,6 +76,40 @@ impl CrossingGuard {
         found
     }
 
+    /// The pairs `[f, g]` (slots, f < g) of live faces that share a point or come within the
+    /// guard's `near` with at least one of them in `faces`: the pairs of
+    /// [`pairs_within`](crate::geometry::self_intersection::pairs_within) over the live faces
+    /// that touch `faces`, decided by the same test with the smaller slot first (faces sharing a
+    /// vertex, degenerate faces and faces with a corner not finite left out). Sorted, each
+    /// once. The guard must know every face's current box ([`Self::changed`]).
+    pub(crate) fn pairs_with<L: Copy>(&self, m: &EditMesh<L>, faces: &[u32]) -> Vec<[u32; 2]> {
+        let p = m.positions();
+        let usable =
+            |t: [u32; 3]| t.iter().all(|&v| p[v as usize].is_finite()) && !is_degenerate_face(p, t);
+        let mut pairs = Vec::new();
+        for &f in faces {
+            let Some(t) = m.face(f).filter(|&t| usable(t)) else {
+                continue;
+            };
+            let query = triangle_aabb(m.corners(t)).loosened(self.near);
+            for g in self.bvh.intersect_aabb(&query) {
+                let Some(u) = m.face(g).filter(|&u| g != f && usable(u)) else {
+                    continue;
+                };
+                if t.iter().any(|v| u.contains(v)) {
+                    continue;
+                }
+                let (a, b) = if f < g { (t, u) } else { (u, t) };
+                if triangles_within(m.corners(a), m.corners(b), self.near) {
+                    pairs.push([f.min(g), f.max(g)]);
+                }
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        pairs
+    }
+
     /// How many live faces the face `t` with corners `p` crosses (as [`Self::visit_crossed`]).
     pub(crate) fn count_crossed<L: Copy>(
         &self,
@@ -102,5 +137,67 @@ impl CrossingGuard {
         faces
             .iter()
             .any(|&t| self.visit_crossed(m, t, m.corners(t), replaced, |_| true))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::self_intersection::pairs_within;
+    use crate::mesh::edit::SlotPolicy;
+    use crate::mesh::test_meshes::grid;
+    use crate::mesh::TriMesh;
+    use rand::{RngExt, SeedableRng};
+
+    /// Pairs kept up to date through the guard, moves after moves, are the pairs a search of
+    /// the whole mesh finds: two wavy sheets 0.05 apart whose vertices are pushed about by up
+    /// to 0.1 (so pairs come and go), with `near` 0 and 0.02.
+    #[test]
+    fn the_pairs_kept_through_the_guard_are_the_pairs_of_a_whole_search() {
+        let sheet = |z: f64| {
+            grid(12, move |i, j| {
+                DVec3::new(i as f64, j as f64, z + 0.03 * ((i + 2 * j) as f64).sin())
+            })
+        };
+        let (a, b) = (sheet(0.0), sheet(0.05));
+        let offset = a.positions.len() as u32;
+        let mesh = TriMesh::new(
+            [a.positions, b.positions].concat(),
+            a.triangles
+                .into_iter()
+                .chain(b.triangles.into_iter().map(|t| t.map(|v| v + offset)))
+                .collect(),
+        );
+        for near in [0.0, 0.02] {
+            let mut m: EditMesh<()> = EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse);
+            let triangles = m.live_faces().0;
+            let mut guard = CrossingGuard::within(&m, near);
+            let mut pairs = pairs_within(m.positions(), &triangles, near);
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+            let mut seen = 0;
+            for _ in 0..40 {
+                let moved: Vec<u32> = (0..5)
+                    .map(|_| rng.random_range(0..m.vertex_count() as u32))
+                    .collect();
+                for &v in &moved {
+                    let d = DVec3::new(0.0, 0.0, rng.random_range(-0.1..0.1));
+                    m.relocate_vertex(v, m.position(v) + d).unwrap();
+                }
+                let mut faces: Vec<u32> = moved
+                    .iter()
+                    .flat_map(|&v| m.faces_around(v).iter().copied())
+                    .collect();
+                faces.sort_unstable();
+                faces.dedup();
+                guard.changed(&m, &faces);
+                pairs.retain(|p| p.iter().all(|f| faces.binary_search(f).is_err()));
+                pairs.extend(guard.pairs_with(&m, &faces));
+                pairs.sort_unstable();
+                pairs.dedup();
+                assert_eq!(pairs, pairs_within(m.positions(), &triangles, near));
+                seen = seen.max(pairs.len());
+            }
+            assert!(seen > 0, "the moves made no pair: the test tests nothing");
+        }
     }
 }

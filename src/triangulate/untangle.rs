@@ -103,13 +103,43 @@ pub fn untangle(
 ) -> (UntangleStats, Vec<Option<u32>>) {
     let start = mesh.positions.clone();
     let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
-    let triangles = m.live_faces().0;
+    let (triangles, slots) = m.live_faces();
     let mut stats = UntangleStats::default();
     let mut moved = vec![false; m.vertex_count()];
     let margin = params.margin_sigma_p * sigma_p;
     let near = params.near.min(0.1 * margin).max(0.0);
     let mut pairs = pairs_within(&mesh.positions, &mesh.triangles, near);
     stats.pairs_before = pairs.len();
+    // The rounds move a few vertices each: the pairs are updated around them through a guard
+    // whose leaves follow the moves, not searched for again over the whole mesh (a face's slot
+    // is its index in `triangles` when every face is live, as here).
+    let mut guard = (!pairs.is_empty() && slots.iter().enumerate().all(|(k, &f)| f as usize == k))
+        .then(|| CrossingGuard::within(&m, near));
+    drop(slots);
+    // The pairs at the current positions from `pairs` (those at the positions before the
+    // vertices in `changed` moved).
+    let update =
+        |m: &Mesh, guard: &mut Option<CrossingGuard>, pairs: &[[u32; 2]], changed: &[u32]| {
+            let Some(guard) = guard else {
+                return pairs_within(m.positions(), &triangles, near);
+            };
+            let mut faces: Vec<u32> = changed
+                .iter()
+                .flat_map(|&v| m.faces_around(v).iter().copied())
+                .collect();
+            faces.sort_unstable();
+            faces.dedup();
+            guard.changed(m, &faces);
+            let mut after: Vec<[u32; 2]> = pairs
+                .iter()
+                .copied()
+                .filter(|p| p.iter().all(|f| faces.binary_search(f).is_err()))
+                .collect();
+            after.extend(guard.pairs_with(m, &faces));
+            after.sort_unstable();
+            after.dedup();
+            after
+        };
     // The pairs that lie outside the input's own crossings: a round may trade a pair where the
     // input crosses for nothing, never for one where it does not.
     let outside = |positions: &[DVec3], pairs: &[[u32; 2]]| match input_crossings {
@@ -138,7 +168,8 @@ pub fn untangle(
             relocated &= m.relocate_vertex(v, m.position(v) + d).is_ok();
         }
         // Moves change positions only: the faces are still `triangles`.
-        let mut after = pairs_within(m.positions(), &triangles, near);
+        let vertices: Vec<u32> = moves.iter().map(|&(v, _)| v).collect();
+        let mut after = update(&m, &mut guard, &pairs, &vertices);
         // Moves that made a pair outside the input's crossings go back (their vertices only),
         // a few times over, as undoing one move can uncover another pair.
         for _ in 0..UNDO_PASSES {
@@ -168,10 +199,11 @@ pub fn untangle(
             if back.is_empty() {
                 break;
             }
-            for (v, p) in back {
+            for &(v, p) in &back {
                 let _ = m.relocate_vertex(v, p);
             }
-            after = pairs_within(m.positions(), &triangles, near);
+            let vertices: Vec<u32> = back.iter().map(|&(v, _)| v).collect();
+            after = update(&m, &mut guard, &after, &vertices);
         }
         let after_outside = outside(m.positions(), &after);
         if relocated && after.len() < pairs.len() && after_outside <= pairs_outside {
@@ -183,8 +215,17 @@ pub fn untangle(
             scale = 1.0;
         } else {
             // Never worse: undo, and try shorter moves next round (three halvings at most).
-            for (v, p) in saved {
+            for &(v, p) in &saved {
                 let _ = m.relocate_vertex(v, p);
+            }
+            if let Some(guard) = &mut guard {
+                let mut faces: Vec<u32> = saved
+                    .iter()
+                    .flat_map(|&(v, _)| m.faces_around(v).iter().copied())
+                    .collect();
+                faces.sort_unstable();
+                faces.dedup();
+                guard.changed(&m, &faces);
             }
             scale *= 0.5;
             if scale < 0.1 {
