@@ -18,6 +18,9 @@ use glam::DVec3;
 /// Triangles per leaf at most.
 const LEAF_SIZE: usize = 4;
 
+/// Points of one [`ClosestPointTree::closest_each`] walk at most.
+pub const GROUP: usize = 8;
+
 /// Entries of a query's stack: twice the depth of a tree of 2^32 triangles, with room to spare.
 const STACK: usize = 72;
 
@@ -117,6 +120,142 @@ impl ClosestPointTree {
         start: Option<u32>,
     ) -> Option<Closest> {
         self.walk(p, max_distance_squared, start, false)
+    }
+
+    /// [`ClosestPointTree::closest`] for up to [`GROUP`] points near each other at once (the
+    /// quadrature points of one face): point k's answer goes to `out[k]`, searched below
+    /// `max_distance_squared[k]` and started from `start[k]`. One walk serves them all: a box is
+    /// entered when it meets the box around every point's ball of its best distance so far
+    /// (one test per box instead of one per point), and a leaf's triangles are tried for the
+    /// points its box is closer to than their best. Each answer is exact, as for one point; among triangles at exactly
+    /// equal distances the one kept can differ from [`ClosestPointTree::closest`]'s, which
+    /// visits the boxes in another order. The four slices have one length, at most [`GROUP`]
+    /// (longer ones are answered in groups).
+    pub fn closest_each(
+        &self,
+        points: &[DVec3],
+        max_distance_squared: &[f64],
+        start: &[Option<u32>],
+        out: &mut [Option<Closest>],
+    ) {
+        let n = points.len();
+        assert!(max_distance_squared.len() == n && start.len() == n && out.len() == n);
+        if n > GROUP {
+            for k in (0..n).step_by(GROUP) {
+                let e = (k + GROUP).min(n);
+                self.closest_each(
+                    &points[k..e],
+                    &max_distance_squared[k..e],
+                    &start[k..e],
+                    &mut out[k..e],
+                );
+            }
+            return;
+        }
+        out.fill(None);
+        if self.nodes.is_empty() {
+            return;
+        }
+        // A point not finite is never closer than its bound of -1.
+        let mut best = [-1.0f64; GROUP];
+        let mut found: [Option<(usize, DVec3, [f64; 3])>; GROUP] = [None; GROUP];
+        for k in 0..n {
+            if !points[k].is_finite() {
+                continue;
+            }
+            best[k] = max_distance_squared[k];
+            if let Some(&slot) = start[k].and_then(|id| self.slot.get(id as usize)) {
+                if slot != u32::MAX {
+                    let (q, bary) = closest_on_triangle(points[k], &self.corners[slot as usize]);
+                    let d = q.distance_squared(points[k]);
+                    if d < best[k] {
+                        best[k] = d;
+                        found[k] = Some((slot as usize, q, bary));
+                    }
+                }
+            }
+        }
+        // The box around every point's ball of its best distance so far (a hair wider, for
+        // the rounding of the root): a box that misses it holds nothing closer for any point.
+        let reach = |best: &[f64; GROUP]| -> (DVec3, DVec3) {
+            let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for k in 0..n {
+                if best[k] >= 0.0 {
+                    let r = best[k].sqrt() * (1.0 + 1e-9) + f64::MIN_POSITIVE;
+                    lo = lo.min(points[k] - r);
+                    hi = hi.max(points[k] + r);
+                }
+            }
+            (lo, hi)
+        };
+        let (mut lo, mut hi) = reach(&best);
+        let centre = 0.5 * (lo + hi);
+        let meets =
+            |node: &Node, lo: DVec3, hi: DVec3| node.lo.cmple(hi).all() && node.hi.cmpge(lo).all();
+        let mut stack = [0u32; STACK];
+        let mut len = 0;
+        if meets(&self.nodes[0], lo, hi) {
+            len = 1;
+        }
+        while len > 0 {
+            len -= 1;
+            let node = self.nodes[stack[len] as usize];
+            if !meets(&node, lo, hi) {
+                continue;
+            }
+            if node.count > 0 {
+                let first = node.first as usize;
+                let mut to_box = [0.0f64; GROUP];
+                for k in 0..n {
+                    to_box[k] = box_distance_squared(points[k], &node);
+                }
+                let mut closer = false;
+                for t in first..first + node.count as usize {
+                    for k in 0..n {
+                        if to_box[k] >= best[k] {
+                            continue;
+                        }
+                        let (q, bary) = closest_on_triangle(points[k], &self.corners[t]);
+                        let d = q.distance_squared(points[k]);
+                        if d < best[k] {
+                            best[k] = d;
+                            found[k] = Some((t, q, bary));
+                            closer = true;
+                        }
+                    }
+                }
+                if closer {
+                    (lo, hi) = reach(&best);
+                }
+            } else {
+                let (l, r) = (node.first, node.first + 1);
+                let (nl, nr) = (&self.nodes[l as usize], &self.nodes[r as usize]);
+                let (ml, mr) = (meets(nl, lo, hi), meets(nr, lo, hi));
+                let (near, far) = match (ml, mr) {
+                    (true, true)
+                        if box_distance_squared(centre, nr) < box_distance_squared(centre, nl) =>
+                    {
+                        (Some(r), Some(l))
+                    }
+                    (true, true) => (Some(l), Some(r)),
+                    (true, false) => (Some(l), None),
+                    (false, true) => (Some(r), None),
+                    (false, false) => (None, None),
+                };
+                for c in [far, near].into_iter().flatten() {
+                    stack[len] = c;
+                    len += 1;
+                }
+            }
+        }
+        for k in 0..n {
+            out[k] = found[k].map(|(t, point, barycentric)| Closest {
+                id: self.ids[t],
+                point,
+                barycentric,
+                distance_squared: best[k],
+            });
+        }
     }
 
     /// The depth-first walk of both queries: nearer child first, pruned by the best squared
@@ -365,6 +504,55 @@ mod tests {
                 assert!(rebuilt.distance(c.point) < 1e-12);
                 assert!((c.barycentric.iter().sum::<f64>() - 1.0).abs() < 1e-12);
             }
+        }
+    }
+
+    #[test]
+    fn one_walk_for_a_group_gives_each_point_its_own_answer() {
+        let tris = random_triangles(300, 6);
+        let tree = ClosestPointTree::new(tris.iter().copied());
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for round in 0..200 {
+            // 11 points around one centre (more than a group), some with a bound that leaves
+            // their answer out, some started from a triangle, one not finite.
+            let centre = DVec3::new(
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+            );
+            let mut points: Vec<DVec3> = (0..11)
+                .map(|_| {
+                    centre
+                        + 0.1
+                            * DVec3::new(
+                                rng.random_range(-1.0..1.0),
+                                rng.random_range(-1.0..1.0),
+                                rng.random_range(-1.0..1.0),
+                            )
+                })
+                .collect();
+            points[round % 11] = DVec3::NAN;
+            let bounds: Vec<f64> = (0..11)
+                .map(|k| if k % 4 == 1 { 0.01 } else { f64::INFINITY })
+                .collect();
+            let starts: Vec<Option<u32>> = (0..11)
+                .map(|k| (k % 3 == 0).then(|| tris[(round + k) % tris.len()].0))
+                .collect();
+            let mut out = vec![None; 11];
+            tree.closest_each(&points, &bounds, &starts, &mut out);
+            for k in 0..11 {
+                let alone = tree.closest(points[k], bounds[k], starts[k]);
+                match (out[k], alone) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => {
+                        assert_eq!(a.distance_squared, b.distance_squared, "point {k}");
+                        let want = brute(&tris, points[k]);
+                        assert!((a.distance_squared - want).abs() <= 1e-12 * (1.0 + want));
+                    }
+                    other => panic!("point {k} of round {round}: {other:?}"),
+                }
+            }
+            assert!(out[round % 11].is_none());
         }
     }
 

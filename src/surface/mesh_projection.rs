@@ -4,7 +4,7 @@
 //! to measure the distance between two surfaces (Hausdorff, RMS).
 
 use crate::error::{Error, Result};
-use crate::geometry::closest_point_tree::ClosestPointTree;
+use crate::geometry::closest_point_tree::{ClosestPointTree, GROUP};
 use crate::geometry::tolerance::SEARCH_BOUND_SLACK;
 use crate::mesh::TriMesh;
 use glam::DVec3;
@@ -89,6 +89,61 @@ impl MeshSurface {
     /// is kept).
     pub fn closest_point_from(&self, p: DVec3, start: u32, max_dist: f64) -> Option<SurfacePoint> {
         self.search(p, max_dist, Some(start))
+    }
+
+    /// [`SurfaceQuery::closest_points_near`](super::SurfaceQuery::closest_points_near): one walk
+    /// of the tree for all the points ([`ClosestPointTree::closest_each`]), then, for a hinted
+    /// point with no surface within its hint, a search within `max_dist` of its own.
+    pub fn closest_points_near(
+        &self,
+        points: &[DVec3],
+        from: &[Option<SurfacePoint>],
+        hint: &[f64],
+        max_dist: f64,
+        out: &mut [Option<SurfacePoint>],
+    ) {
+        let n = points.len();
+        assert!(from.len() == n && hint.len() == n && out.len() == n);
+        if n > GROUP {
+            for k in (0..n).step_by(GROUP) {
+                let e = (k + GROUP).min(n);
+                self.closest_points_near(
+                    &points[k..e],
+                    &from[k..e],
+                    &hint[k..e],
+                    max_dist,
+                    &mut out[k..e],
+                );
+            }
+            return;
+        }
+        // Each point's first bound: max_dist from a start, its hint (a hair more) without one.
+        let mut within = [0.0; GROUP];
+        let mut bounds = [0.0; GROUP];
+        let mut starts = [None; GROUP];
+        for k in 0..n {
+            within[k] = match from[k] {
+                Some(_) => max_dist,
+                None => (hint[k] * (1.0 + SEARCH_BOUND_SLACK) + f64::MIN_POSITIVE).min(max_dist),
+            };
+            bounds[k] = within[k] * within[k] * (1.0 + SEARCH_BOUND_SLACK);
+            starts[k] = from[k].map(|f| f.face);
+        }
+        let mut found = [None; GROUP];
+        self.tree
+            .closest_each(points, &bounds[..n], &starts[..n], &mut found[..n]);
+        for k in 0..n {
+            out[k] = match found[k] {
+                Some(c) => Some(SurfacePoint {
+                    position: c.point,
+                    face: c.id,
+                    barycentric: c.barycentric,
+                    distance: c.distance_squared.sqrt(),
+                }),
+                None if within[k] < max_dist => self.search(points[k], max_dist, None),
+                None => None,
+            };
+        }
     }
 
     fn search(&self, p: DVec3, max_dist: f64, start: Option<u32>) -> Option<SurfacePoint> {
@@ -178,6 +233,51 @@ mod tests {
         // Outside the square: the closest point is on its border.
         let sp = s.closest_point(DVec3::new(2.0, 0.5, 0.0)).unwrap();
         assert!((sp.position - DVec3::new(1.0, 0.5, 0.0)).length() < 1e-12);
+    }
+
+    #[test]
+    fn the_points_of_a_face_searched_together_get_their_own_answers() {
+        use crate::surface::SurfaceQuery;
+        use rand::{RngExt, SeedableRng};
+        let mesh = crate::mesh::test_meshes::uv_sphere(1.0, 16, 32);
+        let s = MeshSurface::new(&mesh).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut fell_back = 0;
+        for _ in 0..300 {
+            let c = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            )
+            .normalize_or_zero();
+            let points: Vec<DVec3> = (0..6)
+                .map(|_| c + 0.05 * DVec3::new(rng.random_range(-1.0..1.0), 0.3, -0.2))
+                .collect();
+            // Half the points start from an earlier answer; the others have a hint, some too
+            // short to hold the answer (the search then goes on to max_dist).
+            let from: Vec<Option<SurfacePoint>> = (0..6)
+                .map(|k| (k % 2 == 0).then(|| s.closest_point(points[(k + 1) % 6]).unwrap()))
+                .collect();
+            let hint: Vec<f64> = (0..6)
+                .map(|k| if k % 3 == 1 { 1e-4 } else { 0.3 })
+                .collect();
+            let mut together = vec![None; 6];
+            s.closest_points_near(&points, &from, &hint, 0.5, &mut together);
+            for k in 0..6 {
+                let alone = match &from[k] {
+                    Some(f) => SurfaceQuery::closest_point_near(&s, points[k], f, 0.5),
+                    None => SurfaceQuery::closest_point_hinted(&s, points[k], hint[k], 0.5),
+                };
+                let (a, b) = (together[k].unwrap(), alone.unwrap());
+                assert_eq!(a.distance, b.distance, "point {k}");
+                assert!(a.position.distance(b.position) < 1e-12);
+                fell_back += usize::from(from[k].is_none() && hint[k] < a.distance);
+            }
+        }
+        assert!(
+            fell_back > 0,
+            "no hint was too short: the fallback went untested"
+        );
     }
 
     #[test]

@@ -115,6 +115,28 @@ pub trait SurfaceQuery: Sync {
     ) -> Option<SurfacePoint> {
         self.closest_point_hinted(p, p.distance(from.position), max_dist)
     }
+
+    /// The closest points to several points near each other (the quadrature points of one
+    /// face): `out[k]` is [`SurfaceQuery::closest_point_near`] of `points[k]` from `from[k]`
+    /// where that is given, and [`SurfaceQuery::closest_point_hinted`] with `hint[k]` where
+    /// not, each within `max_dist`. The same answers as one query at a time (on a mesh one
+    /// walk of its tree serves them all, which can keep another of several faces at exactly
+    /// the same distance). The four slices have one length.
+    fn closest_points_near(
+        &self,
+        points: &[DVec3],
+        from: &[Option<SurfacePoint>],
+        hint: &[f64],
+        max_dist: f64,
+        out: &mut [Option<SurfacePoint>],
+    ) {
+        for (k, &p) in points.iter().enumerate() {
+            out[k] = match &from[k] {
+                Some(f) => self.closest_point_near(p, f, max_dist),
+                None => self.closest_point_hinted(p, hint[k], max_dist),
+            };
+        }
+    }
 }
 
 impl SurfaceQuery for MeshSurface {
@@ -149,6 +171,17 @@ impl SurfaceQuery for MeshSurface {
         max_dist: f64,
     ) -> Option<SurfacePoint> {
         MeshSurface::closest_point_from(self, p, from.face, max_dist)
+    }
+
+    fn closest_points_near(
+        &self,
+        points: &[DVec3],
+        from: &[Option<SurfacePoint>],
+        hint: &[f64],
+        max_dist: f64,
+        out: &mut [Option<SurfacePoint>],
+    ) {
+        MeshSurface::closest_points_near(self, points, from, hint, max_dist, out);
     }
 }
 

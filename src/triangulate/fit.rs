@@ -128,23 +128,22 @@ pub fn fit_to_surface<S: SurfaceQuery + ?Sized>(
                     .distance(p[1])
                     .max(p[1].distance(p[2]))
                     .max(p[2].distance(p[0]));
+                let points = POINTS.map(|(b, _)| b[0] * p[0] + b[1] * p[1] + b[2] * p[2]);
+                // The points' closest points within half the face's longest edge; searched
+                // from the last iteration's answers (on a mesh, starting at their triangles), or
+                // first within the distance to the nearest corner where it started (a point of
+                // the surface): the same answers, with most of the search pruned. One search
+                // for the six (on a mesh, one walk of its tree).
+                let hints = points.map(|x| {
+                    t.iter()
+                        .map(|&v| x.distance(start[v as usize]))
+                        .fold(f64::INFINITY, f64::min)
+                });
+                let mut answers = [None; 6];
+                surface.closest_points_near(&points, &found[f], &hints, 0.5 * reach, &mut answers);
                 for (k, (b, weight)) in POINTS.into_iter().enumerate() {
-                    let x = b[0] * p[0] + b[1] * p[1] + b[2] * p[2];
-                    // The point's closest point within half the face's longest edge; searched
-                    // from the last iteration's answer (on a mesh, starting at its triangle), or
-                    // first within the distance to the nearest corner where it started (a point
-                    // of the surface): the same answer, with most of the search pruned.
-                    let q = match &found[f][k] {
-                        Some(last) => surface.closest_point_near(x, last, 0.5 * reach),
-                        None => {
-                            let near = t
-                                .iter()
-                                .map(|&v| x.distance(start[v as usize]))
-                                .fold(f64::INFINITY, f64::min);
-                            surface.closest_point_hinted(x, near, 0.5 * reach)
-                        }
-                    };
-                    let Some(q) = q else {
+                    let x = points[k];
+                    let Some(q) = answers[k] else {
                         continue;
                     };
                     closest[k] = Some(q);
