@@ -26,7 +26,7 @@ use crate::mesh::bisect::bisect_to_length;
 use crate::mesh::sheets::Sheets;
 use crate::sampling::sizing::SizingField;
 use crate::spatial::StaticTree;
-use crate::surface::MeshSurface;
+use crate::surface::{MeshSurface, SurfacePoint};
 
 /// Parameters of `restricted_delaunay`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -112,72 +112,18 @@ pub fn restricted_delaunay(
     };
     // Vertex -> its neighbours.
     let neighbours = Rows::new(n, &refined.triangles);
-    // Seeds: the refined vertices around each sample's closest point, on its input face.
-    let tree = StaticTree::new(&refined.positions);
     let radius = params.resolution * spacing * 1.01;
     let tolerance = crate::geometry::tolerance::ON_SURFACE_RELATIVE * spacing;
-    let mut dist = vec![f64::INFINITY; n];
-    let mut label = vec![u32::MAX; n];
-    let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
-    let offer =
-        |v: u32, s: u32, d: f64, dist: &mut [f64], label: &mut [u32], heap: &mut BinaryHeap<_>| {
-            let i = v as usize;
-            if d < dist[i] || (d == dist[i] && s < label[i]) {
-                dist[i] = d;
-                label[i] = s;
-                heap.push(Reverse((d.to_bits(), s, v)));
-            }
-        };
-    // Each sample's seeds, found in parallel and offered in sample order.
-    let seeds: Vec<Vec<u32>> = positions
-        .par_iter()
-        .map_init(Vec::new, |near, &x| {
-            // A sample lies on the surface (up to rounding).
-            let Some(sp) = surface.closest_point_hinted(x, tolerance, f64::MAX) else {
-                return Vec::new();
-            };
-            tree.within_unsorted(sp.position, radius * radius, near);
-            if near.is_empty() {
-                tree.nearest_n(sp.position, 1, near);
-            }
-            let on_face: Vec<u32> = near
-                .iter()
-                .map(|q| q.0)
-                .filter(|&v| {
-                    on_sheet(v, sp.face)
-                        && lies_in(surface, sp.face, refined.positions[v as usize], tolerance)
-                })
-                .collect();
-            if on_face.is_empty() {
-                near.iter()
-                    .map(|q| q.0)
-                    .filter(|&v| on_sheet(v, sp.face))
-                    .take(1)
-                    .collect()
-            } else {
-                on_face
-            }
-        })
-        .collect();
-    for (s, (seeds, &x)) in seeds.into_iter().zip(positions).enumerate() {
-        for v in seeds {
-            let d = refined.positions[v as usize].distance(x);
-            offer(v, s as u32, d, &mut dist, &mut label, &mut heap);
-        }
-    }
-    // Grow the cells over the mesh: a vertex takes the nearest sample among its neighbours'.
-    while let Some(Reverse((d, s, v))) = heap.pop() {
-        let i = v as usize;
-        if d != dist[i].to_bits() || s != label[i] {
-            continue;
-        }
-        let x = positions[s as usize];
-        for &u in neighbours.row(v) {
-            let du = refined.positions[u as usize].distance(x);
-            offer(u, s, du, &mut dist, &mut label, &mut heap);
-        }
-    }
-
+    let labels = Labels {
+        surface,
+        refined: &refined,
+        neighbours: &neighbours,
+        positions,
+        radius,
+        tolerance,
+        on_sheet: &on_sheet,
+    };
+    let label = labels.grow();
     // Dual triangles: refined faces with three labels, counted per triple and orientation.
     let mut seen: Vec<([u32; 3], bool)> = refined
         .triangles
@@ -232,6 +178,280 @@ pub fn restricted_delaunay(
         })
         .collect();
     Some((voted, stats))
+}
+
+/// The search of `restricted_delaunay` for each refined vertex's sample: the nearest sample
+/// whose cell reaches the vertex over the refined mesh, as a multi-source Dijkstra search from
+/// each sample's seeds (the refined vertices within `radius` of its closest point on the input
+/// that lie on its face) with the Euclidean distance to the sample as key, ties to the lower
+/// sample index.
+///
+/// Most vertices are settled without the search: a vertex whose nearest sample of all is s, and
+/// that a path of such vertices joins to a seed of s, is labelled s by the search too (every
+/// vertex on the path is offered s, and nothing is nearer). Those are found in parallel
+/// (nearest samples through a kd-tree of the samples, which also lists each vertex's seeds) and
+/// by a flood over the vertices with the same nearest sample; the search then runs over the
+/// rest only (where a cell would reach over a thin part to the other side, or through another
+/// sheet), from the settled vertices around them. No index of the refined vertices is built.
+struct Labels<'a> {
+    surface: &'a MeshSurface,
+    refined: &'a crate::mesh::bisect::Refined,
+    neighbours: &'a Rows,
+    positions: &'a [DVec3],
+    radius: f64,
+    tolerance: f64,
+    on_sheet: &'a (dyn Fn(u32, u32) -> bool + Sync),
+}
+
+/// Refined vertices per parallel task of [`Labels::grow`].
+const LABEL_CHUNK: usize = 4096;
+
+/// Samples asked of the kd-tree per refined vertex: the nearest, its ties, and the seeds
+/// (closest points within `radius`, of which a vertex has one or two); more are listed by a
+/// search within the radius when the last of these is still within it.
+const LABEL_NEAREST: usize = 4;
+
+impl Labels<'_> {
+    /// Each refined vertex's label (`u32::MAX`: reached by no cell).
+    fn grow(&self) -> Vec<u32> {
+        let (refined, positions) = (self.refined, self.positions);
+        let n = refined.positions.len();
+        // Each sample's closest point on the input (a sample lies on it, up to rounding).
+        let anchors: Vec<Option<SurfacePoint>> = positions
+            .par_iter()
+            .map(|&x| {
+                self.surface
+                    .closest_point_hinted(x, self.tolerance, f64::MAX)
+            })
+            .collect();
+        // The seeds are listed around the samples, wider by how far a sample lies from its
+        // closest point.
+        let offset = anchors
+            .iter()
+            .zip(positions)
+            .filter_map(|(a, &x)| a.map(|a| a.position.distance(x)))
+            .fold(0.0, f64::max);
+        let reach_2 = (self.radius + offset).powi(2);
+        let tree = StaticTree::new(positions);
+        let is_seed = |s: u32, v: u32| {
+            anchors[s as usize].is_some_and(|sp| {
+                let p = refined.positions[v as usize];
+                (p - sp.position).length_squared() <= self.radius * self.radius
+                    && (self.on_sheet)(v, sp.face)
+                    && lies_in(self.surface, sp.face, p, self.tolerance)
+            })
+        };
+        // Per vertex, in parallel: its nearest sample, and the (sample, vertex) seed pairs.
+        let chunks: Vec<(Vec<u32>, Vec<(u32, u32)>)> = (0..n.div_ceil(LABEL_CHUNK))
+            .into_par_iter()
+            .map_init(Vec::new, |found, c| {
+                let vertices = c * LABEL_CHUNK..((c + 1) * LABEL_CHUNK).min(n);
+                let mut nearest = Vec::with_capacity(vertices.len());
+                let mut seeds = Vec::new();
+                for v in vertices {
+                    let p = refined.positions[v];
+                    tree.nearest_n(p, LABEL_NEAREST, found);
+                    if found.len() == LABEL_NEAREST
+                        && found.last().is_some_and(|&(_, d2)| d2 <= reach_2)
+                    {
+                        tree.within_unsorted(p, reach_2, found);
+                    }
+                    let best = found
+                        .iter()
+                        .map(|&(s, _)| (p.distance(positions[s as usize]), s))
+                        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                    nearest.push(best.map_or(u32::MAX, |b| b.1));
+                    for &(s, d2) in found.iter() {
+                        if d2 <= reach_2 && is_seed(s, v as u32) {
+                            seeds.push((s, v as u32));
+                        }
+                    }
+                }
+                (nearest, seeds)
+            })
+            .collect();
+        let mut label = Vec::with_capacity(n);
+        let mut seeds = Vec::new();
+        for (l, s) in chunks {
+            label.extend(l);
+            seeds.extend(s);
+        }
+        seeds.sort_unstable();
+        seeds.extend(self.fallback_seeds(&anchors, &seeds));
+        // Settled: joined to a seed of their nearest sample through vertices of that sample.
+        let mut settled = vec![false; n];
+        let mut stack: Vec<u32> = Vec::new();
+        for &(s, v) in &seeds {
+            if label[v as usize] == s && !settled[v as usize] {
+                settled[v as usize] = true;
+                stack.push(v);
+            }
+        }
+        while let Some(v) = stack.pop() {
+            let s = label[v as usize];
+            for &u in self.neighbours.row(v) {
+                if !settled[u as usize] && label[u as usize] == s {
+                    settled[u as usize] = true;
+                    stack.push(u);
+                }
+            }
+        }
+        // The search over the rest, from the settled vertices beside them and their seeds.
+        let mut dist = vec![f64::INFINITY; n];
+        for v in 0..n {
+            if settled[v] {
+                dist[v] = refined.positions[v].distance(positions[label[v] as usize]);
+            } else {
+                label[v] = u32::MAX;
+            }
+        }
+        let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
+        for v in 0..n as u32 {
+            if settled[v as usize] && self.neighbours.row(v).iter().any(|&u| !settled[u as usize]) {
+                heap.push(Reverse((dist[v as usize].to_bits(), label[v as usize], v)));
+            }
+        }
+        let offer = |v: u32,
+                     s: u32,
+                     d: f64,
+                     dist: &mut [f64],
+                     label: &mut [u32],
+                     heap: &mut BinaryHeap<_>| {
+            let i = v as usize;
+            if !settled[i] && (d < dist[i] || (d == dist[i] && s < label[i])) {
+                dist[i] = d;
+                label[i] = s;
+                heap.push(Reverse((d.to_bits(), s, v)));
+            }
+        };
+        for &(s, v) in &seeds {
+            let d = refined.positions[v as usize].distance(positions[s as usize]);
+            offer(v, s, d, &mut dist, &mut label, &mut heap);
+        }
+        while let Some(Reverse((d, s, v))) = heap.pop() {
+            let i = v as usize;
+            if d != dist[i].to_bits() || s != label[i] {
+                continue;
+            }
+            let x = positions[s as usize];
+            for &u in self.neighbours.row(v) {
+                let du = refined.positions[u as usize].distance(x);
+                offer(u, s, du, &mut dist, &mut label, &mut heap);
+            }
+        }
+        label
+    }
+
+    /// Seeds of the samples that have none within the radius on their face (a face of the
+    /// input smaller than the refinement's resolution): the refined vertex of the sample's face
+    /// nearest to its closest point. `seeds`: the others', sorted.
+    fn fallback_seeds(
+        &self,
+        anchors: &[Option<SurfacePoint>],
+        seeds: &[(u32, u32)],
+    ) -> Vec<(u32, u32)> {
+        let mut without: rustc_hash::FxHashMap<u32, Vec<u32>> = Default::default();
+        for (s, a) in anchors.iter().enumerate() {
+            let s = s as u32;
+            if let Some(sp) = a {
+                if seeds.binary_search_by(|&(t, _)| t.cmp(&s)).is_err() {
+                    without.entry(sp.face).or_default().push(s);
+                }
+            }
+        }
+        if without.is_empty() {
+            return Vec::new();
+        }
+        // (distance, vertex) of the best vertex so far per sample.
+        let mut best: std::collections::BTreeMap<u32, (f64, u32)> = Default::default();
+        for (t, &f) in self.refined.triangles.iter().zip(&self.refined.parent) {
+            let Some(samples) = without.get(&f) else {
+                continue;
+            };
+            for &s in samples {
+                let sp = anchors[s as usize].expect("listed with a closest point");
+                for &v in t {
+                    let d = self.refined.positions[v as usize].distance(sp.position);
+                    let e = best.entry(s).or_insert((f64::INFINITY, u32::MAX));
+                    if (d, v) < *e && (self.on_sheet)(v, f) {
+                        *e = (d, v);
+                    }
+                }
+            }
+        }
+        best.into_iter().map(|(s, (_, v))| (s, v)).collect()
+    }
+}
+
+#[cfg(test)]
+impl Labels<'_> {
+    /// The search of every vertex from the seeds (the search before the settled vertices were
+    /// taken out of it): the reference [`Labels::grow`] must equal.
+    fn full_search(&self) -> Vec<u32> {
+        let (refined, positions) = (self.refined, self.positions);
+        let n = refined.positions.len();
+        let anchors: Vec<Option<SurfacePoint>> = positions
+            .par_iter()
+            .map(|&x| {
+                self.surface
+                    .closest_point_hinted(x, self.tolerance, f64::MAX)
+            })
+            .collect();
+        let tree = StaticTree::new(&refined.positions);
+        let mut seeds = Vec::new();
+        let mut near = Vec::new();
+        for (s, a) in anchors.iter().enumerate() {
+            if let Some(sp) = a {
+                tree.within_unsorted(sp.position, self.radius * self.radius, &mut near);
+                for &(v, _) in &near {
+                    if (self.on_sheet)(v, sp.face)
+                        && lies_in(
+                            self.surface,
+                            sp.face,
+                            refined.positions[v as usize],
+                            self.tolerance,
+                        )
+                    {
+                        seeds.push((s as u32, v));
+                    }
+                }
+            }
+        }
+        seeds.sort_unstable();
+        seeds.extend(self.fallback_seeds(&anchors, &seeds));
+        let mut dist = vec![f64::INFINITY; n];
+        let mut label = vec![u32::MAX; n];
+        let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
+        let offer = |v: u32,
+                     s: u32,
+                     d: f64,
+                     dist: &mut [f64],
+                     label: &mut [u32],
+                     heap: &mut BinaryHeap<_>| {
+            let i = v as usize;
+            if d < dist[i] || (d == dist[i] && s < label[i]) {
+                dist[i] = d;
+                label[i] = s;
+                heap.push(Reverse((d.to_bits(), s, v)));
+            }
+        };
+        for &(s, v) in &seeds {
+            let d = refined.positions[v as usize].distance(positions[s as usize]);
+            offer(v, s, d, &mut dist, &mut label, &mut heap);
+        }
+        while let Some(Reverse((d, s, v))) = heap.pop() {
+            let i = v as usize;
+            if d != dist[i].to_bits() || s != label[i] {
+                continue;
+            }
+            let x = positions[s as usize];
+            for &u in self.neighbours.row(v) {
+                let du = refined.positions[u as usize].distance(x);
+                offer(u, s, du, &mut dist, &mut label, &mut heap);
+            }
+        }
+        label
+    }
 }
 
 /// Whether `p` lies in face `f` of `surface`'s mesh: within `tolerance` of its plane and of
@@ -416,6 +636,38 @@ mod tests {
         );
         assert_eq!(t.vertices, positions.len(), "every sample in a face");
         assert_eq!(faces_follow_the_input(&surface, &positions, &faces), 0);
+    }
+
+    /// The labels of the search that settles most vertices first are those of the search over
+    /// every vertex: on a sphere, and on a plate thinner than the spacing (where cells would
+    /// reach through to the other side if the nearest sample were taken alone).
+    #[test]
+    fn the_settled_vertices_leave_the_search_its_answer() {
+        let sphere = test_meshes::uv_sphere(10.0, 24, 48);
+        let surface = MeshSurface::new(&sphere).unwrap();
+        let on_sphere: Vec<DVec3> = test_meshes::fibonacci_sphere(300)
+            .into_iter()
+            .map(|u| surface.closest_point(10.0 * u).unwrap().position)
+            .collect();
+        let plate = test_meshes::cuboid(DVec3::ZERO, DVec3::new(10.0, 10.0, 0.1));
+        for (mesh, positions) in [(sphere, on_sphere), (plate, plate_samples(10, 0.1))] {
+            let surface = MeshSurface::new(&mesh).unwrap();
+            let spacing = (mesh.area() / positions.len() as f64).sqrt();
+            let refined = bisect_to_length(&mesh, 0.5 * spacing, None, usize::MAX).unwrap();
+            let neighbours = Rows::new(refined.positions.len(), &refined.triangles);
+            let labels = Labels {
+                surface: &surface,
+                refined: &refined,
+                neighbours: &neighbours,
+                positions: &positions,
+                radius: 0.505 * spacing,
+                tolerance: 1e-9 * spacing,
+                on_sheet: &|_, _| true,
+            };
+            let grown = labels.grow();
+            assert!(grown.iter().all(|&l| l != u32::MAX));
+            assert_eq!(grown, labels.full_search());
+        }
     }
 
     #[test]
