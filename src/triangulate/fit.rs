@@ -112,17 +112,20 @@ pub fn fit_to_surface<S: SurfaceQuery + ?Sized>(
     // distance to a point bounds its distance to the surface (the search prunes by it).
     let mut found: Vec<Closest> = vec![[None; 6]; mesh.triangles.len()];
     for _ in 0..iterations {
-        // Per face: for each corner, Σ b · residual and Σ b over the face's points.
-        let (contributions, closest): (Vec<Contribution>, Vec<Closest>) = (0..mesh.triangles.len())
-            .into_par_iter()
-            .map(|f| {
+        // Per face: for each corner, Σ b · residual and Σ b over the face's points. Its points'
+        // answers replace the last iteration's in place (one array of them alive, not two: at
+        // 2M faces each is about 0.9 GB).
+        let contributions: Vec<Contribution> = found
+            .par_iter_mut()
+            .enumerate()
+            .map(|(f, last)| {
                 let t = mesh.triangles[f];
                 let p = mesh.corners(f);
                 let normal = mesh.face_normal(f);
                 let mut out = [(0.0, 0.0); 3];
-                let mut closest = [None; 6];
                 if normal == DVec3::ZERO {
-                    return (out, closest);
+                    *last = [None; 6];
+                    return out;
                 }
                 let reach = p[0]
                     .distance(p[1])
@@ -140,13 +143,13 @@ pub fn fit_to_surface<S: SurfaceQuery + ?Sized>(
                         .fold(f64::INFINITY, f64::min)
                 });
                 let mut answers = [None; 6];
-                surface.closest_points_near(&points, &found[f], &hints, 0.5 * reach, &mut answers);
+                surface.closest_points_near(&points, last, &hints, 0.5 * reach, &mut answers);
+                *last = answers;
                 for (k, (b, weight)) in POINTS.into_iter().enumerate() {
                     let x = points[k];
                     let Some(q) = answers[k] else {
                         continue;
                     };
-                    closest[k] = Some(q);
                     // A point on another sheet (facing away: a thin part's other side) is not
                     // this face's sag.
                     if surface.piece_normal(&q).dot(normal) < FIT_MIN_NORMAL_COS {
@@ -160,10 +163,9 @@ pub fn fit_to_surface<S: SurfaceQuery + ?Sized>(
                         }
                     }
                 }
-                (out, closest)
+                out
             })
-            .unzip();
-        found = closest;
+            .collect();
         let mut sum = vec![(0.0f64, 0.0f64); n];
         for (t, c) in mesh.triangles.iter().zip(&contributions) {
             for (&v, &(r, w)) in t.iter().zip(c) {
