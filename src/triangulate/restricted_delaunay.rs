@@ -203,6 +203,10 @@ struct Labels<'a> {
     on_sheet: &'a (dyn Fn(u32, u32) -> bool + Sync),
 }
 
+/// One parallel task's part of [`Labels::grow`]: its vertices' nearest samples and its
+/// (sample, vertex) seed pairs.
+type LabelChunk = (Vec<u32>, Vec<(u32, u32)>);
+
 /// Refined vertices per parallel task of [`Labels::grow`].
 const LABEL_CHUNK: usize = 4096;
 
@@ -242,7 +246,7 @@ impl Labels<'_> {
             })
         };
         // Per vertex, in parallel: its nearest sample, and the (sample, vertex) seed pairs.
-        let chunks: Vec<(Vec<u32>, Vec<(u32, u32)>)> = (0..n.div_ceil(LABEL_CHUNK))
+        let chunks: Vec<LabelChunk> = (0..n.div_ceil(LABEL_CHUNK))
             .into_par_iter()
             .map_init(Vec::new, |found, c| {
                 let vertices = c * LABEL_CHUNK..((c + 1) * LABEL_CHUNK).min(n);
@@ -710,8 +714,8 @@ mod tests {
             let n = mesh.positions.len();
             let rows = Rows::new(n, &mesh.triangles);
             let want = reference(n, &mesh.triangles);
-            for v in 0..n {
-                assert_eq!(rows.row(v as u32), want[v].as_slice(), "vertex {v}");
+            for (v, want) in want.iter().enumerate() {
+                assert_eq!(rows.row(v as u32), want.as_slice(), "vertex {v}");
             }
         }
     }
