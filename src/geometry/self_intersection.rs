@@ -158,6 +158,39 @@ pub(crate) fn has_intersecting_pair(
     })
 }
 
+/// The pairs of [`intersecting_pairs`] found on a BVH already built over `boxes` (items of
+/// [`face_boxes`] of the same faces, leaf data the face index): the same pairs, sorted, without
+/// building the BVH again. In parallel; the answer does not depend on the number of threads.
+pub(crate) fn intersecting_pairs_in(
+    bvh: &Bvh,
+    boxes: &[(usize, Aabb)],
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> Vec<[u32; 2]> {
+    let corners = |f: usize| triangles[f].map(|i| positions[i as usize]);
+    let mut pairs: Vec<[u32; 2]> = boxes
+        .par_chunks(CHUNK)
+        .flat_map_iter(|chunk| {
+            let mut found = Vec::new();
+            for &(f, aabb) in chunk {
+                let tf = triangles[f];
+                for g in bvh.intersect_aabb(&aabb) {
+                    let g = g as usize;
+                    if g > f
+                        && !tf.iter().any(|i| triangles[g].contains(i))
+                        && triangles_intersect(corners(f), corners(g))
+                    {
+                        found.push([f as u32, g as u32]);
+                    }
+                }
+            }
+            found
+        })
+        .collect();
+    pairs.sort_unstable();
+    pairs
+}
+
 /// Where a mesh's own faces cross or touch: for each intersecting pair, the overlap of the two
 /// faces' bounding boxes, and the box of each face where two parts meet at a non-manifold edge
 /// (the faces at the junction of the input's sheets, `mesh::sheets`: parts that share an edge,

@@ -7,7 +7,6 @@ use glam::DVec3;
 use super::params::Target;
 use super::RemeshParams;
 use crate::error::{Error, Result};
-use crate::geometry::self_intersection::intersecting_pairs;
 use crate::geometry::tolerance::DEGENERATE_AREA_TOLERANCE;
 use crate::mesh::sheets::Sheets;
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
@@ -155,15 +154,13 @@ impl<'a> InputIndex<'a> {
     /// Those of [`MeshSurface::new`].
     pub(super) fn new(mesh: &'a TriMesh, points: usize) -> Result<Self> {
         // Each builds a BVH of the input's faces on one thread.
-        let (surface, buried_test) =
-            rayon::join(|| MeshSurface::new(mesh), || BuriedTest::new(mesh, points));
+        // With the buried test, where the input's own faces cross (looked for on the test's
+        // BVH): the finishing stage leaves the output's crossings there alone.
+        let (surface, (buried_test, crossing_pairs)) = rayon::join(
+            || MeshSurface::new(mesh),
+            || BuriedTest::with_crossings(mesh, points),
+        );
         let surface = surface?;
-        // Where the input's own faces cross: the finishing stage leaves the output's crossings
-        // there alone.
-        let crossing_pairs = match &buried_test {
-            Some(_) => intersecting_pairs(&mesh.positions, &mesh.triangles),
-            None => Vec::new(),
-        };
         // Where parts of the input meet at non-manifold edges (the triangulation keeps them
         // apart).
         let sheets = Sheets::new(mesh);

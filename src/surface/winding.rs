@@ -74,6 +74,26 @@ impl<'a> BuriedTest<'a> {
         if !rays.crosses_itself() {
             return None;
         }
+        Self::of_crossing(mesh, points, rays)
+    }
+
+    /// [`BuriedTest::new`] and, when there is a test, the pairs of `mesh`'s faces that cross
+    /// ([`intersecting_pairs`](crate::geometry::self_intersection::intersecting_pairs), found
+    /// on the test's own BVH; empty without a test).
+    pub fn with_crossings(mesh: &'a TriMesh, points: usize) -> (Option<Self>, Vec<[u32; 2]>) {
+        let rays = RayWinding::new(mesh);
+        let pairs = rays.crossing_pairs();
+        if pairs.is_empty() {
+            return (None, pairs);
+        }
+        match Self::of_crossing(mesh, points, rays) {
+            Some(test) => (Some(test), pairs),
+            None => (None, Vec::new()),
+        }
+    }
+
+    /// The test of a `mesh` that crosses itself, on its ray count `rays`.
+    fn of_crossing(mesh: &'a TriMesh, points: usize, rays: RayWinding<'a>) -> Option<Self> {
         let orientation = if mesh.signed_volume() < 0.0 { -1 } else { 1 };
         let winding = if topology(mesh).boundary_edges == 0 {
             Some(rays)
@@ -303,6 +323,28 @@ mod tests {
             a.triangles.clone(),
         );
         union_of(&a, &b)
+    }
+
+    /// The crossing pairs found on the test's BVH are the whole search's, and there are none
+    /// (and no test) for spheres apart.
+    #[test]
+    fn the_crossings_found_with_the_test_are_those_of_the_whole_search() {
+        use crate::geometry::self_intersection::intersecting_pairs;
+        let m = two_crossing_spheres();
+        let (test, pairs) = BuriedTest::with_crossings(&m, 1000);
+        assert!(test.is_some());
+        assert!(!pairs.is_empty());
+        assert_eq!(pairs, intersecting_pairs(&m.positions, &m.triangles));
+        let a = uv_sphere(10.0, 24, 48);
+        let apart = union_of(
+            &a,
+            &TriMesh::new(
+                a.positions.iter().map(|&p| p + DVec3::Z * 30.0).collect(),
+                a.triangles.clone(),
+            ),
+        );
+        let (test, pairs) = BuriedTest::with_crossings(&apart, 1000);
+        assert!(test.is_none() && pairs.is_empty());
     }
 
     #[test]

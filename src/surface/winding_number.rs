@@ -6,7 +6,9 @@ use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::partitioning::Bvh;
 use parry3d_f64::query::{Ray, RayCast};
 
-use crate::geometry::self_intersection::{face_boxes, has_intersecting_pair};
+use crate::geometry::self_intersection::{
+    face_boxes, has_intersecting_pair, intersecting_pairs_in,
+};
 use crate::mesh::TriMesh;
 
 /// The directions of the crossing-count rays: fixed, unit length, far from every axis and
@@ -76,6 +78,18 @@ impl<'a> RayWinding<'a> {
     /// structure's BVH (the same one), stopping at the first pair.
     pub(crate) fn crosses_itself(&self) -> bool {
         has_intersecting_pair(
+            &self.bvh,
+            &self.boxes,
+            &self.mesh.positions,
+            &self.mesh.triangles,
+        )
+    }
+
+    /// The pairs of counted faces that share no vertex and meet, as
+    /// [`intersecting_pairs`](crate::geometry::self_intersection::intersecting_pairs) gives
+    /// them, found on this structure's BVH.
+    pub(crate) fn crossing_pairs(&self) -> Vec<[u32; 2]> {
+        intersecting_pairs_in(
             &self.bvh,
             &self.boxes,
             &self.mesh.positions,
