@@ -110,6 +110,33 @@ impl CrossingGuard {
         pairs
     }
 
+    /// The pairs of [`Self::pairs_with`] over all live faces after the vertices in `moved`
+    /// moved, from `pairs` (those before): the faces around the moved vertices take their new
+    /// boxes, their pairs are dropped and searched again; the others' pairs stand. Sorted.
+    pub(crate) fn moved<L: Copy>(
+        &mut self,
+        m: &EditMesh<L>,
+        pairs: &[[u32; 2]],
+        moved: &[u32],
+    ) -> Vec<[u32; 2]> {
+        let mut faces: Vec<u32> = moved
+            .iter()
+            .flat_map(|&v| m.faces_around(v).iter().copied())
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        self.changed(m, &faces);
+        let mut after: Vec<[u32; 2]> = pairs
+            .iter()
+            .copied()
+            .filter(|p| p.iter().all(|f| faces.binary_search(f).is_err()))
+            .collect();
+        after.extend(self.pairs_with(m, &faces));
+        after.sort_unstable();
+        after.dedup();
+        after
+    }
+
     /// How many live faces the face `t` with corners `p` crosses (as [`Self::visit_crossed`]).
     pub(crate) fn count_crossed<L: Copy>(
         &self,
@@ -183,17 +210,7 @@ mod tests {
                     let d = DVec3::new(0.0, 0.0, rng.random_range(-0.1..0.1));
                     m.relocate_vertex(v, m.position(v) + d).unwrap();
                 }
-                let mut faces: Vec<u32> = moved
-                    .iter()
-                    .flat_map(|&v| m.faces_around(v).iter().copied())
-                    .collect();
-                faces.sort_unstable();
-                faces.dedup();
-                guard.changed(&m, &faces);
-                pairs.retain(|p| p.iter().all(|f| faces.binary_search(f).is_err()));
-                pairs.extend(guard.pairs_with(&m, &faces));
-                pairs.sort_unstable();
-                pairs.dedup();
+                pairs = guard.moved(&m, &pairs, &moved);
                 assert_eq!(pairs, pairs_within(m.positions(), &triangles, near));
                 seen = seen.max(pairs.len());
             }

@@ -300,7 +300,15 @@ impl Labels<'_> {
                 }
             }
         }
-        // The search over the rest, from the settled vertices beside them and their seeds.
+        self.search(&seeds, &settled, label)
+    }
+
+    /// The Dijkstra search over the vertices not `settled`, from the settled ones beside them
+    /// (which keep their `label`) and from the `seeds` (sample, vertex) among them: each
+    /// vertex's label (`u32::MAX`: reached by no cell).
+    fn search(&self, seeds: &[(u32, u32)], settled: &[bool], mut label: Vec<u32>) -> Vec<u32> {
+        let (refined, positions) = (self.refined, self.positions);
+        let n = refined.positions.len();
         let mut dist = vec![f64::INFINITY; n];
         for v in 0..n {
             if settled[v] {
@@ -328,7 +336,7 @@ impl Labels<'_> {
                 heap.push(Reverse((d.to_bits(), s, v)));
             }
         };
-        for &(s, v) in &seeds {
+        for &(s, v) in seeds {
             let d = refined.positions[v as usize].distance(positions[s as usize]);
             offer(v, s, d, &mut dist, &mut label, &mut heap);
         }
@@ -423,38 +431,7 @@ impl Labels<'_> {
         }
         seeds.sort_unstable();
         seeds.extend(self.fallback_seeds(&anchors, &seeds));
-        let mut dist = vec![f64::INFINITY; n];
-        let mut label = vec![u32::MAX; n];
-        let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
-        let offer = |v: u32,
-                     s: u32,
-                     d: f64,
-                     dist: &mut [f64],
-                     label: &mut [u32],
-                     heap: &mut BinaryHeap<_>| {
-            let i = v as usize;
-            if d < dist[i] || (d == dist[i] && s < label[i]) {
-                dist[i] = d;
-                label[i] = s;
-                heap.push(Reverse((d.to_bits(), s, v)));
-            }
-        };
-        for &(s, v) in &seeds {
-            let d = refined.positions[v as usize].distance(positions[s as usize]);
-            offer(v, s, d, &mut dist, &mut label, &mut heap);
-        }
-        while let Some(Reverse((d, s, v))) = heap.pop() {
-            let i = v as usize;
-            if d != dist[i].to_bits() || s != label[i] {
-                continue;
-            }
-            let x = positions[s as usize];
-            for &u in self.neighbours.row(v) {
-                let du = refined.positions[u as usize].distance(x);
-                offer(u, s, du, &mut dist, &mut label, &mut heap);
-            }
-        }
-        label
+        self.search(&seeds, &vec![false; n], vec![u32::MAX; n])
     }
 }
 

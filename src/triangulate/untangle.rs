@@ -120,25 +120,10 @@ pub fn untangle(
     // vertices in `changed` moved).
     let update =
         |m: &Mesh, guard: &mut Option<CrossingGuard>, pairs: &[[u32; 2]], changed: &[u32]| {
-            let Some(guard) = guard else {
-                return pairs_within(m.positions(), &triangles, near);
-            };
-            let mut faces: Vec<u32> = changed
-                .iter()
-                .flat_map(|&v| m.faces_around(v).iter().copied())
-                .collect();
-            faces.sort_unstable();
-            faces.dedup();
-            guard.changed(m, &faces);
-            let mut after: Vec<[u32; 2]> = pairs
-                .iter()
-                .copied()
-                .filter(|p| p.iter().all(|f| faces.binary_search(f).is_err()))
-                .collect();
-            after.extend(guard.pairs_with(m, &faces));
-            after.sort_unstable();
-            after.dedup();
-            after
+            match guard {
+                Some(guard) => guard.moved(m, pairs, changed),
+                None => pairs_within(m.positions(), &triangles, near),
+            }
         };
     // The pairs that lie outside the input's own crossings: a round may trade a pair where the
     // input crosses for nothing, never for one where it does not.
@@ -219,13 +204,9 @@ pub fn untangle(
                 let _ = m.relocate_vertex(v, p);
             }
             if let Some(guard) = &mut guard {
-                let mut faces: Vec<u32> = saved
-                    .iter()
-                    .flat_map(|&(v, _)| m.faces_around(v).iter().copied())
-                    .collect();
-                faces.sort_unstable();
-                faces.dedup();
-                guard.changed(&m, &faces);
+                // The pairs are those before the round again; the guard follows the positions.
+                let vertices: Vec<u32> = saved.iter().map(|&(v, _)| v).collect();
+                guard.moved(&m, &pairs, &vertices);
             }
             scale *= 0.5;
             if scale < 0.1 {
