@@ -127,10 +127,10 @@ impl ClosestPointTree {
     /// `max_distance_squared[k]` and started from `start[k]`. One walk serves them all: a box is
     /// entered when it meets the box around every point's ball of its best distance so far
     /// (one test per box instead of one per point), and a leaf's triangles are tried for the
-    /// points its box is closer to than their best. Each answer is exact, as for one point; among triangles at exactly
-    /// equal distances the one kept can differ from [`ClosestPointTree::closest`]'s, which
-    /// visits the boxes in another order. The four slices have one length, at most [`GROUP`]
-    /// (longer ones are answered in groups).
+    /// points its box is closer to than their best. Each answer is exact, as for one point;
+    /// among triangles at exactly equal distances the one kept can differ from
+    /// [`ClosestPointTree::closest`]'s, which visits the boxes in another order. The four slices
+    /// have one length (more than [`GROUP`] points are answered in groups).
     pub fn closest_each(
         &self,
         points: &[DVec3],
@@ -164,16 +164,7 @@ impl ClosestPointTree {
                 continue;
             }
             best[k] = max_distance_squared[k];
-            if let Some(&slot) = start[k].and_then(|id| self.slot.get(id as usize)) {
-                if slot != u32::MAX {
-                    let (q, bary) = closest_on_triangle(points[k], &self.corners[slot as usize]);
-                    let d = q.distance_squared(points[k]);
-                    if d < best[k] {
-                        best[k] = d;
-                        found[k] = Some((slot as usize, q, bary));
-                    }
-                }
-            }
+            found[k] = self.from_start(points[k], start[k], &mut best[k]);
         }
         // The box around every point's ball of its best distance so far (a hair wider, for
         // the rounding of the root): a box that misses it holds nothing closer for any point.
@@ -258,6 +249,26 @@ impl ClosestPointTree {
         }
     }
 
+    /// The start of a query at `p`: `start`'s closest point when `start` names a triangle of
+    /// the tree and it lies below `best` (which it then lowers to its squared distance).
+    fn from_start(
+        &self,
+        p: DVec3,
+        start: Option<u32>,
+        best: &mut f64,
+    ) -> Option<(usize, DVec3, [f64; 3])> {
+        let k = *start.and_then(|id| self.slot.get(id as usize))?;
+        if k == u32::MAX {
+            return None;
+        }
+        let (q, bary) = closest_on_triangle(p, &self.corners[k as usize]);
+        let d = q.distance_squared(p);
+        (d < *best).then(|| {
+            *best = d;
+            (k as usize, q, bary)
+        })
+    }
+
     /// The depth-first walk of both queries: nearer child first, pruned by the best squared
     /// distance so far (first `start`'s, when it names a triangle); with `first_hit`, it ends at
     /// the first triangle below the bound.
@@ -272,17 +283,7 @@ impl ClosestPointTree {
             return None;
         }
         let mut best = max_distance_squared;
-        let mut found: Option<(usize, DVec3, [f64; 3])> = None;
-        if let Some(&k) = start.and_then(|id| self.slot.get(id as usize)) {
-            if k != u32::MAX {
-                let (q, bary) = closest_on_triangle(p, &self.corners[k as usize]);
-                let d = q.distance_squared(p);
-                if d < best {
-                    best = d;
-                    found = Some((k as usize, q, bary));
-                }
-            }
-        }
+        let mut found = self.from_start(p, start, &mut best);
         // The stack grows by at most one entry per level, and median splits keep the depth
         // below 32 for any u32 count of triangles.
         let mut stack = [(0u32, 0.0f64); STACK];

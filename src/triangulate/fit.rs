@@ -137,11 +137,13 @@ pub fn fit_to_surface<S: SurfaceQuery + ?Sized>(
                 // first within the distance to the nearest corner where it started (a point of
                 // the surface): the same answers, with most of the search pruned. One search
                 // for the six (on a mesh, one walk of its tree).
-                let hints = points.map(|x| {
-                    t.iter()
-                        .map(|&v| x.distance(start[v as usize]))
-                        .fold(f64::INFINITY, f64::min)
-                });
+                let mut hints = [0.0; 6];
+                for k in (0..6).filter(|&k| last[k].is_none()) {
+                    hints[k] = t
+                        .iter()
+                        .map(|&v| points[k].distance(start[v as usize]))
+                        .fold(f64::INFINITY, f64::min);
+                }
                 let mut answers = [None; 6];
                 surface.closest_points_near(&points, last, &hints, 0.5 * reach, &mut answers);
                 *last = answers;

@@ -220,14 +220,7 @@ impl Labels<'_> {
     fn grow(&self) -> Vec<u32> {
         let (refined, positions) = (self.refined, self.positions);
         let n = refined.positions.len();
-        // Each sample's closest point on the input (a sample lies on it, up to rounding).
-        let anchors: Vec<Option<SurfacePoint>> = positions
-            .par_iter()
-            .map(|&x| {
-                self.surface
-                    .closest_point_hinted(x, self.tolerance, f64::MAX)
-            })
-            .collect();
+        let anchors = self.anchors();
         // The seeds are listed around the samples, wider by how far a sample lies from its
         // closest point.
         let offset = anchors
@@ -237,14 +230,6 @@ impl Labels<'_> {
             .fold(0.0, f64::max);
         let reach_2 = (self.radius + offset).powi(2);
         let tree = StaticTree::new(positions);
-        let is_seed = |s: u32, v: u32| {
-            anchors[s as usize].is_some_and(|sp| {
-                let p = refined.positions[v as usize];
-                (p - sp.position).length_squared() <= self.radius * self.radius
-                    && (self.on_sheet)(v, sp.face)
-                    && lies_in(self.surface, sp.face, p, self.tolerance)
-            })
-        };
         // Per vertex, in parallel: its nearest sample, and the (sample, vertex) seed pairs.
         let chunks: Vec<LabelChunk> = (0..n.div_ceil(LABEL_CHUNK))
             .into_par_iter()
@@ -266,7 +251,7 @@ impl Labels<'_> {
                         .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
                     nearest.push(best.map_or(u32::MAX, |b| b.1));
                     for &(s, d2) in found.iter() {
-                        if d2 <= reach_2 && is_seed(s, v as u32) {
+                        if d2 <= reach_2 && self.is_seed(&anchors, s, v as u32) {
                             seeds.push((s, v as u32));
                         }
                     }
@@ -354,6 +339,28 @@ impl Labels<'_> {
         label
     }
 
+    /// Each sample's closest point on the input (a sample lies on it, up to rounding).
+    fn anchors(&self) -> Vec<Option<SurfacePoint>> {
+        self.positions
+            .par_iter()
+            .map(|&x| {
+                self.surface
+                    .closest_point_hinted(x, self.tolerance, f64::MAX)
+            })
+            .collect()
+    }
+
+    /// Whether refined vertex `v` is a seed of sample `s` (closest points `anchors`): within
+    /// `radius` of its closest point, on its sheet, and lying in its face.
+    fn is_seed(&self, anchors: &[Option<SurfacePoint>], s: u32, v: u32) -> bool {
+        anchors[s as usize].is_some_and(|sp| {
+            let p = self.refined.positions[v as usize];
+            (p - sp.position).length_squared() <= self.radius * self.radius
+                && (self.on_sheet)(v, sp.face)
+                && lies_in(self.surface, sp.face, p, self.tolerance)
+        })
+    }
+
     /// Seeds of the samples that have none within the radius on their face (a face of the
     /// input smaller than the refinement's resolution): the refined vertex of the sample's face
     /// nearest to its closest point. `seeds`: the others', sorted.
@@ -402,13 +409,7 @@ impl Labels<'_> {
     fn full_search(&self) -> Vec<u32> {
         let (refined, positions) = (self.refined, self.positions);
         let n = refined.positions.len();
-        let anchors: Vec<Option<SurfacePoint>> = positions
-            .par_iter()
-            .map(|&x| {
-                self.surface
-                    .closest_point_hinted(x, self.tolerance, f64::MAX)
-            })
-            .collect();
+        let anchors = self.anchors();
         let tree = StaticTree::new(&refined.positions);
         let mut seeds = Vec::new();
         let mut near = Vec::new();
@@ -416,14 +417,7 @@ impl Labels<'_> {
             if let Some(sp) = a {
                 tree.within_unsorted(sp.position, self.radius * self.radius, &mut near);
                 for &(v, _) in &near {
-                    if (self.on_sheet)(v, sp.face)
-                        && lies_in(
-                            self.surface,
-                            sp.face,
-                            refined.positions[v as usize],
-                            self.tolerance,
-                        )
-                    {
+                    if self.is_seed(&anchors, s as u32, v) {
                         seeds.push((s as u32, v));
                     }
                 }
