@@ -164,7 +164,7 @@ impl ClosestPointTree {
                 continue;
             }
             best[k] = max_distance_squared[k];
-            found[k] = self.from_start(points[k], start[k], &mut best[k]);
+            found[k] = self.start_answer(points[k], start[k], &mut best[k]);
         }
         // The box around every point's ball of its best distance so far (a hair wider, for
         // the rounding of the root): a box that misses it holds nothing closer for any point.
@@ -251,7 +251,7 @@ impl ClosestPointTree {
 
     /// The start of a query at `p`: `start`'s closest point when `start` names a triangle of
     /// the tree and it lies below `best` (which it then lowers to its squared distance).
-    fn from_start(
+    fn start_answer(
         &self,
         p: DVec3,
         start: Option<u32>,
@@ -283,7 +283,7 @@ impl ClosestPointTree {
             return None;
         }
         let mut best = max_distance_squared;
-        let mut found = self.from_start(p, start, &mut best);
+        let mut found = self.start_answer(p, start, &mut best);
         // The stack grows by at most one entry per level, and median splits keep the depth
         // below 32 for any u32 count of triangles.
         let mut stack = [(0u32, 0.0f64); STACK];

@@ -407,7 +407,7 @@ impl Labels<'_> {
     /// The search of every vertex from the seeds (the search before the settled vertices were
     /// taken out of it): the reference [`Labels::grow`] must equal.
     fn full_search(&self) -> Vec<u32> {
-        let (refined, positions) = (self.refined, self.positions);
+        let refined = self.refined;
         let n = refined.positions.len();
         let anchors = self.anchors();
         let tree = StaticTree::new(&refined.positions);
