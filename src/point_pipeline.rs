@@ -20,14 +20,19 @@ use crate::kernel::Kernel;
 use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::pipeline::finish::{finish, Finishing, StrayRule};
 use crate::pipeline::{Density, RemeshParams};
+use crate::points::boundary::{local_spacings, DataEdges};
 use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{rimls_of, OutOfCoreParams, RimlsSupport, ScannedInput};
 use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
 use crate::points::source::PointSource;
+use crate::sampling::curves::BoundarySamples;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::linear_scan::LinearScanner;
 use crate::sampling::sizing::Uniform;
+use crate::sampling::spacing::BOUNDARY_SPACING_PER_SIGMA;
+use crate::spatial::StaticTree;
+use crate::surface::feature_lines::FeatureLines;
 use crate::surface::features::FeatureDetection;
 use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
@@ -64,8 +69,20 @@ pub fn rimls_params(sigma_p: f64, sigma_n: f64) -> RimlsParams {
 /// from every point of the RIMLS surface's support is removed (with the hole fill it is part
 /// of). The support holds about `RIMLS_POINTS_PER_SAMPLE` points per sigma_p², uniformly
 /// random: an empty disc of radius 1.5 sigma_p in it has probability exp(-4π 2.25) ≈ 5e-13
-/// where the data goes on.
+/// where the data goes on. Sparse data widens it: see `OPEN_GAP_SPACINGS`.
 pub const OPEN_GAP_SIGMA_P: f64 = 1.5;
+
+/// The open-scan gap in local spacings of the data (the distance from the nearest support point
+/// to its 8th nearest, [`local_spacings`]), where that is wider than `OPEN_GAP_SIGMA_P` sigma_p:
+/// data sparser than the samples (a scan of 5,000 points meshed at 4,000) has chance gaps wider
+/// than 1.5 sigma_p. With ρ points per unit area the spacing s has ρ π s² ≈ 8, so an empty
+/// disc of radius 1.25 s has probability about exp(-8 · 1.25²) ≈ 4e-6.
+pub const OPEN_GAP_SPACINGS: f64 = 1.25;
+
+/// The projections' reach past the data in local spacings, where that is wider than
+/// `DOMAIN_GAP_SIGMA_P` sigma_p: an empty disc of radius 0.6 s has probability
+/// exp(-8 · 0.36) ≈ 0.06.
+pub const DOMAIN_GAP_SPACINGS: f64 = 0.6;
 
 /// Distance, in units of sigma_p, from the nearest support point beyond which a projection onto
 /// the RIMLS surface is refused: the samples and the mesh stay on the data rather than on the
@@ -74,21 +91,27 @@ pub const OPEN_GAP_SIGMA_P: f64 = 1.5;
 /// goes on: a move refused there is only a move not made.
 pub const DOMAIN_GAP_SIGMA_P: f64 = 0.75;
 
-/// The RIMLS surface restricted to where there is data: within `max_gap` of a support point.
+/// The RIMLS surface restricted to where there is data: within a gap of a support point.
 struct Domain<'a> {
     rimls: &'a Rimls,
-    /// The projections' reach past the data (`DOMAIN_GAP_SIGMA_P` sigma_p).
-    max_gap: f64,
+    /// The support points' local spacings ([`local_spacings`]).
+    spacings: &'a [f64],
+    sigma_p: f64,
 }
 
 impl Domain<'_> {
-    /// Whether a support point lies within `r` of `p`.
-    fn within(&self, p: DVec3, r: f64) -> bool {
-        self.rimls.nearest(p).is_some_and(|(_, d2)| d2 <= r * r)
+    /// Whether the support point nearest `p` lies within `gap_sigma_p` sigma_p of it, or within
+    /// `gap_spacings` of its own local spacing.
+    fn within(&self, p: DVec3, gap_sigma_p: f64, gap_spacings: f64) -> bool {
+        self.rimls.nearest(p).is_some_and(|(i, d2)| {
+            let r = (gap_sigma_p * self.sigma_p).max(gap_spacings * self.spacings[i as usize]);
+            d2 <= r * r
+        })
     }
 
+    /// Whether `p` is within the projections' reach of the data.
     fn covers_one(&self, p: DVec3) -> bool {
-        self.within(p, self.max_gap)
+        self.within(p, DOMAIN_GAP_SIGMA_P, DOMAIN_GAP_SPACINGS)
     }
 }
 
@@ -108,6 +131,48 @@ impl SurfaceQuery for Domain<'_> {
     fn smooth_normal(&self, sp: &SurfacePoint) -> DVec3 {
         self.rimls.smooth_normal(sp)
     }
+}
+
+/// How near the boundary samples, in boundary spacings, a sample of the scan may stay: closer,
+/// or nearer the data's edge than this, it goes (the gradient ascent spreads the others).
+pub const BOUNDARY_CLEARANCE: f64 = 0.5;
+
+/// The samples of `moving` clear of the data's boundary: farther than `BOUNDARY_CLEARANCE`
+/// spacings from every boundary sample and, within 2.5 spacings of one, at least as far inside
+/// the data's edge (`spacing`: the boundary spacing, bbox-100 units). In their order.
+fn clear_of_boundary(
+    moving: Vec<SurfaceSample>,
+    boundary: &BoundarySamples,
+    edges: &DataEdges,
+    spacing: f64,
+) -> Vec<SurfaceSample> {
+    if boundary.samples.is_empty() {
+        return moving;
+    }
+    let tree = StaticTree::new(
+        &boundary
+            .samples
+            .iter()
+            .map(|s| s.position)
+            .collect::<Vec<_>>(),
+    );
+    let clear = BOUNDARY_CLEARANCE * spacing;
+    let keep: Vec<bool> = moving
+        .par_iter()
+        .map(|s| match tree.nearest(s.position) {
+            Some((_, d2)) if d2 <= clear * clear => false,
+            Some((_, d2)) if d2 <= (2.5 * spacing).powi(2) => edges
+                .width_at(s.position)
+                .and_then(|h| edges.edge(s.position, s.normal, h))
+                .is_some_and(|v| v.distance >= clear),
+            _ => true,
+        })
+        .collect();
+    moving
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(s, k)| k.then_some(s))
+        .collect()
 }
 
 /// Edge collapses at most where untangling by moves leaves crossing faces
@@ -285,7 +350,7 @@ pub fn remesh_points(
     let mut source = ScannedInput::open(source, &scan_params, params.drop_outliers)?;
     let mut sigma_p = source.sigma_p;
     let mut scans = 0;
-    let (scan, kernel, rimls, samples, moving, unprojected_samples, rescan_rejected) = loop {
+    let (scan, kernel, rimls, spacings, samples, moving, boundary, unprojected, rescan_rejected) = loop {
         scans += 1;
         let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE)?;
         let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
@@ -308,15 +373,20 @@ pub fn remesh_points(
             // The points are in the bbox-100 frame, a viewpoint in model units.
             params.orientation.in_frame(&scan.normalization),
         )?;
+        let spacings = local_spacings(&rimls);
+        let domain = Domain {
+            rimls: &rimls,
+            spacings: &spacings,
+            sigma_p,
+        };
         // The samples are input points, noisy: they start on the surface.
         let positions: Vec<DVec3> = samples.iter().map(|p| p.position).collect();
         let projected = rimls.project_all(&positions);
         drop(positions);
-        let reach2 = (DOMAIN_GAP_SIGMA_P * sigma_p).powi(2);
         let mut moving: Vec<SurfaceSample> = projected
             .into_iter()
             .flatten()
-            .filter(|&(position, _)| rimls.nearest(position).is_some_and(|(_, d2)| d2 <= reach2))
+            .filter(|&(position, _)| domain.covers_one(position))
             .map(|(position, normal)| SurfaceSample {
                 position,
                 normal,
@@ -338,10 +408,18 @@ pub fn remesh_points(
             before - moving.len()
         };
         timer.lap("RIMLS surface");
+        // Where the data ends: its boundary curves, sampled at the boundary spacing, and the
+        // samples clear of them.
+        on_stage("boundary");
+        let edges = DataEdges::new(&rimls, &spacings, sigma_p);
+        let spacing = BOUNDARY_SPACING_PER_SIGMA * sigma_p;
+        let boundary = edges.boundary_samples(spacing);
+        let moving = clear_of_boundary(moving, &boundary, &edges, spacing);
+        timer.lap("boundary");
         // The count the search aimed at was for the points as read; on the surface (noise and
         // outliers gone) it can be lower: sigma_p is corrected (the count goes as
         // sigma_p^-2) and the input scanned again.
-        let v = moving.len() as f64;
+        let v = (moving.len() + boundary.samples.len()) as f64;
         match target {
             Some(n)
                 if scans < MAX_SCANS
@@ -351,13 +429,26 @@ pub fn remesh_points(
                 sigma_p *= (v / n as f64).sqrt();
                 on_stage("scan");
             }
-            _ => break (scan, kernel, rimls, samples, moving, unprojected, rejected),
+            _ => {
+                break (
+                    scan,
+                    kernel,
+                    rimls,
+                    spacings,
+                    samples,
+                    moving,
+                    boundary,
+                    unprojected,
+                    rejected,
+                )
+            }
         }
     };
     let normalization = scan.normalization;
     let domain = Domain {
         rimls: &rimls,
-        max_gap: DOMAIN_GAP_SIGMA_P * sigma_p,
+        spacings: &spacings,
+        sigma_p,
     };
     // The RIMLS points on their own surface: the points the optimization keeps covered.
     let cover_points: Vec<DVec3> = rimls
@@ -375,12 +466,19 @@ pub fn remesh_points(
     let order = crate::geometry::morton::morton_order(
         &moving.iter().map(|s| s.position).collect::<Vec<_>>(),
     );
-    let mut moving: Vec<SurfaceSample> = order.iter().map(|&i| moving[i as usize]).collect();
+    // The boundary samples first: they stay where they are.
+    let fixed = boundary.samples.len();
+    let mut moving: Vec<SurfaceSample> = boundary
+        .samples
+        .iter()
+        .copied()
+        .chain(order.iter().map(|&i| moving[i as usize]))
+        .collect();
     let ga = gradient_ascent(
         &kernel,
         &domain,
         &mut moving,
-        0,
+        fixed,
         &Uniform,
         None,
         &rp.gradient_ascent,
@@ -402,7 +500,7 @@ pub fn remesh_points(
     let set = SampleSet {
         positions: &positions,
         normals: &normals,
-        boundary_edges: &[],
+        boundary_edges: &boundary.edges,
     };
     let (faces, mut sources, assembly) = triangulate(&set, &rp.triangulate);
     if faces.is_empty() {
@@ -414,7 +512,7 @@ pub fn remesh_points(
     let mut mesh = TriMesh::new(positions, faces);
     // Faces the assembly closed across a gap in the data (an open scan's holes) go.
     let unsupported = remove_unsupported_faces(&mut mesh, &mut sources, |p| {
-        domain.within(p, OPEN_GAP_SIGMA_P * sigma_p)
+        domain.within(p, OPEN_GAP_SIGMA_P, OPEN_GAP_SPACINGS)
     });
 
     // The RIMLS surface is a level set: it never passes through itself, so a crossing of the
@@ -443,12 +541,20 @@ pub fn remesh_points(
         );
         lo.distance(hi) <= 4.0 * sigma_p
     };
+    let boundary_lines = FeatureLines::new(
+        &boundary
+            .samples
+            .iter()
+            .map(|s| s.position)
+            .collect::<Vec<_>>(),
+        boundary.edges.iter().copied(),
+    );
     let finishing = Finishing {
         surface: &domain,
         cover_points: &cover_points,
-        fixed: 0,
+        fixed,
         protected: &[],
-        boundary: None,
+        boundary: boundary_lines.as_ref(),
         input_crossings: None,
         sigma_p,
         optimize: rp.optimize.as_ref(),
@@ -471,7 +577,7 @@ pub fn remesh_points(
         had_normals: scan.had_normals,
         outliers_removed: scan.outliers_removed,
         samples: samples.len(),
-        unprojected_samples,
+        unprojected_samples: unprojected,
         rescan_rejected,
         rimls_points: rimls.len(),
         gradient_ascent: ga,

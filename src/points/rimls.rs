@@ -340,6 +340,22 @@ impl Rimls {
         self.tree.nearest(p)
     }
 
+    /// The unit normals (`N`, outward), in the order given.
+    pub fn normals(&self) -> &[DVec3] {
+        &self.normals
+    }
+
+    /// Calls `visit(index, squared distance)` for the points within squared distance
+    /// `radius_2` of `p` (position units²), in no particular order.
+    pub fn visit_within(&self, p: DVec3, radius_2: f64, visit: impl FnMut(u32, f64)) {
+        self.tree.visit_within(p, radius_2, visit);
+    }
+
+    /// The `k` points nearest `p`, nearest first, as `(index, squared distance)`.
+    pub fn nearest_n(&self, p: DVec3, k: usize, out: &mut Vec<(u32, f64)>) {
+        self.tree.nearest_n(p, k, out);
+    }
+
     /// Always false ([`Rimls::new`] refuses an empty set).
     pub fn is_empty(&self) -> bool {
         self.positions.is_empty()
