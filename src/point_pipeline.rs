@@ -240,6 +240,11 @@ pub struct PointRemeshOutput {
     pub unprojected_samples: usize,
     /// Projected samples the second linear scan rejected (they were accepted off the surface).
     pub rescan_rejected: usize,
+    /// Samples placed on the data's boundary curves (fixed; see
+    /// [`DataEdges`](crate::points::boundary::DataEdges)).
+    pub boundary_samples: usize,
+    /// The data's boundary curves (closed loops and open chains).
+    pub boundary_curves: usize,
     /// Points of the RIMLS surface.
     pub rimls_points: usize,
     /// The gradient ascent on the RIMLS surface.
@@ -350,7 +355,18 @@ pub fn remesh_points(
     let mut source = ScannedInput::open(source, &scan_params, params.drop_outliers)?;
     let mut sigma_p = source.sigma_p;
     let mut scans = 0;
-    let (scan, kernel, rimls, spacings, samples, moving, boundary, unprojected, rescan_rejected) = loop {
+    let (
+        scan,
+        kernel,
+        rimls,
+        spacings,
+        samples,
+        moving,
+        boundary,
+        boundary_curves,
+        unprojected,
+        rescan_rejected,
+    ) = loop {
         scans += 1;
         let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE)?;
         let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
@@ -413,7 +429,7 @@ pub fn remesh_points(
         on_stage("boundary");
         let edges = DataEdges::new(&rimls, &spacings, sigma_p);
         let spacing = BOUNDARY_SPACING_PER_SIGMA * sigma_p;
-        let boundary = edges.boundary_samples(spacing);
+        let (boundary, boundary_curves) = edges.boundary_samples(spacing);
         let moving = clear_of_boundary(moving, &boundary, &edges, spacing);
         timer.lap("boundary");
         // The count the search aimed at was for the points as read; on the surface (noise and
@@ -438,6 +454,7 @@ pub fn remesh_points(
                     samples,
                     moving,
                     boundary,
+                    boundary_curves,
                     unprojected,
                     rejected,
                 )
@@ -579,6 +596,8 @@ pub fn remesh_points(
         samples: samples.len(),
         unprojected_samples: unprojected,
         rescan_rejected,
+        boundary_samples: fixed,
+        boundary_curves,
         rimls_points: rimls.len(),
         gradient_ascent: ga,
         assembly,

@@ -106,6 +106,8 @@ pub(super) fn run(
     extra.insert("samples".into(), out.samples.into());
     extra.insert("unprojected_samples".into(), out.unprojected_samples.into());
     extra.insert("rescan_rejected".into(), out.rescan_rejected.into());
+    extra.insert("boundary_samples".into(), out.boundary_samples.into());
+    extra.insert("boundary_curves".into(), out.boundary_curves.into());
     extra.insert("rimls_points".into(), out.rimls_points.into());
     extra.insert(
         "scan_seconds".into(),

@@ -230,15 +230,15 @@ impl<'a> DataEdges<'a> {
         (self.outside_count(q, n, inward, h) <= MAX_OUTSIDE).then_some((q, n, inward))
     }
 
-    /// The data's boundary curves, sampled at `spacing` (position units), on the surface.
-    /// Deterministic.
-    pub fn boundary_samples(&self, spacing: f64) -> BoundarySamples {
+    /// The data's boundary curves, sampled at `spacing` (position units), on the surface, and
+    /// how many curves there are (closed loops and open chains). Deterministic.
+    pub fn boundary_samples(&self, spacing: f64) -> (BoundarySamples, usize) {
         let found: Vec<(DVec3, DVec3, DVec3)> = (0..self.rimls.len())
             .into_par_iter()
             .filter_map(|i| self.edge_point(i))
             .collect();
         if found.is_empty() {
-            return BoundarySamples::default();
+            return (BoundarySamples::default(), 0);
         }
         // The band of estimates averaged to its middle: each with the points within a spacing
         // that face the same way.
@@ -279,6 +279,7 @@ impl<'a> DataEdges<'a> {
             kept.push(a);
         }
         let chains = link_chains(&kept, spacing);
+        let curves = chains.len();
         let mut out = BoundarySamples::default();
         for (chain, closed) in chains {
             let pts = smooth(
@@ -293,7 +294,7 @@ impl<'a> DataEdges<'a> {
                 }
             });
         }
-        out
+        (out, curves)
     }
 }
 
@@ -482,7 +483,8 @@ mod tests {
         let sigma_p = rimls.params().sigma_p;
         let spacings = local_spacings(&rimls);
         let edges = DataEdges::new(&rimls, &spacings, sigma_p);
-        let b = edges.boundary_samples(sigma_p);
+        let (b, curves) = edges.boundary_samples(sigma_p);
+        assert_eq!(curves, 1);
         let h = edges.width_at(DVec3::new(0.5, 0.5, 0.0)).unwrap();
         let m = b.samples.len();
         // One closed loop: every sample starts one edge and ends one.
@@ -552,7 +554,9 @@ mod tests {
         let sigma_p = (4.0 * std::f64::consts::PI / n as f64).sqrt() * 2.0;
         let rimls = Rimls::new(p, normals, RimlsParams::new(sigma_p, f64::INFINITY)).unwrap();
         let spacings = local_spacings(&rimls);
-        let b = DataEdges::new(&rimls, &spacings, sigma_p).boundary_samples(sigma_p);
+        let b = DataEdges::new(&rimls, &spacings, sigma_p)
+            .boundary_samples(sigma_p)
+            .0;
         assert!(b.samples.is_empty(), "{} boundary samples", b.samples.len());
     }
 
@@ -577,7 +581,9 @@ mod tests {
         let sigma_p = (6.0 / 4000.0f64).sqrt() * 2.0;
         let rimls = Rimls::new(p, normals, RimlsParams::new(sigma_p, f64::INFINITY)).unwrap();
         let spacings = local_spacings(&rimls);
-        let b = DataEdges::new(&rimls, &spacings, sigma_p).boundary_samples(sigma_p);
+        let b = DataEdges::new(&rimls, &spacings, sigma_p)
+            .boundary_samples(sigma_p)
+            .0;
         assert!(b.samples.is_empty(), "{} boundary samples", b.samples.len());
     }
 }
