@@ -571,6 +571,7 @@ pub fn remesh_points(
         cover_points: &cover_points,
         fixed,
         protected: &[],
+        untangle_moves_fixed: true,
         boundary: boundary_lines.as_ref(),
         input_crossings: None,
         sigma_p,

@@ -46,6 +46,10 @@ pub(crate) struct Finishing<'a, S: SurfaceQuery + ?Sized> {
     pub cover_points: &'a [DVec3],
     /// The first `fixed` vertices stay where they are (boundary and crease samples).
     pub fixed: usize,
+    /// Whether the separation of crossing faces may move the `fixed` vertices too (a point
+    /// set's boundary samples are estimates of where its data ends; an input mesh's are on its
+    /// boundary).
+    pub untangle_moves_fixed: bool,
     /// Edges the optimization keeps (the sampled creases).
     pub protected: &'a [[u32; 2]],
     /// The input's boundary curves, which boundary vertices slide along.
@@ -131,8 +135,18 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     // Faces that still cross (where the surface's sheets lie closer than the output's chords
     // bend away from them) are moved apart.
     let mut later_dropped = 0;
-    let (untangle_stats, origin) =
-        untangle(mesh, &fixed, f.sigma_p, &f.untangle, f.input_crossings);
+    let untangle_fixed = if f.untangle_moves_fixed {
+        vec![false; mesh.positions.len()]
+    } else {
+        fixed.clone()
+    };
+    let (untangle_stats, origin) = untangle(
+        mesh,
+        &untangle_fixed,
+        f.sigma_p,
+        &f.untangle,
+        f.input_crossings,
+    );
     if untangle_stats.collapses > 0 {
         *face_sources = carried_sources(&origin, face_sources);
         later_dropped += mesh.remove_unreferenced_vertices();

@@ -223,6 +223,7 @@ fn run_once<'s>(
         surface: &index.surface,
         cover_points: &candidates.cover_points,
         fixed: ascended.boundary_count,
+        untangle_moves_fixed: false,
         protected: feature_edges,
         boundary: input.boundary_lines.as_ref(),
         input_crossings: input_crossings.as_ref(),
