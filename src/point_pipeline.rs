@@ -97,14 +97,21 @@ struct Domain<'a> {
     /// The support points' local spacings ([`local_spacings`]).
     spacings: &'a [f64],
     sigma_p: f64,
+    /// Whether the data is sparser than the support asks for (the support is all of it): the
+    /// gaps then widen with its local spacing. A random subset of dense data has the support's
+    /// density, which the sigma_p rules assume.
+    sparse: bool,
 }
 
 impl Domain<'_> {
-    /// Whether the support point nearest `p` lies within `gap_sigma_p` sigma_p of it, or within
-    /// `gap_spacings` of its own local spacing.
+    /// Whether the support point nearest `p` lies within `gap_sigma_p` sigma_p of it, or, for
+    /// sparse data, within `gap_spacings` of its own local spacing.
     fn within(&self, p: DVec3, gap_sigma_p: f64, gap_spacings: f64) -> bool {
         self.rimls.nearest(p).is_some_and(|(i, d2)| {
-            let r = (gap_sigma_p * self.sigma_p).max(gap_spacings * self.spacings[i as usize]);
+            let mut r = gap_sigma_p * self.sigma_p;
+            if self.sparse {
+                r = r.max(gap_spacings * self.spacings[i as usize]);
+            }
             d2 <= r * r
         })
     }
@@ -360,6 +367,7 @@ pub fn remesh_points(
         kernel,
         rimls,
         spacings,
+        sparse,
         samples,
         moving,
         boundary,
@@ -374,6 +382,9 @@ pub fn remesh_points(
         timer.lap("scan");
 
         on_stage("RIMLS surface");
+        // Data sparser than the surface's support asks for: the support is all of it, and its
+        // gaps are the data's own, not a random subset's.
+        let sparse = scan.support.len() < RIMLS_POINTS_PER_SAMPLE * samples.len();
         let rimls = rimls_of(
             rimls_params(sigma_p, rp.sigma_n),
             &mut samples,
@@ -394,6 +405,7 @@ pub fn remesh_points(
             rimls: &rimls,
             spacings: &spacings,
             sigma_p,
+            sparse,
         };
         // The samples are input points, noisy: they start on the surface.
         let positions: Vec<DVec3> = samples.iter().map(|p| p.position).collect();
@@ -451,6 +463,7 @@ pub fn remesh_points(
                     kernel,
                     rimls,
                     spacings,
+                    sparse,
                     samples,
                     moving,
                     boundary,
@@ -466,6 +479,7 @@ pub fn remesh_points(
         rimls: &rimls,
         spacings: &spacings,
         sigma_p,
+        sparse,
     };
     // The RIMLS points on their own surface: the points the optimization keeps covered.
     let cover_points: Vec<DVec3> = rimls
