@@ -72,7 +72,9 @@ const SMOOTHING_PASSES: usize = 8;
 /// Edge points are averaged with those within this many spacings.
 const AVERAGE_SPACINGS: f64 = 1.5;
 
-/// The Gaussian is cut off at this many widths.
+/// The Gaussian is cut off at this many widths (its weight there is exp(-6.25) ≈ 0.002). At
+/// 2.0 the stage took 5.3 s instead of 6.8 of 14M points -> 300k, but a corner of the square of
+/// 5,000 points (seed 1) got boundary samples half a sigma_p outside it and a 16° angle.
 const CUTOFF_WIDTHS: f64 = 2.5;
 
 /// The data's edge as seen from a point of the surface.
