@@ -458,3 +458,61 @@ fn points_in_memory_give_the_file_jobs_mesh_and_name_themselves_in_errors() {
     assert!(e.contains("input points"), "{e}");
     assert!(!e.contains(".xyz"), "{e}");
 }
+
+/// Issue 39: open surfaces of points without normals end where their data ends, as boundary
+/// loops along it: `n` uniform points of `surface(u, v)` over the unit square, meshed at `count`,
+/// give one part with `loops` boundary loops, no crossing, and θmin ≥ 30° (the angle bounds hold
+/// along the boundary too).
+fn assert_open_points(
+    name: &str,
+    surface: impl Fn(f64, f64) -> DVec3,
+    n: usize,
+    count: usize,
+    loops: usize,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(39);
+    let points: Vec<DVec3> = (0..n)
+        .map(|_| surface(rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)))
+        .collect();
+    let input = dir.path().join(format!("{name}.xyz"));
+    write_xyz(&input, &points, None);
+    for seed in 1..=2 {
+        let out = remesh_points(
+            &PointSource::File(input.clone()),
+            &params(count, seed),
+            &|_| {},
+        )
+        .unwrap();
+        let t = topology(&out.mesh);
+        assert!(t.is_manifold(), "{name}, seed {seed}: {t:?}");
+        assert_eq!(t.components, 1, "{name}, seed {seed}: {t:?}");
+        assert_eq!(t.boundary_loops, loops, "{name}, seed {seed}: {t:?}");
+        assert!(
+            check_invariants(&out.mesh).is_empty(),
+            "{name}, seed {seed}"
+        );
+        let q = spectral_remesh::QualityReport::new(&out.mesh_normalized);
+        assert!(
+            q.triangles.theta_min >= 30.0,
+            "{name}, seed {seed}: θmin {}",
+            q.triangles.theta_min
+        );
+    }
+}
+
+#[test]
+fn a_flat_square_of_points_is_a_disc() {
+    // 5,000 points -> 500: before the data's boundary was found, the assembly closed the outer
+    // loop with a cap and wrote a pillow of zero thickness.
+    assert_open_points("square", |u, v| DVec3::new(u, v, 0.0), 5000, 500, 1);
+}
+
+#[test]
+fn an_open_band_of_points_has_two_loops() {
+    let band = |u: f64, v: f64| {
+        let a = u * std::f64::consts::TAU;
+        DVec3::new(a.cos(), a.sin(), v)
+    };
+    assert_open_points("band", band, 20_000, 1000, 2);
+}
