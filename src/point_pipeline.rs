@@ -22,10 +22,13 @@ use crate::pipeline::finish::{finish, Finishing, StrayRule};
 use crate::pipeline::{Density, RemeshParams};
 use crate::points::boundary::{local_spacings, DataEdges};
 use crate::points::normals::NormalOrientation;
-use crate::points::out_of_core::{rimls_of, OutOfCoreParams, RimlsSupport, ScannedInput};
+use crate::points::out_of_core::{
+    rimls_of, OutOfCoreParams, RimlsSupport, ScanOutput, ScannedInput,
+};
 use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
 use crate::points::source::PointSource;
+use crate::points::Point;
 use crate::sampling::curves::BoundarySamples;
 use crate::sampling::gradient_ascent::{gradient_ascent, GradientAscentResult};
 use crate::sampling::linear_scan::LinearScanner;
@@ -252,7 +255,7 @@ pub struct PointRemeshOutput {
     /// Projected samples the second linear scan rejected (they were accepted off the surface).
     pub rescan_rejected: usize,
     /// Samples placed on the data's boundary curves (fixed; see
-    /// [`DataEdges`](crate::points::boundary::DataEdges)).
+    /// `DataEdges`, src/points/boundary.rs).
     pub boundary_samples: usize,
     /// The data's boundary curves (closed loops and open chains).
     pub boundary_curves: usize,
@@ -343,6 +346,29 @@ pub fn remesh_points(
     Ok(kept)
 }
 
+/// What the scans leave on the RIMLS surface: the last scan, its kernel and surface, and the
+/// samples on it.
+struct OnSurface {
+    scan: ScanOutput,
+    kernel: Kernel,
+    rimls: Rimls,
+    /// The support points' local spacings ([`local_spacings`]).
+    spacings: Vec<f64>,
+    /// Whether the data is sparser than the support asks for (see [`Domain`]).
+    sparse: bool,
+    /// The scan's samples as read.
+    samples: Vec<Point>,
+    /// The samples projected onto the surface, clear of the boundary.
+    moving: Vec<SurfaceSample>,
+    /// The data's boundary, sampled, and how many curves it has.
+    boundary: BoundarySamples,
+    boundary_curves: usize,
+    /// Samples the projection did not reach.
+    unprojected: usize,
+    /// Projected samples the second linear scan rejected.
+    rescan_rejected: usize,
+}
+
 /// One run of [`remesh_points`] for the count (or sigma_p) `params` asks.
 fn remesh_points_once(
     source: &PointSource,
@@ -405,7 +431,7 @@ fn remesh_points_once(
     let mut source = ScannedInput::open(source, &scan_params, params.drop_outliers)?;
     let mut sigma_p = source.sigma_p;
     let mut scans = 0;
-    let (
+    let OnSurface {
         scan,
         kernel,
         rimls,
@@ -417,7 +443,7 @@ fn remesh_points_once(
         boundary_curves,
         unprojected,
         rescan_rejected,
-    ) = loop {
+    } = loop {
         scans += 1;
         let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE)?;
         let kernel = Kernel::new(sigma_p, rp.sigma_n)?;
@@ -501,7 +527,7 @@ fn remesh_points_once(
                 on_stage("scan");
             }
             _ => {
-                break (
+                break OnSurface {
                     scan,
                     kernel,
                     rimls,
@@ -512,8 +538,8 @@ fn remesh_points_once(
                     boundary,
                     boundary_curves,
                     unprojected,
-                    rejected,
-                )
+                    rescan_rejected: rejected,
+                }
             }
         }
     };
