@@ -176,8 +176,7 @@ fn clear_of_boundary(
         .map(|s| match tree.nearest(s.position) {
             Some((_, d2)) if d2 <= clear * clear => false,
             Some((_, d2)) if d2 <= (2.5 * spacing).powi(2) => edges
-                .width_at(s.position)
-                .and_then(|h| edges.edge(s.position, s.normal, h))
+                .edge_at(s.position, s.normal)
                 .is_some_and(|v| v.distance >= clear),
             _ => true,
         })
@@ -334,14 +333,8 @@ pub fn remesh_points(
         (first, second)
     };
     kept.target = Some(n);
-    for st in other.stages {
-        match kept.stages.iter_mut().find(|s| s.name == st.name) {
-            Some(s) => {
-                s.seconds += st.seconds;
-                s.cpu_seconds += st.cpu_seconds;
-            }
-            None => kept.stages.push(st),
-        }
+    for stage in other.stages {
+        crate::timing::add_stage(&mut kept.stages, stage);
     }
     Ok(kept)
 }

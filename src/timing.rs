@@ -66,23 +66,32 @@ impl StageTimer {
     pub fn lap(&mut self, name: &'static str) {
         let next = Clock::start();
         let (seconds, cpu_seconds) = self.last.elapsed();
-        match self.stages.iter_mut().find(|s| s.name == name) {
-            Some(s) => {
-                s.seconds += seconds;
-                s.cpu_seconds += cpu_seconds;
-            }
-            None => self.stages.push(Stage {
+        add_stage(
+            &mut self.stages,
+            Stage {
                 name,
                 seconds,
                 cpu_seconds,
-            }),
-        }
+            },
+        );
         self.last = next;
     }
 
     /// The stages so far, in the order they first ended; the timer starts an empty list.
     pub fn take_stages(&mut self) -> Vec<Stage> {
         std::mem::take(&mut self.stages)
+    }
+}
+
+/// Adds `stage` to `stages`: to the times of the stage of its name if there is one (which keeps
+/// its place), else at the end.
+pub fn add_stage(stages: &mut Vec<Stage>, stage: Stage) {
+    match stages.iter_mut().find(|s| s.name == stage.name) {
+        Some(s) => {
+            s.seconds += stage.seconds;
+            s.cpu_seconds += stage.cpu_seconds;
+        }
+        None => stages.push(stage),
     }
 }
 

@@ -157,7 +157,8 @@ pub(super) fn run(
     if let Some(n) = out.target {
         let v = out.mesh.vertex_count() as f64;
         let per_vertex = out.input_points as f64 / n as f64;
-        if (v - n as f64).abs() > 0.01 * n as f64 && per_vertex < 4.0 {
+        let sparse = per_vertex < crate::point_pipeline::RIMLS_POINTS_PER_SAMPLE as f64;
+        if (v - n as f64).abs() > 0.01 * n as f64 && sparse {
             report.notes.push(format!(
                 "the input has {per_vertex:.2} points per vertex asked: samples are lost where                  the data is no denser than the output (projections refused across its gaps,                  samples in no triangle or collapsed), and a second run for a raised count came                  no closer than this"
             ));

@@ -135,14 +135,16 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     // Faces that still cross (where the surface's sheets lie closer than the output's chords
     // bend away from them) are moved apart.
     let mut later_dropped = 0;
-    let untangle_fixed = if f.untangle_moves_fixed {
-        vec![false; mesh.positions.len()]
+    let none_fixed;
+    let untangle_fixed: &[bool] = if f.untangle_moves_fixed {
+        none_fixed = vec![false; mesh.positions.len()];
+        &none_fixed
     } else {
-        fixed.clone()
+        &fixed
     };
     let (untangle_stats, origin) = untangle(
         mesh,
-        &untangle_fixed,
+        untangle_fixed,
         f.sigma_p,
         &f.untangle,
         f.input_crossings,

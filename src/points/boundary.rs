@@ -172,6 +172,11 @@ impl<'a> DataEdges<'a> {
         self.rimls.nearest(x).map(|(i, _)| self.width(i as usize))
     }
 
+    /// The edge seen from `x` (normal `n`, unit) at the width there ([`DataEdges::width_at`]).
+    pub fn edge_at(&self, x: DVec3, n: DVec3) -> Option<EdgeView> {
+        self.edge(x, n, self.width_at(x)?)
+    }
+
     /// The edge seen from `x` (normal `n`, unit) through a Gaussian of width `h`. `None` when no
     /// point lies within the cut-off.
     pub fn edge(&self, x: DVec3, n: DVec3, h: f64) -> Option<EdgeView> {
