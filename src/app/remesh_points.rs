@@ -160,7 +160,10 @@ pub(super) fn run(
         let sparse = per_vertex < crate::point_pipeline::RIMLS_POINTS_PER_SAMPLE as f64;
         if (v - n as f64).abs() > 0.01 * n as f64 && sparse {
             report.notes.push(format!(
-                "the input has {per_vertex:.2} points per vertex asked: samples are lost where                  the data is no denser than the output (projections refused across its gaps,                  samples in no triangle or collapsed), and a second run for a raised count came                  no closer than this"
+                "the input has {per_vertex:.2} points per vertex asked: samples are lost where \
+                 the data is no denser than the output (projections refused across its gaps, \
+                 samples in no triangle or collapsed), and a second run for a raised count came \
+                 no closer than this"
             ));
         }
     }
