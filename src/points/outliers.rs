@@ -202,12 +202,49 @@ pub const PLANE_NEIGHBORS: usize = 16;
 /// it is off the surface (see [`off_surface`]).
 pub const PLANE_FACTOR: f64 = 4.0;
 
+/// The sheet test's radius is never below this many times the data's median distance from a
+/// point to its sixth nearest neighbour (see [`off_surface`]): data sparser than the radius asks
+/// for (5,000 points of a model meshed at 4,000) is a sheet at its own spacing, not strands.
+/// For uniformly random points of density ρ the median m₆ has ρπm₆² ≈ 5.67 (the median of a
+/// Gamma(6, 1) variable), so a disc of radius 1.9 m₆ holds about 20.5 of them on average, and
+/// fewer than `SHEET_NEIGHBORS` with probability about 5e-5. A dense support (4 points per
+/// sigma_p²) has m₆ ≈ 0.67 sigma_p, and the radius the point pipeline asks for (3 sigma_p)
+/// stands. Flying pixels, a few in a thousand, do not move the median.
+pub const SHEET_RADIUS_SIXTH_NEIGHBORS: f64 = 1.9;
+
+/// Points whose sixth-neighbour distance estimates the data's median one (every k-th point,
+/// deterministic).
+const SPACING_PROBES: usize = 4096;
+
+/// `radius`, widened to `SHEET_RADIUS_SIXTH_NEIGHBORS` times the median sixth-neighbour
+/// distance of `positions` (estimated on at most `SPACING_PROBES` of them) where that is wider.
+fn sheet_radius_for(tree: &StaticTree, positions: &[DVec3], radius: f64) -> f64 {
+    if positions.len() <= SHEET_NEIGHBORS {
+        return radius;
+    }
+    let step = positions.len().div_ceil(SPACING_PROBES);
+    let mut found = Vec::new();
+    let mut sixth: Vec<f64> = positions
+        .iter()
+        .step_by(step)
+        .map(|&p| {
+            tree.nearest_n(p, SHEET_NEIGHBORS + 1, &mut found);
+            found.last().map_or(0.0, |&(_, d2)| d2.sqrt())
+        })
+        .collect();
+    let mid = sixth.len() / 2;
+    let (_, median, _) = sixth.select_nth_unstable_by(mid, f64::total_cmp);
+    radius.max(SHEET_RADIUS_SIXTH_NEIGHBORS * *median)
+}
+
 /// For each of `positions`, whether it is off the surface its neighbours describe (the plane
 /// test, `is_off_plane`) or, with `sheet_radius`, on no sheet of data at that radius (the sheet
-/// test, `is_off_sheet`): the two tests on one kd-tree and one neighbour query per point. Any
-/// units; deterministic (parallel).
+/// test, `is_off_sheet`; the radius is widened to the data's own spacing where that is wider,
+/// see [`SHEET_RADIUS_SIXTH_NEIGHBORS`]): the two tests on one kd-tree and one neighbour query
+/// per point. Any units; deterministic (parallel).
 pub fn off_surface(positions: &[DVec3], sheet_radius: Option<f64>) -> Vec<bool> {
     let tree = StaticTree::new(positions);
+    let sheet_radius = sheet_radius.map(|r| sheet_radius_for(&tree, positions, r));
     let k = (PLANE_NEIGHBORS + 1).max(SHEET_NEIGHBORS + 1);
     positions
         .par_iter()
@@ -397,6 +434,40 @@ mod tests {
         let filter = OutlierFilter::new(&points);
         let mut found = Vec::new();
         assert!(!filter.is_outlier(DVec3::splat(1e6), &mut found));
+    }
+
+    #[test]
+    fn sparse_random_points_are_a_sheet_at_their_own_spacing() {
+        // 2,000 uniformly random points of a 100 x 100 square: their sixth neighbour is about 3
+        // away, so almost none has six others within the asked radius of 1. The radius widens
+        // to their spacing and the interior points are on the sheet; a strand of points 6
+        // apart leaving the square's centre along its normal is still off it.
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let mut points: Vec<DVec3> = (0..2000)
+            .map(|_| {
+                DVec3::new(
+                    rng.random_range(0.0..100.0),
+                    rng.random_range(0.0..100.0),
+                    0.0,
+                )
+            })
+            .collect();
+        let strand: Vec<DVec3> = (1..=8)
+            .map(|k| DVec3::new(50.0, 50.0, 6.0 * k as f64))
+            .collect();
+        points.extend_from_slice(&strand);
+        let off = off_surface(&points, Some(1.0));
+        let interior = |p: &DVec3| p.x.min(p.y).min(100.0 - p.x).min(100.0 - p.y) > 8.0;
+        let off_interior = points[..2000]
+            .iter()
+            .zip(&off)
+            .filter(|(p, &o)| interior(p) && o)
+            .count();
+        assert_eq!(off_interior, 0, "interior points off the sheet");
+        assert!(
+            off[2000..].iter().all(|&o| o),
+            "a strand point is on a sheet"
+        );
     }
 
     #[test]
