@@ -16,7 +16,9 @@
 //!
 //! **Which points are on an edge.** The points within `CANDIDATE_DEPTH` widths inside an edge are
 //! taken to it, and an edge point is kept when the half-disc beyond it is empty: at most one
-//! point within h of it and more than `MARGIN` h outside. Where the data goes on, that region
+//! point within h of it and more than `MARGIN` h outside, more than h/2 off its tangent plane
+//! or facing away from it (the other side of a part thinner than h, round whose rim the surface
+//! folds: a closed ear's rim is no edge). Where the data goes on, that region
 //! holds about 1.1 ρ h² points (ρ points per unit area): at the least width of
 //! `WIDTH_SPACINGS` local spacings (the distance to the 8th nearest point, about
 //! √(8/(πρ))), 16 expected, and at most one with probability about 1e-6.
@@ -209,18 +211,22 @@ impl<'a> DataEdges<'a> {
     }
 
     /// The points within `h` of `q` (normal `n`) beyond it: more than `MARGIN · h` outside it
-    /// (along `-inward`), or more than `h / 2` off its tangent plane (a crease, a tip or a thin
+    /// (along `-inward`), more than `h / 2` off its tangent plane (a crease, a tip or a thick
     /// part's other side, which the tangent plane sees edge-on, has points there; a smooth
-    /// surface's bend over `h` is far less where `h` is below its radius).
+    /// surface's bend over `h` is far less where `h` is below its radius), or facing away from
+    /// `n` (the other side of a part thinner than `h`, an ear or a horn, whose rim is no edge of
+    /// the data: the surface folds round it; a smooth sheet's normals turn by far less than
+    /// 90° within `h`).
     /// Also returns the points within `h` more than `MARGIN · h` inside and near the tangent
     /// plane: the data the edge bounds.
     fn half_disc_counts(&self, q: DVec3, n: DVec3, inward: DVec3, h: f64) -> (usize, usize) {
-        let positions = self.rimls.positions();
+        let (positions, normals) = (self.rimls.positions(), self.rimls.normals());
         let (mut outside, mut inside) = (0, 0);
         self.rimls.visit_within(q, h * h, |i, _| {
             let d = positions[i as usize] - q;
             let along = d.dot(inward);
-            if along < -MARGIN * h || d.dot(n).abs() > 0.5 * h {
+            if along < -MARGIN * h || d.dot(n).abs() > 0.5 * h || normals[i as usize].dot(n) < -0.5
+            {
                 outside += 1;
             } else if along > MARGIN * h {
                 inside += 1;
@@ -614,6 +620,30 @@ mod tests {
             }
         }
         let sigma_p = (6.0 / 4000.0f64).sqrt() * 2.0;
+        let rimls = Rimls::new(p, normals, RimlsParams::new(sigma_p, f64::INFINITY)).unwrap();
+        let spacings = local_spacings(&rimls);
+        let b = DataEdges::new(&rimls, &spacings, sigma_p)
+            .boundary_samples(sigma_p)
+            .0;
+        assert!(b.samples.is_empty(), "{} boundary samples", b.samples.len());
+    }
+
+    #[test]
+    fn a_thin_closed_plate_has_no_boundary_at_its_rim() {
+        // Both sides of a closed plate thinner than the kernel (an ear, a horn seen from its
+        // side): 10,000 points on each, normals outward. From one side the data ends at the
+        // rim within the tangent plane, but the other side lies there, facing away.
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        let n = 10_000;
+        let sigma_p = (1.0 / n as f64).sqrt() * 2.0;
+        let thickness = 0.25 * sigma_p;
+        let (mut p, mut normals) = (Vec::new(), Vec::new());
+        for (z, normal) in [(0.0, -DVec3::Z), (thickness, DVec3::Z)] {
+            for _ in 0..n {
+                p.push(DVec3::new(rng.random(), rng.random(), z));
+                normals.push(normal);
+            }
+        }
         let rimls = Rimls::new(p, normals, RimlsParams::new(sigma_p, f64::INFINITY)).unwrap();
         let spacings = local_spacings(&rimls);
         let b = DataEdges::new(&rimls, &spacings, sigma_p)
