@@ -124,12 +124,15 @@ mod tests {
 
     #[test]
     fn busy_work_takes_processor_time() {
+        // Busy until the processor clock shows 20 ms (or 10 s pass on the wall clock): on a
+        // loaded machine the wall clock runs ahead of the processor time, so the test asks only
+        // that the processor clock moves with the work.
         let clock = Clock::start();
         let mut x = 0u64;
-        while clock.elapsed().0 < 0.02 {
+        while clock.elapsed().1 < 0.02 && clock.elapsed().0 < 10.0 {
             x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
         }
         let (wall, cpu) = clock.elapsed();
-        assert!(cpu > 0.5 * wall, "wall {wall}, cpu {cpu}");
+        assert!(cpu >= 0.02, "wall {wall}, cpu {cpu}");
     }
 }

@@ -579,6 +579,15 @@ mod tests {
         assert!(area > 0.0, "signed area {area}");
     }
 
+    /// The boundary samples found in `p` (normals `normals`) at `sigma_p`.
+    fn boundary_of(p: Vec<DVec3>, normals: Vec<DVec3>, sigma_p: f64) -> BoundarySamples {
+        let rimls = Rimls::new(p, normals, RimlsParams::new(sigma_p, f64::INFINITY)).unwrap();
+        let spacings = local_spacings(&rimls);
+        DataEdges::new(&rimls, &spacings, sigma_p)
+            .boundary_samples(sigma_p)
+            .0
+    }
+
     #[test]
     fn a_closed_surface_has_no_boundary() {
         let mut rng = rand::rngs::StdRng::seed_from_u64(3);
@@ -593,11 +602,7 @@ mod tests {
         }
         let normals = p.clone();
         let sigma_p = (4.0 * std::f64::consts::PI / n as f64).sqrt() * 2.0;
-        let rimls = Rimls::new(p, normals, RimlsParams::new(sigma_p, f64::INFINITY)).unwrap();
-        let spacings = local_spacings(&rimls);
-        let b = DataEdges::new(&rimls, &spacings, sigma_p)
-            .boundary_samples(sigma_p)
-            .0;
+        let b = boundary_of(p, normals, sigma_p);
         assert!(b.samples.is_empty(), "{} boundary samples", b.samples.len());
     }
 
@@ -620,11 +625,7 @@ mod tests {
             }
         }
         let sigma_p = (6.0 / 4000.0f64).sqrt() * 2.0;
-        let rimls = Rimls::new(p, normals, RimlsParams::new(sigma_p, f64::INFINITY)).unwrap();
-        let spacings = local_spacings(&rimls);
-        let b = DataEdges::new(&rimls, &spacings, sigma_p)
-            .boundary_samples(sigma_p)
-            .0;
+        let b = boundary_of(p, normals, sigma_p);
         assert!(b.samples.is_empty(), "{} boundary samples", b.samples.len());
     }
 
@@ -644,11 +645,7 @@ mod tests {
                 normals.push(normal);
             }
         }
-        let rimls = Rimls::new(p, normals, RimlsParams::new(sigma_p, f64::INFINITY)).unwrap();
-        let spacings = local_spacings(&rimls);
-        let b = DataEdges::new(&rimls, &spacings, sigma_p)
-            .boundary_samples(sigma_p)
-            .0;
+        let b = boundary_of(p, normals, sigma_p);
         assert!(b.samples.is_empty(), "{} boundary samples", b.samples.len());
     }
 }
