@@ -283,8 +283,8 @@ impl ScannedInput {
         })
     }
 
-    /// Pass 2 at `sigma_p` (bbox-100 units), keeping up to `support_per_sample` points of the
-    /// first bucket per sample as the support. A scan after the first draws other shuffles.
+    /// Pass 2 at `sigma_p` (bbox-100 units), keeping up to `support_per_sample` points per
+    /// sample as the support: the first bucket's first points that are not outliers. A scan after the first draws other shuffles.
     pub(crate) fn scan(&mut self, sigma_p: f64, support_per_sample: usize) -> Result<ScanOutput> {
         let t2 = Instant::now();
         let params = &self.params;
@@ -307,9 +307,13 @@ impl ScannedInput {
         if let Some(f) = &self.filter {
             outliers_removed += f.retain(&mut samples, |p| p.position);
         }
-        support.truncate(support_per_sample.saturating_mul(samples.len()));
-        if let Some(f) = &self.filter {
-            outliers_removed += f.retain(&mut support, |p| p.position);
+        // The first points of the bucket that are not outliers: the support is as dense as asked
+        // for whenever the data has that many points (filtering after truncating would leave it
+        // thinner by the outliers' share, and read as sparse data).
+        let want = support_per_sample.saturating_mul(samples.len());
+        match &self.filter {
+            Some(f) => outliers_removed += f.retain_first(&mut support, want, |p| p.position),
+            None => support.truncate(want),
         }
         let t3 = Instant::now();
         Ok(ScanOutput {

@@ -105,6 +105,39 @@ impl OutlierFilter {
         });
         before - items.len()
     }
+
+    /// Keeps the first `want` items of `items` that are not outliers, in order (all of them when
+    /// there are fewer), testing only as many as that takes; returns how many of those tested
+    /// were dropped. Deterministic: the same as [`retain`](Self::retain) then truncating to
+    /// `want`.
+    pub fn retain_first<T: Send + Sync>(
+        &self,
+        items: &mut Vec<T>,
+        want: usize,
+        position: impl Fn(&T) -> DVec3 + Sync,
+    ) -> usize {
+        // items[..kept] are kept; items[kept..tested] were dropped.
+        let (mut kept, mut tested, mut dropped) = (0, 0, 0);
+        while kept < want && tested < items.len() {
+            let need = want - kept;
+            let chunk = (need + need / 8 + 64).min(items.len() - tested);
+            let keep: Vec<bool> = items[tested..tested + chunk]
+                .par_iter()
+                .map_init(Vec::new, |found, t| !self.is_outlier(position(t), found))
+                .collect();
+            for (j, k) in keep.into_iter().enumerate() {
+                if k {
+                    items.swap(kept, tested + j);
+                    kept += 1;
+                } else {
+                    dropped += 1;
+                }
+            }
+            tested += chunk;
+        }
+        items.truncate(kept.min(want));
+        dropped
+    }
 }
 
 /// Points that decide the bounding box of a point set are far isolated when fewer than this
@@ -409,6 +442,43 @@ mod tests {
             "{surface_dropped} surface points dropped"
         );
         assert_eq!(dropped, surface_dropped + 200);
+    }
+
+    #[test]
+    fn retain_first_keeps_what_retain_keeps_up_to_the_count() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut points = sphere(5_000, 0.0, &mut rng);
+        // Outliers uniform in the cube around the sphere, at least 0.2 off it, spread through
+        // the list (every 50th item).
+        let mut k = 0;
+        while k < 100 {
+            let p = DVec3::new(
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+                rng.random_range(-1.5..1.5),
+            );
+            if (p.length() - 1.0).abs() > 0.2 {
+                points.insert(k * 50, p);
+                k += 1;
+            }
+        }
+        let filter = OutlierFilter::new(&points);
+        let mut all: Vec<(usize, DVec3)> = points.iter().copied().enumerate().collect();
+        filter.retain(&mut all, |&(_, p)| p);
+        assert!(all.len() < points.len() - 90, "{} kept", all.len());
+        for want in [0, 1, 1_000, 3_000, all.len(), points.len()] {
+            let mut first: Vec<(usize, DVec3)> = points.iter().copied().enumerate().collect();
+            let dropped = filter.retain_first(&mut first, want, |&(_, p)| p);
+            let expected = &all[..want.min(all.len())];
+            assert_eq!(first.len(), expected.len(), "want {want}");
+            assert!(
+                first.iter().zip(expected).all(|(a, b)| a.0 == b.0),
+                "want {want}"
+            );
+            // The dropped ones among those tested: at least those before the last kept.
+            let last = first.last().map_or(0, |f| f.0 + 1);
+            assert!(dropped >= (0..last).filter(|i| !all.iter().any(|a| a.0 == *i)).count());
+        }
     }
 
     #[test]
