@@ -413,24 +413,30 @@ mod tests {
         assert!(far_isolated(&candidates, &set).iter().all(|&f| !f));
     }
 
-    #[test]
-    fn far_points_go_and_the_surface_stays() {
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let mut points = sphere(20_000, 0.005, &mut rng);
-        let surface = points.len();
-        // 1% outliers uniform in the cube around the sphere, at least 0.2 off it (10 spacings).
-        let mut outliers = 0;
-        while outliers < 200 {
+    /// `n` points uniform in the cube [-1.5, 1.5]³ around the unit sphere, each at least 0.2 off
+    /// it.
+    fn cube_outliers(n: usize, rng: &mut ChaCha8Rng) -> Vec<DVec3> {
+        let mut out = Vec::with_capacity(n);
+        while out.len() < n {
             let p = DVec3::new(
                 rng.random_range(-1.5..1.5),
                 rng.random_range(-1.5..1.5),
                 rng.random_range(-1.5..1.5),
             );
             if (p.length() - 1.0).abs() > 0.2 {
-                points.push(p);
-                outliers += 1;
+                out.push(p);
             }
         }
+        out
+    }
+
+    #[test]
+    fn far_points_go_and_the_surface_stays() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut points = sphere(20_000, 0.005, &mut rng);
+        let surface = points.len();
+        // 1% outliers, at least 0.2 off the sphere (10 spacings).
+        points.extend(cube_outliers(200, &mut rng));
         let filter = OutlierFilter::new(&points);
         let mut kept: Vec<(usize, DVec3)> = points.iter().copied().enumerate().collect();
         let dropped = filter.retain(&mut kept, |&(_, p)| p);
@@ -448,19 +454,9 @@ mod tests {
     fn retain_first_keeps_what_retain_keeps_up_to_the_count() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let mut points = sphere(5_000, 0.0, &mut rng);
-        // Outliers uniform in the cube around the sphere, at least 0.2 off it, spread through
-        // the list (every 50th item).
-        let mut k = 0;
-        while k < 100 {
-            let p = DVec3::new(
-                rng.random_range(-1.5..1.5),
-                rng.random_range(-1.5..1.5),
-                rng.random_range(-1.5..1.5),
-            );
-            if (p.length() - 1.0).abs() > 0.2 {
-                points.insert(k * 50, p);
-                k += 1;
-            }
+        // Outliers spread through the list (every 50th item).
+        for (k, p) in cube_outliers(100, &mut rng).into_iter().enumerate() {
+            points.insert(k * 50, p);
         }
         let filter = OutlierFilter::new(&points);
         let mut all: Vec<(usize, DVec3)> = points.iter().copied().enumerate().collect();
