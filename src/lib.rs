@@ -157,7 +157,7 @@ pub use check::{check_invariants, topology, Topology, Violation};
 pub use report::{QualityReport, SurfaceDistance, TriangleQuality};
 // Point sets: a scan to a mesh, and the out-of-core linear scan.
 pub use app::remesh_point_set;
-pub use point_pipeline::{remesh_points, PointRemeshOutput, PointRemeshParams};
+pub use point_pipeline::{remesh_points, PointRemeshOutput, PointRemeshParams, OPEN_GAP_SIGMA_P};
 pub use points::out_of_core::{simplify_out_of_core, OutOfCoreParams, OutOfCoreResult};
 pub use points::source::PointSource;
 // Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.

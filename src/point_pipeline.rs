@@ -266,6 +266,9 @@ pub struct PointRemeshOutput {
     pub assembly: AssemblyStats,
     /// Faces removed for spanning a gap in the data (open scans).
     pub unsupported: UnsupportedFaces,
+    /// Faces the finishing made across a gap in the data (its collapses can close a hole the
+    /// removal opened), removed again after it.
+    pub unsupported_after_finishing: UnsupportedFaces,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,
     /// The separation of crossing faces of the umbrellas (before the optimization).
@@ -604,9 +607,8 @@ fn remesh_points_once(
     }
     let mut mesh = TriMesh::new(positions, faces);
     // Faces the assembly closed across a gap in the data (an open scan's holes) go.
-    let unsupported = remove_unsupported_faces(&mut mesh, &mut sources, |p| {
-        domain.within(p, OPEN_GAP_SIGMA_P, OPEN_GAP_SPACINGS)
-    });
+    let supported = |p| domain.within(p, OPEN_GAP_SIGMA_P, OPEN_GAP_SPACINGS);
+    let unsupported = remove_unsupported_faces(&mut mesh, &mut sources, supported);
 
     // The RIMLS surface is a level set: it never passes through itself, so a crossing of the
     // umbrellas is a fold of the triangulation (a tip thinner than sigma_p, where the samples
@@ -661,6 +663,10 @@ fn remesh_points_once(
     };
     // The points' normals point outward (given, or oriented so): so does the output.
     let finished = finish(&mut mesh, &mut sources, &finishing, on_stage, &mut timer);
+    // The same rule once more: no output face spans a gap in the data. (Removing faces makes no
+    // angle smaller and no faces cross.)
+    let unsupported_after_finishing = remove_unsupported_faces(&mut mesh, &mut sources, supported);
+    let dropped_after_finishing = mesh.remove_unreferenced_vertices();
     Ok(PointRemeshOutput {
         mesh: normalization.invert_mesh(&mesh),
         mesh_normalized: mesh,
@@ -679,10 +685,13 @@ fn remesh_points_once(
         gradient_ascent: ga,
         assembly,
         unsupported,
+        unsupported_after_finishing,
         optimize: finished.optimize,
         untangle_umbrellas,
         untangle: finished.untangle,
-        dropped_samples: finished.dropped_samples + finished.later_dropped,
+        dropped_samples: finished.dropped_samples
+            + finished.later_dropped
+            + dropped_after_finishing,
         stray_shells: finished.stray_shells,
         output_orientation: finished.orientation,
         scan_seconds: scan.seconds,

@@ -279,6 +279,66 @@ fn an_open_patch_keeps_its_boundary_and_its_hole() {
 }
 
 #[test]
+fn no_output_face_spans_a_gap_in_the_data() {
+    // A wavy patch 2 × 2 with eight small round holes (radius 0.12, about five spacings across
+    // at 1500 vertices), 60,000 points with normals: every output face's centroid and edge
+    // midpoints lie within the gap rule's reach (OPEN_GAP_SIGMA_P sigma_p) of an input point,
+    // after the finishing as after the umbrellas.
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(23);
+    let holes: Vec<(f64, f64)> = (0..8)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::FRAC_PI_4;
+            (0.55 * a.cos(), 0.55 * a.sin())
+        })
+        .collect();
+    let height = |x: f64, y: f64| 0.1 * (2.0 * x).sin() * (1.5 * y).cos();
+    let (mut points, mut normals) = (Vec::new(), Vec::new());
+    while points.len() < 60_000 {
+        let (x, y): (f64, f64) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        if holes.iter().any(|&(hx, hy)| (x - hx).hypot(y - hy) < 0.12) {
+            continue;
+        }
+        points.push(DVec3::new(x, y, height(x, y)));
+        let (hx, hy) = (
+            0.2 * (2.0 * x).cos() * (1.5 * y).cos(),
+            -0.15 * (2.0 * x).sin() * (1.5 * y).sin(),
+        );
+        normals.push(DVec3::new(-hx, -hy, 1.0).normalize());
+    }
+    let input = dir.path().join("holes.xyz");
+    write_xyz(&input, &points, Some(&normals));
+    for seed in 1..=3 {
+        let out = remesh_points(
+            &PointSource::File(input.clone()),
+            &params(1500, seed),
+            &|_| {},
+        )
+        .unwrap();
+        let t = topology(&out.mesh);
+        assert!(t.is_manifold(), "seed {seed}: {t:?}");
+        assert!(check_invariants(&out.mesh).is_empty());
+        let reach = spectral_remesh::OPEN_GAP_SIGMA_P * out.sigma_p / out.normalization.scale
+            * (1.0 + 1e-9);
+        let m = &out.mesh;
+        for tri in &m.triangles {
+            let [a, b, c] = tri.map(|i| m.positions[i as usize]);
+            for probe in [
+                (a + b + c) / 3.0,
+                (a + b) / 2.0,
+                (b + c) / 2.0,
+                (c + a) / 2.0,
+            ] {
+                assert!(
+                    points.iter().any(|p| p.distance(probe) <= reach),
+                    "seed {seed}: a face over a hole at {probe} (reach {reach})"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn many_buckets_give_the_same_guarantees_as_one() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("sphere.ply");

@@ -122,6 +122,10 @@ pub(super) fn run(
         serde_json::to_value(out.unsupported).unwrap_or_default(),
     );
     extra.insert(
+        "unsupported_after_finishing".into(),
+        serde_json::to_value(out.unsupported_after_finishing).unwrap_or_default(),
+    );
+    extra.insert(
         "optimize".into(),
         serde_json::to_value(out.optimize).unwrap_or_default(),
     );
@@ -176,7 +180,10 @@ pub(super) fn run(
              {} faces across them were removed)",
             report.topology.boundary_loops,
             crate::point_pipeline::OPEN_GAP_SIGMA_P,
-            out.unsupported.faces + out.unsupported.pinched_faces
+            out.unsupported.faces
+                + out.unsupported.pinched_faces
+                + out.unsupported_after_finishing.faces
+                + out.unsupported_after_finishing.pinched_faces
         ));
     }
     let st = &out.stray_shells;
