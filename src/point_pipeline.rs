@@ -667,6 +667,7 @@ fn remesh_points_once(
     // angle smaller and no faces cross.)
     let unsupported_after_finishing = remove_unsupported_faces(&mut mesh, &mut sources, supported);
     let dropped_after_finishing = mesh.remove_unreferenced_vertices();
+    timer.lap("untangle");
     Ok(PointRemeshOutput {
         mesh: normalization.invert_mesh(&mesh),
         mesh_normalized: mesh,

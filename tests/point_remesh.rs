@@ -225,26 +225,37 @@ fn noise_and_outliers_still_give_the_closed_surface() {
     assert!(off < 0.02, "a vertex {off} off the unit sphere");
 }
 
-#[test]
-fn an_open_patch_keeps_its_boundary_and_its_hole() {
-    // A wavy square patch 2 × 2 with a round hole of radius 0.3 in the middle, 60,000 points
-    // with normals: at 1500 vertices the spacing is about 0.05, the hole 12 spacings wide.
-    let dir = tempfile::tempdir().unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(21);
-    let height = |x: f64, y: f64| 0.1 * (2.0 * x).sin() * (1.5 * y).cos();
+/// The height of the wavy patch over [-1, 1]² of [`wavy_patch`].
+fn wavy_height(x: f64, y: f64) -> f64 {
+    0.1 * (2.0 * x).sin() * (1.5 * y).cos()
+}
+
+/// 60,000 uniform points (by x and y) of the wavy patch z = [`wavy_height`] over [-1, 1]², none
+/// where `in_hole(x, y)`, with their unit normals (+z side); from rng seed `seed`.
+fn wavy_patch(seed: u64, in_hole: impl Fn(f64, f64) -> bool) -> (Vec<DVec3>, Vec<DVec3>) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let (mut points, mut normals) = (Vec::new(), Vec::new());
     while points.len() < 60_000 {
         let (x, y): (f64, f64) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-        if x.hypot(y) < 0.3 {
+        if in_hole(x, y) {
             continue;
         }
-        points.push(DVec3::new(x, y, height(x, y)));
+        points.push(DVec3::new(x, y, wavy_height(x, y)));
         let (hx, hy) = (
             0.2 * (2.0 * x).cos() * (1.5 * y).cos(),
             -0.15 * (2.0 * x).sin() * (1.5 * y).sin(),
         );
         normals.push(DVec3::new(-hx, -hy, 1.0).normalize());
     }
+    (points, normals)
+}
+
+#[test]
+fn an_open_patch_keeps_its_boundary_and_its_hole() {
+    // A wavy square patch 2 × 2 with a round hole of radius 0.3 in the middle, 60,000 points
+    // with normals: at 1500 vertices the spacing is about 0.05, the hole 12 spacings wide.
+    let dir = tempfile::tempdir().unwrap();
+    let (points, normals) = wavy_patch(21, |x, y| x.hypot(y) < 0.3);
     let input = dir.path().join("patch.xyz");
     write_xyz(&input, &points, Some(&normals));
     for seed in 1..=2 {
@@ -273,7 +284,7 @@ fn an_open_patch_keeps_its_boundary_and_its_hole() {
             );
         }
         // On the surface.
-        let off = worst_off(&out.mesh, |p| p.z - height(p.x, p.y));
+        let off = worst_off(&out.mesh, |p| p.z - wavy_height(p.x, p.y));
         assert!(off < 0.01, "seed {seed}: a vertex {off} off the patch");
     }
 }
@@ -285,27 +296,15 @@ fn no_output_face_spans_a_gap_in_the_data() {
     // midpoints lie within the gap rule's reach (OPEN_GAP_SIGMA_P sigma_p) of an input point,
     // after the finishing as after the umbrellas.
     let dir = tempfile::tempdir().unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(23);
     let holes: Vec<(f64, f64)> = (0..8)
         .map(|k| {
             let a = k as f64 * std::f64::consts::FRAC_PI_4;
             (0.55 * a.cos(), 0.55 * a.sin())
         })
         .collect();
-    let height = |x: f64, y: f64| 0.1 * (2.0 * x).sin() * (1.5 * y).cos();
-    let (mut points, mut normals) = (Vec::new(), Vec::new());
-    while points.len() < 60_000 {
-        let (x, y): (f64, f64) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
-        if holes.iter().any(|&(hx, hy)| (x - hx).hypot(y - hy) < 0.12) {
-            continue;
-        }
-        points.push(DVec3::new(x, y, height(x, y)));
-        let (hx, hy) = (
-            0.2 * (2.0 * x).cos() * (1.5 * y).cos(),
-            -0.15 * (2.0 * x).sin() * (1.5 * y).sin(),
-        );
-        normals.push(DVec3::new(-hx, -hy, 1.0).normalize());
-    }
+    let (points, normals) = wavy_patch(23, |x, y| {
+        holes.iter().any(|&(hx, hy)| (x - hx).hypot(y - hy) < 0.12)
+    });
     let input = dir.path().join("holes.xyz");
     write_xyz(&input, &points, Some(&normals));
     for seed in 1..=3 {

@@ -284,7 +284,8 @@ impl ScannedInput {
     }
 
     /// Pass 2 at `sigma_p` (bbox-100 units), keeping up to `support_per_sample` points per
-    /// sample as the support: the first bucket's first points that are not outliers. A scan after the first draws other shuffles.
+    /// sample as the support: the first bucket's first points that are not outliers. A scan
+    /// after the first draws other shuffles.
     pub(crate) fn scan(&mut self, sigma_p: f64, support_per_sample: usize) -> Result<ScanOutput> {
         let t2 = Instant::now();
         let params = &self.params;

@@ -86,6 +86,18 @@ impl OutlierFilter {
         d > LOCAL_FACTOR * local
     }
 
+    /// Per item of `items` (positions by `position`), whether it is not an outlier (in parallel).
+    fn keep_flags<T: Sync>(
+        &self,
+        items: &[T],
+        position: &(impl Fn(&T) -> DVec3 + Sync),
+    ) -> Vec<bool> {
+        items
+            .par_iter()
+            .map_init(Vec::new, |found, t| !self.is_outlier(position(t), found))
+            .collect()
+    }
+
     /// Keeps the items of `items` (positions by `position`) that are not outliers, in order;
     /// returns how many were dropped. Deterministic.
     pub fn retain<T: Send + Sync>(
@@ -93,10 +105,7 @@ impl OutlierFilter {
         items: &mut Vec<T>,
         position: impl Fn(&T) -> DVec3 + Sync,
     ) -> usize {
-        let keep: Vec<bool> = items
-            .par_iter()
-            .map_init(Vec::new, |found, t| !self.is_outlier(position(t), found))
-            .collect();
+        let keep = self.keep_flags(items, &position);
         let before = items.len();
         let mut i = 0;
         items.retain(|_| {
@@ -121,10 +130,7 @@ impl OutlierFilter {
         while kept < want && tested < items.len() {
             let need = want - kept;
             let chunk = (need + need / 8 + 64).min(items.len() - tested);
-            let keep: Vec<bool> = items[tested..tested + chunk]
-                .par_iter()
-                .map_init(Vec::new, |found, t| !self.is_outlier(position(t), found))
-                .collect();
+            let keep = self.keep_flags(&items[tested..tested + chunk], &position);
             for (j, k) in keep.into_iter().enumerate() {
                 if k {
                     items.swap(kept, tested + j);
