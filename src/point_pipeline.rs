@@ -41,6 +41,7 @@ use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::optimize::OptimizeStats;
+use crate::triangulate::pillows::{open_pillows, Pillows};
 use crate::triangulate::stray_shells::StrayShells;
 use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
@@ -85,6 +86,13 @@ pub const OPEN_GAP_SIGMA_P: f64 = 1.5;
 /// a closed surface removed), none at 2.0. Data sparse enough for this rule has its holes found
 /// as boundaries ([`DataEdges`]).
 pub const OPEN_GAP_SPACINGS: f64 = 2.0;
+
+/// Thickness (3·volume/area), in units of sigma_p, below which a closed part of the output
+/// other than the largest is a pillow ([`open_pillows`]): both sides of one sheet of data. Two
+/// sheets closer than sigma_p are one RIMLS surface, so no real part is that thin; the
+/// smallest closed parts that split off thin parts of closed models (noisy cow -> 10k, seeds
+/// 1-5) are 0.23-0.81 sigma_p thick, the pillows of face000 at most 0.07.
+pub const PILLOW_THICKNESS_SIGMA_P: f64 = 0.1;
 
 /// The projections' reach past the data in local spacings, where that is wider than
 /// `DOMAIN_GAP_SIGMA_P` sigma_p: an empty disc of radius 0.6 s has probability
@@ -269,6 +277,8 @@ pub struct PointRemeshOutput {
     /// Faces the finishing made across a gap in the data (its collapses can close a hole the
     /// removal opened), removed again after it.
     pub unsupported_after_finishing: UnsupportedFaces,
+    /// Flat closed parts (both sides of a strip of one-sided data) opened after the finishing.
+    pub pillows: Pillows,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,
     /// The separation of crossing faces of the umbrellas (before the optimization).
@@ -663,6 +673,17 @@ fn remesh_points_once(
     };
     // The points' normals point outward (given, or oriented so): so does the output.
     let finished = finish(&mut mesh, &mut sources, &finishing, on_stage, &mut timer);
+    // A strip of one-sided data closed into a flat part: its side facing against the data goes.
+    let pillows = open_pillows(
+        &mut mesh,
+        &mut sources,
+        PILLOW_THICKNESS_SIGMA_P * sigma_p,
+        |centroid, normal| {
+            rimls
+                .value_and_gradient(centroid)
+                .is_none_or(|(_, g)| g.dot(normal) > 0.0)
+        },
+    );
     // The same rule once more: no output face spans a gap in the data. (Removing faces makes no
     // angle smaller and no faces cross.)
     let unsupported_after_finishing = remove_unsupported_faces(&mut mesh, &mut sources, supported);
@@ -687,6 +708,7 @@ fn remesh_points_once(
         assembly,
         unsupported,
         unsupported_after_finishing,
+        pillows,
         optimize: finished.optimize,
         untangle_umbrellas,
         untangle: finished.untangle,

@@ -126,6 +126,10 @@ pub(super) fn run(
         serde_json::to_value(out.unsupported_after_finishing).unwrap_or_default(),
     );
     extra.insert(
+        "pillows".into(),
+        serde_json::to_value(out.pillows).unwrap_or_default(),
+    );
+    extra.insert(
         "optimize".into(),
         serde_json::to_value(out.optimize).unwrap_or_default(),
     );
@@ -192,6 +196,15 @@ pub(super) fn run(
             "{} tiny closed pieces ({} vertices) that split off where the surface is too thin \
              for this count were left out",
             st.shells, st.vertices
+        ));
+    }
+    if out.pillows.opened > 0 {
+        report.notes.push(format!(
+            "{} flat closed pieces (both sides of a strip of data a sample or two wide, thinner \
+             than {} sigma_p) were opened: their {} faces facing against the data were removed",
+            out.pillows.opened,
+            crate::point_pipeline::PILLOW_THICKNESS_SIGMA_P,
+            out.pillows.faces + out.pillows.pinched_faces
         ));
     }
     if out.assembly.holes_left > 0 {

@@ -7,6 +7,7 @@ pub mod bisect;
 pub(crate) mod crossing_guard;
 pub mod edit;
 mod orient;
+pub(crate) mod parts;
 pub mod sheets;
 pub mod topology;
 mod trimesh;

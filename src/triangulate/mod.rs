@@ -6,6 +6,7 @@ pub mod degenerate;
 pub mod fit;
 mod flip;
 pub mod optimize;
+pub mod pillows;
 pub mod recover;
 pub mod refine;
 pub mod restricted_delaunay;

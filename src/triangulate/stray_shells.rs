@@ -6,9 +6,8 @@
 //! an extra component.
 
 use glam::DVec3;
-use rustc_hash::FxHashMap;
 
-use crate::disjoint_sets::Dsu;
+use crate::mesh::parts::parts;
 use crate::mesh::TriMesh;
 use crate::triangulate::FaceSource;
 
@@ -42,71 +41,44 @@ pub fn remove_stray_shells(
         max: DVec3::splat(f64::NEG_INFINITY),
         ..StrayShells::default()
     };
-    let mut sets = Dsu::new(mesh.positions.len());
-    for t in &mesh.triangles {
-        for k in 1..3 {
-            sets.union(t[0] as usize, t[k] as usize, false);
-        }
-    }
-    // Per component: its faces, vertices and whether it is closed.
-    let mut faces_of: FxHashMap<usize, Vec<usize>> = FxHashMap::default();
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        faces_of
-            .entry(sets.find(t[0] as usize).0)
-            .or_default()
-            .push(f);
-    }
-    if faces_of.len() <= keep {
+    let parts = parts(mesh);
+    if parts.len() <= keep {
         return record;
     }
-    let mut small: Vec<(usize, u32, usize, Vec<u32>)> = Vec::new();
-    for (&root, faces) in &faces_of {
-        let mut vertices: Vec<u32> = faces
-            .iter()
-            .flat_map(|&f| mesh.triangles[f])
-            .collect::<Vec<_>>();
-        vertices.sort_unstable();
-        vertices.dedup();
-        if vertices.len() > max_vertices {
+    let mut small: Vec<(usize, u32, usize)> = Vec::new();
+    for (k, part) in parts.iter().enumerate() {
+        if part.vertices.len() > max_vertices || !part.closed {
             continue;
         }
-        let mut edges: FxHashMap<(u32, u32), u32> = FxHashMap::default();
-        for &f in faces {
-            let t = mesh.triangles[f];
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
-        let closed = edges.values().all(|&c| c == 2);
-        let points: Vec<DVec3> = vertices
+        let points: Vec<DVec3> = part
+            .vertices
             .iter()
             .map(|&v| mesh.positions[v as usize])
             .collect();
-        if closed && stray(&points) {
-            // Ties broken by the smallest vertex index (deterministic, whatever the roots).
-            small.push((vertices.len(), vertices[0], root, vertices));
+        if stray(&points) {
+            // Ties broken by the smallest vertex index (deterministic, whatever the order).
+            small.push((part.vertices.len(), part.vertices[0], k));
         }
     }
     small.sort_by_key(|s| (s.0, s.1));
-    let excess = faces_of.len() - keep;
-    let mut removed_roots = Vec::new();
-    for (_, _, root, vertices) in small.into_iter().take(excess) {
+    let excess = parts.len() - keep;
+    let mut removed_parts = Vec::new();
+    for (_, _, k) in small.into_iter().take(excess) {
         record.shells += 1;
-        record.vertices += vertices.len();
-        for v in vertices {
+        record.vertices += parts[k].vertices.len();
+        for &v in &parts[k].vertices {
             let p = mesh.positions[v as usize];
             record.min = record.min.min(p);
             record.max = record.max.max(p);
         }
-        removed_roots.push(root);
+        removed_parts.push(k);
     }
-    if removed_roots.is_empty() {
+    if removed_parts.is_empty() {
         return record;
     }
     let mut keep_face = vec![true; mesh.triangles.len()];
-    for root in removed_roots {
-        for &f in &faces_of[&root] {
+    for k in removed_parts {
+        for &f in &parts[k].faces {
             keep_face[f] = false;
         }
     }

@@ -79,7 +79,22 @@ pub fn remove_unsupported_faces(
     if faces == 0 {
         return UnsupportedFaces::default();
     }
-    // The removal and the pinched fans (the assembly's repair) on the edit mesh.
+    let pinched_faces = remove_faces_keeping_manifold(mesh, sources, &drop);
+    UnsupportedFaces {
+        faces,
+        pinched_faces,
+    }
+}
+
+/// Removes the faces `drop` marks (one flag per face), then the smaller fans at the vertices
+/// the removal pinched (two fans meeting at one vertex: the assembly's own repair), until every
+/// vertex has one fan. Returns how many faces that repair removed. Vertices stay; `sources`
+/// (one per face, or empty) is filtered along. Deterministic.
+pub(crate) fn remove_faces_keeping_manifold(
+    mesh: &mut TriMesh,
+    sources: &mut Vec<FaceSource>,
+    drop: &[bool],
+) -> usize {
     let mut m: EditMesh<FaceSource> = EditMesh::from_trimesh(
         mesh,
         |f| {
@@ -108,10 +123,7 @@ pub fn remove_unsupported_faces(
     if !sources.is_empty() {
         *sources = labels;
     }
-    UnsupportedFaces {
-        faces,
-        pinched_faces,
-    }
+    pinched_faces
 }
 
 #[cfg(test)]
