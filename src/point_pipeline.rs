@@ -277,7 +277,8 @@ pub struct PointRemeshOutput {
     /// Faces the finishing made across a gap in the data (its collapses can close a hole the
     /// removal opened), removed again after it.
     pub unsupported_after_finishing: UnsupportedFaces,
-    /// Flat closed parts (both sides of a strip of one-sided data) opened after the finishing.
+    /// Faces facing against the data removed from the parts apart from the surface (both sides
+    /// of a strip of one-sided data), after the finishing and the gap rule.
     pub pillows: Pillows,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,
@@ -608,7 +609,10 @@ fn remesh_points_once(
         normals: &normals,
         boundary_edges: &boundary.edges,
     };
-    let (faces, mut sources, assembly) = triangulate(&set, &rp.triangulate);
+    // Where the data has edges, a loop that closes only from behind is a sheet's outline.
+    let mut triangulate_params = rp.triangulate;
+    triangulate_params.assembly.fill_outlines = boundary_curves == 0;
+    let (faces, mut sources, assembly) = triangulate(&set, &triangulate_params);
     if faces.is_empty() {
         return Err(Error::invalid_mesh(
             input,
@@ -673,7 +677,12 @@ fn remesh_points_once(
     };
     // The points' normals point outward (given, or oriented so): so does the output.
     let finished = finish(&mut mesh, &mut sources, &finishing, on_stage, &mut timer);
-    // A strip of one-sided data closed into a flat part: its side facing against the data goes.
+    // The same rule once more: no output face spans a gap in the data. (Removing faces makes no
+    // angle smaller and no faces cross.)
+    let unsupported_after_finishing = remove_unsupported_faces(&mut mesh, &mut sources, supported);
+    // Then the parts apart from the surface (after the gap rule, whose removal of a hole's
+    // fill starts from its faces over the gap): the faces facing against the data go (a fold;
+    // a strip of one-sided data closed into a flat part).
     let pillows = open_pillows(
         &mut mesh,
         &mut sources,
@@ -684,9 +693,6 @@ fn remesh_points_once(
                 .is_none_or(|(_, g)| g.dot(normal) > 0.0)
         },
     );
-    // The same rule once more: no output face spans a gap in the data. (Removing faces makes no
-    // angle smaller and no faces cross.)
-    let unsupported_after_finishing = remove_unsupported_faces(&mut mesh, &mut sources, supported);
     let dropped_after_finishing = mesh.remove_unreferenced_vertices();
     timer.lap("untangle");
     Ok(PointRemeshOutput {

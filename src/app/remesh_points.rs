@@ -200,10 +200,9 @@ pub(super) fn run(
     }
     if out.pillows.opened > 0 {
         report.notes.push(format!(
-            "{} flat closed pieces (both sides of a strip of data a sample or two wide, thinner \
-             than {} sigma_p) were opened: their {} faces facing against the data were removed",
+            "{} pieces apart from the surface lost their {} faces facing against the data (both \
+             sides of a strip of data a sample or two wide, closed flat or folded over)",
             out.pillows.opened,
-            crate::point_pipeline::PILLOW_THICKNESS_SIGMA_P,
             out.pillows.faces + out.pillows.pinched_faces
         ));
     }

@@ -33,6 +33,11 @@ pub struct AssemblyParams {
     pub two_vote_phase: bool,
     /// Insertion of left-over samples and edge flips after the holes are closed.
     pub refine: RefineParams,
+    /// Close loops whose only fill faces every triangle against its corners' normals (default
+    /// true: on a closed surface every loop is a hole). False where the surface has edges (an
+    /// open scan): such a loop is a sheet's outline seen from behind, left open and counted in
+    /// [`AssemblyStats::outlines_left`].
+    pub fill_outlines: bool,
 }
 
 impl Default for AssemblyParams {
@@ -41,6 +46,7 @@ impl Default for AssemblyParams {
             max_hole_edges: 100,
             two_vote_phase: false,
             refine: RefineParams::default(),
+            fill_outlines: true,
         }
     }
 }
@@ -60,6 +66,10 @@ pub struct AssemblyStats {
     pub hole_triangles: usize,
     /// Holes that could not be closed (too large, or no valid triangulation).
     pub holes_left: usize,
+    /// Loops left open because the only way to close them faced every triangle against its
+    /// corners' normals: the outline of a sheet seen from behind (a strip of an open scan a
+    /// sample or two wide), not a hole.
+    pub outlines_left: usize,
     /// Faces removed to repair vertices whose faces formed several fans.
     pub faces_removed_at_pinched_vertices: usize,
     /// Faces removed around holes that could not be closed, to retry them larger.
@@ -122,7 +132,12 @@ pub fn assemble(
     }
     for round in 0..6 {
         let mut failed = Vec::new();
-        let (filled, tris, left) = fill_holes(&mut b, normals, params, &mut failed);
+        let FillResult {
+            filled,
+            added,
+            left,
+            outlines,
+        } = fill_holes(&mut b, normals, params, &mut failed);
         if round < 4 {
             // Grow each hole that could not be closed by the faces around its corners: the
             // larger polygon (with the samples inside it) often has a valid triangulation where
@@ -130,8 +145,9 @@ pub fn assemble(
             stats.faces_removed_growing_holes += grow_holes(&mut b, &failed);
         }
         stats.holes_filled += filled;
-        stats.hole_triangles += tris;
+        stats.hole_triangles += added;
         stats.holes_left = left;
+        stats.outlines_left = outlines;
         let removed = repair_pinched_vertices(&mut b);
         stats.faces_removed_at_pinched_vertices += removed;
         if removed == 0 && left == 0 {
@@ -187,7 +203,7 @@ fn fill_holes(
     normals: &[DVec3],
     params: &AssemblyParams,
     failed: &mut Vec<Vec<u32>>,
-) -> (usize, usize, usize) {
+) -> FillResult {
     let edges = b.boundary_half_edges();
     let mut referenced = vec![false; b.vertex_count()];
     for t in b.live_faces().0 {
@@ -203,7 +219,7 @@ fn fill_holes(
         from.entry(x).or_default().push(y);
     }
     let mut used: FxHashSet<(u32, u32)> = FxHashSet::default();
-    let (mut filled, mut added, mut left) = (0, 0, 0);
+    let (mut filled, mut added, mut left, mut outlines) = (0, 0, 0, 0);
     for &(x0, y0) in &edges {
         if used.contains(&(x0, y0)) {
             continue;
@@ -242,6 +258,18 @@ fn fill_holes(
             let tris = triangulate_hole_with_interior(b, normals, &lp, &loose)
                 .or_else(|| triangulate_polygon(b, normals, &lp, false))
                 .or_else(|| triangulate_polygon(b, normals, &lp, true));
+            // Every triangle of the only fill facing against its corners' normals: the loop
+            // is a sheet's outline seen from behind (a strip of data a sample or two wide,
+            // covered from one side), not a hole; closing it would give the strip a second
+            // side on top of the first.
+            if !params.fill_outlines
+                && tris
+                    .as_ref()
+                    .is_some_and(|t| t.iter().all(|&t| oriented_quality(b, normals, t) <= 0.0))
+            {
+                outlines += 1;
+                continue;
+            }
             match tris {
                 Some(tris) => match b.fill_hole(&tris, FaceSource::HoleFill) {
                     Ok(done) => {
@@ -263,7 +291,24 @@ fn fill_holes(
             }
         }
     }
-    (filled, added, left)
+    FillResult {
+        filled,
+        added,
+        left,
+        outlines,
+    }
+}
+
+/// What one round of [`fill_holes`] did.
+struct FillResult {
+    /// Loops closed.
+    filled: usize,
+    /// Triangles added to close them.
+    added: usize,
+    /// Loops that could not be closed.
+    left: usize,
+    /// Loops left open as outlines (see [`AssemblyStats::outlines_left`]).
+    outlines: usize,
 }
 
 /// Whether segments p1-p2 and q1-q2 properly cross (shared endpoints do not count).
@@ -584,6 +629,33 @@ mod tests {
         assert!(mesh.signed_volume() > 0.0);
         assert_eq!(stats.candidates, voted.len());
         assert!(stats.accepted_three_votes > n, "{stats:?}");
+    }
+
+    #[test]
+    fn a_strips_outline_is_closed_from_behind_only_when_outlines_are_filled() {
+        // Two rows of samples, one sheet facing +z: the umbrellas cover it from the front;
+        // its outline can only be closed by faces facing -z (a second side on the first).
+        let mut positions = Vec::new();
+        for i in 0..6 {
+            positions.push(DVec3::new(i as f64, 0.0, 0.0));
+            positions.push(DVec3::new(i as f64 + 0.3, 1.0, 0.0));
+        }
+        let normals = vec![DVec3::Z; positions.len()];
+        let voted = votes(&positions, &normals, &[]);
+        let run = |fill_outlines| {
+            let params = AssemblyParams {
+                fill_outlines,
+                ..AssemblyParams::default()
+            };
+            let (faces, _, stats) = assemble(&positions, &normals, &voted, &[], &params);
+            assert_sane(&positions, &faces);
+            (topology(&TriMesh::new(positions.clone(), faces)), stats)
+        };
+        let (closed, stats) = run(true);
+        assert_eq!(closed.boundary_edges, 0, "the test case closes: {stats:?}");
+        let (open, stats) = run(false);
+        assert_eq!(stats.outlines_left, 1);
+        assert_eq!((open.faces, open.boundary_loops), (10, 1), "{stats:?}");
     }
 
     #[test]

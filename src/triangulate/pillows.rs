@@ -1,11 +1,15 @@
-//! Flat closed parts of an open scan ("pillows"): where the data is one sheet a sample or two
-//! wide (a strip of a range map seen at a grazing angle), the umbrellas cover it from one side
-//! and the assembly's hole filling closes its outline from the other, so the strip comes out as
-//! a closed part of no thickness, both sides lying on the same data. One sheet of data encloses
-//! no volume, and two sheets closer than sigma_p are one RIMLS surface: a closed part whose
-//! thickness 3·volume/area (the radius of a ball, 1.5 times that of a long tube) is far below
-//! sigma_p is such a pillow. It is opened: the faces facing against the data's normals go, the
-//! side facing along them stays, so the strip is kept as an open part with the data under it.
+//! Parts of an open scan apart from its surface that face against the data. Where the data is
+//! one sheet a sample or two wide (a strip of a range map seen at a grazing angle), the
+//! umbrellas cover it from one side and the assembly's hole filling closes its outline from
+//! the other, so the strip comes out as a closed part of no thickness ("pillow"), both sides on
+//! the same data; or, partly closed, as an open part folded over itself. One sheet of data
+//! encloses no volume, and two sheets closer than sigma_p are one RIMLS surface: a closed part
+//! whose thickness 3·volume/area (the radius of a ball, 1.5 times that of a long tube) is far
+//! below sigma_p is a pillow, and in an open part, a face facing against the data's normals is
+//! a fold. Both lose the faces facing against the data; the side facing along it stays, so the
+//! strip is kept as an open part with the data under it. Closed parts thicker than that stay
+//! (a thin part of a closed model that split off is a volume, if a wrong one), and so does the
+//! largest part (the surface itself).
 
 use glam::DVec3;
 use serde::Serialize;
@@ -18,17 +22,17 @@ use crate::triangulate::FaceSource;
 /// What [`open_pillows`] did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct Pillows {
-    /// Flat closed parts opened.
+    /// Parts opened (closed ones) or trimmed (open ones).
     pub opened: usize,
-    /// Their faces removed (the sides facing against the data).
+    /// Their faces removed (those facing against the data).
     pub faces: usize,
     /// Faces of the smaller fans at vertices the removal pinched.
     pub pinched_faces: usize,
 }
 
-/// Opens every closed part of `mesh` but the largest (by faces; the first of equals) whose
-/// thickness 3·|volume|/area is below `max_thickness` (model units of `mesh`): of its faces,
-/// those that `front(centroid, unit normal)` says face against the data go. A part with all
+/// In every part of `mesh` but the largest (by faces; the first of equals) that is open, or
+/// closed with a thickness 3·|volume|/area below `max_thickness` (model units of `mesh`), the
+/// faces that `front(centroid, unit normal)` says face against the data go. A part with all
 /// its faces on one side (no back, or no front) stays as it is. The smaller fans at vertices
 /// the removal pinches go too, so the output stays manifold. Vertices stay (unreferenced ones
 /// are left for the caller); `sources` (one per face, or empty) is filtered along.
@@ -47,7 +51,7 @@ pub fn open_pillows(
     let mut record = Pillows::default();
     let mut drop = vec![false; mesh.triangles.len()];
     for (k, part) in parts.iter().enumerate() {
-        if k == largest || !part.closed {
+        if k == largest {
             continue;
         }
         let area: f64 = part.faces.iter().map(|&f| mesh.face_area(f)).sum();
@@ -61,7 +65,7 @@ pub fn open_pillows(
             .sum::<f64>()
             .abs()
             / 6.0;
-        if area <= 0.0 || 3.0 * volume / area >= max_thickness {
+        if part.closed && (area <= 0.0 || 3.0 * volume / area >= max_thickness) {
             continue;
         }
         let back: Vec<usize> = part
@@ -163,9 +167,24 @@ mod tests {
     }
 
     #[test]
+    fn an_open_part_loses_its_faces_facing_against_the_data() {
+        // The pillow with two faces of its bottom gone: open, folded over itself.
+        let mut m = grid_and_pillow(0.5);
+        m.triangles.remove(32);
+        m.triangles.remove(32);
+        assert_eq!(topology(&m).boundary_loops, 1 + 1, "the test case");
+        let mut sources = vec![FaceSource::ThreeVotes; m.triangles.len()];
+        let r = open_pillows(&mut m, &mut sources, 0.05, faces_up);
+        assert_eq!((r.opened, r.faces), (1, 6));
+        assert_eq!(m.triangles.len(), 32 + 16);
+        assert!((32..m.triangles.len()).all(|f| m.face_normal(f).z > 0.0));
+        assert!(topology(&m).is_manifold());
+    }
+
+    #[test]
     fn thick_parts_the_largest_part_and_one_sided_parts_stay() {
         let mut sources = Vec::new();
-        // Thicker than the bound.
+        // Closed and thicker than the bound.
         let mut m = grid_and_pillow(0.5);
         assert_eq!(open_pillows(&mut m, &mut sources, 0.05, faces_up).opened, 0);
         // The same pillow alone is the largest part.
