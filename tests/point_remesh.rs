@@ -250,6 +250,21 @@ fn wavy_patch(seed: u64, in_hole: impl Fn(f64, f64) -> bool) -> (Vec<DVec3>, Vec
     (points, normals)
 }
 
+/// The point file `input` remeshed at 1500 vertices with `seed`, checked manifold and free of
+/// invariant violations.
+fn remesh_valid_patch(input: &Path, seed: u64) -> PointRemeshOutput {
+    let out = remesh_points(
+        &PointSource::File(input.to_path_buf()),
+        &params(1500, seed),
+        &|_| {},
+    )
+    .unwrap();
+    let t = topology(&out.mesh);
+    assert!(t.is_manifold(), "seed {seed}: {t:?}");
+    assert!(check_invariants(&out.mesh).is_empty(), "seed {seed}");
+    out
+}
+
 #[test]
 fn an_open_patch_keeps_its_boundary_and_its_hole() {
     // A wavy square patch 2 × 2 with a round hole of radius 0.3 in the middle, 60,000 points
@@ -259,17 +274,10 @@ fn an_open_patch_keeps_its_boundary_and_its_hole() {
     let input = dir.path().join("patch.xyz");
     write_xyz(&input, &points, Some(&normals));
     for seed in 1..=2 {
-        let out = remesh_points(
-            &PointSource::File(input.clone()),
-            &params(1500, seed),
-            &|_| {},
-        )
-        .unwrap();
+        let out = remesh_valid_patch(&input, seed);
         let t = topology(&out.mesh);
-        assert!(t.is_manifold(), "seed {seed}: {t:?}");
         assert_eq!(t.components, 1, "seed {seed}: {t:?}");
         assert_eq!(t.boundary_loops, 2, "seed {seed}: {t:?}");
-        assert!(check_invariants(&out.mesh).is_empty());
         // No face over the hole, none beyond the square (up to a spacing).
         for tri in &out.mesh.triangles {
             let c = tri
@@ -308,15 +316,7 @@ fn no_output_face_spans_a_gap_in_the_data() {
     let input = dir.path().join("holes.xyz");
     write_xyz(&input, &points, Some(&normals));
     for seed in 1..=3 {
-        let out = remesh_points(
-            &PointSource::File(input.clone()),
-            &params(1500, seed),
-            &|_| {},
-        )
-        .unwrap();
-        let t = topology(&out.mesh);
-        assert!(t.is_manifold(), "seed {seed}: {t:?}");
-        assert!(check_invariants(&out.mesh).is_empty());
+        let out = remesh_valid_patch(&input, seed);
         let reach = spectral_remesh::OPEN_GAP_SIGMA_P * out.sigma_p / out.normalization.scale
             * (1.0 + 1e-9);
         let m = &out.mesh;

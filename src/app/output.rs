@@ -41,6 +41,15 @@ impl Outputs {
     }
 }
 
+/// The report's entry `key`: `value` as JSON (null if it does not serialize).
+pub(super) fn insert_json(
+    extra: &mut serde_json::Map<String, serde_json::Value>,
+    key: &str,
+    value: impl serde::Serialize,
+) {
+    extra.insert(key.into(), serde_json::to_value(value).unwrap_or_default());
+}
+
 /// The report's `sigma_p`, `sigma_n`, `target_points` and `seed` entries.
 pub(super) fn insert_kernel_extras(
     extra: &mut serde_json::Map<String, serde_json::Value>,

@@ -10,7 +10,7 @@ use super::memory;
 use super::notes::{
     count_note, dropped_note, features_note, grading_notes, holes_note, orientation_notes,
 };
-use super::output::{check_and_write, insert_kernel_extras, write_output, Outputs};
+use super::output::{check_and_write, insert_json, insert_kernel_extras, write_output, Outputs};
 use super::quality::{
     as_quality_reads, crossings_of_the_input, into_normal_range, scale_by_power_of_two,
 };
@@ -280,18 +280,9 @@ pub(super) fn remesh_read(
     extra.insert("samples".into(), out.samples.into());
     extra.insert("boundary_samples".into(), out.boundary_samples.into());
     extra.insert("candidates".into(), out.candidates.into());
-    extra.insert(
-        "sigma_p_search".into(),
-        serde_json::to_value(&out.search_history).unwrap_or_default(),
-    );
-    extra.insert(
-        "assembly".into(),
-        serde_json::to_value(&out.assembly).unwrap_or_default(),
-    );
-    extra.insert(
-        "restricted_delaunay".into(),
-        serde_json::to_value(&out.restricted_delaunay).unwrap_or_default(),
-    );
+    insert_json(extra, "sigma_p_search", &out.search_history);
+    insert_json(extra, "assembly", &out.assembly);
+    insert_json(extra, "restricted_delaunay", &out.restricted_delaunay);
     if out.restricted_delaunay.is_none() && params.triangulation != TriangulationMethod::Umbrellas {
         report.notes.push(
             "the samples were connected by tangent-plane umbrellas: the restricted Delaunay \
@@ -299,19 +290,10 @@ pub(super) fn remesh_read(
                 .into(),
         );
     }
-    extra.insert(
-        "optimize".into(),
-        serde_json::to_value(out.optimize).unwrap_or_default(),
-    );
-    extra.insert(
-        "untangle".into(),
-        serde_json::to_value(out.untangle).unwrap_or_default(),
-    );
+    insert_json(extra, "optimize", out.optimize);
+    insert_json(extra, "untangle", out.untangle);
     if out.degenerate.found > 0 {
-        extra.insert(
-            "degenerate".into(),
-            serde_json::to_value(out.degenerate).unwrap_or_default(),
-        );
+        insert_json(extra, "degenerate", out.degenerate);
     }
     let crossing = report.self_intersections.pairs;
     // The file's crossing pairs, and of them those where the input's own faces cross or its
@@ -338,12 +320,9 @@ pub(super) fn remesh_read(
             )
         });
     }
-    extra.insert(
-        "features".into(),
-        serde_json::to_value(&out.features).unwrap_or_default(),
-    );
+    insert_json(extra, "features", &out.features);
     if let Some(fit) = out.fit {
-        extra.insert("fit".into(), serde_json::to_value(fit).unwrap_or_default());
+        insert_json(extra, "fit", fit);
     }
     extra.insert("input_vertices".into(), input.vertex_count().into());
     extra.insert("input_faces".into(), input.face_count().into());
@@ -408,10 +387,7 @@ pub(super) fn remesh_read(
             }
         ));
     }
-    extra.insert(
-        "input_cleanup".into(),
-        serde_json::to_value(cleanup).unwrap_or_default(),
-    );
+    insert_json(extra, "input_cleanup", cleanup);
     if welded_vertices > 0 {
         report.notes.push(format!(
             "{welded_vertices} input vertices at identical positions were merged"
@@ -463,14 +439,8 @@ pub(super) fn remesh_read(
             serde_json::json!({"shells": st.shells, "vertices": st.vertices}),
         );
     }
-    extra.insert(
-        "orientation".into(),
-        serde_json::to_value(out.orientation).unwrap_or_default(),
-    );
-    extra.insert(
-        "output_orientation".into(),
-        serde_json::to_value(out.output_orientation).unwrap_or_default(),
-    );
+    insert_json(extra, "orientation", out.orientation);
+    insert_json(extra, "output_orientation", out.output_orientation);
     report.notes.extend(orientation_notes(
         &out.orientation,
         &out.output_orientation,

@@ -11,7 +11,7 @@ use super::files::with_path;
 use super::job::{RemeshJob, RemeshedMesh};
 use super::memory;
 use super::notes::{count_note, dropped_note, holes_note};
-use super::output::{check_and_write, insert_kernel_extras};
+use super::output::{check_and_write, insert_json, insert_kernel_extras};
 use super::DISTANCE_SAMPLES;
 use crate::error::{Error, Result};
 use crate::io::{as_written, MeshFormat};
@@ -109,42 +109,19 @@ pub(super) fn run(
     extra.insert("boundary_samples".into(), out.boundary_samples.into());
     extra.insert("boundary_curves".into(), out.boundary_curves.into());
     extra.insert("rimls_points".into(), out.rimls_points.into());
-    extra.insert(
-        "scan_seconds".into(),
-        serde_json::to_value(out.scan_seconds).unwrap_or_default(),
+    insert_json(extra, "scan_seconds", out.scan_seconds);
+    insert_json(extra, "assembly", &out.assembly);
+    insert_json(extra, "unsupported_faces", out.unsupported);
+    insert_json(
+        extra,
+        "unsupported_after_finishing",
+        out.unsupported_after_finishing,
     );
-    extra.insert(
-        "assembly".into(),
-        serde_json::to_value(&out.assembly).unwrap_or_default(),
-    );
-    extra.insert(
-        "unsupported_faces".into(),
-        serde_json::to_value(out.unsupported).unwrap_or_default(),
-    );
-    extra.insert(
-        "unsupported_after_finishing".into(),
-        serde_json::to_value(out.unsupported_after_finishing).unwrap_or_default(),
-    );
-    extra.insert(
-        "pillows".into(),
-        serde_json::to_value(out.pillows).unwrap_or_default(),
-    );
-    extra.insert(
-        "optimize".into(),
-        serde_json::to_value(out.optimize).unwrap_or_default(),
-    );
-    extra.insert(
-        "untangle".into(),
-        serde_json::to_value(out.untangle).unwrap_or_default(),
-    );
-    extra.insert(
-        "untangle_umbrellas".into(),
-        serde_json::to_value(out.untangle_umbrellas).unwrap_or_default(),
-    );
-    extra.insert(
-        "output_orientation".into(),
-        serde_json::to_value(out.output_orientation).unwrap_or_default(),
-    );
+    insert_json(extra, "pillows", out.pillows);
+    insert_json(extra, "optimize", out.optimize);
+    insert_json(extra, "untangle", out.untangle);
+    insert_json(extra, "untangle_umbrellas", out.untangle_umbrellas);
+    insert_json(extra, "output_orientation", out.output_orientation);
     report.notes.push(format!(
         "the input is a point set ({} points, {}): the samples lie on the RIMLS surface of the \
          points and were connected by tangent-plane umbrellas",

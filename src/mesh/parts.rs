@@ -19,7 +19,7 @@ pub(crate) struct Part {
 }
 
 /// The parts of `mesh`, in the order of their first face. Time O(F α(V)) plus a hash of the
-/// edges. Indices must be in range.
+/// edges ([`TriMesh::edge_uses`]). Indices must be in range.
 pub(crate) fn parts(mesh: &TriMesh) -> Vec<Part> {
     let mut sets = Dsu::new(mesh.positions.len());
     for t in &mesh.triangles {
@@ -37,21 +37,20 @@ pub(crate) fn parts(mesh: &TriMesh) -> Vec<Part> {
         });
         faces_of[k].push(f);
     }
+    // A part is closed when no edge of its faces is in other than two of them.
+    let mut closed = vec![true; faces_of.len()];
+    for (_, ([f, _], uses)) in mesh.edge_uses() {
+        if uses != 2 {
+            closed[index_of[&sets.find(mesh.triangles[f as usize][0] as usize).0]] = false;
+        }
+    }
     faces_of
         .into_iter()
-        .map(|faces| {
+        .zip(closed)
+        .map(|(faces, closed)| {
             let mut vertices: Vec<u32> = faces.iter().flat_map(|&f| mesh.triangles[f]).collect();
             vertices.sort_unstable();
             vertices.dedup();
-            let mut edges: FxHashMap<(u32, u32), u32> = FxHashMap::default();
-            for &f in &faces {
-                let t = mesh.triangles[f];
-                for k in 0..3 {
-                    let (a, b) = (t[k], t[(k + 1) % 3]);
-                    *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-                }
-            }
-            let closed = edges.values().all(|&c| c == 2);
             Part {
                 faces,
                 vertices,

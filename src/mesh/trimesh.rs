@@ -119,7 +119,13 @@ impl TriMesh {
     /// for an open mesh, the volume of the cone from the origin, whose sign still tells the
     /// orientation of a mostly closed surface whose holes are small.
     pub fn signed_volume(&self) -> f64 {
-        (0..self.face_count())
+        self.signed_volume_of(0..self.face_count())
+    }
+
+    /// [`signed_volume`](Self::signed_volume) of the faces `faces` only (a part of the mesh).
+    pub fn signed_volume_of(&self, faces: impl IntoIterator<Item = usize>) -> f64 {
+        faces
+            .into_iter()
             .map(|f| {
                 let [a, b, c] = self.corners(f);
                 a.dot(b.cross(c)) / 6.0

@@ -55,16 +55,7 @@ pub fn open_pillows(
             continue;
         }
         let area: f64 = part.faces.iter().map(|&f| mesh.face_area(f)).sum();
-        let volume = part
-            .faces
-            .iter()
-            .map(|&f| {
-                let [a, b, c] = mesh.corners(f);
-                a.dot(b.cross(c))
-            })
-            .sum::<f64>()
-            .abs()
-            / 6.0;
+        let volume = mesh.signed_volume_of(part.faces.iter().copied()).abs();
         if part.closed && (area <= 0.0 || 3.0 * volume / area >= max_thickness) {
             continue;
         }
