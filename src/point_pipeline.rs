@@ -41,7 +41,7 @@ use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::optimize::OptimizeStats;
-use crate::triangulate::pillows::{open_pillows, Pillows};
+use crate::triangulate::pillows::{open_pillows, FaceSide, Pillows};
 use crate::triangulate::stray_shells::StrayShells;
 use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
@@ -87,12 +87,18 @@ pub const OPEN_GAP_SIGMA_P: f64 = 1.5;
 /// as boundaries ([`DataEdges`]).
 pub const OPEN_GAP_SPACINGS: f64 = 2.0;
 
-/// Thickness (3·volume/area), in units of sigma_p, below which a closed part of the output
-/// other than the largest is a pillow ([`open_pillows`]): both sides of one sheet of data. Two
-/// sheets closer than sigma_p are one RIMLS surface, so no real part is that thin; the
-/// smallest closed parts that split off thin parts of closed models (noisy cow -> 10k, seeds
-/// 1-5) are 0.23-0.81 sigma_p thick, the pillows of face000 at most 0.07.
-pub const PILLOW_THICKNESS_SIGMA_P: f64 = 0.1;
+/// Radius, in units of sigma_p, within which data on a face's side is looked for when the face
+/// faces against the RIMLS gradient ([`open_pillows`]): a thin part's other sheet (two sheets
+/// closer than the RIMLS support, where the gradient follows one of them) has its points within
+/// a spacing of the face, about 4 support points per sigma_p²; a fold over one sheet has none.
+/// Measured on the closed parts other than the largest (seeds 1-5): face000 -> 20k, pillows
+/// 0.002-0.32 sigma_p thick, no face against the gradient with data on its side; the noisy cow
+/// -> 10k, parts 0.17-0.8 sigma_p thick, 2-21 such faces in each part.
+pub const FOLD_DATA_RADIUS_SIGMA_P: f64 = 1.0;
+
+/// A data point is on a face's side when its normal is within 60° of the face's
+/// ([`FOLD_DATA_RADIUS_SIGMA_P`]).
+pub const FOLD_SIDE_COS: f64 = 0.5;
 
 /// The projections' reach past the data in local spacings, where that is wider than
 /// `DOMAIN_GAP_SIGMA_P` sigma_p: an empty disc of radius 0.6 s has probability
@@ -277,8 +283,9 @@ pub struct PointRemeshOutput {
     /// Faces the finishing made across a gap in the data (its collapses can close a hole the
     /// removal opened), removed again after it.
     pub unsupported_after_finishing: UnsupportedFaces,
-    /// Faces facing against the data removed from the parts apart from the surface (both sides
-    /// of a strip of one-sided data), after the finishing and the gap rule.
+    /// Faces folded over the data removed (facing against it with no data on their side: both
+    /// sides of a strip of one-sided data, a flap at the data's edge), after the finishing and
+    /// the gap rule.
     pub pillows: Pillows,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,
@@ -680,17 +687,30 @@ fn remesh_points_once(
     // The same rule once more: no output face spans a gap in the data. (Removing faces makes no
     // angle smaller and no faces cross.)
     let unsupported_after_finishing = remove_unsupported_faces(&mut mesh, &mut sources, supported);
-    // Then the parts apart from the surface (after the gap rule, whose removal of a hole's
-    // fill starts from its faces over the gap): the faces facing against the data go (a fold;
-    // a strip of one-sided data closed into a flat part).
+    // Then the folds (after the gap rule, whose removal of a hole's fill starts from its faces
+    // over the gap): faces facing against the data with no data on their side (both sides of a
+    // strip of one-sided data closed into a flat part, a part or a flap folded over one sheet).
+    let fold_radius_2 = (FOLD_DATA_RADIUS_SIGMA_P * sigma_p).powi(2);
     let pillows = open_pillows(
         &mut mesh,
         &mut sources,
-        PILLOW_THICKNESS_SIGMA_P * sigma_p,
+        boundary_curves > 0,
         |centroid, normal| {
-            rimls
+            if rimls
                 .value_and_gradient(centroid)
                 .is_none_or(|(_, g)| g.dot(normal) > 0.0)
+            {
+                return FaceSide::Front;
+            }
+            let mut backed = false;
+            rimls.visit_within(centroid, fold_radius_2, |i, _| {
+                backed |= rimls.normals()[i as usize].dot(normal) > FOLD_SIDE_COS;
+            });
+            if backed {
+                FaceSide::Backed
+            } else {
+                FaceSide::Fold
+            }
         },
     );
     let dropped_after_finishing = mesh.remove_unreferenced_vertices();

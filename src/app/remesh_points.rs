@@ -177,8 +177,8 @@ pub(super) fn run(
     }
     if out.pillows.opened > 0 {
         report.notes.push(format!(
-            "{} pieces apart from the surface lost their {} faces facing against the data (both \
-             sides of a strip of data a sample or two wide, closed flat or folded over)",
+            "{} pieces lost {} faces folded over the data (facing against it, no data on their \
+             side: both sides of a strip of data a sample or two wide, a flap at the data's edge)",
             out.pillows.opened,
             out.pillows.faces + out.pillows.pinched_faces
         ));
