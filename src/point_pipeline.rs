@@ -40,7 +40,7 @@ use crate::surface::features::FeatureDetection;
 use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
-use crate::triangulate::optimize::OptimizeStats;
+use crate::triangulate::optimize::{MendStats, OptimizeStats};
 use crate::triangulate::pillows::{open_pillows, FaceSide, Pillows};
 use crate::triangulate::stray_shells::StrayShells;
 use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
@@ -293,6 +293,8 @@ pub struct PointRemeshOutput {
     pub untangle_umbrellas: UntangleStats,
     /// The separation of crossing faces after the optimization.
     pub untangle: UntangleStats,
+    /// The optimization's last pass again around the faces untangle's collapses changed.
+    pub mend_after_untangle: MendStats,
     /// Samples that ended in no triangle (the optimization's and the untangling's collapses
     /// included).
     pub dropped_samples: usize,
@@ -316,8 +318,9 @@ pub struct PointRemeshOutput {
 /// is off by more than `count_tolerance`, sigma_p is corrected and the buckets scanned again (up to
 /// [`MAX_SCANS`] scans); when the output's count is still off by more than 1% (samples lost to the
 /// triangulation and its finishing, as on data hardly denser than the output), the whole job runs
-/// once more for a goal moved by the miss, and the nearer of the two is kept (its stage times
-/// include both runs). There is no least-squares fit of the output to the surface (no closer, at
+/// once more for a goal moved by the miss, and of the two the one with fewer faces still
+/// crossing where untangle stopped is kept, of equals the nearer (its stage times include both
+/// runs). There is no least-squares fit of the output to the surface (no closer, at
 /// twice the run time: `docs/decisions/point-set-no-fit.md`). Closed shells of at most 8 vertices
 /// and 4 sigma_p across are left out, the largest part always kept.
 ///
@@ -348,7 +351,10 @@ pub fn remesh_points(
     again.remesh.density = Density::Points(((n as f64 + miss(&first)).round() as usize).max(4));
     on_stage("scan");
     let second = remesh_points_once(source, &again, on_stage)?;
-    let (mut kept, other) = if miss(&second).abs() < miss(&first).abs() {
+    // A run whose faces still cross where untangle stopped is a worse output than one off
+    // the count.
+    let worse = |o: &PointRemeshOutput| (o.untangle.pairs_after, miss(o).abs());
+    let (mut kept, other) = if worse(&second) < worse(&first) {
         (second, first)
     } else {
         (first, second)
@@ -738,6 +744,7 @@ fn remesh_points_once(
         optimize: finished.optimize,
         untangle_umbrellas,
         untangle: finished.untangle,
+        mend_after_untangle: finished.mend_after_untangle,
         dropped_samples: finished.dropped_samples
             + finished.later_dropped
             + dropped_after_finishing,

@@ -292,6 +292,9 @@ pub(super) fn remesh_read(
     }
     insert_json(extra, "optimize", out.optimize);
     insert_json(extra, "untangle", out.untangle);
+    if out.mend_after_untangle.attempts > 0 {
+        insert_json(extra, "mend_after_untangle", out.mend_after_untangle);
+    }
     if out.degenerate.found > 0 {
         insert_json(extra, "degenerate", out.degenerate);
     }

@@ -120,6 +120,9 @@ pub(super) fn run(
     insert_json(extra, "pillows", out.pillows);
     insert_json(extra, "optimize", out.optimize);
     insert_json(extra, "untangle", out.untangle);
+    if out.mend_after_untangle.attempts > 0 {
+        insert_json(extra, "mend_after_untangle", out.mend_after_untangle);
+    }
     insert_json(extra, "untangle_umbrellas", out.untangle_umbrellas);
     insert_json(extra, "output_orientation", out.output_orientation);
     report.notes.push(format!(
@@ -147,8 +150,8 @@ pub(super) fn run(
             report.notes.push(format!(
                 "the input has {per_vertex:.2} points per vertex asked: samples are lost where \
                  the data is no denser than the output (projections refused across its gaps, \
-                 samples in no triangle or collapsed), and a second run for a raised count came \
-                 no closer than this"
+                 samples in no triangle or collapsed), and a second run for a raised count did no \
+                 better (no nearer, or with faces left crossing)"
             ));
         }
     }

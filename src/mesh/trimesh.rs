@@ -277,6 +277,14 @@ impl TriMesh {
     /// Removes the vertices no triangle uses, renumbering the triangles. Returns how many were
     /// removed.
     pub fn remove_unreferenced_vertices(&mut self) -> usize {
+        let before = self.positions.len();
+        self.compact_vertices();
+        before - self.positions.len()
+    }
+
+    /// [`TriMesh::remove_unreferenced_vertices`], returning each old vertex's new index
+    /// (`u32::MAX` for a removed one), `V` entries.
+    pub fn compact_vertices(&mut self) -> Vec<u32> {
         let mut new_index = vec![u32::MAX; self.positions.len()];
         for t in &self.triangles {
             for &i in t {
@@ -290,14 +298,13 @@ impl TriMesh {
                 kept.push(self.positions[i]);
             }
         }
-        let removed = self.positions.len() - kept.len();
         for t in &mut self.triangles {
             for i in t.iter_mut() {
                 *i = new_index[*i as usize];
             }
         }
         self.positions = kept;
-        removed
+        new_index
     }
 
     /// Removes the faces a remesh cannot use, in one pass in face order: faces whose corners are

@@ -1,7 +1,8 @@
 //! The finishing stage, shared by meshes and point sets: the triangulated samples optimized
 //! against the surface they came from (cover, collapse, flip, relax), fitted to it, faces that
-//! cross moved apart, faces of no area mended, stray shells left out, closed parts turned
-//! outward.
+//! cross moved apart (and, where that collapsed edges, the faces around them mended by the
+//! optimization's last pass again), faces of no area mended, stray shells left out, closed parts
+//! turned outward.
 
 use glam::DVec3;
 
@@ -12,7 +13,7 @@ use crate::surface::SurfaceQuery;
 use crate::timing::StageTimer;
 use crate::triangulate::degenerate::{mend_degenerate_faces, DegenerateStats};
 use crate::triangulate::fit::{fit_to_surface, FitStats};
-use crate::triangulate::optimize::{optimize, OptimizeParams, OptimizeStats};
+use crate::triangulate::optimize::{mend_near, optimize, MendStats, OptimizeParams, OptimizeStats};
 use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::FaceSource;
@@ -79,6 +80,9 @@ pub(crate) struct Finished {
     pub later_dropped: usize,
     pub fit: Option<FitStats>,
     pub untangle: UntangleStats,
+    /// The optimization's last pass again around the faces untangle's collapses changed (none
+    /// without collapses or without the optimization).
+    pub mend_after_untangle: MendStats,
     pub degenerate: DegenerateStats,
     pub stray_shells: StrayShells,
     /// What orienting the output did (closed parts turned outward).
@@ -117,7 +121,17 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     // Connectivity is final here but for the collapses of untangle's folds (where the output
     // crosses itself where the input does not).
     let protected_kept = edges_present(mesh, f.protected);
-    let dropped_samples = mesh.remove_unreferenced_vertices();
+    let renumbered = mesh.compact_vertices();
+    let dropped_samples = renumbered.iter().filter(|&&i| i == u32::MAX).count();
+    // The protected edges by the new numbers, for the mending after untangle.
+    let protected: Vec<[u32; 2]> = f
+        .protected
+        .iter()
+        .filter_map(|e| {
+            let [a, b] = e.map(|v| renumbered.get(v as usize).copied().unwrap_or(u32::MAX));
+            (a != u32::MAX && b != u32::MAX).then_some([a, b])
+        })
+        .collect();
     timer.lap("optimize");
     on_stage("untangle");
     let fixed = fixed_prefix(mesh.positions.len());
@@ -149,8 +163,28 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
         &f.untangle,
         f.input_crossings,
     );
+    let mut mend_after_untangle = MendStats::default();
     if untangle_stats.collapses > 0 {
         *face_sources = carried_sources(&origin, face_sources);
+        // The collapses leave the faces around them as they fall (a hub where a fold was
+        // collapsed away): the last pass of the optimization mends them, and the faces around
+        // them, under its guards (no new crossing, near the surface).
+        if let Some(op) = f.optimize {
+            let near = around_changed_faces(mesh, &origin);
+            let (stats, origin) = mend_near(
+                mesh,
+                f.surface,
+                &fixed,
+                &protected,
+                f.boundary,
+                f.input_crossings,
+                f.sigma_p,
+                op,
+                &near,
+            );
+            *face_sources = carried_sources(&origin, face_sources);
+            mend_after_untangle = stats;
+        }
         later_dropped += mesh.remove_unreferenced_vertices();
     }
     // No face of no area is written.
@@ -184,10 +218,33 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
         later_dropped,
         fit,
         untangle: untangle_stats,
+        mend_after_untangle,
         degenerate,
         stray_shells,
         orientation,
     }
+}
+
+/// The vertices of the faces of `mesh` that an edit changed (`origin[f]` is `None`: as
+/// `EditMesh::into_parts` gives it) and of the faces that share a vertex with them: `V` flags.
+fn around_changed_faces(mesh: &TriMesh, origin: &[Option<u32>]) -> Vec<bool> {
+    let mut changed = vec![false; mesh.positions.len()];
+    for (t, o) in mesh.triangles.iter().zip(origin) {
+        if o.is_none() {
+            for &v in t {
+                changed[v as usize] = true;
+            }
+        }
+    }
+    let mut near = changed.clone();
+    for t in &mesh.triangles {
+        if t.iter().any(|&v| changed[v as usize]) {
+            for &v in t {
+                near[v as usize] = true;
+            }
+        }
+    }
+    near
 }
 
 /// How many of `edges` (vertex pairs, either direction) are edges of a face of `mesh`.

@@ -9,7 +9,7 @@ use crate::sampling::gradient_ascent::GradientAscentResult;
 use crate::sampling::grading::GradingStats;
 use crate::surface::features::Features;
 use crate::timing::{Stage, StageTimer};
-use crate::triangulate::optimize::OptimizeStats;
+use crate::triangulate::optimize::{MendStats, OptimizeStats};
 use crate::triangulate::stray_shells::StrayShells;
 use crate::triangulate::untangle::UntangleStats;
 use crate::triangulate::AssemblyStats;
@@ -100,6 +100,8 @@ pub struct RemeshOutput {
     pub optimize: OptimizeStats,
     /// What the separation of crossing faces did.
     pub untangle: UntangleStats,
+    /// The optimization's last pass again around the faces untangle's collapses changed.
+    pub mend_after_untangle: MendStats,
     /// What the mending of faces of no area did.
     pub degenerate: crate::triangulate::degenerate::DegenerateStats,
     /// The pairs of `input_normalized`'s faces that cross (looked for only when the input
@@ -201,6 +203,7 @@ pub(super) fn assemble(
         restricted_delaunay: triangulated.restricted_delaunay,
         optimize: finished.optimize,
         untangle: finished.untangle,
+        mend_after_untangle: finished.mend_after_untangle,
         degenerate: finished.degenerate,
         input_crossing_pairs,
         junction_faces,

@@ -66,6 +66,27 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     params: &Limits,
 ) -> MendStats {
+    mend_faces_near(m, surface, boundary, input_crossings, fixed, params, None)
+}
+
+/// [`mend_faces`], with the faces of small angle taken only where they have a corner marked in
+/// `near` (when given; vertices beyond it count as unmarked), and those that cross another
+/// everywhere.
+pub(super) fn mend_faces_near<S: SurfaceQuery + ?Sized>(
+    m: &mut Mesh,
+    surface: &S,
+    boundary: Option<&FeatureLines>,
+    input_crossings: Option<&CrossingRegions>,
+    fixed: &[bool],
+    params: &Limits,
+    near: Option<&[bool]>,
+) -> MendStats {
+    let marked = |t: [u32; 3]| {
+        near.is_none_or(|n| {
+            t.iter()
+                .any(|&v| n.get(v as usize).copied().unwrap_or(false))
+        })
+    };
     // A crossing inside a region where the input's own faces cross is the input's: it is left
     // as it is (and costs no attempt).
     let own = |m: &Mesh, t: [u32; 3]| input_crossings.is_some_and(|r| r.meets(m.corners(t)));
@@ -77,6 +98,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
         let mut small: Vec<(f64, u32)> = live
             .iter()
             .zip(&slots)
+            .filter(|&(&t, _)| marked(t))
             .map(|(&t, &f)| (angle_score(m, t, params), f))
             .filter(|&(a, _)| a < bound)
             .collect();

@@ -24,7 +24,7 @@ mod cover;
 mod relax;
 mod smooth;
 
-use angles::mend_faces;
+use angles::{mend_faces, mend_faces_near};
 pub use angles::{FacesLeft, MendStats};
 use collapse::collapse_short;
 use cover::cover;
@@ -384,6 +384,44 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
     }
     stats.mend = mend_faces(&mut m, surface, boundary, input_crossings, &fixed, params);
     stats.mends = stats.mend.ops;
+    let (positions, faces, origin) = m.into_parts();
+    *mesh = TriMesh::new(positions, faces);
+    (stats, origin)
+}
+
+/// The last pass of [`optimize`] alone, on the faces of small angle with a corner marked in
+/// `near` (`V` flags; the faces a later stage changed, such as untangle's collapses, and their
+/// neighbours) and on every face that crosses another, with the same guards (same arguments
+/// and units as [`optimize`]). Returns what it did and, for each face of the result, the index
+/// of the face of `mesh` it still is (`None` for a new or changed face). Deterministic.
+#[allow(clippy::too_many_arguments)] // optimize's arguments, and where to work
+pub fn mend_near<S: SurfaceQuery + ?Sized>(
+    mesh: &mut TriMesh,
+    surface: &S,
+    fixed: &[bool],
+    protected: &[[u32; 2]],
+    boundary: Option<&FeatureLines>,
+    input_crossings: Option<&CrossingRegions>,
+    sigma_p: f64,
+    params: &OptimizeParams,
+    near: &[bool],
+) -> (MendStats, Vec<Option<u32>>) {
+    let params = &Limits::new(params, sigma_p);
+    let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
+    for &[a, b] in protected {
+        m.protect_edge(a, b);
+    }
+    let mut fixed = fixed.to_vec();
+    fixed.resize(m.vertex_count(), false);
+    let stats = mend_faces_near(
+        &mut m,
+        surface,
+        boundary,
+        input_crossings,
+        &fixed,
+        params,
+        Some(near),
+    );
     let (positions, faces, origin) = m.into_parts();
     *mesh = TriMesh::new(positions, faces);
     (stats, origin)

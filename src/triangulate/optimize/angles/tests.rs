@@ -321,3 +321,38 @@ fn the_compass_search_finds_the_best_angle_position_of_a_ring() {
     );
     assert!(found.z.abs() < 1e-12);
 }
+
+#[test]
+fn mending_near_marked_vertices_leaves_the_other_faces_as_they_are() {
+    // Two interior vertices of a 10 × 10 grid pulled most of the way to a neighbour, far apart:
+    // only the one whose faces are marked is mended.
+    let (g, surface) = flat(10);
+    let pulled = |m: &mut Mesh, v: u32| {
+        let p = m.position(v);
+        m.relocate_vertex(v, p + DVec3::new(0.8, 0.0, 0.0)).unwrap();
+    };
+    let (a, b) = (2 * 11 + 2, 7 * 11 + 7);
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    pulled(&mut m, a);
+    pulled(&mut m, b);
+    let worst_at = |m: &Mesh, v: u32| {
+        m.faces_around(v)
+            .iter()
+            .map(|&f| min_angle(m, face(m, f)))
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(
+        worst_at(&m, a) < 20.0 && worst_at(&m, b) < 20.0,
+        "the test case"
+    );
+    let before_b = m.position(b);
+    let mut near = vec![false; m.vertex_count()];
+    near[a as usize] = true;
+    let fixed = vec![false; m.vertex_count()];
+    let made = mend_faces_near(&mut m, &surface, None, None, &fixed, &limits(), Some(&near));
+    assert!(made.ops >= 1);
+    assert!(m.degree(a) == 0 || worst_at(&m, a) >= 30.0);
+    assert_eq!(m.position(b), before_b);
+    assert!(worst_at(&m, b) < 20.0);
+    assert_eq!(m.sanity_check(), Ok(()));
+}
