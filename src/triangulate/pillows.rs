@@ -63,9 +63,13 @@ pub fn open_pillows(
     };
     // The vertices on the boundary or one edge from it: the largest part's folds are flaps
     // there (elsewhere, a face against data without data on its side is a thin part whose
-    // data's normals are wrong, and removing it would open the surface).
+    // data's normals are wrong, and removing it would open the surface). Read only with flaps.
     let mut near_boundary = vec![false; mesh.positions.len()];
-    let uses = mesh.edge_uses();
+    let uses = if flaps {
+        mesh.edge_uses()
+    } else {
+        Default::default()
+    };
     for (&(a, b), &(_, n)) in &uses {
         if n == 1 {
             near_boundary[a as usize] = true;

@@ -23,8 +23,9 @@ enum Op {
     Split(u32, u32, DVec3),
 }
 
-/// Mends the faces of `m` whose smallest angle is below `params.final_theta_deg` (worst first),
-/// then the faces that cross another face (the exact pairs of [`intersecting_pairs`]), in up to
+/// Mends the faces of `m` whose smallest angle is below `params.final_theta_deg` (worst first;
+/// with `near`, only those with a corner marked in it, vertices beyond it unmarked), then the
+/// faces that cross another face (the exact pairs of [`intersecting_pairs`]), in up to
 /// `params.final_rounds` rounds. For each such face the candidates are: the max-min flip of each
 /// of its edges, the collapse of each of its edges (an end that may move merges into the other,
 /// at the other's position or, when both may move, at the surface point nearest the edge's
@@ -59,20 +60,6 @@ enum Op {
 /// pass's budget ([`MEND_BUDGET_PER_FACE`] per face, at most [`MEND_TRIES_PER_FACE`] failed
 /// attempts a face). Deterministic.
 pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
-    m: &mut Mesh,
-    surface: &S,
-    boundary: Option<&FeatureLines>,
-    input_crossings: Option<&CrossingRegions>,
-    fixed: &[bool],
-    params: &Limits,
-) -> MendStats {
-    mend_faces_near(m, surface, boundary, input_crossings, fixed, params, None)
-}
-
-/// [`mend_faces`], with the faces of small angle taken only where they have a corner marked in
-/// `near` (when given; vertices beyond it count as unmarked), and those that cross another
-/// everywhere.
-pub(super) fn mend_faces_near<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
     boundary: Option<&FeatureLines>,

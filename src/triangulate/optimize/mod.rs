@@ -24,7 +24,7 @@ mod cover;
 mod relax;
 mod smooth;
 
-use angles::{mend_faces, mend_faces_near};
+use angles::mend_faces;
 pub use angles::{FacesLeft, MendStats};
 use collapse::collapse_short;
 use cover::cover;
@@ -348,12 +348,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
 ) -> (OptimizeStats, Vec<Option<u32>>) {
     let params = &Limits::new(params, sigma_p);
     let mut stats = OptimizeStats::default();
-    let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
-    for &[a, b] in protected {
-        m.protect_edge(a, b);
-    }
-    let mut fixed = fixed.to_vec();
-    fixed.resize(m.vertex_count(), false);
+    let (mut m, mut fixed) = editable(mesh, fixed, protected);
     let short = params.short_edge_ratio * median_edge_length(&m);
     let mut watch = None;
     stats.smooth = smooth(&mut m, surface, &fixed, params, params.smooth_iterations);
@@ -382,11 +377,37 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
             break;
         }
     }
-    stats.mend = mend_faces(&mut m, surface, boundary, input_crossings, &fixed, params);
+    stats.mend = mend_faces(
+        &mut m,
+        surface,
+        boundary,
+        input_crossings,
+        &fixed,
+        params,
+        None,
+    );
     stats.mends = stats.mend.ops;
+    (stats, write_back(m, mesh))
+}
+
+/// `mesh` as the mesh the operations edit (each face labelled with its index), its `protected`
+/// edges protected, and `fixed` extended to every vertex.
+fn editable(mesh: &TriMesh, fixed: &[bool], protected: &[[u32; 2]]) -> (Mesh, Vec<bool>) {
+    let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
+    for &[a, b] in protected {
+        m.protect_edge(a, b);
+    }
+    let mut fixed = fixed.to_vec();
+    fixed.resize(m.vertex_count(), false);
+    (m, fixed)
+}
+
+/// Writes the edited `m` back into `mesh`; returns, for each face, the index of the face of
+/// `mesh` it still is (`None` for a new or changed face).
+fn write_back(m: Mesh, mesh: &mut TriMesh) -> Vec<Option<u32>> {
     let (positions, faces, origin) = m.into_parts();
     *mesh = TriMesh::new(positions, faces);
-    (stats, origin)
+    origin
 }
 
 /// The last pass of [`optimize`] alone, on the faces of small angle with a corner marked in
@@ -407,13 +428,8 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
     near: &[bool],
 ) -> (MendStats, Vec<Option<u32>>) {
     let params = &Limits::new(params, sigma_p);
-    let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
-    for &[a, b] in protected {
-        m.protect_edge(a, b);
-    }
-    let mut fixed = fixed.to_vec();
-    fixed.resize(m.vertex_count(), false);
-    let stats = mend_faces_near(
+    let (mut m, fixed) = editable(mesh, fixed, protected);
+    let stats = mend_faces(
         &mut m,
         surface,
         boundary,
@@ -422,9 +438,7 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
         params,
         Some(near),
     );
-    let (positions, faces, origin) = m.into_parts();
-    *mesh = TriMesh::new(positions, faces);
-    (stats, origin)
+    (stats, write_back(m, mesh))
 }
 
 /// The vertices of the faces with Q below `q_below`, sorted.

@@ -63,7 +63,7 @@ fn a_vertex_of_three_faces_near_an_edge_is_collapsed_away() {
     let before = theta_min(&m);
     assert!(before < 20.0, "{before}");
     let fixed = vec![false; m.vertex_count()];
-    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
     assert!(made.ops >= 1);
     assert_eq!(m.degree(v), 0, "the vertex is gone");
     assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
@@ -87,7 +87,7 @@ fn a_sliver_on_a_short_fixed_boundary_edge_is_mended_and_the_boundary_stays() {
         .filter(|&v| fixed[v])
         .map(|v| m.position(v as u32))
         .collect();
-    mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
     assert!(theta_min(&m) >= 25.0, "{before} -> {}", theta_min(&m));
     let after: Vec<DVec3> = (0..m.vertex_count())
         .filter(|&v| fixed[v])
@@ -104,7 +104,7 @@ fn a_mesh_without_small_angles_is_left_alone() {
     let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
     let fixed = vec![false; m.vertex_count()];
     assert_eq!(
-        mend_faces(&mut m, &surface, None, None, &fixed, &limits()).ops,
+        mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None).ops,
         0
     );
     assert_eq!(m.to_trimesh(), g);
@@ -134,7 +134,7 @@ fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
     let fixed = vec![false; m.vertex_count()];
     // sigma_p 4: the pass may move the mesh by up to 1 off the surface, more than the poke.
     let wide = Limits::new(&OptimizeParams::default(), 4.0);
-    let made = mend_faces(&mut m, &surface, None, None, &fixed, &wide);
+    let made = mend_faces(&mut m, &surface, None, None, &fixed, &wide, None);
     assert!(made.ops >= 1);
     let out = m.to_trimesh();
     let pairs = intersecting_pairs(&out.positions, &out.triangles);
@@ -148,7 +148,7 @@ fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
     assert_eq!(m.sanity_check(), Ok(()));
     // Without moves that far (sigma_p 1: 0.25), nothing is made that would cross.
     let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
-    mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
     let out = m.to_trimesh();
     assert!(
         intersecting_pairs(&out.positions, &out.triangles).len()
@@ -224,7 +224,7 @@ fn a_reflex_boundary_corner_with_two_faces_gets_its_edge_split() {
     // neighbours on the boundary have two faces each (no collapse): no flip, collapse or move
     // mends the corner's faces, whose angles at it add up to 206°.
     let fixed = vec![true; m.vertex_count()];
-    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
     assert!(made.ops >= 1);
     assert!(m.vertex_count() > 7, "no vertex added");
     assert!(m.degree(v) >= 3, "the corner has {} faces", m.degree(v));
@@ -254,9 +254,17 @@ fn a_boundary_vertex_slides_along_the_boundary_to_mend_its_face() {
     let before = theta_min(&m);
     assert!(before < 10.0, "{before}");
     // Without the boundary's lines, vertex 1 stays and nothing mends the face.
-    mend_faces(&mut m, &surface, None, None, &fixed, &limits());
+    mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
     assert_eq!(m.position(1), DVec3::new(0.12, 0.0, 0.0));
-    let made = mend_faces(&mut m, &surface, Some(&boundary), None, &fixed, &limits());
+    let made = mend_faces(
+        &mut m,
+        &surface,
+        Some(&boundary),
+        None,
+        &fixed,
+        &limits(),
+        None,
+    );
     assert!(made.ops >= 1);
     let p = m.position(1);
     assert!(p.y.abs() < 1e-12 && p.x > 0.12 && p.x < 1.0, "{p}");
@@ -349,7 +357,7 @@ fn mending_near_marked_vertices_leaves_the_other_faces_as_they_are() {
     let mut near = vec![false; m.vertex_count()];
     near[a as usize] = true;
     let fixed = vec![false; m.vertex_count()];
-    let made = mend_faces_near(&mut m, &surface, None, None, &fixed, &limits(), Some(&near));
+    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), Some(&near));
     assert!(made.ops >= 1);
     assert!(m.degree(a) == 0 || worst_at(&m, a) >= 30.0);
     assert_eq!(m.position(b), before_b);
