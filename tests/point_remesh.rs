@@ -575,3 +575,49 @@ fn an_open_band_of_points_has_two_loops() {
     };
     assert_open_points("band", band, 20_000, 1000, 2);
 }
+
+/// A range map (a PLY with the scanner's `camera` before its points, as MeshLab writes them)
+/// without normals: the estimated normals, and so the output's faces, point towards the
+/// camera, here below the patch, where the spanning tree's rule (the highest point's normal up)
+/// would turn them away from it.
+#[test]
+fn a_range_maps_camera_orients_its_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let (points, _) = wavy_patch(5, |_, _| false);
+    let camera = DVec3::new(0.2, -0.1, -4.0);
+    let mut text = format!(
+        "ply\nformat ascii 1.0\nelement camera 1\nproperty float view_px\nproperty float \
+         view_py\nproperty float view_pz\nproperty float focal\nelement vertex {}\nproperty \
+         double x\nproperty double y\nproperty double z\nend_header\n{} {} {} 14\n",
+        points.len(),
+        camera.x,
+        camera.y,
+        camera.z
+    );
+    for p in &points {
+        text.push_str(&format!("{} {} {}\n", p.x, p.y, p.z));
+    }
+    let input = dir.path().join("range.ply");
+    std::fs::write(&input, text).unwrap();
+    let output = dir.path().join("out.obj");
+    let report = run_remesh(&job(input, output.clone(), false), &|_| {}).unwrap();
+    let (mesh, _) = spectral_remesh::read_mesh(&output).unwrap();
+    assert!(mesh.triangles.len() > 1000);
+    for tri in &mesh.triangles {
+        let [a, b, c] = tri.map(|i| mesh.positions[i as usize]);
+        let normal = (b - a).cross(c - a);
+        assert!(
+            normal.dot(camera - (a + b + c) / 3.0) > 0.0,
+            "a face at {} turned away from the camera",
+            (a + b + c) / 3.0
+        );
+    }
+    assert!(
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains("oriented towards the range map's camera")),
+        "{:?}",
+        report.notes
+    );
+}

@@ -40,8 +40,9 @@ pub struct RemeshJob {
     /// point set either way ([`is_point_set`](crate::internal::is_point_set)).
     pub as_points: bool,
     /// For a point set without normals: the estimated normals face this point (model units; a
-    /// single scan's sensor) instead of being oriented outward by a spanning tree. Not used for
-    /// meshes.
+    /// single scan's sensor) instead of being oriented outward by a spanning tree. `None`: a PLY
+    /// range map's own camera when it has one ([`PointReader::viewpoint`](crate::points::PointReader::viewpoint)),
+    /// else the spanning tree. Not used for meshes.
     pub viewpoint: Option<glam::DVec3>,
     /// Where the JSON report goes as well (`--report`): written with the mesh, both only once
     /// everything has been written. `None`: nowhere.

@@ -37,9 +37,14 @@ pub(super) fn run(
     write: &dyn Fn(&TriMesh) -> Result<()>,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<QualityReport> {
+    // A range map's own camera orients estimated normals when no viewpoint is given.
+    let camera = match job.viewpoint {
+        Some(_) => None,
+        None => source.viewpoint().map_err(|e| with_path(e, &job.input))?,
+    };
     let params = PointRemeshParams {
         remesh: job.params,
-        orientation: match job.viewpoint {
+        orientation: match job.viewpoint.or(camera) {
             Some(v) => NormalOrientation::Viewpoint(v),
             None => NormalOrientation::SpanningTree,
         },
@@ -102,6 +107,9 @@ pub(super) fn run(
     insert_kernel_extras(extra, out.sigma_p, &job.params, out.target);
     extra.insert("input_points".into(), out.input_points.into());
     extra.insert("had_normals".into(), out.had_normals.into());
+    if let Some(v) = camera.filter(|_| !out.had_normals) {
+        insert_json(extra, "camera_viewpoint", v.to_array());
+    }
     extra.insert("outliers_removed".into(), out.outliers_removed.into());
     extra.insert("samples".into(), out.samples.into());
     extra.insert("unprojected_samples".into(), out.unprojected_samples.into());
@@ -129,10 +137,16 @@ pub(super) fn run(
         "the input is a point set ({} points, {}): the samples lie on the RIMLS surface of the \
          points and were connected by tangent-plane umbrellas",
         out.input_points,
-        if out.had_normals {
-            "with normals"
-        } else {
-            "normals estimated"
+        match (out.had_normals, camera) {
+            (true, _) => "with normals".to_string(),
+            (false, None) => "normals estimated".to_string(),
+            (false, Some(v)) => format!(
+                "normals estimated, oriented towards the range map's camera at ({}, {}, {})",
+                // (as the file's single precision, and no negative zero)
+                v.x as f32 + 0.0,
+                v.y as f32 + 0.0,
+                v.z as f32 + 0.0
+            ),
         }
     ));
     if out.outliers_removed > 0 {

@@ -10,6 +10,7 @@ use glam::DVec3;
 use crate::error::{Error, Result};
 use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{simplify_out_of_core, simplify_progressive, OutOfCoreParams};
+use crate::points::source::PointSource;
 use crate::points::{PlyPointWriter, PointReader};
 
 /// How dense the simplified point set is.
@@ -40,7 +41,8 @@ pub struct SimplifyJob {
     /// Seed of every random choice.
     pub seed: u64,
     /// For an input without normals: orient the estimated normals towards this point (model
-    /// units) instead of outward by a spanning tree.
+    /// units) instead of outward by a spanning tree. `None`: a PLY range map's own camera when
+    /// it has one ([`PointReader::viewpoint`]), else the spanning tree.
     pub viewpoint: Option<DVec3>,
 }
 
@@ -121,9 +123,14 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
             message: format!("{} has no normals; sigma_n needs them", job.input.display()),
         });
     }
+    // A range map's own camera orients estimated normals when no viewpoint is given.
+    let camera = match job.viewpoint {
+        Some(_) => None,
+        None => PointSource::File(job.input.clone()).viewpoint()?,
+    };
     let params = OutOfCoreParams {
         resample: job.resample,
-        orientation: match job.viewpoint {
+        orientation: match job.viewpoint.or(camera) {
             Some(v) => NormalOrientation::Viewpoint(v),
             None => NormalOrientation::SpanningTree,
         },

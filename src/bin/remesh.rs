@@ -174,6 +174,7 @@ struct Cli {
 
     /// For a point set without normals: orient the estimated normals towards this point
     /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
+    /// Without it, a PLY range map's own camera (`view_px view_py view_pz`) is used.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
     viewpoint: Option<[f64; 3]>,
 
@@ -241,6 +242,7 @@ enum Command {
         seed: u64,
         /// For an input without normals: orient the estimated normals towards this point
         /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
+        /// Without it, a PLY range map's own camera (`view_px view_py view_pz`) is used.
         #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
         viewpoint: Option<[f64; 3]>,
         /// Print nothing but errors.

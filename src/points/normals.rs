@@ -20,7 +20,10 @@ pub enum NormalOrientation {
     /// planes (across a part thinner than the neighbourhood), each connected part seeded at its highest point (largest
     /// z) with its normal pointing up (+z): outward on a closed surface.
     SpanningTree,
-    /// Each normal towards this viewpoint (a single scan).
+    /// Towards this viewpoint (a single scan): propagated as by `SpanningTree`, then each
+    /// connected part turned as a whole to face the viewpoint, by the vote of its normals, each
+    /// weighted by the cosine between it and its line of sight (so points seen at a grazing
+    /// angle, whose own side is a toss-up, follow their neighbours).
     Viewpoint(DVec3),
 }
 
@@ -51,16 +54,20 @@ pub fn estimate_normals(points: &[DVec3], k: usize, orientation: NormalOrientati
             (normal, ids)
         })
         .unzip();
-    match orientation {
-        NormalOrientation::Viewpoint(v) => {
-            for (n, &p) in normals.iter_mut().zip(points) {
-                if n.dot(v - p) < 0.0 {
-                    *n = -*n;
-                }
-            }
+    let parts = orient_by_spanning_tree(points, &mut normals, &neighbors);
+    if let NormalOrientation::Viewpoint(v) = orientation {
+        // Each part of the spanning forest, consistent in itself, turned as a whole to face
+        // the viewpoint: by the vote of its normals, each weighted by the cosine to its line of
+        // sight (a point seen at a grazing angle, where a flying pixel's strand is, has little
+        // say, and its neighbours decide its side).
+        let mut votes = vec![0.0; parts.iter().max().map_or(0, |&m| m as usize + 1)];
+        for ((n, &p), &part) in normals.iter().zip(points).zip(&parts) {
+            votes[part as usize] += n.dot((v - p).normalize_or_zero());
         }
-        NormalOrientation::SpanningTree => {
-            orient_by_spanning_tree(points, &mut normals, &neighbors)
+        for (n, &part) in normals.iter_mut().zip(&parts) {
+            if votes[part as usize] < 0.0 {
+                *n = -*n;
+            }
         }
     }
     normals
@@ -112,8 +119,13 @@ impl PartialOrd for Edge {
 
 /// Prim's algorithm over the symmetric k-nearest-neighbour graph (without edges more than 30°
 /// off both ends' tangent planes), flipping each newly reached
-/// normal to agree with the one it is reached from.
-fn orient_by_spanning_tree(points: &[DVec3], normals: &mut [DVec3], neighbors: &[Vec<u32>]) {
+/// normal to agree with the one it is reached from. Returns each point's part (the tree it was
+/// reached in, numbered from 0).
+fn orient_by_spanning_tree(
+    points: &[DVec3],
+    normals: &mut [DVec3],
+    neighbors: &[Vec<u32>],
+) -> Vec<u32> {
     let n = points.len();
     // Symmetric adjacency.
     // No edge straight across a thin part (the other side of an ear): one that leaves both
@@ -149,11 +161,14 @@ fn orient_by_spanning_tree(points: &[DVec3], normals: &mut [DVec3], neighbors: &
             .then(a.cmp(&b))
     });
     let mut heap = BinaryHeap::new();
+    let mut parts = vec![0u32; n];
+    let mut part = 0u32;
     for seed in order {
         if reached[seed as usize] {
             continue;
         }
         reached[seed as usize] = true;
+        parts[seed as usize] = part;
         if normals[seed as usize].z < 0.0 {
             normals[seed as usize] = -normals[seed as usize];
         }
@@ -175,12 +190,15 @@ fn orient_by_spanning_tree(points: &[DVec3], normals: &mut [DVec3], neighbors: &
                 continue;
             }
             reached[to as usize] = true;
+            parts[to as usize] = part;
             if normals[to as usize].dot(normals[from as usize]) < 0.0 {
                 normals[to as usize] = -normals[to as usize];
             }
             push(&mut heap, to, normals, &reached);
         }
+        part += 1;
     }
+    parts
 }
 
 #[cfg(test)]
@@ -202,5 +220,27 @@ mod tests {
         // A viewpoint inside turns them all inward.
         let inward = estimate_normals(&points, 12, NormalOrientation::Viewpoint(DVec3::ZERO));
         assert!(inward.iter().zip(&points).all(|(n, p)| n.dot(*p) < 0.0));
+    }
+
+    #[test]
+    fn a_scan_past_its_silhouette_keeps_one_side() {
+        // A cylinder (radius 1, along z) scanned from far along +y, its points reaching a
+        // little past the silhouette (y down to -0.3): there the outward normals face away from
+        // the scanner, and each normal turned on its own to face it would point inward.
+        let mut points = Vec::new();
+        for i in 0..120 {
+            let t =
+                -0.3f64.asin() + (std::f64::consts::PI + 2.0 * 0.3f64.asin()) * i as f64 / 119.0;
+            for j in 0..30 {
+                points.push(DVec3::new(t.cos(), t.sin(), j as f64 * 0.03));
+            }
+        }
+        assert!(points.iter().any(|p| p.y < -0.29));
+        let viewpoint = DVec3::new(0.0, 40.0, 0.5);
+        let normals = estimate_normals(&points, 12, NormalOrientation::Viewpoint(viewpoint));
+        for (p, n) in points.iter().zip(&normals) {
+            let outward = DVec3::new(p.x, p.y, 0.0).normalize();
+            assert!(n.dot(outward) > 0.9, "{p:?} {n:?}");
+        }
     }
 }

@@ -53,6 +53,21 @@ impl PointSource {
         }
     }
 
+    /// The scanner's position the source gives: a PLY range map's `camera`
+    /// ([`PointReader::viewpoint`], the file's units; only the header is read). `None` for text
+    /// files (not read) and points in memory.
+    ///
+    /// # Errors
+    /// Those of [`PointReader::open`].
+    pub fn viewpoint(&self) -> Result<Option<DVec3>> {
+        match self {
+            PointSource::File(path) if !super::stream::is_text_extension(path) => {
+                Ok(PointReader::open(path)?.viewpoint())
+            }
+            _ => Ok(None),
+        }
+    }
+
     /// A reader from the first point.
     ///
     /// # Errors
@@ -79,6 +94,10 @@ pub trait ReadPoints: Send {
     fn count(&self) -> u64;
     /// Whether the points have normals.
     fn has_normals(&self) -> bool;
+    /// The scanner's position, when the source says it ([`PointReader::viewpoint`]).
+    fn viewpoint(&self) -> Option<DVec3> {
+        None
+    }
     /// Replaces `out` with up to `max` next points; returns how many (0 at the end).
     ///
     /// # Errors
@@ -92,6 +111,9 @@ impl ReadPoints for PointReader {
     }
     fn has_normals(&self) -> bool {
         PointReader::has_normals(self)
+    }
+    fn viewpoint(&self) -> Option<DVec3> {
+        PointReader::viewpoint(self)
     }
     fn read_chunk(&mut self, out: &mut Vec<Point>, max: usize) -> Result<usize> {
         PointReader::read_chunk(self, out, max)

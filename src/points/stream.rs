@@ -94,6 +94,17 @@ impl Scalar {
     }
 }
 
+/// The viewpoint from a camera record's `view_px view_py view_pz` values (`None` for a missing
+/// or non-finite one).
+fn camera_viewpoint<'a>(mut xyz: impl Iterator<Item = Option<&'a f64>>) -> Option<DVec3> {
+    let mut v = [0.0; 3];
+    for c in &mut v {
+        *c = *xyz.next()??;
+    }
+    let v = DVec3::from(v);
+    v.is_finite().then_some(v)
+}
+
 /// Reads a point set in chunks, from
 /// - PLY (ascii or binary of either byte order): the `vertex` element (elements before it, such
 ///   as a range map's `camera`, are skipped; in binary they must hold scalars only); its
@@ -114,6 +125,8 @@ pub struct PointReader {
     properties: Vec<(Scalar, Option<usize>)>,
     record_size: usize,
     has_normals: bool,
+    /// The viewpoint of a range map's `camera` element, the file's units.
+    viewpoint: Option<DVec3>,
     buffer: Vec<u8>,
     line: String,
     line_number: usize,
@@ -164,24 +177,45 @@ impl PointReader {
         };
         let mut input = input;
         let mut line_number = line_number;
+        let mut viewpoint = None;
         for (name, element) in header.elements.iter().take(at) {
+            // A range map's camera: its viewpoint, `view_px view_py view_pz` of the first
+            // record (VCG's layout, as MeshLab writes range maps).
+            let view_slots: Option<Vec<usize>> = (name == "camera" && element.count > 0)
+                .then(|| {
+                    ["view_px", "view_py", "view_pz"]
+                        .iter()
+                        .map(|n| element.properties.keys().position(|k| k == n))
+                        .collect()
+                })
+                .flatten();
             match encoding {
                 Encoding::Ascii => {
                     let mut line = String::new();
-                    for _ in 0..element.count {
+                    for record in 0..element.count {
                         line.clear();
                         if input.read_line(&mut line).map_err(|e| Error::io(path, e))? == 0 {
                             return Err(parse(format!("the file ends inside `{name}`")));
                         }
                         line_number += 1;
+                        if let (0, Some(slots)) = (record, &view_slots) {
+                            let values: Vec<f64> = line
+                                .split_whitespace()
+                                .map(|v| v.parse().unwrap_or(f64::NAN))
+                                .collect();
+                            viewpoint = camera_viewpoint(slots.iter().map(|&i| values.get(i)));
+                        }
                     }
                 }
                 _ => {
                     let mut size = 0u64;
+                    let mut fields = Vec::new();
                     for property in element.properties.values() {
                         match &property.data_type {
                             PropertyType::Scalar(ty) => {
-                                size += Scalar::from(ty.clone()).size() as u64
+                                let scalar = Scalar::from(ty.clone());
+                                fields.push((size as usize, scalar));
+                                size += scalar.size() as u64
                             }
                             PropertyType::List(..) => {
                                 return Err(parse(format!(
@@ -191,7 +225,20 @@ impl PointReader {
                             }
                         }
                     }
-                    let skip = size * element.count as u64;
+                    let mut skip = size * element.count as u64;
+                    if let Some(slots) = &view_slots {
+                        let mut record = vec![0u8; size as usize];
+                        input
+                            .read_exact(&mut record)
+                            .map_err(|_| parse(format!("the file ends inside `{name}`")))?;
+                        skip -= size;
+                        let little = encoding == Encoding::BinaryLittle;
+                        let values: Vec<f64> = fields
+                            .iter()
+                            .map(|&(at, scalar)| scalar.decode(&record[at..], little))
+                            .collect();
+                        viewpoint = camera_viewpoint(slots.iter().map(|&i| values.get(i)));
+                    }
                     let copied = std::io::copy(&mut (&mut input).take(skip), &mut std::io::sink())
                         .map_err(|e| Error::io(path, e))?;
                     if copied < skip {
@@ -266,6 +313,7 @@ impl PointReader {
             properties,
             record_size,
             has_normals,
+            viewpoint,
             buffer: Vec::new(),
             line: String::new(),
             line_number,
@@ -365,6 +413,7 @@ impl PointReader {
             properties: columns.into_iter().map(|c| (Scalar::F64, c)).collect(),
             record_size: 0,
             has_normals,
+            viewpoint: None,
             buffer: Vec::new(),
             line,
             line_number: skipped_head,
@@ -379,6 +428,14 @@ impl PointReader {
     /// Whether the points have normals (`nx ny nz`).
     pub fn has_normals(&self) -> bool {
         self.has_normals
+    }
+
+    /// The scanner's position when the file is a range map that says it: a PLY `camera`
+    /// element before `vertex` with `view_px view_py view_pz` (VCG's layout, as MeshLab writes
+    /// range maps; the first camera when there are several), in the points' units. `None`
+    /// otherwise, or when those values are not finite.
+    pub fn viewpoint(&self) -> Option<DVec3> {
+        self.viewpoint
     }
 
     /// Replaces `out` with up to `max` next points; returns how many (0 at the end).
@@ -570,7 +627,7 @@ pub(crate) fn is_point_set(path: &Path) -> Result<bool> {
     Ok(has_vertices && !has_faces)
 }
 
-fn is_text_extension(path: &Path) -> bool {
+pub(crate) fn is_text_extension(path: &Path) -> bool {
     path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
         ["xyz", "csv", "txt", "pts", "asc", "xyzn"]
             .iter()

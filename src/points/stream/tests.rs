@@ -149,6 +149,80 @@ fn elements_before_the_vertices_are_skipped() {
 }
 
 #[test]
+fn a_range_maps_camera_gives_the_viewpoint() {
+    // VCG's camera element (as MeshLab writes range maps): view_p among other scalars.
+    let dir = tempfile::tempdir().unwrap();
+    let vertex = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
+    let camera = "element camera 2\nproperty int flags\nproperty float view_px\n\
+                  property double view_py\nproperty float view_pz\nproperty float focal\n";
+    for little in [true, false] {
+        let order = if little { "little" } else { "big" };
+        let mut bytes =
+            format!("ply\nformat binary_{order}_endian 1.0\n{camera}{vertex}end_header\n")
+                .into_bytes();
+        let mut put = |b: &[u8]| {
+            let mut b = b.to_vec();
+            if !little {
+                b.reverse();
+            }
+            bytes.extend(b);
+        };
+        // The first camera is read, the second skipped.
+        for (x, y, z) in [(1.5f32, -2.25f64, 40.0f32), (9.0, 9.0, 9.0)] {
+            put(&7i32.to_le_bytes());
+            put(&x.to_le_bytes());
+            put(&y.to_le_bytes());
+            put(&z.to_le_bytes());
+            put(&14.0f32.to_le_bytes());
+        }
+        for v in [1.0f32, 2.0, 3.0] {
+            put(&v.to_le_bytes());
+        }
+        let path = dir.path().join(format!("cam-{order}.ply"));
+        std::fs::write(&path, &bytes).unwrap();
+        let mut r = PointReader::open(&path).unwrap();
+        assert_eq!(r.viewpoint(), Some(DVec3::new(1.5, -2.25, 40.0)), "{order}");
+        let mut out = Vec::new();
+        assert_eq!(r.read_chunk(&mut out, 10).unwrap(), 1);
+        assert_eq!(out[0].position, DVec3::new(1.0, 2.0, 3.0), "{order}");
+    }
+    let ascii = format!(
+        "ply\nformat ascii 1.0\n{}{vertex}end_header\n7 1.5 -2.25 40 14\n1 1 1 1 1\n1 2 3\n",
+        camera
+    );
+    let path = dir.path().join("cam.ply");
+    std::fs::write(&path, ascii).unwrap();
+    let mut r = PointReader::open(&path).unwrap();
+    assert_eq!(r.viewpoint(), Some(DVec3::new(1.5, -2.25, 40.0)));
+    let mut out = Vec::new();
+    assert_eq!(r.read_chunk(&mut out, 10).unwrap(), 1);
+    assert_eq!(out[0].position, DVec3::new(1.0, 2.0, 3.0));
+    // No camera, a camera without its viewpoint, or a non-finite one: none.
+    for (name, head) in [
+        ("plain", String::new()),
+        (
+            "other",
+            "element camera 1\nproperty float view_px\nproperty float a\n".into(),
+        ),
+    ] {
+        let body = if head.is_empty() { "" } else { "1 2\n" };
+        let text = format!("ply\nformat ascii 1.0\n{head}{vertex}end_header\n{body}1 2 3\n");
+        let path = dir.path().join(format!("{name}.ply"));
+        std::fs::write(&path, text).unwrap();
+        assert_eq!(
+            PointReader::open(&path).unwrap().viewpoint(),
+            None,
+            "{name}"
+        );
+    }
+    let nan = format!("ply\nformat ascii 1.0\n{camera}{vertex}end_header\n7 nan 0 0 1\n1 2 3\n")
+        .replace("element camera 2", "element camera 1");
+    let path = dir.path().join("nan.ply");
+    std::fs::write(&path, nan).unwrap();
+    assert_eq!(PointReader::open(&path).unwrap().viewpoint(), None);
+}
+
+#[test]
 fn bad_ply_headers_are_one_line_errors_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let vertex = "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n";
