@@ -181,7 +181,11 @@ impl PointReader {
         for (name, element) in header.elements.iter().take(at) {
             // A range map's camera: its viewpoint, `view_px view_py view_pz` of the first
             // record (VCG's layout, as MeshLab writes range maps).
-            let view_slots: Option<Vec<usize>> = (name == "camera" && element.count > 0)
+            let scalars = element
+                .properties
+                .values()
+                .all(|p| matches!(p.data_type, PropertyType::Scalar(_)));
+            let view_slots: Option<Vec<usize>> = (name == "camera" && element.count > 0 && scalars)
                 .then(|| {
                     ["view_px", "view_py", "view_pz"]
                         .iter()
@@ -431,7 +435,7 @@ impl PointReader {
     }
 
     /// The scanner's position when the file is a range map that says it: a PLY `camera`
-    /// element before `vertex` with `view_px view_py view_pz` (VCG's layout, as MeshLab writes
+    /// element of scalars before `vertex` with `view_px view_py view_pz` (VCG's layout, as MeshLab writes
     /// range maps; the first camera when there are several), in the points' units. `None`
     /// otherwise, or when those values are not finite.
     pub fn viewpoint(&self) -> Option<DVec3> {

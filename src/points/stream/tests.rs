@@ -197,15 +197,26 @@ fn a_range_maps_camera_gives_the_viewpoint() {
     let mut out = Vec::new();
     assert_eq!(r.read_chunk(&mut out, 10).unwrap(), 1);
     assert_eq!(out[0].position, DVec3::new(1.0, 2.0, 3.0));
-    // No camera, a camera without its viewpoint, or a non-finite one: none.
+    // No camera, a camera without its viewpoint, one with a list (whose ascii values cannot be
+    // placed), or a non-finite viewpoint: none.
     for (name, head) in [
         ("plain", String::new()),
         (
             "other",
             "element camera 1\nproperty float view_px\nproperty float a\n".into(),
         ),
+        (
+            "list",
+            "element camera 1\nproperty list uchar float k\nproperty float view_px\n\
+             property float view_py\nproperty float view_pz\n"
+                .into(),
+        ),
     ] {
-        let body = if head.is_empty() { "" } else { "1 2\n" };
+        let body = match name {
+            "plain" => "",
+            "list" => "2 5 6 1 2 3\n",
+            _ => "1 2\n",
+        };
         let text = format!("ply\nformat ascii 1.0\n{head}{vertex}end_header\n{body}1 2 3\n");
         let path = dir.path().join(format!("{name}.ply"));
         std::fs::write(&path, text).unwrap();
