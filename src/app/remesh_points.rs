@@ -19,7 +19,6 @@ use crate::mesh::TriMesh;
 use crate::pipeline::RemeshParams;
 use crate::pipeline::{Density, MAX_POINTS};
 use crate::point_pipeline::{remesh_points, PointRemeshParams};
-use crate::points::normals::NormalOrientation;
 use crate::points::source::PointSource;
 use crate::report::{PointSetDistance, QualityReport};
 use crate::surface::MeshSurface;
@@ -37,17 +36,12 @@ pub(super) fn run(
     write: &dyn Fn(&TriMesh) -> Result<()>,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<QualityReport> {
-    // A range map's own camera orients estimated normals when no viewpoint is given.
-    let camera = match job.viewpoint {
-        Some(_) => None,
-        None => source.viewpoint().map_err(|e| with_path(e, &job.input))?,
-    };
+    let (orientation, camera) = source
+        .orientation(job.viewpoint)
+        .map_err(|e| with_path(e, &job.input))?;
     let params = PointRemeshParams {
         remesh: job.params,
-        orientation: match job.viewpoint.or(camera) {
-            Some(v) => NormalOrientation::Viewpoint(v),
-            None => NormalOrientation::SpanningTree,
-        },
+        orientation,
         ..PointRemeshParams::default()
     };
     if let (Some(limit), Density::Points(n)) = (job.max_memory, job.params.density) {

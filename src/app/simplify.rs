@@ -8,7 +8,6 @@ use std::time::Instant;
 use glam::DVec3;
 
 use crate::error::{Error, Result};
-use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{simplify_out_of_core, simplify_progressive, OutOfCoreParams};
 use crate::points::source::PointSource;
 use crate::points::{PlyPointWriter, PointReader};
@@ -123,17 +122,10 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
             message: format!("{} has no normals; sigma_n needs them", job.input.display()),
         });
     }
-    // A range map's own camera orients estimated normals when no viewpoint is given.
-    let camera = match job.viewpoint {
-        Some(_) => None,
-        None => PointSource::File(job.input.clone()).viewpoint()?,
-    };
+    let (orientation, _) = PointSource::File(job.input.clone()).orientation(job.viewpoint)?;
     let params = OutOfCoreParams {
         resample: job.resample,
-        orientation: match job.viewpoint.or(camera) {
-            Some(v) => NormalOrientation::Viewpoint(v),
-            None => NormalOrientation::SpanningTree,
-        },
+        orientation,
         target: match job.density {
             SimplifyDensity::Points(n) => Some(n),
             _ => None,

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
+use super::normals::NormalOrientation;
 use super::stream::{Point, PointReader};
 use crate::error::Result;
 
@@ -66,6 +67,24 @@ impl PointSource {
             }
             _ => Ok(None),
         }
+    }
+
+    /// How normals estimated for these points are oriented: towards `given` (model units) when
+    /// there is one, else towards the range map's camera ([`PointSource::viewpoint`]) when
+    /// there is one, else by the spanning tree. Also returns the camera when it is the one used.
+    ///
+    /// # Errors
+    /// Those of [`PointSource::viewpoint`].
+    pub fn orientation(&self, given: Option<DVec3>) -> Result<(NormalOrientation, Option<DVec3>)> {
+        let camera = match given {
+            Some(_) => None,
+            None => self.viewpoint()?,
+        };
+        let orientation = match given.or(camera) {
+            Some(v) => NormalOrientation::Viewpoint(v),
+            None => NormalOrientation::SpanningTree,
+        };
+        Ok((orientation, camera))
     }
 
     /// A reader from the first point.

@@ -94,14 +94,14 @@ impl Scalar {
     }
 }
 
-/// The viewpoint from a camera record's `view_px view_py view_pz` values (`None` for a missing
-/// or non-finite one).
-fn camera_viewpoint<'a>(mut xyz: impl Iterator<Item = Option<&'a f64>>) -> Option<DVec3> {
-    let mut v = [0.0; 3];
-    for c in &mut v {
-        *c = *xyz.next()??;
-    }
-    let v = DVec3::from(v);
+/// The viewpoint from a camera record's `values` at `slots` (those of `view_px view_py
+/// view_pz`); `None` for a missing or non-finite one.
+fn camera_viewpoint(slots: &[usize], values: &[f64]) -> Option<DVec3> {
+    let v = DVec3::new(
+        *values.get(slots[0])?,
+        *values.get(slots[1])?,
+        *values.get(slots[2])?,
+    );
     v.is_finite().then_some(v)
 }
 
@@ -207,7 +207,7 @@ impl PointReader {
                                 .split_whitespace()
                                 .map(|v| v.parse().unwrap_or(f64::NAN))
                                 .collect();
-                            viewpoint = camera_viewpoint(slots.iter().map(|&i| values.get(i)));
+                            viewpoint = camera_viewpoint(slots, &values);
                         }
                     }
                 }
@@ -241,7 +241,7 @@ impl PointReader {
                             .iter()
                             .map(|&(at, scalar)| scalar.decode(&record[at..], little))
                             .collect();
-                        viewpoint = camera_viewpoint(slots.iter().map(|&i| values.get(i)));
+                        viewpoint = camera_viewpoint(slots, &values);
                     }
                     let copied = std::io::copy(&mut (&mut input).take(skip), &mut std::io::sink())
                         .map_err(|e| Error::io(path, e))?;
