@@ -1,5 +1,7 @@
 """The bounds of issue 17 at default settings, seeds 1-5: every angle in [35°, 100°], Qave >= 0.94,
-Hausdorff <= 0.2% of the input's bounding-box diagonal, the vertex count within 1% of --points.
+Hausdorff <= 0.2% of the input's bounding-box diagonal, the vertex count within 1% of --points;
+and (issue 55) no self-intersection by CGAL's `self_intersections` (eval/cgal_ruler.py), beside
+our report's count.
 
 Runs `remesh IN OUT --points N --seed S --report R.json` (the release binary, or $REMESH_BIN) on
 the shared models at the eval harness's counts and writes a table per model (one row per seed,
@@ -20,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+import cgal_ruler
 from compare import DEFAULT_MODELS, HERE, REMESH, SHARED
 
 # The models of the eval harness and their counts, by name.
@@ -51,7 +54,13 @@ def run(model, n, seed, work):
     seconds = time.perf_counter() - t
     r = json.loads(rep.read_text())
     t = r["triangles"]
+    cgal = cgal_ruler.check(out)
     return {
+        "pairs": r["self_intersections"]["pairs"],
+        "cgal_pairs": cgal["pairs"],
+        "cgal_error": cgal["error"],
+        "cgal_agrees": cgal_ruler.agrees(r["self_intersections"]["pairs"], cgal,
+                                         cgal_ruler.degenerate_count(r)),
         "seed": seed,
         "theta_min": t["theta_min"],
         "theta_max": t["theta_max"],
@@ -73,6 +82,10 @@ def verdicts(rows, n, diag):
         f"Qave ≥ {Q_AVE:g}": (min(r["q_ave"] for r in rows) >= Q_AVE, f"{min(r['q_ave'] for r in rows):.4f}"),
         f"Hausdorff ≤ {h_bound:.3f} (0.2% diag)": (max(r["hausdorff"] for r in rows) <= h_bound, f"{max(r['hausdorff'] for r in rows):.3f}"),
         f"count within {COUNT_PCT:g}%": (worst_count <= COUNT_PCT, f"{worst_count:.2f}%"),
+        "CGAL finds no self-intersection": (
+            all(r["cgal_pairs"] == 0 for r in rows),
+            f"{max((r['cgal_pairs'] for r in rows if r['cgal_pairs'] is not None), default='-')} pairs"
+            + ("" if all(r["cgal_agrees"] for r in rows) else ", disagrees with our report")),
     }
 
 
@@ -98,13 +111,15 @@ def main():
             results[model] = {"count": n, "diagonal": float(diag), "rows": rows,
                               "bounds": {k: {"holds": bool(ok), "worst": w} for k, (ok, w) in v.items()}}
             lines += [f"## {model} at {n} (diagonal {diag:.1f})", "",
-                      "| seed | θmin | θmax | Qave | Hausdorff | RMS | V | seconds |", "|---|---|---|---|---|---|---|---|"]
+                      "| seed | θmin | θmax | Qave | Hausdorff | RMS | V | crossing pairs (ours / CGAL) | seconds |",
+                      "|---|---|---|---|---|---|---|---|---|"]
             for r in rows:
                 lines.append(f"| {r['seed']} | {r['theta_min']:.2f} | {r['theta_max']:.2f} | {r['q_ave']:.4f} | "
-                             f"{r['hausdorff']:.3f} | {r['rms']:.4f} | {r['vertices']} | {r['seconds']:.2f} |")
+                             f"{r['hausdorff']:.3f} | {r['rms']:.4f} | {r['vertices']} | "
+                             f"{r['pairs']} / {'-' if r['cgal_pairs'] is None else r['cgal_pairs']} | {r['seconds']:.2f} |")
             med = lambda k: statistics.median(r[k] for r in rows)
             lines.append(f"| median | {med('theta_min'):.2f} | {med('theta_max'):.2f} | {med('q_ave'):.4f} | "
-                         f"{med('hausdorff'):.3f} | {med('rms'):.4f} | {med('vertices'):.0f} | {med('seconds'):.2f} |")
+                         f"{med('hausdorff'):.3f} | {med('rms'):.4f} | {med('vertices'):.0f} | | {med('seconds'):.2f} |")
             lines.append("")
             for k, (ok, w) in v.items():
                 lines.append(f"- {k}: {'holds' if ok else 'NOT met'} (worst seed: {w})")

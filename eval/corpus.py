@@ -11,13 +11,16 @@ Run through eval/corpus (it builds remesh):
 Each run is `remesh FILE OUT.obj --points N --seed S -q --no-distance --report R.json`, capped at
 --timeout seconds of wall time. The input is checked once with `remesh quality FILE --json` (its
 crossing face pairs), and every written output with `remesh quality OUT.obj --json`, which must
-agree with the run's own report on crossings and invariant violations.
+agree with the run's own report on crossings and invariant violations, and with CGAL's
+`does_self_intersect` and `self_intersections` (eval/cgal_ruler.py, a ruler we did not write:
+the same pair count, CGAL's degenerate faces counted with ours; column `cgal`: its pair count,
+`-` where it could not build a polyhedron from the file). `--no-cgal` leaves CGAL out.
 
 Outcomes of a run, worst first:
   timeout    over --timeout seconds
   crash      a non-zero exit other than 3 (a refusal), or a message of more than one line
   disagree   the run's report and `remesh quality` of the file it wrote differ (crossing pairs or
-             invariant violations)
+             invariant violations), or CGAL's count of self-intersecting pairs differs from ours
   violation  exit 0, and the output breaks an invariant, or its faces cross where the input's
              neither cross nor meet (the report's extra.output_crossings counts the pairs that lie
              where the input's own faces cross or its parts meet at a non-manifold edge)
@@ -43,6 +46,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import cgal_ruler
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 FORMATS = {".obj", ".ply", ".stl", ".off", ".gltf", ".glb"}
@@ -59,6 +64,7 @@ def parse_args():
     ap.add_argument("--min-angle", type=float, default=35.0)
     ap.add_argument("--max-angle", type=float, default=100.0)
     ap.add_argument("--json", help="also write the rows as JSON to this file")
+    ap.add_argument("--no-cgal", action="store_true", help="skip CGAL's self-intersection test")
     return ap.parse_args()
 
 
@@ -152,8 +158,12 @@ def one_run(binary, path, seed, args, tmp, input_pairs):
     row["theta_min"] = min((a for a, _ in faces), default=float("nan"))
     row["theta_max"] = max((b for _, b in faces), default=float("nan"))
     row["outside"] = sum(1 for a, b in faces if a < args.min_angle or b > args.max_angle)
+    if not args.no_cgal:
+        row["cgal"] = cgal_ruler.check(out, args.timeout)
+        row["cgal_agrees"] = cgal_ruler.agrees(row["pairs"], row["cgal"],
+                                               cgal_ruler.degenerate_count(report))
     if check is None or check["self_intersections"]["pairs"] != row["pairs"] or violations_key(
-            check) != violations_key(report):
+            check) != violations_key(report) or row.get("cgal_agrees") is False:
         row["outcome"] = "disagree"
         row["check"] = None if check is None else {
             "pairs": check["self_intersections"]["pairs"],
@@ -201,7 +211,7 @@ def main():
     rows = []
     pass_time = {s: 0.0 for s in seeds}
     slow = []
-    print(f"{'file':34} {'outcome':10} {'wall med/max s':>15} {'θmin':>6} {'θmax':>6} {'outside':>7}  topology change / message")
+    print(f"{'file':34} {'outcome':10} {'wall med/max s':>15} {'θmin':>6} {'θmax':>6} {'outside':>7} {'cgal':>5}  topology change / message")
     with tempfile.TemporaryDirectory(prefix="remesh-corpus-") as tmp:
         for path in files:
             q = quality(binary, path, args.timeout)
@@ -225,8 +235,11 @@ def main():
                 note = worst["message"].splitlines()[0][:90] if worst["message"] else f"exit {worst['exit']}"
             if worst["outcome"] in ("violation", "crossings", "disagree"):
                 note = f"pairs {worst.get('pairs')} ({worst.get('pairs_where_input_crosses', 0)} at the input's; input {input_pairs}) {','.join(sorted(set(worst.get('violations', []))))} " + note
+            cgal = [r["cgal"]["pairs"] for r in done if r.get("cgal")]
+            cgal_text = "" if args.no_cgal else (
+                "-" if not cgal or any(c is None for c in cgal) else str(max(cgal)))
             print(f"{path.name[:34]:34} {worst['outcome']:10} {statistics.median(walls):7.2f}/{max(walls):6.2f}"
-                  f" {tmin:6.1f} {tmax:6.1f} {outside:7d}  {note}", flush=True)
+                  f" {tmin:6.1f} {tmax:6.1f} {outside:7d} {cgal_text:>5}  {note}", flush=True)
             rows.append({"file": str(path.relative_to(corpus)), "input_faces": input_faces,
                          "input_pairs": input_pairs, "runs": runs})
     all_runs = [r for row in rows for r in row["runs"]]
@@ -236,6 +249,13 @@ def main():
     print("files by worst outcome: " + ", ".join(
         f"{o} {sum(1 for row in rows if min(row['runs'], key=lambda r: ORDER.index(r['outcome']))['outcome'] == o)}"
         for o in ORDER))
+    if not args.no_cgal:
+        checked = [r for r in all_runs if "cgal_agrees" in r]
+        print(f"outputs CGAL checked: {sum(1 for r in checked if r['cgal_agrees'] is not None)} of "
+              f"{len(checked)} written; CGAL and our report disagree on "
+              f"{sum(1 for r in checked if r['cgal_agrees'] is False)}; CGAL finds a self-intersection in "
+              f"{sum(1 for r in checked if (r['cgal'].get('self_intersects') or False))}; no answer from CGAL: "
+              f"{sum(1 for r in checked if r['cgal_agrees'] is None)}")
     print(f"runs over 5 s (inputs under 200k faces): {len(slow)}"
           + ("".join(f"\n  {n} seed {s}: {w:.1f} s" for n, s, w in slow)))
     print("total wall time per pass over the corpus: " + ", ".join(

@@ -15,7 +15,8 @@ Cases (the point sets are made here, in a temporary folder, from a fixed seed):
 - `horse-nn`, `horse-noisy` (only when asked for: --cases): 1M horse points without normals, and
   with Gaussian noise of 0.1% of the diagonal and 1% outliers -> 10k, Hausdorff to horse.obj.
 
-Per run: vertices (and the count's error), parts, loops, genus, manifold, crossing pairs, θmin,
+Per run: vertices (and the count's error), parts, loops, genus, manifold, crossing pairs (our
+report's, and CGAL's `self_intersections` as an independent ruler: eval/cgal_ruler.py), θmin,
 θmin of the faces with no boundary vertex ("inner"), the widest gap a face spans (the farthest
 point of a face - centroid or edge midpoint - from every input point, in output spacings:
 a face across a hole 3 spacings wide reaches 1.5), Hausdorff (bbox-100), seconds. For face000 also
@@ -37,6 +38,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 from scipy.spatial import cKDTree
+
+import cgal_ruler
 
 ROOT = Path(__file__).resolve().parent.parent
 SHARED = ROOT.parent / "shared" / "data"
@@ -157,6 +160,7 @@ def regions_covered(ref_mesh, V, F, spacing):
 
 
 def measure(out_path, pts, ref, n, seconds, report):
+    cgal = cgal_ruler.check(out_path)
     m = trimesh.load(out_path, process=False)
     V, F = np.asarray(m.vertices), np.asarray(m.faces)
     e = np.vstack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
@@ -178,6 +182,9 @@ def measure(out_path, pts, ref, n, seconds, report):
         "genus": topo["genus"],
         "manifold": topo["non_manifold_edges"] == 0 and topo["non_manifold_vertices"] == 0,
         "crossings": report["self_intersections"]["pairs"],
+        "cgal_pairs": cgal["pairs"],
+        "cgal_agrees": cgal_ruler.agrees(report["self_intersections"]["pairs"], cgal,
+                                         cgal_ruler.degenerate_count(report)),
         "theta_min": tri["theta_min"],
         "theta_min_inner": float(th[inner].min()) if inner.any() else None,
         "q_ave": tri["q_ave"],
@@ -239,7 +246,8 @@ def main():
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "scans.json").write_text(json.dumps(rows, indent=1))
-    cols = ["vertices", "count_error_pct", "parts", "loops", "genus", "manifold", "crossings", "theta_min",
+    cols = ["vertices", "count_error_pct", "parts", "loops", "genus", "manifold", "crossings", "cgal_pairs",
+            "cgal_agrees", "theta_min",
             "theta_min_inner", "q_ave", "gap_spacings", "hausdorff", "regions", "regions_split", "seconds"]
     lines = ["# Real scans to meshes (issue 39)", "",
              f"`eval/.venv/bin/python3 eval/scans.py --cases {a.cases} --seeds {a.seeds}`. Per case, the "

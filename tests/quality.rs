@@ -873,6 +873,9 @@ fn shared_models_match_the_data_readme() {
         problems[0],
         Violation::Crossing {
             count: 2,
+            apart: 2,
+            at_vertex: 0,
+            along_edge: 0,
             f: 70686,
             g: 71145
         }

@@ -90,11 +90,19 @@ pub enum Violation {
         /// The first such vertex.
         vertex: usize,
     },
-    /// Pairs of non-adjacent faces that intersect
-    /// ([`self_intersections`](super::self_intersections)); the first pair is `f`, `g`, f < g.
+    /// Pairs of faces that intersect
+    /// ([`self_intersections`](super::self_intersections): faces that share no vertex and
+    /// meet, share one and meet elsewhere too, or share an edge and overlap); the first pair is
+    /// `f`, `g`, f < g.
     Crossing {
-        /// Intersecting pairs.
+        /// Intersecting pairs (all kinds).
         count: usize,
+        /// Of them, pairs of faces with no vertex in common.
+        apart: usize,
+        /// Pairs of faces with one vertex in common that meet elsewhere too.
+        at_vertex: usize,
+        /// Pairs of faces with an edge in common that overlap.
+        along_edge: usize,
         /// The first face of the first pair.
         f: u32,
         /// The second face of the first pair.
@@ -148,14 +156,10 @@ impl fmt::Display for Violation {
                 "{} used by no face (first: vertex {vertex})",
                 plural(count, "vertex", "vertices")
             ),
-            Violation::Crossing { count, f, g } => write!(
+            Violation::Crossing { count, apart, at_vertex, along_edge, f, g } => write!(
                 out,
-                "{} (first: faces {f} and {g})",
-                plural(
-                    count,
-                    "pair of non-adjacent faces intersects",
-                    "pairs of non-adjacent faces intersect"
-                )
+                "{} ({apart} apart, {at_vertex} at a shared vertex, {along_edge} along a shared edge) (first: faces {f} and {g})",
+                plural(count, "pair of faces intersects", "pairs of faces intersect")
             ),
         }
     }
@@ -169,8 +173,9 @@ impl fmt::Display for Violation {
 /// ([`is_degenerate_face`](crate::geometry::triangle::is_degenerate_face)); no duplicate face;
 /// every edge in at most 2 faces; every vertex a single fan (see
 /// [`Topology::non_manifold_vertices`](super::Topology)); every interior edge traversed once
-/// each way (consistent orientation); no unreferenced vertex; no two non-adjacent faces sharing
-/// a point ([`self_intersections`](super::self_intersections): exact, through a BVH).
+/// each way (consistent orientation); no unreferenced vertex; no two faces that intersect
+/// ([`self_intersections`](super::self_intersections): the standard definition, exact, through
+/// a BVH).
 /// Boundaries are allowed (an open mesh passes), and so is an empty mesh.
 pub fn check_invariants(mesh: &TriMesh) -> Vec<Violation> {
     violations(mesh, &analyze(mesh), &self_intersections(mesh))
@@ -249,6 +254,9 @@ fn violations(mesh: &TriMesh, a: &Analysis, crossings: &SelfIntersections) -> Ve
     if let Some([f, g]) = crossings.first {
         out.push(Violation::Crossing {
             count: crossings.pairs,
+            apart: crossings.apart,
+            at_vertex: crossings.at_vertex,
+            along_edge: crossings.along_edge,
             f,
             g,
         });

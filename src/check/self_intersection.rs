@@ -2,30 +2,59 @@
 
 use serde::Serialize;
 
-use crate::geometry::self_intersection::intersecting_pairs_counted;
+use crate::geometry::self_intersection::classified_pairs;
+use crate::geometry::PairKind;
 use crate::mesh::TriMesh;
 
 /// The outcome of [`self_intersections`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct SelfIntersections {
-    /// Pairs of non-adjacent faces (no vertex index in common) whose closed triangles share at
-    /// least one point: they cross, or touch at a point, along an edge or in a common area.
+    /// Pairs of faces that intersect by the standard definition
+    /// ([`faces_intersect`](crate::geometry::faces_intersect)): they share no vertex and their
+    /// closed triangles share a point, share one vertex and meet elsewhere too, or share an edge
+    /// and overlap. The sum of the three counts below.
     pub pairs: usize,
+    /// Of those, pairs of faces with no vertex in common (they cross or touch).
+    pub apart: usize,
+    /// Pairs of faces with one vertex in common that meet elsewhere too (a fan folded over
+    /// itself).
+    pub at_vertex: usize,
+    /// Pairs of faces with an edge in common that overlap (a face folded flat onto its
+    /// neighbour).
+    pub along_edge: usize,
     /// The first such pair `[f, g]`, f < g, in lexicographic order.
     pub first: Option<[u32; 2]>,
-    /// Pairs of non-adjacent faces whose bounding boxes overlap: the exact tests made.
+    /// The kind of the first pair.
+    pub first_kind: Option<PairKind>,
+    /// Pairs of faces whose bounding boxes overlap: the exact tests made.
     pub candidates: usize,
 }
 
-/// Finds the pairs of non-adjacent faces of `mesh` that intersect (see [`SelfIntersections`];
-/// the search is [`intersecting_pairs_counted`]: a BVH and exact predicates, parallel and
-/// deterministic). Faces with an index out of range, a non-finite corner or zero area are left
-/// out (the invariant check reports them on their own).
+impl SelfIntersections {
+    /// The pairs of `kind`.
+    pub fn of_kind(&self, kind: PairKind) -> usize {
+        match kind {
+            PairKind::Apart => self.apart,
+            PairKind::AtVertex => self.at_vertex,
+            PairKind::AlongEdge => self.along_edge,
+        }
+    }
+}
+
+/// Finds the pairs of faces of `mesh` that intersect (see [`SelfIntersections`]; the search is
+/// [`classified_pairs`]: a BVH and exact predicates, parallel and deterministic). Faces with an
+/// index out of range, a non-finite corner or zero area, and pairs of faces on the same three
+/// vertices, are left out (the invariant check reports them on their own).
 pub fn self_intersections(mesh: &TriMesh) -> SelfIntersections {
-    let (pairs, candidates) = intersecting_pairs_counted(&mesh.positions, &mesh.triangles);
+    let (pairs, candidates) = classified_pairs(&mesh.positions, &mesh.triangles);
+    let count = |k: PairKind| pairs.iter().filter(|p| p.1 == k).count();
     SelfIntersections {
         pairs: pairs.len(),
-        first: pairs.first().copied(),
+        apart: count(PairKind::Apart),
+        at_vertex: count(PairKind::AtVertex),
+        along_edge: count(PairKind::AlongEdge),
+        first: pairs.first().map(|p| p.0),
+        first_kind: pairs.first().map(|p| p.1),
         candidates,
     }
 }

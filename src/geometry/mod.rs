@@ -7,6 +7,7 @@
 
 pub(crate) mod bvh;
 pub(crate) mod closest_point_tree;
+pub(crate) mod face_intersection;
 pub(crate) mod morton;
 pub(crate) mod plane;
 pub(crate) mod self_intersection;
@@ -14,6 +15,7 @@ pub(crate) mod tolerance;
 pub(crate) mod triangle;
 pub(crate) mod triangle_intersection;
 
+pub use face_intersection::{faces_intersect, PairKind};
 pub use plane::tangent_basis;
 pub use self_intersection::{intersecting_pairs, intersecting_pairs_counted};
 pub use tolerance::{

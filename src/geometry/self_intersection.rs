@@ -1,14 +1,15 @@
-//! The pairs of non-adjacent triangles of an indexed triangle set that share a point, found
-//! through a bounding-volume hierarchy (parry's) and decided by exact predicates
-//! ([`triangles_intersect`]).
+//! The pairs of faces of an indexed triangle set that intersect by the standard definition
+//! ([`faces_intersect`]: faces that share no vertex and meet, share one vertex and meet elsewhere
+//! too, or share an edge and overlap), found through a bounding-volume hierarchy (parry's) and
+//! decided by exact predicates.
 
 use glam::DVec3;
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::partitioning::Bvh;
 use rayon::prelude::*;
 
+use super::face_intersection::{faces_intersect, faces_within, PairKind};
 use super::triangle::is_degenerate_face;
-use super::triangle_intersection::{triangles_intersect, triangles_within};
 
 /// The pairs of `boxes` (items of [`face_boxes`]: a face index and its bounding box) whose
 /// closed boxes overlap, each once as `[f, g]` with f < g (face indices), sorted. The boxes go
@@ -29,80 +30,80 @@ pub(crate) fn overlapping_box_pairs(boxes: &[(usize, Aabb)]) -> Vec<[u32; 2]> {
     pairs
 }
 
-/// The pairs of non-adjacent triangles of `triangles` (indices into `positions`) whose closed
-/// triangles share at least one point (they cross, or touch at a point, along an edge or in a
-/// common area), as `[f, g]` with f < g in lexicographic order, and the number of exact tests
-/// made (pairs of non-adjacent faces whose bounding boxes overlap).
+/// The pairs of faces of `triangles` (indices into `positions`) that intersect
+/// ([`faces_intersect`]: no vertex in common and their closed triangles share a point; one in
+/// common and they meet elsewhere too; an edge in common and they overlap), each as `[f, g]`
+/// with f < g with its [`PairKind`], in lexicographic order, and the number of exact tests made
+/// (pairs of faces whose bounding boxes overlap).
 ///
 /// Triangles with an index out of range, a non-finite corner or zero area
 /// ([`is_degenerate_face`]) are left out (the invariant check reports them on their own), and so
-/// are pairs that share a vertex index, since adjacent triangles meet by construction.
+/// are pairs of faces with the same three vertices (duplicate faces, reported on their own too).
 ///
 /// # Runtime
 /// The pairs of overlapping bounding boxes come from a BVH traversed against itself
-/// (parry's parallel BVTT), and every non-adjacent one is decided by
-/// [`triangles_intersect`], which is exact. O(F + pairs) for a mesh whose triangles are small
-/// against the model; parallel (rayon), and deterministic.
-pub fn intersecting_pairs_counted(
+/// (parry's parallel BVTT), and every one is decided by [`faces_intersect`], which is exact.
+/// O(F + pairs) for a mesh whose triangles are small against the model; parallel (rayon), and
+/// deterministic.
+pub fn classified_pairs(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
-) -> (Vec<[u32; 2]>, usize) {
-    let candidates = non_adjacent_pairs(positions, triangles, 0.0);
-    let pairs: Vec<[u32; 2]> = candidates
+) -> (Vec<([u32; 2], PairKind)>, usize) {
+    let candidates = box_pairs(positions, triangles, 0.0);
+    let pairs: Vec<([u32; 2], PairKind)> = candidates
         .par_iter()
-        .copied()
-        .filter(|&[f, g]| {
-            triangles_intersect(
-                corners(positions, triangles, f),
-                corners(positions, triangles, g),
-            )
+        .filter_map(|&[f, g]| {
+            let (a, b) = (triangles[f as usize], triangles[g as usize]);
+            faces_intersect(a, corners(positions, a), b, corners(positions, b)).map(|k| ([f, g], k))
         })
         .collect();
     (pairs, candidates.len())
 }
 
-/// The pairs of [`intersecting_pairs`] and the pairs of non-adjacent faces that come within
-/// `near` of each other ([`triangles_within`]; the same units as `positions`), in the same
-/// order: the faces that may share a point once their corners are rounded by up to `near / 2`.
-/// Boxes loosened by `near / 2` each; the same cost as [`intersecting_pairs_counted`] for a
-/// `near` short against the faces.
+/// The intersecting pairs of [`classified_pairs`] without their kinds, and the number of exact
+/// tests made.
+pub fn intersecting_pairs_counted(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> (Vec<[u32; 2]>, usize) {
+    let (pairs, candidates) = classified_pairs(positions, triangles);
+    (pairs.into_iter().map(|(p, _)| p).collect(), candidates)
+}
+
+/// The pairs of [`intersecting_pairs`] and the pairs of faces that come within `near` of
+/// intersecting ([`faces_within`]; the same units as `positions`), in the same order: the faces
+/// that may intersect once their corners are rounded by up to `near / 2`. Boxes loosened by
+/// `near / 2` each; the same cost as [`intersecting_pairs_counted`] for a `near` short against
+/// the faces.
 pub(crate) fn pairs_within(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
     near: f64,
 ) -> Vec<[u32; 2]> {
-    non_adjacent_pairs(positions, triangles, near)
+    box_pairs(positions, triangles, near)
         .into_par_iter()
         .filter(|&[f, g]| {
-            triangles_within(
-                corners(positions, triangles, f),
-                corners(positions, triangles, g),
-                near,
-            )
+            let (a, b) = (triangles[f as usize], triangles[g as usize]);
+            faces_within(a, corners(positions, a), b, corners(positions, b), near).is_some()
         })
         .collect()
 }
 
-/// The corners of face `f`.
-fn corners(positions: &[DVec3], triangles: &[[u32; 3]], f: u32) -> [DVec3; 3] {
-    triangles[f as usize].map(|i| positions[i as usize])
+/// The corners of the face with vertex indices `t`.
+fn corners(positions: &[DVec3], t: [u32; 3]) -> [DVec3; 3] {
+    t.map(|i| positions[i as usize])
 }
 
-/// The pairs of faces of [`face_boxes`] whose bounding boxes overlap and that share no vertex
-/// index, as [`overlapping_box_pairs`] gives them, each box loosened by `near / 2`.
-fn non_adjacent_pairs(positions: &[DVec3], triangles: &[[u32; 3]], near: f64) -> Vec<[u32; 2]> {
+/// The pairs of faces of [`face_boxes`] whose bounding boxes overlap, as
+/// [`overlapping_box_pairs`] gives them, each box loosened by `near / 2`.
+fn box_pairs(positions: &[DVec3], triangles: &[[u32; 3]], near: f64) -> Vec<[u32; 2]> {
     let mut boxes = face_boxes(positions, triangles);
     if near > 0.0 {
         for (_, b) in &mut boxes {
             *b = b.loosened(0.5 * near);
         }
     }
-    let mut pairs = overlapping_box_pairs(&boxes);
-    pairs.retain(|&[f, g]| {
-        let tf = triangles[f as usize];
-        !tf.iter().any(|i| triangles[g as usize].contains(i))
-    });
-    pairs
+    overlapping_box_pairs(&boxes)
 }
 
 /// The axis-aligned bounding box of the triangle with corners `p`.
@@ -144,15 +145,13 @@ pub(crate) fn has_intersecting_pair(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
 ) -> bool {
-    let corners = |f: usize| triangles[f].map(|i| positions[i as usize]);
     boxes.par_chunks(CHUNK).any(|chunk| {
         chunk.iter().any(|&(f, aabb)| {
-            let tf = triangles[f];
+            let a = triangles[f];
             bvh.intersect_aabb(&aabb).any(|g| {
-                let g = g as usize;
-                g > f
-                    && !tf.iter().any(|i| triangles[g].contains(i))
-                    && triangles_intersect(corners(f), corners(g))
+                let b = triangles[g as usize];
+                g as usize > f
+                    && faces_intersect(a, corners(positions, a), b, corners(positions, b)).is_some()
             })
         })
     })
@@ -167,20 +166,19 @@ pub(crate) fn intersecting_pairs_in(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
 ) -> Vec<[u32; 2]> {
-    let corners = |f: usize| triangles[f].map(|i| positions[i as usize]);
     let mut pairs: Vec<[u32; 2]> = boxes
         .par_chunks(CHUNK)
         .flat_map_iter(|chunk| {
             let mut found = Vec::new();
             for &(f, aabb) in chunk {
-                let tf = triangles[f];
+                let a = triangles[f];
                 for g in bvh.intersect_aabb(&aabb) {
-                    let g = g as usize;
-                    if g > f
-                        && !tf.iter().any(|i| triangles[g].contains(i))
-                        && triangles_intersect(corners(f), corners(g))
+                    let b = triangles[g as usize];
+                    if g as usize > f
+                        && faces_intersect(a, corners(positions, a), b, corners(positions, b))
+                            .is_some()
                     {
-                        found.push([f as u32, g as u32]);
+                        found.push([f as u32, g]);
                     }
                 }
             }

@@ -90,28 +90,53 @@ pub(crate) fn triangles_within(a: [DVec3; 3], b: [DVec3; 3], near: f64) -> bool 
 /// from a corner of one to the other triangle and between an edge of one and an edge of the
 /// other.
 fn triangle_distance(a: [DVec3; 3], b: [DVec3; 3]) -> f64 {
-    use parry3d_f64::query::closest_points::closest_points_segment_segment_with_locations_nD;
-    use parry3d_f64::query::PointQuery;
-    use parry3d_f64::shape::{Segment, Triangle};
-    let (ta, tb) = (
-        Triangle::new(a[0], a[1], a[2]),
-        Triangle::new(b[0], b[1], b[2]),
-    );
     let corners = a
         .iter()
-        .map(|&p| tb.distance_to_local_point(p, true))
-        .chain(b.iter().map(|&p| ta.distance_to_local_point(p, true)));
+        .map(|&p| point_triangle_distance(p, b))
+        .chain(b.iter().map(|&p| point_triangle_distance(p, a)));
     let edges = (0..3).flat_map(|i| {
-        (0..3).map(move |j| {
-            let (p0, p1) = (a[i], a[(i + 1) % 3]);
-            let (q0, q1) = (b[j], b[(j + 1) % 3]);
-            let (la, lb) = closest_points_segment_segment_with_locations_nD((&p0, &p1), (&q0, &q1));
-            Segment::new(p0, p1)
-                .point_at(&la)
-                .distance(Segment::new(q0, q1).point_at(&lb))
-        })
+        (0..3).map(move |j| segment_distance(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3]))
     });
     corners.chain(edges).fold(f64::INFINITY, f64::min)
+}
+
+/// The distance from point `p` to the closed triangle `t` (parry's point query).
+pub(crate) fn point_triangle_distance(p: DVec3, t: [DVec3; 3]) -> f64 {
+    use parry3d_f64::query::PointQuery;
+    parry3d_f64::shape::Triangle::new(t[0], t[1], t[2]).distance_to_local_point(p, true)
+}
+
+/// The distance between the closed segments `p0 p1` and `q0 q1` (parry's closest points).
+fn segment_distance(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> f64 {
+    use parry3d_f64::query::closest_points::closest_points_segment_segment_with_locations_nD;
+    use parry3d_f64::shape::Segment;
+    let (la, lb) = closest_points_segment_segment_with_locations_nD((&p0, &p1), (&q0, &q1));
+    Segment::new(p0, p1)
+        .point_at(&la)
+        .distance(Segment::new(q0, q1).point_at(&lb))
+}
+
+/// The distance between the closed segment `p q` and the closed triangle `t` (non-degenerate):
+/// 0 when they meet ([`segment_meets_triangle`], exact), else the least distance from an end of
+/// the segment to the triangle or from the segment to an edge of the triangle.
+pub(crate) fn segment_triangle_distance(p: DVec3, q: DVec3, t: [DVec3; 3]) -> f64 {
+    if segment_meets_triangle(p, q, t) {
+        return 0.0;
+    }
+    let ends = [p, q].map(|x| point_triangle_distance(x, t));
+    let edges = (0..3).map(|k| segment_distance(p, q, t[k], t[(k + 1) % 3]));
+    ends.into_iter().chain(edges).fold(f64::INFINITY, f64::min)
+}
+
+/// Whether `r` and `s`, coplanar with the segment `p q` (`orient(p, q, r, s) == 0`, `p q r` a
+/// non-degenerate triangle), lie strictly on the same side of the line through `p` and `q`,
+/// decided exactly: in the plane's projection along the largest component of its normal, which
+/// keeps incidence and orientation up to sign.
+pub(crate) fn same_side_in_plane(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> bool {
+    let axis = drop_axis([p, q, r]);
+    let [p2, q2, r2, s2] = [p, q, r, s].map(|x| project(x, axis));
+    let (or, os) = (orient_2d(p2, q2, r2), orient_2d(p2, q2, s2));
+    or != 0 && or == os
 }
 
 /// Whether the closed segment `p q` meets the closed triangle `t` (non-degenerate), exactly.

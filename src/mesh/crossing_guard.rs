@@ -9,9 +9,9 @@ use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::partitioning::Bvh;
 
 use super::edit::EditMesh;
+use crate::geometry::face_intersection::faces_within;
 use crate::geometry::self_intersection::triangle_aabb;
 use crate::geometry::triangle::is_degenerate_face;
-use crate::geometry::triangle_intersection::triangles_within;
 
 /// A BVH over the live faces of an edit mesh, by slot (see the module).
 pub(crate) struct CrossingGuard {
@@ -50,9 +50,12 @@ impl CrossingGuard {
     }
 
     /// Calls `visit` with each live face (slot) of `m` that the face `t` with corners `p` (its
-    /// vertices' positions, or where an operation would put them) shares a point with, leaving
-    /// out the slots in `replaced` and the faces with a vertex of `t` (exact test, or nearer
-    /// than the guard's `near`), until `visit` returns true; whether it did.
+    /// vertices' positions, or where an operation would put them) intersects by the standard
+    /// definition ([`faces_within`]: sharing no vertex and meeting, sharing one and meeting
+    /// elsewhere too, sharing an edge and overlapping; exact, or nearer than the guard's `near`),
+    /// leaving out the slots in `replaced`, until `visit` returns true; whether it did. The
+    /// faces sharing a vertex with `t` that are not replaced must have their corners where `p`
+    /// has them (an operation replaces every face around a vertex it moves).
     pub(crate) fn visit_crossed<L: Copy>(
         &self,
         m: &EditMesh<L>,
@@ -69,19 +72,17 @@ impl CrossingGuard {
             let Some(u) = m.face(g) else {
                 return false;
             };
-            !t.iter().any(|v| u.contains(v))
-                && triangles_within(p, m.corners(u), self.near)
-                && visit(g)
+            faces_within(t, p, u, m.corners(u), self.near).is_some() && visit(g)
         });
         found
     }
 
-    /// The pairs `[f, g]` (slots, f < g) of live faces that share a point or come within the
-    /// guard's `near` with at least one of them in `faces`: the pairs of
-    /// [`pairs_within`](crate::geometry::self_intersection::pairs_within) over the live faces
-    /// that touch `faces`, decided by the same test with the smaller slot first (faces sharing a
-    /// vertex, degenerate faces and faces with a corner not finite left out). Sorted, each
-    /// once. The guard must know every face's current box ([`Self::changed`]).
+    /// The pairs `[f, g]` (slots, f < g) of live faces that intersect or come within the
+    /// guard's `near` of intersecting ([`faces_within`]) with at least one of them in `faces`:
+    /// the pairs of [`pairs_within`](crate::geometry::self_intersection::pairs_within) over the
+    /// live faces that touch `faces`, decided by the same test with the smaller slot first
+    /// (degenerate faces and faces with a corner not finite left out). Sorted, each once. The
+    /// guard must know every face's current box ([`Self::changed`]).
     pub(crate) fn pairs_with<L: Copy>(&self, m: &EditMesh<L>, faces: &[u32]) -> Vec<[u32; 2]> {
         let p = m.positions();
         let usable =
@@ -96,11 +97,8 @@ impl CrossingGuard {
                 let Some(u) = m.face(g).filter(|&u| g != f && usable(u)) else {
                     continue;
                 };
-                if t.iter().any(|v| u.contains(v)) {
-                    continue;
-                }
                 let (a, b) = if f < g { (t, u) } else { (u, t) };
-                if triangles_within(m.corners(a), m.corners(b), self.near) {
+                if faces_within(a, m.corners(a), b, m.corners(b), self.near).is_some() {
                     pairs.push([f.min(g), f.max(g)]);
                 }
             }
@@ -153,18 +151,45 @@ impl CrossingGuard {
         n
     }
 
-    /// Whether one of `faces` (at the mesh's current positions) shares a point with a live face
-    /// of `m` that is not in `replaced` and has no vertex in common with it.
+    /// Whether one of `faces` (at the mesh's current positions: the faces an operation makes in
+    /// place of the slots `replaced`) intersects a live face of `m` that is not in `replaced`
+    /// ([`Self::visit_crossed`]), or another of `faces` ([`new_faces_intersect`]).
     pub(crate) fn crosses<L: Copy>(
         &self,
         m: &EditMesh<L>,
         faces: &[[u32; 3]],
         replaced: &[u32],
     ) -> bool {
-        faces
-            .iter()
-            .any(|&t| self.visit_crossed(m, t, m.corners(t), replaced, |_| true))
+        new_faces_intersect(faces, |t| m.corners(t), self.near)
+            || faces
+                .iter()
+                .any(|&t| self.visit_crossed(m, t, m.corners(t), replaced, |_| true))
     }
+}
+
+/// Whether two of `faces` (vertex indices; `corners` gives each one's corners) intersect or come
+/// within `near` of intersecting ([`faces_within`]): the faces an operation makes, among
+/// themselves (a fan moved around its vertex may fold over itself). Degenerate faces are left
+/// out, as everywhere.
+pub(crate) fn new_faces_intersect(
+    faces: &[[u32; 3]],
+    corners: impl Fn([u32; 3]) -> [DVec3; 3],
+    near: f64,
+) -> bool {
+    let usable = |t: [u32; 3]| {
+        let p = corners(t);
+        p.iter().all(|x| x.is_finite())
+            && !crate::geometry::triangle::is_degenerate_triangle(p)
+            && t[0] != t[1]
+            && t[1] != t[2]
+            && t[0] != t[2]
+    };
+    faces.iter().enumerate().any(|(i, &a)| {
+        usable(a)
+            && faces[i + 1..]
+                .iter()
+                .any(|&b| usable(b) && faces_within(a, corners(a), b, corners(b), near).is_some())
+    })
 }
 
 #[cfg(test)]

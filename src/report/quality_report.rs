@@ -14,6 +14,7 @@ use crate::check::{
 };
 #[cfg(doc)]
 use crate::check::{check_invariants, self_intersections};
+use crate::geometry::PairKind;
 use crate::mesh::TriMesh;
 
 /// The wall-clock time of one pipeline stage.
@@ -79,7 +80,7 @@ pub struct QualityReport {
     pub triangles: TriangleQuality,
     /// Topology of the output ([`topology`]).
     pub topology: Topology,
-    /// Pairs of non-adjacent output faces that intersect ([`self_intersections`]).
+    /// Pairs of output faces that intersect, by kind ([`self_intersections`]).
     pub self_intersections: SelfIntersections,
     /// The output's violated invariants ([`check_invariants`]), one per kind; empty when all
     /// hold. Serialized with a `kind` tag and the variant's fields.
@@ -265,11 +266,17 @@ impl fmt::Display for QualityReport {
 
         writeln!(f)?;
         writeln!(f, "Invariants")?;
-        row(
-            f,
-            "self-intersecting face pairs",
-            self.self_intersections.pairs.to_string(),
-        )?;
+        let si = &self.self_intersections;
+        row(f, "self-intersecting face pairs", si.pairs.to_string())?;
+        if si.pairs > 0 {
+            for kind in PairKind::ALL {
+                row(
+                    f,
+                    &format!("  {}", kind.describe()),
+                    si.of_kind(kind).to_string(),
+                )?;
+            }
+        }
         if self.invariant_violations.is_empty() {
             writeln!(
                 f,

@@ -9,12 +9,13 @@
 use glam::DVec3;
 use serde::Serialize;
 
+use crate::geometry::face_intersection::{shared, Shared};
 use crate::geometry::self_intersection::{pairs_within, CrossingRegions};
 use crate::geometry::triangle::{
     is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,
 };
 use crate::geometry::triangle_intersection::triangles_within;
-use crate::mesh::crossing_guard::CrossingGuard;
+use crate::mesh::crossing_guard::{new_faces_intersect, CrossingGuard};
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 
@@ -59,7 +60,7 @@ impl Default for UntangleParams {
 /// What [`untangle`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct UntangleStats {
-    /// Crossing pairs of non-adjacent faces before.
+    /// Intersecting pairs of faces before (all kinds).
     pub pairs_before: usize,
     /// Crossing pairs left after (0 unless the rounds ran out).
     pub pairs_after: usize,
@@ -73,10 +74,12 @@ pub struct UntangleStats {
     pub collapses: usize,
 }
 
-/// Moves vertices of `mesh` (bbox-100 units) until no two non-adjacent faces intersect
-/// ([`intersecting_pairs`](crate::geometry::intersecting_pairs)), nor come within `params.near`
-/// of each other (faces that would touch once written), or `params.max_rounds` rounds have
-/// run. In a round the crossing pairs are taken in order; for a pair that still crosses, the
+/// Moves vertices of `mesh` (bbox-100 units) until no two faces intersect
+/// ([`intersecting_pairs`](crate::geometry::intersecting_pairs): the standard definition), nor
+/// come within `params.near` of intersecting (faces that would touch once written), or
+/// `params.max_rounds` rounds have run. In a round the crossing pairs of faces that share no
+/// vertex are taken in order (a fold, two faces that share a vertex, is left to the collapses);
+/// for a pair that still crosses, the
 /// shortest of four moves separates it (for either face: its corners behind the other's plane
 /// move along that plane's normal to `margin_sigma_p · σ_p` in front of it, or the other face
 /// moves back along its normal until they are; at most `max_step_sigma_p · σ_p` per round). A
@@ -311,7 +314,9 @@ fn collapse_folds(
                     .map(|t| t.map(|u| if u == removed { kept } else { u }))
                     .collect();
                 let corners = |t: [u32; 3]| t.map(|u| if u == kept { at } else { m.position(u) });
-                if fan.iter().any(|&t| is_degenerate_triangle(corners(t))) {
+                if fan.iter().any(|&t| is_degenerate_triangle(corners(t)))
+                    || new_faces_intersect(&fan, corners, near)
+                {
                     continue;
                 }
                 let after: usize = fan
@@ -369,7 +374,7 @@ fn faces_around_both(m: &Mesh, a: u32, b: u32) -> Vec<u32> {
 }
 
 /// The crossing pairs of live faces with at least one face in `faces` (slots), as
-/// untangle counts them (faces sharing a vertex and degenerate faces left out; faces within the
+/// untangle counts them (degenerate faces left out; faces within the
 /// guard's `near` count), found through `guard`.
 fn crossings_around(m: &Mesh, guard: &CrossingGuard, faces: &[u32]) -> usize {
     let p = m.positions();
@@ -408,7 +413,13 @@ fn round_moves(
     let mut total = vec![DVec3::ZERO; positions.len()];
     let corners = |p: &[DVec3], f: u32| triangles[f as usize].map(|v| p[v as usize]);
     for &[f, g] in pairs {
-        if !triangles_within(corners(&positions, f), corners(&positions, g), near) {
+        // A pair that shares a vertex (a fold) is not separated by pushing one face off the
+        // other's plane (the shared corners lie on both): the collapses and the mending after
+        // them take it.
+        let (a, b) = (triangles[f as usize], triangles[g as usize]);
+        if shared(a, b) != Shared::None
+            || !triangles_within(corners(&positions, f), corners(&positions, g), near)
+        {
             continue;
         }
         // Two ways to separate face a from face b: a's corners behind b's plane move forward
