@@ -8,7 +8,7 @@ use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::partitioning::Bvh;
 use rayon::prelude::*;
 
-use super::face_intersection::{faces_intersect, faces_within, PairKind};
+use super::face_intersection::{faces_intersect, faces_within, shared, PairKind, Shared};
 use super::triangle::is_degenerate_face;
 
 /// The pairs of `boxes` (items of [`face_boxes`]: a face index and its bounding box) whose
@@ -233,7 +233,7 @@ impl CrossingRegions {
     }
 
     /// How many of the crossing `pairs` of the faces `triangles` over `positions` (another mesh
-    /// in the same frame, the output) lie in a region: both faces reach into one.
+    /// in the same frame, the output) lie in a region ([`Self::holds_faces`]).
     pub fn count_inside(
         &self,
         positions: &[DVec3],
@@ -243,8 +243,18 @@ impl CrossingRegions {
         let corners = |f: u32| triangles[f as usize].map(|v| positions[v as usize]);
         pairs
             .iter()
-            .filter(|&&[f, g]| self.holds(corners(f), corners(g)))
+            .filter(|&&[f, g]| {
+                let (a, b) = (triangles[f as usize], triangles[g as usize]);
+                self.holds_faces(a, corners(f), b, corners(g))
+            })
             .count()
+    }
+
+    /// Whether the crossing pair of faces `a` and `b` (vertex indices of one mesh) with corners
+    /// `pa` and `pb` is the input's: they share no vertex and both reach into a region. A pair
+    /// that shares a vertex (a fold of the output's own faces) never is.
+    pub fn holds_faces(&self, a: [u32; 3], pa: [DVec3; 3], b: [u32; 3], pb: [DVec3; 3]) -> bool {
+        shared(a, b) == Shared::None && self.holds(pa, pb)
     }
 
     /// Whether the crossing pair of triangles with corners `f` and `g` lies in a region: both

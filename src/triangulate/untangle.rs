@@ -9,7 +9,7 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::geometry::face_intersection::{shared, Shared};
+use crate::geometry::face_intersection::{faces_intersect, shared, Shared};
 use crate::geometry::self_intersection::{pairs_within, CrossingRegions};
 use crate::geometry::triangle::{
     is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,
@@ -88,7 +88,7 @@ pub struct UntangleStats {
 /// pair outside the input's own crossings (`input_crossings`) go back, vertex by vertex: a
 /// press never trades a crossing where the input crosses for one where it does not. A round
 /// that then does not lower the number of crossing pairs, or raises the number outside the
-/// input's crossings, is undone and tried again with moves half as long (never worse than
+/// input's crossings, or the number that intersect (not merely come within `near`), is undone and tried again with moves half as long (never worse than
 /// before). Faces that cross nothing do not move. Then, for pairs still crossing that are not
 /// the input's own (both faces reaching into `input_crossings`, where the input's faces cross
 /// or its parts meet), edges are collapsed (at most `params.max_collapses`; the only change of
@@ -135,6 +135,19 @@ pub fn untangle(
         None => pairs.len(),
     };
     let mut pairs_outside = outside(&mesh.positions, &pairs);
+    // Of the pairs, those that intersect (not merely within `near`): a round never trades
+    // pairs that only come near each other for pairs that intersect.
+    let intersecting = |positions: &[DVec3], pairs: &[[u32; 2]]| {
+        pairs
+            .iter()
+            .filter(|&&[f, g]| {
+                let (a, b) = (triangles[f as usize], triangles[g as usize]);
+                let c = |t: [u32; 3]| t.map(|v| positions[v as usize]);
+                faces_intersect(a, c(a), b, c(b)).is_some()
+            })
+            .count()
+    };
+    let mut pairs_intersecting = intersecting(&mesh.positions, &pairs);
     let mut scale = 1.0;
     while !pairs.is_empty() && stats.rounds < params.max_rounds {
         stats.rounds += 1;
@@ -166,8 +179,9 @@ pub fn untangle(
                     .iter()
                     .filter(|p| pairs.binary_search(p).is_err())
                     .filter(|&&[f, g]| {
-                        let c = |h: u32| triangles[h as usize].map(|v| m.position(v));
-                        !r.holds(c(f), c(g))
+                        let (a, b) = (triangles[f as usize], triangles[g as usize]);
+                        let c = |t: [u32; 3]| t.map(|v| m.position(v));
+                        !r.holds_faces(a, c(a), b, c(b))
                     })
                     .flat_map(|&[f, g]| {
                         triangles[f as usize]
@@ -194,12 +208,18 @@ pub fn untangle(
             after = update(&m, &mut guard, &after, &vertices);
         }
         let after_outside = outside(m.positions(), &after);
-        if relocated && after.len() < pairs.len() && after_outside <= pairs_outside {
+        let after_intersecting = intersecting(m.positions(), &after);
+        if relocated
+            && after.len() < pairs.len()
+            && after_outside <= pairs_outside
+            && after_intersecting <= pairs_intersecting
+        {
             for &(v, p) in &saved {
                 moved[v as usize] |= m.position(v) != p;
             }
             pairs = after;
             pairs_outside = after_outside;
+            pairs_intersecting = after_intersecting;
             scale = 1.0;
         } else {
             // Never worse: undo, and try shorter moves next round (three halvings at most).
@@ -217,11 +237,11 @@ pub fn untangle(
             }
         }
     }
-    // A pair is the output's own fold unless both faces lie where the input's faces cross or
-    // its parts meet (there a collapse would eat the part).
+    // A pair is the output's own fold unless its faces share no vertex and both lie where the
+    // input's faces cross or its parts meet (there a collapse would eat the part).
     let own = |m: &Mesh, [f, g]: [u32; 2]| {
         input_crossings.is_none_or(|r| match (m.face(f), m.face(g)) {
-            (Some(t), Some(u)) => !r.holds(m.corners(t), m.corners(u)),
+            (Some(t), Some(u)) => !r.holds_faces(t, m.corners(t), u, m.corners(u)),
             _ => true,
         })
     };

@@ -5,6 +5,7 @@
 use glam::DVec3;
 
 use super::*;
+use crate::geometry::face_intersection::{shared, Shared};
 use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::mesh::crossing_guard::CrossingGuard;
 use crate::surface::feature_lines::FeatureLines;
@@ -75,8 +76,9 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
         })
     };
     // A crossing inside a region where the input's own faces cross is the input's: it is left
-    // as it is (and costs no attempt).
+    // as it is (and costs no attempt). A fold (two faces that share a vertex) never is.
     let own = |m: &Mesh, t: [u32; 3]| input_crossings.is_some_and(|r| r.meets(m.corners(t)));
+    let fold = |t: [u32; 3], u: [u32; 3]| shared(t, u) != Shared::None;
     let bound = params.final_theta_deg;
     // The faces to mend: those with a small angle, smallest first, then those that cross
     // another face.
@@ -93,9 +95,12 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
         let mut out: Vec<u32> = small.into_iter().map(|x| x.1).collect();
         let mut crossing: Vec<u32> = intersecting_pairs(m.positions(), &live)
             .into_iter()
+            .filter(|&[f, g]| {
+                let (t, u) = (live[f as usize], live[g as usize]);
+                fold(t, u) || !own(m, t) || !own(m, u)
+            })
             .flatten()
             .map(|i| slots[i as usize])
-            .filter(|&f| !own(m, face(m, f)))
             .collect();
         crossing.sort_unstable();
         crossing.dedup();
@@ -133,7 +138,9 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             // A face that crosses another is mended by any operation that replaces or moves it
             // without a crossing or a new angle below the bound; there, a covering vertex may
             // go too. A face with a small angle is mended by one that raises that angle.
-            let crossing = guard.crosses(m, &[t], &[f]) && !own(m, t);
+            let crossing = guard.visit_crossed(m, t, m.corners(t), &[f], |g| {
+                !own(m, t) || m.face(g).is_some_and(|u| fold(t, u))
+            });
             if !crossing && angle_score(m, t, params) >= bound {
                 continue;
             }
