@@ -65,6 +65,47 @@ mod tests {
     use crate::geometry::triangle_intersection::triangles_intersect;
 
     #[test]
+    fn pairs_are_counted_by_kind() {
+        use glam::DVec3;
+        // Two faces on the edge 0-1, the second folded flat onto the first; a third face around
+        // vertex 0 lying over the first's corner region; a fourth apart, through the first.
+        let p = vec![
+            DVec3::new(0., 0., 0.),
+            DVec3::new(4., 0., 0.),
+            DVec3::new(0., 4., 0.),
+            DVec3::new(1., 2., 0.),
+            DVec3::new(1., 1., 0.),
+            DVec3::new(0.5, 0.2, 0.),
+            DVec3::new(1., 1., -1.),
+            DVec3::new(1., 1., 1.),
+            DVec3::new(2., 1., 1.),
+        ];
+        let m = TriMesh::new(p, vec![[0, 1, 2], [1, 0, 3], [0, 4, 5], [6, 7, 8]]);
+        let r = self_intersections(&m);
+        // [0,1,2] with [1,0,3] along the edge; [0,1,2] and [1,0,3] with [0,4,5] at vertex 0;
+        // [6,7,8] apart from all three, through the point (1, 1, 0) that each of them holds.
+        assert_eq!(r.along_edge, 1, "{r:?}");
+        assert_eq!(r.at_vertex, 2, "{r:?}");
+        assert_eq!(r.apart, 3, "{r:?}");
+        assert_eq!(r.pairs, 6);
+        assert_eq!(
+            (r.first, r.first_kind),
+            (Some([0, 1]), Some(PairKind::AlongEdge))
+        );
+        let text = crate::check::check_invariants(&m)
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join("; ");
+        assert!(
+            text.contains(
+                "6 pairs of faces intersect (3 apart, 2 at a shared vertex, 1 along a shared edge)"
+            ),
+            "{text}"
+        );
+    }
+
+    #[test]
     fn a_sphere_has_none_and_a_pushed_vertex_makes_some() {
         // A closed UV sphere: no self-intersection.
         let mut m = crate::mesh::test_meshes::uv_sphere(1.0, 12, 24);

@@ -17,7 +17,7 @@ pub(crate) mod triangle_intersection;
 
 pub use face_intersection::{faces_intersect, PairKind};
 pub use plane::tangent_basis;
-pub use self_intersection::{intersecting_pairs, intersecting_pairs_counted};
+pub use self_intersection::{classified_pairs, intersecting_pairs, intersecting_pairs_counted};
 pub use tolerance::{
     BURIED_OFFSET, DEGENERATE_AREA_TOLERANCE, SEARCH_BOUND_SLACK, SINGULAR_TOLERANCE,
 };

@@ -671,18 +671,42 @@ mod tests {
             None,
         );
         assert_eq!((s.pairs_after, s.collapses), (before, 0), "{s:?}");
-        // Where the input's own faces cross (here: a region over the whole grid), the crossing
-        // is the input's, and no collapse eats it.
-        let mut kept = m.clone();
-        let everywhere = CrossingRegions::new(
-            &m.positions,
-            &m.triangles,
-            &[],
-            &(0..m.triangles.len() as u32).collect::<Vec<_>>(),
-            0.1,
+        // Where the input's own faces cross (here: a region over the whole grid), a crossing of
+        // faces that share no vertex is the input's, and no collapse eats it: a second flat grid
+        // passing upright through the first.
+        let everywhere = |m: &TriMesh| {
+            CrossingRegions::new(
+                &m.positions,
+                &m.triangles,
+                &[],
+                &(0..m.triangles.len() as u32).collect::<Vec<_>>(),
+                0.1,
+            )
+        };
+        let mut sheets = grid(8, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let upright = grid(8, |i, j| DVec3::new(i as f64 + 0.25, 3.5, j as f64 - 3.75));
+        let offset = sheets.positions.len() as u32;
+        sheets.positions.extend(upright.positions);
+        sheets
+            .triangles
+            .extend(upright.triangles.iter().map(|t| t.map(|v| v + offset)));
+        let crossing = intersecting_pairs(&sheets.positions, &sheets.triangles).len();
+        assert!(crossing > 0);
+        let regions = everywhere(&sheets);
+        let fixed_sheets = vec![false; sheets.positions.len()];
+        let (s, _) = untangle(
+            &mut sheets,
+            &fixed_sheets,
+            1.0,
+            &only_collapses,
+            Some(&regions),
         );
-        let (s, _) = untangle(&mut kept, &fixed, 1.0, &only_collapses, Some(&everywhere));
-        assert_eq!((s.pairs_after, s.collapses), (before, 0), "{s:?}");
+        assert_eq!((s.pairs_after, s.collapses), (crossing, 0), "{s:?}");
+        // A fold (faces sharing a vertex) is the output's own even there: it is collapsed.
+        let mut folded = m.clone();
+        let regions = everywhere(&m);
+        let (s, _) = untangle(&mut folded, &fixed, 1.0, &only_collapses, Some(&regions));
+        assert!(s.collapses >= 1 && s.pairs_after < before, "{s:?}");
         let (s, _) = untangle(&mut m, &fixed, 1.0, &only_collapses, None);
         assert!(s.collapses >= 1 && s.pairs_after == 0, "{s:?}");
         assert!(intersecting_pairs(&m.positions, &m.triangles).is_empty());
