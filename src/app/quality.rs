@@ -72,6 +72,8 @@ pub(super) fn quality_read(
     let normalization = own_frame(frame, path)?;
     let m = normalization.apply_mesh(&mesh);
     let mut report = QualityReport::new(&m);
+    // Crossings at the file's own coordinates, not the frame's rounded ones.
+    report.decide_crossings_on(&mesh);
     let (wall, cpu) = t.elapsed();
     report.push_stage("read and measure", wall, cpu);
     if let Some((r, reference_path)) = &reference {
@@ -100,11 +102,16 @@ pub(super) fn quality_read(
 /// dropped), subnormal coordinates scaled up, in its own bbox-100 frame ([`own_frame`]).
 /// `None` when the file would be refused.
 /// With it, the map from model units (before the subnormal scaling) into that frame.
-pub(super) fn as_quality_reads(mesh: TriMesh, path: &Path) -> Option<(TriMesh, FileFrame)> {
+/// Also the same mesh before the frame: the file's coordinates (scaled by `2^up`, which is
+/// exact), where crossings are decided ([`QualityReport::decide_crossings_on`]).
+pub(super) fn as_quality_reads(
+    mesh: TriMesh,
+    path: &Path,
+) -> Option<(TriMesh, FileFrame, TriMesh)> {
     let (mesh, _) = check_and_clean(path, mesh).ok()?;
     let (mesh, up) = into_normal_range(mesh);
     let frame = own_frame(&mesh, path).ok()?;
-    Some((frame.apply_mesh(&mesh), FileFrame { frame, up }))
+    Some((frame.apply_mesh(&mesh), FileFrame { frame, up }, mesh))
 }
 
 /// The frame [`as_quality_reads`] puts a file's mesh in: scaled by `2^up`, then `frame`.
@@ -130,6 +137,7 @@ impl FileFrame {
 pub(super) fn crossings_of_the_input(
     out: &RemeshOutput,
     checked: &TriMesh,
+    stored: &TriMesh,
     file: &FileFrame,
     run_up: i32,
 ) -> usize {
@@ -155,7 +163,7 @@ pub(super) fn crossings_of_the_input(
         &out.junction_faces,
         out.sigma_p * unit.length(),
     );
-    let pairs = intersecting_pairs(&checked.positions, &checked.triangles);
+    let pairs = intersecting_pairs(&stored.positions, &stored.triangles);
     regions.count_inside(&checked.positions, &checked.triangles, &pairs)
 }
 

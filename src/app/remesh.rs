@@ -223,10 +223,15 @@ pub(super) fn remesh_read(
         }
     };
     // The invariants, crossings and topology are those `remesh quality` finds in the file: the
-    // mesh as stored, welded as a reader welds it, in its own bbox-100 frame (crossings are
-    // decided exactly, so a face pair that rounding makes touch is seen here as in the file).
+    // mesh as stored, welded as a reader welds it, in its own bbox-100 frame; crossings are
+    // decided exactly at the file's own coordinates, so a face pair that rounding makes touch is
+    // seen here as in the file.
     let file = as_quality_reads(as_written(mesh_out, format), &job.output);
-    let mut report = QualityReport::new(file.as_ref().map_or(checked, |(m, _)| m));
+    let mut report = QualityReport::new(file.as_ref().map_or(checked, |(m, _, _)| m));
+    // Crossings at the file's own coordinates (exact there), not the frame's rounded ones.
+    if let Some((_, _, stored)) = &file {
+        report.decide_crossings_on(stored);
+    }
     // The input column describes the input as read: its faces before they were oriented
     // (orientation changes none of the counts the topology is compared by).
     report.set_input(&TriMesh::new(
@@ -302,7 +307,7 @@ pub(super) fn remesh_read(
     // The file's crossing pairs, and of them those where the input's own faces cross or its
     // closed parts meet.
     let theirs = match (&file, crossing) {
-        (Some((m, frame)), 1..) => crossings_of_the_input(&out, m, frame, up),
+        (Some((m, frame, stored)), 1..) => crossings_of_the_input(&out, m, stored, frame, up),
         _ => 0,
     };
     extra.insert(

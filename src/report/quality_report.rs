@@ -123,6 +123,28 @@ impl QualityReport {
         }
     }
 
+    /// Decides the self-intersections again on `stored`: the same faces as the mesh the report
+    /// was made of, at the coordinates the file stores (the report's own mesh is mapped into a
+    /// bbox-100 frame, whose rounding can make two faces that touch in the file apart, or the
+    /// reverse; the exact test is only as exact as the coordinates it is given). Replaces
+    /// [`QualityReport::self_intersections`] and the `Crossing` violation.
+    pub fn decide_crossings_on(&mut self, stored: &TriMesh) {
+        let crossings = crate::check::self_intersections(stored);
+        self.self_intersections = crossings;
+        self.invariant_violations
+            .retain(|v| !matches!(v, Violation::Crossing { .. }));
+        if let Some([f, g]) = crossings.first {
+            self.invariant_violations.push(Violation::Crossing {
+                count: crossings.pairs,
+                apart: crossings.apart,
+                at_vertex: crossings.at_vertex,
+                along_edge: crossings.along_edge,
+                f,
+                g,
+            });
+        }
+    }
+
     /// Sets the input's topology ([`topology`] of `input`) and compares the output's with its
     /// surface's ([`surface_topology`]: without zero-area, repeated-index or duplicate faces):
     /// every difference of components, Euler characteristic and boundary loops goes into
