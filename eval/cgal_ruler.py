@@ -86,21 +86,18 @@ def check(path, timeout=120.0):
     return json.loads(lines[-1])
 
 
-def agrees(ours_pairs, cgal, ours_degenerate=0):
-    """Whether our report and CGAL's answer agree: both find nothing, or both find something
-    and the same number of pairs. CGAL reports a degenerate face as a pair of its own, our report
-    as an invariant of its own (`ours_degenerate`: the count of the report's DegenerateFace
-    violation), so those are added to ours. None when CGAL gave no answer."""
+def agrees(report, cgal):
+    """Whether our report (the JSON of `remesh --report` or `remesh quality --json`) and CGAL's
+    answer agree: both find nothing, or both find something and the same number of pairs. CGAL
+    reports a degenerate face as a pair of its own, our report as an invariant of its own (the
+    count of its DegenerateFace violation), so those are added to ours. None when CGAL gave no
+    answer."""
     if cgal.get("self_intersects") is None:
         return None
-    ours = ours_pairs + ours_degenerate
+    degenerate = sum(v.get("count", 0) for v in report.get("invariant_violations", [])
+                     if v.get("kind") == "DegenerateFace")
+    ours = report["self_intersections"]["pairs"] + degenerate
     return (ours > 0) == cgal["self_intersects"] and cgal.get("pairs") in (None, ours)
-
-
-def degenerate_count(report):
-    """The count of a report's DegenerateFace violation (0 without one)."""
-    return sum(v.get("count", 0) for v in report.get("invariant_violations", [])
-               if v.get("kind") == "DegenerateFace")
 
 
 def main():

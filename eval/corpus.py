@@ -160,8 +160,7 @@ def one_run(binary, path, seed, args, tmp, input_pairs):
     row["outside"] = sum(1 for a, b in faces if a < args.min_angle or b > args.max_angle)
     if not args.no_cgal:
         row["cgal"] = cgal_ruler.check(out, args.timeout)
-        row["cgal_agrees"] = cgal_ruler.agrees(row["pairs"], row["cgal"],
-                                               cgal_ruler.degenerate_count(report))
+        row["cgal_agrees"] = cgal_ruler.agrees(report, row["cgal"])
     if check is None or check["self_intersections"]["pairs"] != row["pairs"] or violations_key(
             check) != violations_key(report) or row.get("cgal_agrees") is False:
         row["outcome"] = "disagree"

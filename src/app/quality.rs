@@ -71,9 +71,8 @@ pub(super) fn quality_read(
     let frame = reference.as_ref().map_or(&mesh, |(r, _)| r);
     let normalization = own_frame(frame, path)?;
     let m = normalization.apply_mesh(&mesh);
-    let mut report = QualityReport::new(&m);
     // Crossings at the file's own coordinates, not the frame's rounded ones.
-    report.decide_crossings_on(&mesh);
+    let mut report = QualityReport::with_crossings_on(&m, &mesh);
     let (wall, cpu) = t.elapsed();
     report.push_stage("read and measure", wall, cpu);
     if let Some((r, reference_path)) = &reference {
@@ -103,7 +102,7 @@ pub(super) fn quality_read(
 /// `None` when the file would be refused.
 /// With it, the map from model units (before the subnormal scaling) into that frame.
 /// Also the same mesh before the frame: the file's coordinates (scaled by `2^up`, which is
-/// exact), where crossings are decided ([`QualityReport::decide_crossings_on`]).
+/// exact), where crossings are decided ([`QualityReport::with_crossings_on`]).
 pub(super) fn as_quality_reads(
     mesh: TriMesh,
     path: &Path,
@@ -130,8 +129,8 @@ impl FileFrame {
     }
 }
 
-/// How many of the crossing pairs of `checked` (the written mesh as [`as_quality_reads`] sees
-/// it, in `file`'s frame) lie where the input's own faces cross or its closed parts meet (both
+/// How many of the crossing pairs of `stored` (the written mesh as [`as_quality_reads`] gives
+/// it, at the file's coordinates; `checked` is the same in `file`'s frame) lie where the input's own faces cross or its closed parts meet (both
 /// faces reach into the input's [`CrossingRegions`], loosened by sigma_p, mapped into that
 /// frame).
 pub(super) fn crossings_of_the_input(

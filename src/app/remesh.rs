@@ -227,11 +227,10 @@ pub(super) fn remesh_read(
     // decided exactly at the file's own coordinates, so a face pair that rounding makes touch is
     // seen here as in the file.
     let file = as_quality_reads(as_written(mesh_out, format), &job.output);
-    let mut report = QualityReport::new(file.as_ref().map_or(checked, |(m, _, _)| m));
-    // Crossings at the file's own coordinates (exact there), not the frame's rounded ones.
-    if let Some((_, _, stored)) = &file {
-        report.decide_crossings_on(stored);
-    }
+    let mut report = match &file {
+        Some((m, _, stored)) => QualityReport::with_crossings_on(m, stored),
+        None => QualityReport::new(checked),
+    };
     // The input column describes the input as read: its faces before they were oriented
     // (orientation changes none of the counts the topology is compared by).
     report.set_input(&TriMesh::new(

@@ -61,9 +61,8 @@ pub(super) fn run(
             &written
         }
     };
-    let mut report = QualityReport::new(checked);
     // Crossings at the coordinates the file stores (exact there), not the frame's rounded ones.
-    report.decide_crossings_on(&as_written(&out.mesh, format));
+    let mut report = QualityReport::with_crossings_on(checked, &as_written(&out.mesh, format));
     let check_seconds = t.elapsed();
     check_and_write(
         job,

@@ -182,10 +182,17 @@ pub fn check_invariants(mesh: &TriMesh) -> Vec<Violation> {
 }
 
 /// The topology, the self-intersections and the violations of `mesh` in one pass (what the
-/// report needs; [`check_invariants`] alone computes the same violations).
-pub(crate) fn check_all(mesh: &TriMesh) -> (Topology, SelfIntersections, Vec<Violation>) {
+/// report needs; [`check_invariants`] alone computes the same violations), the
+/// self-intersections decided on `stored`: the same faces at the coordinates a file stores
+/// (`mesh` itself, or `mesh` before it was mapped into a bbox-100 frame, whose rounding can make
+/// two faces that touch apart or the reverse; the exact test is only as exact as the coordinates
+/// it is given).
+pub(crate) fn check_all(
+    mesh: &TriMesh,
+    stored: &TriMesh,
+) -> (Topology, SelfIntersections, Vec<Violation>) {
     let analysis = analyze(mesh);
-    let crossings = self_intersections(mesh);
+    let crossings = self_intersections(stored);
     let found = violations(mesh, &analysis, &crossings);
     (analysis.topology, crossings, found)
 }

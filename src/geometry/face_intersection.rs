@@ -99,6 +99,13 @@ pub(crate) fn shared(a: [u32; 3], b: [u32; 3]) -> Shared {
     }
 }
 
+/// Whether faces `a` and `b` have a vertex index in common (or one repeats an index): a pair that
+/// intersects is then a fold of the mesh's own faces, never two sheets passing through each
+/// other.
+pub(crate) fn share_a_vertex(a: [u32; 3], b: [u32; 3]) -> bool {
+    shared(a, b) != Shared::None
+}
+
 /// Whether faces `a` and `b` (vertex indices) with corners `pa` and `pb` (their vertices'
 /// positions, any length unit) intersect by the standard definition (see the module), and how
 /// they are joined; `None` when they do not, or when the pair is not one this test decides (a

@@ -8,7 +8,9 @@ use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::partitioning::Bvh;
 use rayon::prelude::*;
 
-use super::face_intersection::{faces_intersect, faces_within, shared, PairKind, Shared};
+#[cfg(doc)]
+use super::face_intersection::faces_intersect;
+use super::face_intersection::{faces_within, share_a_vertex, PairKind};
 use super::triangle::is_degenerate_face;
 
 /// The pairs of `boxes` (items of [`face_boxes`]: a face index and its bounding box) whose
@@ -52,10 +54,7 @@ pub fn classified_pairs(
     let candidates = box_pairs(positions, triangles, 0.0);
     let pairs: Vec<([u32; 2], PairKind)> = candidates
         .par_iter()
-        .filter_map(|&[f, g]| {
-            let (a, b) = (triangles[f as usize], triangles[g as usize]);
-            faces_intersect(a, corners(positions, a), b, corners(positions, b)).map(|k| ([f, g], k))
-        })
+        .filter_map(|&[f, g]| pair_within(positions, triangles, f, g, 0.0).map(|k| ([f, g], k)))
         .collect();
     (pairs, candidates.len())
 }
@@ -82,16 +81,22 @@ pub(crate) fn pairs_within(
 ) -> Vec<[u32; 2]> {
     box_pairs(positions, triangles, near)
         .into_par_iter()
-        .filter(|&[f, g]| {
-            let (a, b) = (triangles[f as usize], triangles[g as usize]);
-            faces_within(a, corners(positions, a), b, corners(positions, b), near).is_some()
-        })
+        .filter(|&[f, g]| pair_within(positions, triangles, f, g, near).is_some())
         .collect()
 }
 
-/// The corners of the face with vertex indices `t`.
-fn corners(positions: &[DVec3], t: [u32; 3]) -> [DVec3; 3] {
-    t.map(|i| positions[i as usize])
+/// How faces `f` and `g` of `triangles` (indices into `positions`) intersect or come within
+/// `near` of intersecting ([`faces_within`]; `near` 0: [`faces_intersect`], exact).
+fn pair_within(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    f: u32,
+    g: u32,
+    near: f64,
+) -> Option<PairKind> {
+    let (a, b) = (triangles[f as usize], triangles[g as usize]);
+    let corners = |t: [u32; 3]| t.map(|i| positions[i as usize]);
+    faces_within(a, corners(a), b, corners(b), near)
 }
 
 /// The pairs of faces of [`face_boxes`] whose bounding boxes overlap, as
@@ -147,11 +152,8 @@ pub(crate) fn has_intersecting_pair(
 ) -> bool {
     boxes.par_chunks(CHUNK).any(|chunk| {
         chunk.iter().any(|&(f, aabb)| {
-            let a = triangles[f];
             bvh.intersect_aabb(&aabb).any(|g| {
-                let b = triangles[g as usize];
-                g as usize > f
-                    && faces_intersect(a, corners(positions, a), b, corners(positions, b)).is_some()
+                g as usize > f && pair_within(positions, triangles, f as u32, g, 0.0).is_some()
             })
         })
     })
@@ -171,12 +173,9 @@ pub(crate) fn intersecting_pairs_in(
         .flat_map_iter(|chunk| {
             let mut found = Vec::new();
             for &(f, aabb) in chunk {
-                let a = triangles[f];
                 for g in bvh.intersect_aabb(&aabb) {
-                    let b = triangles[g as usize];
                     if g as usize > f
-                        && faces_intersect(a, corners(positions, a), b, corners(positions, b))
-                            .is_some()
+                        && pair_within(positions, triangles, f as u32, g, 0.0).is_some()
                     {
                         found.push([f as u32, g]);
                     }
@@ -254,7 +253,7 @@ impl CrossingRegions {
     /// `pa` and `pb` is the input's: they share no vertex and both reach into a region. A pair
     /// that shares a vertex (a fold of the output's own faces) never is.
     pub fn holds_faces(&self, a: [u32; 3], pa: [DVec3; 3], b: [u32; 3], pb: [DVec3; 3]) -> bool {
-        shared(a, b) == Shared::None && self.holds(pa, pb)
+        !share_a_vertex(a, b) && self.holds(pa, pb)
     }
 
     /// Whether the crossing pair of triangles with corners `f` and `g` lies in a region: both

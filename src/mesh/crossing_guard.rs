@@ -176,13 +176,11 @@ pub(crate) fn new_faces_intersect(
     corners: impl Fn([u32; 3]) -> [DVec3; 3],
     near: f64,
 ) -> bool {
+    // A face that repeats an index is never decided (`faces_within`); one of no area is left
+    // out here.
     let usable = |t: [u32; 3]| {
         let p = corners(t);
-        p.iter().all(|x| x.is_finite())
-            && !crate::geometry::triangle::is_degenerate_triangle(p)
-            && t[0] != t[1]
-            && t[1] != t[2]
-            && t[0] != t[2]
+        p.iter().all(|x| x.is_finite()) && !crate::geometry::triangle::is_degenerate_triangle(p)
     };
     faces.iter().enumerate().any(|(i, &a)| {
         usable(a)

@@ -108,7 +108,16 @@ impl QualityReport {
     /// The report of `mesh` with its triangle measures and topology; no distance, input
     /// topology, stages, notes or extras yet.
     pub fn new(mesh: &TriMesh) -> Self {
-        let (topology, crossings, violations) = check_all(mesh);
+        Self::with_crossings_on(mesh, mesh)
+    }
+
+    /// [`QualityReport::new`], with the self-intersections (and the `Crossing` violation)
+    /// decided on `stored`: the same faces at the coordinates the file stores, where `mesh` is
+    /// the file mapped into a bbox-100 frame (whose rounding can make two faces that touch in the
+    /// file apart, or the reverse; the exact test is only as exact as the coordinates it is
+    /// given).
+    pub fn with_crossings_on(mesh: &TriMesh, stored: &TriMesh) -> Self {
+        let (topology, crossings, violations) = check_all(mesh, stored);
         QualityReport {
             triangles: triangle_quality(mesh),
             invariant_violations: violations,
@@ -120,28 +129,6 @@ impl QualityReport {
             stages: Vec::new(),
             notes: Vec::new(),
             extra: serde_json::Map::new(),
-        }
-    }
-
-    /// Decides the self-intersections again on `stored`: the same faces as the mesh the report
-    /// was made of, at the coordinates the file stores (the report's own mesh is mapped into a
-    /// bbox-100 frame, whose rounding can make two faces that touch in the file apart, or the
-    /// reverse; the exact test is only as exact as the coordinates it is given). Replaces
-    /// [`QualityReport::self_intersections`] and the `Crossing` violation.
-    pub fn decide_crossings_on(&mut self, stored: &TriMesh) {
-        let crossings = crate::check::self_intersections(stored);
-        self.self_intersections = crossings;
-        self.invariant_violations
-            .retain(|v| !matches!(v, Violation::Crossing { .. }));
-        if let Some([f, g]) = crossings.first {
-            self.invariant_violations.push(Violation::Crossing {
-                count: crossings.pairs,
-                apart: crossings.apart,
-                at_vertex: crossings.at_vertex,
-                along_edge: crossings.along_edge,
-                f,
-                g,
-            });
         }
     }
 

@@ -9,7 +9,7 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::geometry::face_intersection::{faces_intersect, shared, Shared};
+use crate::geometry::face_intersection::{faces_intersect, share_a_vertex};
 use crate::geometry::self_intersection::{pairs_within, CrossingRegions};
 use crate::geometry::triangle::{
     is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,
@@ -79,8 +79,7 @@ pub struct UntangleStats {
 /// come within `params.near` of intersecting (faces that would touch once written), or
 /// `params.max_rounds` rounds have run. In a round the crossing pairs of faces that share no
 /// vertex are taken in order (a fold, two faces that share a vertex, is left to the collapses);
-/// for a pair that still crosses, the
-/// shortest of four moves separates it (for either face: its corners behind the other's plane
+/// for a pair that still crosses, the shortest of four moves separates it (for either face: its corners behind the other's plane
 /// move along that plane's normal to `margin_sigma_p · σ_p` in front of it, or the other face
 /// moves back along its normal until they are; at most `max_step_sigma_p · σ_p` per round). A
 /// move of a vertex marked in `fixed` (a boundary sample) counts as four times as long, so
@@ -88,8 +87,8 @@ pub struct UntangleStats {
 /// pair outside the input's own crossings (`input_crossings`) go back, vertex by vertex: a
 /// press never trades a crossing where the input crosses for one where it does not. A round
 /// that then does not lower the number of crossing pairs, or raises the number outside the
-/// input's crossings, or the number that intersect (not merely come within `near`), is undone and tried again with moves half as long (never worse than
-/// before). Faces that cross nothing do not move. Then, for pairs still crossing that are not
+/// input's crossings, or the number that intersect (not merely come within `near`), is undone
+/// and tried again with moves half as long (never worse than before). Faces that cross nothing do not move. Then, for pairs still crossing that are not
 /// the input's own (both faces reaching into `input_crossings`, where the input's faces cross
 /// or its parts meet), edges are collapsed (at most `params.max_collapses`; the only change of
 /// connectivity).
@@ -437,7 +436,7 @@ fn round_moves(
         // other's plane (the shared corners lie on both): the collapses and the mending after
         // them take it.
         let (a, b) = (triangles[f as usize], triangles[g as usize]);
-        if shared(a, b) != Shared::None
+        if share_a_vertex(a, b)
             || !triangles_within(corners(&positions, f), corners(&positions, g), near)
         {
             continue;

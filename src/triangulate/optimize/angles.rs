@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use super::*;
-use crate::geometry::face_intersection::{shared, Shared};
+use crate::geometry::face_intersection::share_a_vertex;
 use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::mesh::crossing_guard::CrossingGuard;
 use crate::surface::feature_lines::FeatureLines;
@@ -78,7 +78,6 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     // A crossing inside a region where the input's own faces cross is the input's: it is left
     // as it is (and costs no attempt). A fold (two faces that share a vertex) never is.
     let own = |m: &Mesh, t: [u32; 3]| input_crossings.is_some_and(|r| r.meets(m.corners(t)));
-    let fold = |t: [u32; 3], u: [u32; 3]| shared(t, u) != Shared::None;
     let bound = params.final_theta_deg;
     // The faces to mend: those with a small angle, smallest first, then those that cross
     // another face.
@@ -97,7 +96,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             .into_iter()
             .filter(|&[f, g]| {
                 let (t, u) = (live[f as usize], live[g as usize]);
-                fold(t, u) || !own(m, t) || !own(m, u)
+                share_a_vertex(t, u) || !own(m, t) || !own(m, u)
             })
             .flatten()
             .map(|i| slots[i as usize])
@@ -139,7 +138,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             // without a crossing or a new angle below the bound; there, a covering vertex may
             // go too. A face with a small angle is mended by one that raises that angle.
             let crossing = guard.visit_crossed(m, t, m.corners(t), &[f], |g| {
-                !own(m, t) || m.face(g).is_some_and(|u| fold(t, u))
+                !own(m, t) || m.face(g).is_some_and(|u| share_a_vertex(t, u))
             });
             if !crossing && angle_score(m, t, params) >= bound {
                 continue;
