@@ -10,6 +10,7 @@ pub(crate) mod closest_point_tree;
 pub(crate) mod face_intersection;
 pub(crate) mod morton;
 pub(crate) mod plane;
+pub(crate) mod polygon_triangulation;
 pub(crate) mod self_intersection;
 pub(crate) mod tolerance;
 pub(crate) mod triangle;

@@ -7,7 +7,7 @@
 //! consistent. Boundary edges of an open input are usable in their own direction only (the
 //! other is blocked), so they stay boundary edges.
 
-use crate::geometry::tolerance::IMPROVEMENT_TOLERANCE;
+use crate::geometry::polygon_triangulation::max_min_triangulation;
 use glam::{DVec2, DVec3};
 use rustc_hash::{FxHashMap, FxHashSet};
 
@@ -454,63 +454,22 @@ fn triangulate_polygon(
     lp: &[u32],
     allow_folds: bool,
 ) -> Option<Vec<[u32; 3]>> {
-    let m = lp.len();
-    if m == 3 {
+    if lp.len() == 3 {
         let t = [lp[0], lp[1], lp[2]];
         return if b.fits(t) { Some(vec![t]) } else { None };
     }
-    // best[i][k]: max-min quality of triangulating the sub-polygon i..=k; choice[i][k] = j.
-    let idx = |i: usize, k: usize| i * m + k;
-    let mut best = vec![f64::NEG_INFINITY; m * m];
-    let mut choice = vec![usize::MAX; m * m];
-    let diagonal_ok = |i: usize, k: usize| -> bool {
-        if k == i + 1 || (i == 0 && k == m - 1) {
-            return true;
-        }
-        !b.has_edge(lp[i], lp[k])
-    };
-    for i in 0..m - 1 {
-        best[idx(i, i + 1)] = f64::INFINITY;
-    }
-    for len in 2..m {
-        for i in 0..m - len {
-            let k = i + len;
-            if !diagonal_ok(i, k) {
-                continue;
+    max_min_triangulation(
+        lp,
+        |x, y| !b.has_edge(x, y),
+        |t| {
+            let q = oriented_quality(b, normals, t);
+            if q <= 0.0 && allow_folds {
+                FOLD_WEIGHT * crate::geometry::triangle::triangle_q(b.corners(t))
+            } else {
+                q
             }
-            for j in i + 1..k {
-                let t = [lp[i], lp[j], lp[k]];
-                let mut q = oriented_quality(b, normals, t);
-                if q <= 0.0 && allow_folds {
-                    q = FOLD_WEIGHT * crate::geometry::triangle::triangle_q(b.corners(t));
-                }
-                if q.is_nan() || q <= IMPROVEMENT_TOLERANCE {
-                    continue;
-                }
-                let v = best[idx(i, j)].min(best[idx(j, k)]).min(q);
-                if v > best[idx(i, k)] {
-                    best[idx(i, k)] = v;
-                    choice[idx(i, k)] = j;
-                }
-            }
-        }
-    }
-    let whole = best[idx(0, m - 1)];
-    if whole.is_nan() || whole <= 0.0 {
-        return None;
-    }
-    let mut out = Vec::with_capacity(m - 2);
-    let mut stack = vec![(0usize, m - 1)];
-    while let Some((i, k)) = stack.pop() {
-        if k < i + 2 {
-            continue;
-        }
-        let j = choice[idx(i, k)];
-        out.push([lp[i], lp[j], lp[k]]);
-        stack.push((i, j));
-        stack.push((j, k));
-    }
-    Some(out)
+        },
+    )
 }
 
 /// Finds vertices whose faces form more than one edge-connected fan and removes the faces of

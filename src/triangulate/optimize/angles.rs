@@ -6,8 +6,10 @@ use glam::DVec3;
 
 use super::*;
 use crate::geometry::face_intersection::share_a_vertex;
+use crate::geometry::polygon_triangulation::max_min_triangulation;
 use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::mesh::crossing_guard::CrossingGuard;
+use crate::mesh::edit::EditError;
 use crate::surface::feature_lines::FeatureLines;
 use crate::triangulate::flip::max_min_candidate;
 
@@ -22,6 +24,8 @@ enum Op {
     Move(u32, DVec3),
     /// Split the edge `a`–`b` at a new vertex at the position.
     Split(u32, u32, DVec3),
+    /// Remove the vertex and triangulate its link anew ([`try_remove`]).
+    Remove(u32),
 }
 
 /// Mends the faces of `m` whose smallest angle is below `params.final_theta_deg` (worst first;
@@ -37,7 +41,9 @@ enum Op {
 /// moves only along the input's boundary curves `boundary` (none without them: [`slide_targets`]);
 /// a fixed vertex on a crease moves only to undo a crossing; other fixed vertices (covering
 /// vertices, at the tips of the input) move like the rest, their old position kept within the
-/// collapse offset of their faces. Where none of these
+/// collapse offset of their faces. Where none of these mends a face that crosses another or
+/// folds onto a neighbour, each corner that may move may be removed, its link triangulated
+/// anew ([`try_remove`]). Where none of these
 /// mends the face, each of its interior edges may be split at a new vertex placed by the same
 /// compass search ([`try_split`]; Hu et al.'s edge split): a boundary vertex where the
 /// boundary turns by more than 180° and only two faces share the angle gets a third.
@@ -220,6 +226,19 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
                     offer(&mut best, try_move(m, &guard, v, q, params), Op::Move(v, q));
                 }
             }
+            // Only where nothing else mends it, a face that crosses another (or folds onto a
+            // neighbour) may lose a corner: the corner's link triangulated anew on the side of
+            // the fan's mean normal, which unfolds a fan that the other operations, each
+            // comparing with the folded faces' turned-over normals, cannot.
+            if crossing && best.is_none() {
+                for &v in &t {
+                    if !stays(m, v) {
+                        if let Some((value, _)) = try_remove(m, &guard, v, params) {
+                            offer(&mut best, Some(value), Op::Remove(v));
+                        }
+                    }
+                }
+            }
             // Only where nothing else mends the face, one of its edges is split at the surface
             // point nearest its middle (a vertex with too few faces for the angle around it,
             // such as a boundary vertex where the boundary turns, gets one more).
@@ -251,6 +270,10 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
                     }
                     split
                 }
+                Op::Remove(v) => match try_remove(m, &guard, v, params) {
+                    Some((_, new)) => remove_vertex(m, v, &new),
+                    None => Err(EditError::NoSuchVertex { vertex: v }),
+                },
             };
             if let Ok(slots) = applied {
                 guard.changed(m, &slots);
@@ -654,6 +677,94 @@ fn try_move(
         && !guard.crosses(m, &faces, &slots);
     let _ = m.relocate_vertex(v, p);
     ok.then_some((old, new))
+}
+
+/// The link of the interior vertex `v`: its neighbours in the order of its faces (each face
+/// `[v, a, b]` gives the link edge a → b), or `None` when its faces do not make one closed fan
+/// with distinct neighbours (a boundary vertex, a pinched fan).
+fn link_of(m: &Mesh, v: u32) -> Option<Vec<u32>> {
+    let faces = m.faces_around(v);
+    let edges: Vec<[u32; 2]> = faces
+        .iter()
+        .map(|&f| {
+            let t = starting_at(face(m, f), v);
+            [t[1], t[2]]
+        })
+        .collect();
+    let mut link = vec![edges.first()?[0]];
+    for _ in 0..edges.len() {
+        let last = *link.last()?;
+        let next = edges.iter().find(|e| e[0] == last)?[1];
+        link.push(next);
+    }
+    // Closed after as many steps as faces, through distinct neighbours.
+    if link.pop() != Some(link[0]) {
+        return None;
+    }
+    let mut sorted = link.clone();
+    sorted.sort_unstable();
+    sorted.dedup();
+    (sorted.len() == edges.len() && edges.len() >= 3).then_some(link)
+}
+
+/// The smallest angle scores of the faces around `v` and of the faces that replace them when
+/// `v` is removed and its link ([`link_of`]) is triangulated anew, with those faces, when the
+/// removal passes the guards of [`mend_faces`]. The new faces are the triangulation of the link
+/// of largest smallest angle score ([`max_min_triangulation`]) among those with no diagonal
+/// that is already an edge and every face facing the side of the link's own normal (Newell's:
+/// the fan's mean orientation, which folded faces do not turn over as they turn their own
+/// normals; the other operations' turn guard compares with those); the old position of `v`
+/// stays within `collapse_offset` of them and none crosses another face or another new face.
+/// The vertex removal of Schroeder et al. ("Decimation of triangle meshes", SIGGRAPH 1992),
+/// here a mend: it replaces a fan folded over itself or onto a neighbour.
+fn try_remove(
+    m: &Mesh,
+    guard: &CrossingGuard,
+    v: u32,
+    params: &Limits,
+) -> Option<((f64, f64), Vec<[u32; 3]>)> {
+    let link = link_of(m, v)?;
+    let pts: Vec<DVec3> = link.iter().map(|&u| m.position(u)).collect();
+    let center = pts.iter().sum::<DVec3>() / pts.len() as f64;
+    let n_ref = (0..pts.len())
+        .map(|i| (pts[i] - center).cross(pts[(i + 1) % pts.len()] - center))
+        .sum::<DVec3>()
+        .try_normalize()?;
+    let new = max_min_triangulation(
+        &link,
+        |a, b| !m.has_edge(a, b),
+        |t| {
+            if normal(m, t).dot(n_ref) <= 0.0 {
+                -1.0
+            } else {
+                angle_score(m, t, params)
+            }
+        },
+    )?;
+    let slots = m.faces_around(v).to_vec();
+    let old = worst_angle(m, slots.iter().map(|&f| face(m, f)), params);
+    if distance_to(m, new.iter().copied(), m.position(v)) > params.collapse_offset
+        || guard.crosses(m, &new, &slots)
+    {
+        return None;
+    }
+    let value = worst_angle(m, new.iter().copied(), params);
+    Some(((old, value), new))
+}
+
+/// Removes the faces around `v` and fills the hole with `new` (its link's triangulation, as
+/// [`try_remove`] gives it): the new faces' slots. `v` is left unreferenced.
+/// On an error the old faces are put back (in new slots) and the error returned.
+fn remove_vertex(m: &mut Mesh, v: u32, new: &[[u32; 3]]) -> Result<Vec<u32>, EditError> {
+    let old: Vec<(u32, [u32; 3])> = m.faces_around(v).iter().map(|&f| (f, face(m, f))).collect();
+    for &(f, _) in &old {
+        m.remove_face(f)?;
+    }
+    m.fill_hole(new, None).inspect_err(|_| {
+        let faces: Vec<[u32; 3]> = old.iter().map(|&(_, t)| t).collect();
+        // The faces were there a moment ago: their edges are free again.
+        let _ = m.fill_hole(&faces, None);
+    })
 }
 
 /// The edge of `t` opposite its largest angle, when that angle is above the bound

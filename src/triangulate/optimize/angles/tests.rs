@@ -1,4 +1,5 @@
 use super::*;
+use crate::geometry::self_intersection::classified_pairs;
 use crate::mesh::test_meshes::grid;
 
 /// The smallest angle of the live faces, degrees.
@@ -124,6 +125,67 @@ fn poked_sheets() -> (MeshSurface, TriMesh, usize) {
     let poke = off as usize + 3 * 7 + 3;
     both.positions[poke].z = -0.3;
     (surface, both, poke)
+}
+
+#[test]
+fn removing_the_vertex_of_a_folded_fan_unfolds_it_and_a_peak_is_not_removed() {
+    // An interior vertex of a flat grid pushed past its neighbour: part of its fan turns over
+    // and lies on the rest (folds: pairs sharing a vertex that overlap). A move or collapse
+    // compares its new faces with the folded faces' own (turned over) normals; the removal
+    // triangulates the link on the side of the fan's mean normal.
+    let (g, _) = flat(6);
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    let v = 3 * 7 + 3;
+    let p = m.position(v);
+    m.relocate_vertex(v, p + DVec3::new(1.4, 0.3, 0.0)).unwrap();
+    let folded = m.to_trimesh();
+    let (pairs, _) = classified_pairs(&folded.positions, &folded.triangles);
+    assert!(
+        pairs.iter().any(|&([f, g], _)| share_a_vertex(
+            folded.triangles[f as usize],
+            folded.triangles[g as usize]
+        )),
+        "the case must fold: {pairs:?}"
+    );
+    let guard = CrossingGuard::new(&m);
+    // sigma_p 4: the old position (1.4 from the grid's vertex) may be that far from the faces.
+    let wide = Limits::new(&OptimizeParams::default(), 4.0);
+    let ((old, new), faces) = try_remove(&m, &guard, v, &wide).expect("a removal");
+    assert!(new > old, "{old} -> {new}");
+    assert_eq!(faces.len(), m.degree(v) - 2);
+    remove_vertex(&mut m, v, &faces).unwrap();
+    assert_eq!(m.degree(v), 0);
+    let out = m.to_trimesh();
+    let (pairs, _) = classified_pairs(&out.positions, &out.triangles);
+    assert!(pairs.is_empty(), "{pairs:?}");
+    // Every face faces up again, and together they cover the grid once.
+    let area: f64 = out
+        .triangles
+        .iter()
+        .map(|&t| {
+            let [a, b, c] = t.map(|i| out.positions[i as usize]);
+            let z = (b - a).cross(c - a).z;
+            assert!(z > 0.0, "{t:?} faces down");
+            0.5 * z
+        })
+        .sum();
+    assert!((area - 36.0).abs() < 1e-9, "{area}");
+    assert_eq!(m.sanity_check(), Ok(()));
+
+    // A vertex lifted 2 off the grid: its removal would leave it farther from the faces than
+    // a collapse may (0.25 at sigma_p 1), so it is not offered.
+    let (g, _) = flat(6);
+    let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
+    m.relocate_vertex(v, p + DVec3::new(0.0, 0.0, 2.0)).unwrap();
+    let guard = CrossingGuard::new(&m);
+    assert!(try_remove(&m, &guard, v, &limits()).is_none());
+    assert!(try_remove(
+        &m,
+        &guard,
+        v,
+        &Limits::new(&OptimizeParams::default(), 16.0)
+    )
+    .is_some());
 }
 
 #[test]
