@@ -679,6 +679,9 @@ fn try_move(
     ok.then_some((old, new))
 }
 
+/// A vertex removal's smallest angle scores before and after, and the faces it makes.
+type Removal = ((f64, f64), Vec<[u32; 3]>);
+
 /// The link of the interior vertex `v`: its neighbours in the order of its faces (each face
 /// `[v, a, b]` gives the link edge a → b), or `None` when its faces do not make one closed fan
 /// with distinct neighbours (a boundary vertex, a pinched fan).
@@ -722,7 +725,7 @@ fn try_remove(
     guard: &CrossingGuard,
     v: u32,
     params: &Limits,
-) -> Option<((f64, f64), Vec<[u32; 3]>)> {
+) -> Option<Removal> {
     let link = link_of(m, v)?;
     let pts: Vec<DVec3> = link.iter().map(|&u| m.position(u)).collect();
     let center = pts.iter().sum::<DVec3>() / pts.len() as f64;
