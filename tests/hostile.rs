@@ -625,3 +625,101 @@ fn a_handful_of_points_is_too_few_for_a_surface() {
         assert_error(&o, 3, &[&name, &format!("{n} points are too few")]);
     }
 }
+
+// Issue 56: the second hostile round.
+
+/// R3: `remesh simplify S.ply S.ply` and `remesh points M.ply M.ply` replaced their input and
+/// exited 0. Every subcommand refuses an output that is its input (the same name, another
+/// spelling of it, a symbolic or a hard link), before any work, and leaves the input as it was.
+#[test]
+fn no_subcommand_writes_over_its_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = write(dir.path(), "s.ply", ply_points(300, 300));
+    let mesh = dir.path().join("m.ply");
+    spectral_remesh::write_mesh(&mesh, &common::icosphere(2)).unwrap();
+    let other_spelling = |p: &Path| dir.path().join(".").join(p.file_name().unwrap());
+    let linked = |p: &Path, name: &str| {
+        let l = dir.path().join(name);
+        #[cfg(unix)]
+        std::os::unix::fs::symlink(p, &l).unwrap();
+        #[cfg(not(unix))]
+        std::fs::hard_link(p, &l).unwrap();
+        l
+    };
+    let hard = |p: &Path, name: &str| {
+        let l = dir.path().join(name);
+        std::fs::hard_link(p, &l).unwrap();
+        l
+    };
+    let points_as = [
+        points.clone(),
+        other_spelling(&points),
+        linked(&points, "s-link.ply"),
+        hard(&points, "s-hard.ply"),
+    ];
+    let mesh_as = [
+        mesh.clone(),
+        other_spelling(&mesh),
+        linked(&mesh, "m-link.ply"),
+        hard(&mesh, "m-hard.ply"),
+    ];
+    let (points_before, mesh_before) = (
+        std::fs::read(&points).unwrap(),
+        std::fs::read(&mesh).unwrap(),
+    );
+    for out in &points_as {
+        let o = remesh(&["simplify", arg(&points), arg(out), "--points", "100", "-q"]);
+        assert_error(&o, 2, &["is the input file"]);
+        // The main command, on the point set, too.
+        let o = remesh(&[arg(&points), arg(out), "--points", "100", "-q"]);
+        assert_error(&o, 2, &["is the input file"]);
+    }
+    for out in &mesh_as {
+        let o = remesh(&["points", arg(&mesh), arg(out), "--count", "50"]);
+        assert_error(&o, 2, &["is the input file"]);
+    }
+    assert_eq!(std::fs::read(&points).unwrap(), points_before);
+    assert_eq!(std::fs::read(&mesh).unwrap(), mesh_before);
+    assert_no_temporaries(dir.path());
+    // Another output is written.
+    let o = remesh(&[
+        "points",
+        arg(&mesh),
+        arg(&dir.path().join("p.ply")),
+        "--count",
+        "50",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// R9: an element before `vertex` whose count times its record size passes 2^64
+/// (`element camera 1152921504606846977`, 16-byte records: 16 bytes once wrapped) was taken as
+/// one 16-byte record and the file read on. It is an input error naming the element.
+#[test]
+fn an_element_count_that_wraps_is_an_input_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement camera 1152921504606846977\n\
+        property float view_px\nproperty float view_py\nproperty float view_pz\n\
+        property float scale\n"
+        .to_vec();
+    // The camera's one record, then 300 points, as `ply_points` writes them.
+    let points = ply_points(300, 300);
+    let header_end = points
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    bytes.extend_from_slice(&points[b"ply\nformat binary_little_endian 1.0\n".len()..header_end]);
+    bytes.extend(std::iter::repeat_n(0u8, 16));
+    bytes.extend_from_slice(&points[header_end..]);
+    let input = write(dir.path(), "wrap.ply", bytes);
+    let out = dir.path().join("out.ply");
+    for args in [
+        vec![arg(&input), arg(&out), "--points", "100", "-q"],
+        vec!["simplify", arg(&input), arg(&out), "--points", "100", "-q"],
+    ] {
+        let o = remesh(&args);
+        assert_error(&o, 3, &["wrap.ply", "camera"]);
+        assert!(!out.exists());
+    }
+}

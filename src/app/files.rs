@@ -91,6 +91,25 @@ pub(super) fn same_target(a: &Path, b: &Path) -> bool {
     matches!((place(a), place(b)), (Some(x), Some(y)) if x == y)
 }
 
+/// Refuses, before any work, an `output` that would replace the `input` it is made from
+/// ([`same_target`]: the same file under any name, a hard link, or the same name in the same
+/// folder): every subcommand that reads one file and writes another.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `OUTPUT`.
+pub(super) fn refuse_input_as_output(input: &Path, output: &Path) -> Result<()> {
+    if same_target(input, output) {
+        return Err(Error::InvalidParameter {
+            name: "OUTPUT",
+            message: format!(
+                "{} is the input file; choose another output path",
+                output.display()
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Writes `report` as pretty JSON to `path`, atomically (a temporary file beside it, renamed
 /// over the target only when complete).
 ///

@@ -27,9 +27,11 @@ pub struct PointsJob {
 /// Runs a [`PointsJob`].
 ///
 /// # Errors
-/// Reading and writing errors naming the file.
+/// [`Error::InvalidParameter`] for an output that is not a `.ply` file or is the input; reading
+/// and writing errors naming the file.
 pub fn run_points(job: &PointsJob) -> Result<()> {
     require_ply_output(&job.output)?;
+    super::files::refuse_input_as_output(&job.mesh, &job.output)?;
     if job.count > MAX_SURFACE_POINTS {
         return Err(Error::InvalidParameter {
             name: "count",

@@ -4,7 +4,7 @@
 use crate::timing::Clock;
 use std::path::{Path, PathBuf};
 
-use super::files::{is_stdout, output_format, report_clash, same_target, with_path};
+use super::files::{is_stdout, output_format, refuse_input_as_output, report_clash, with_path};
 use super::job::{RemeshJob, RemeshedMesh};
 use super::memory;
 use super::notes::{
@@ -70,14 +70,8 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             });
         }
     }
-    if !to_stdout && same_target(&job.input, &job.output) {
-        return Err(Error::InvalidParameter {
-            name: "OUTPUT",
-            message: format!(
-                "{} is the input file; choose another output path",
-                job.output.display()
-            ),
-        });
+    if !to_stdout {
+        refuse_input_as_output(&job.input, &job.output)?;
     }
     if let Some(report) = &job.report {
         let mut others = vec![(job.input.as_path(), "the input file")];

@@ -95,10 +95,11 @@ pub enum SimplifyDetail {
 /// Runs a [`SimplifyJob`]: simplifies the input out of core and writes the output atomically.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for `--points 0` or a finite sigma_n on an input without normals;
-/// reading and writing errors naming the file.
+/// [`Error::InvalidParameter`] for `--points 0`, a finite sigma_n on an input without normals,
+/// or an output that is the input; reading and writing errors naming the file.
 pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
     super::points::require_ply_output(&job.output)?;
+    super::files::refuse_input_as_output(&job.input, &job.output)?;
     if job.density == SimplifyDensity::Points(0) {
         return Err(Error::InvalidParameter {
             name: "points",

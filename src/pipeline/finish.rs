@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 
-use crate::geometry::self_intersection::CrossingRegions;
+use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::mesh::{orient_consistently, OrientStats, TriMesh};
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::SurfaceQuery;
@@ -156,36 +156,52 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     } else {
         &fixed
     };
-    let (untangle_stats, origin) = untangle(
-        mesh,
-        untangle_fixed,
-        f.sigma_p,
-        &f.untangle,
-        f.input_crossings,
-    );
+    // Two stages: first the collapses that keep the mesh within the optimization's bound on a
+    // collapse (then the last pass mends around them, with the surface at hand: a fold it can
+    // undo keeps its vertices), then, where folds are left, any collapse that removes them.
+    let mut untangle_stats = UntangleStats::default();
     let mut mend_after_untangle = MendStats::default();
-    if untangle_stats.collapses > 0 {
-        *face_sources = carried_sources(&origin, face_sources);
-        // The collapses leave the faces around them as they fall (a hub where a fold was
-        // collapsed away): the last pass of the optimization mends them, and the faces around
-        // them, under its guards (no new crossing, near the surface).
-        if let Some(op) = f.optimize {
-            let near = around_changed_faces(mesh, &origin);
-            let (stats, origin) = mend_near(
-                mesh,
-                f.surface,
-                &fixed,
-                &protected,
-                f.boundary,
-                f.input_crossings,
-                f.sigma_p,
-                op,
-                &near,
-            );
+    for (stage, offset) in [f.untangle.collapse_offset_sigma_p, f64::INFINITY]
+        .into_iter()
+        .enumerate()
+    {
+        let params = UntangleParams {
+            collapse_offset_sigma_p: offset,
+            ..f.untangle
+        };
+        let (stats, origin) = untangle(mesh, untangle_fixed, f.sigma_p, &params, f.input_crossings);
+        untangle_stats = if stage == 0 {
+            stats
+        } else {
+            untangle_stats.then(&stats)
+        };
+        if stats.collapses > 0 {
             *face_sources = carried_sources(&origin, face_sources);
-            mend_after_untangle = stats;
+            // The collapses leave the faces around them as they fall (a hub where a fold was
+            // collapsed away): the last pass of the optimization mends them, and the faces
+            // around them, under its guards (no new crossing, near the surface).
+            if let Some(op) = f.optimize {
+                let near = around_changed_faces(mesh, &origin);
+                let (stats, origin) = mend_near(
+                    mesh,
+                    f.surface,
+                    &fixed,
+                    &protected,
+                    f.boundary,
+                    f.input_crossings,
+                    f.sigma_p,
+                    op,
+                    &near,
+                );
+                *face_sources = carried_sources(&origin, face_sources);
+                mend_after_untangle = mend_after_untangle.then(&stats);
+            }
+            later_dropped += mesh.remove_unreferenced_vertices();
         }
-        later_dropped += mesh.remove_unreferenced_vertices();
+        // The second stage only where the first left the output's own folds or crossings.
+        if !has_own_crossings(mesh, f.input_crossings) {
+            break;
+        }
     }
     // No face of no area is written.
     let (degenerate, origin) = mend_degenerate_faces(mesh, &fixed);
@@ -223,6 +239,19 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
         stray_shells,
         orientation,
     }
+}
+
+/// Whether faces of `mesh` intersect ([`classified_pairs`]) other than where the input's own
+/// faces cross (a pair that shares a vertex, a fold, always counts: as
+/// [`CrossingRegions::holds_faces`] says).
+fn has_own_crossings(mesh: &TriMesh, regions: Option<&CrossingRegions>) -> bool {
+    let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
+    intersecting_pairs(&mesh.positions, &mesh.triangles)
+        .iter()
+        .any(|&[f, g]| {
+            let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
+            regions.is_none_or(|r| !r.holds_faces(a, corners(a), b, corners(b)))
+        })
 }
 
 /// The vertices of the faces of `mesh` that an edit changed (`origin[f]` is `None`: as

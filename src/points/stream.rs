@@ -229,7 +229,14 @@ impl PointReader {
                             }
                         }
                     }
-                    let mut skip = size * element.count as u64;
+                    // Checked: a count near 2^64 must not wrap to a small length.
+                    let mut skip = size.checked_mul(element.count as u64).ok_or_else(|| {
+                        parse(format!(
+                            "the header announces {} `{name}` records of {size} bytes, more \
+                             than a file holds",
+                            element.count
+                        ))
+                    })?;
                     if let Some(slots) = &view_slots {
                         let mut record = vec![0u8; size as usize];
                         input

@@ -14,7 +14,7 @@ use crate::geometry::self_intersection::{pairs_within, CrossingRegions};
 use crate::geometry::triangle::{
     is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,
 };
-use crate::geometry::triangle_intersection::triangles_within;
+use crate::geometry::triangle_intersection::{point_triangle_distance, triangles_within};
 use crate::mesh::crossing_guard::{new_faces_intersect, CrossingGuard};
 use crate::mesh::edit::{EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
@@ -37,6 +37,9 @@ pub struct UntangleParams {
     /// mesh passes through itself or its parts meet (the [`CrossingRegions`] given to
     /// [`untangle`]) a crossing is the input's, and collapses would eat the part.
     pub max_collapses: usize,
+    /// How far a collapse may leave the two old positions of its edge from the faces it makes
+    /// (σ_p units; the optimization's `collapse_offset_sigma_p`). Default 0.25.
+    pub collapse_offset_sigma_p: f64,
     /// Faces nearer than this count as crossing (bbox-100 units, not σ_p; at most a tenth of the
     /// margin is used): faces that would share a point once the mesh is written, whose coordinates
     /// are rounded
@@ -52,6 +55,7 @@ impl Default for UntangleParams {
             margin_sigma_p: 0.01,
             max_step_sigma_p: 0.25,
             max_collapses: 100,
+            collapse_offset_sigma_p: 0.25,
             near: 0.0,
         }
     }
@@ -66,12 +70,28 @@ pub struct UntangleStats {
     pub pairs_after: usize,
     /// Rounds run.
     pub rounds: usize,
-    /// Distinct vertices moved.
+    /// Distinct vertices moved (in each run of [`untangle`], summed over runs by [`UntangleStats::then`]).
     pub vertices_moved: usize,
     /// The largest total displacement of a vertex (σ_p units).
     pub max_displacement: f64,
     /// Edges collapsed after the moves (see [`UntangleParams::max_collapses`]).
     pub collapses: usize,
+}
+
+impl UntangleStats {
+    /// These stats followed by those of a `later` run on the result: the pairs before this
+    /// one and after the later one, the rounds, vertices moved (counted once per run) and
+    /// collapses of both, the larger displacement.
+    pub fn then(&self, later: &UntangleStats) -> UntangleStats {
+        UntangleStats {
+            pairs_before: self.pairs_before,
+            pairs_after: later.pairs_after,
+            rounds: self.rounds + later.rounds,
+            vertices_moved: self.vertices_moved + later.vertices_moved,
+            max_displacement: self.max_displacement.max(later.max_displacement),
+            collapses: self.collapses + later.collapses,
+        }
+    }
 }
 
 /// Moves vertices of `mesh` (bbox-100 units) until no two faces intersect
@@ -246,7 +266,9 @@ pub fn untangle(
     };
     let mut pairs_after = pairs.len();
     if !pairs.is_empty() && params.max_collapses > 0 {
-        let (collapses, left) = collapse_folds(&mut m, fixed, params.max_collapses, near, &own);
+        let offset = params.collapse_offset_sigma_p * sigma_p;
+        let (collapses, left) =
+            collapse_folds(&mut m, fixed, params.max_collapses, near, offset, &own);
         stats.collapses = collapses;
         pairs_after = left;
     }
@@ -275,7 +297,9 @@ const COLLAPSE_CANDIDATES: usize = 16;
 
 /// Collapses edges of crossing faces, one at a time: of the `COLLAPSE_CANDIDATES` shortest edges
 /// of the faces of pairs that `own` keeps (neither end `fixed`), each collapsed to its midpoint
-/// or to either end, the legal collapse ([`EditMesh::collapse_edge`]) that leaves fewer
+/// or to either end, with both old positions of the edge within `offset` of the faces it makes
+/// (the optimization's bound on a collapse: a fold at a thin tip is not cut off with the tip),
+/// the legal collapse ([`EditMesh::collapse_edge`]) that leaves fewer
 /// crossings among the faces it makes than there were among the faces around the edge, and of
 /// those the best smallest angle among the faces it makes; until no pair is left to `own`, none
 /// helps, or `max` collapses are made. The faces are in a [`CrossingGuard`] (a BVH whose leaves
@@ -287,6 +311,7 @@ fn collapse_folds(
     fixed: &[bool],
     max: usize,
     near: f64,
+    offset: f64,
     own: &dyn Fn(&Mesh, [u32; 2]) -> bool,
 ) -> (usize, usize) {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
@@ -335,6 +360,12 @@ fn collapse_folds(
                 let corners = |t: [u32; 3]| t.map(|u| if u == kept { at } else { m.position(u) });
                 if fan.iter().any(|&t| is_degenerate_triangle(corners(t)))
                     || new_faces_intersect(&fan, corners, near)
+                    || [pa, pb].into_iter().any(|p| {
+                        fan.iter()
+                            .map(|&t| point_triangle_distance(p, corners(t)))
+                            .fold(f64::INFINITY, f64::min)
+                            > offset
+                    })
                 {
                     continue;
                 }
@@ -652,12 +683,63 @@ mod tests {
         let before = intersecting_pairs(&m.positions, &m.triangles).len();
         assert!(before > 0);
         let fixed = vec![false; m.positions.len()];
-        // Collapses only (no move rounds), so the collapses are what is tested.
+        // Collapses only (no move rounds), so the collapses are what is tested, and as far from
+        // the old positions as they need.
         let only_collapses = UntangleParams {
             max_rounds: 0,
             max_collapses: 10,
+            collapse_offset_sigma_p: f64::INFINITY,
             ..Default::default()
         };
+        // A vertex of the upper of two sheets 0.2 apart poked to 0.3 below the lower one: the
+        // collapse of the poked vertex leaves its position 0.5 from the faces it makes, more
+        // than the optimization's bound (0.25 sigma_p): within the bound the vertex stays (other
+        // collapses may lower the crossings); without it, the crossing goes.
+        let (mut poked, off) = crate::mesh::test_meshes::stacked_grids(6);
+        poked.positions[off as usize + 3 * 7 + 3].z = -0.3;
+        let crossing = intersecting_pairs(&poked.positions, &poked.triangles).len();
+        assert!(crossing > 0);
+        // The lower sheet fixed: only the upper one's edges may go.
+        let lower_fixed: Vec<bool> = (0..poked.positions.len())
+            .map(|v| v < off as usize)
+            .collect();
+        let mut bounded = poked.clone();
+        let (s, _) = untangle(
+            &mut bounded,
+            &lower_fixed,
+            1.0,
+            &UntangleParams {
+                collapse_offset_sigma_p: 0.25,
+                ..only_collapses
+            },
+            None,
+        );
+        assert!(s.pairs_after > 0 && s.pairs_after <= crossing, "{s:?}");
+        let tip = off + 3 * 7 + 3;
+        assert!(
+            bounded.triangles.iter().any(|t| t.contains(&tip)),
+            "the poked vertex is collapsed away"
+        );
+        assert_eq!(bounded.positions[tip as usize].z, -0.3);
+        let (s, _) = untangle(&mut poked, &lower_fixed, 1.0, &only_collapses, None);
+        assert!(s.collapses >= 1 && s.pairs_after == 0, "{s:?}");
+        // A vertex dragged just past its neighbour: collapsing it into that neighbour leaves
+        // its old position on the faces made (the grid is flat), within any bound.
+        let mut near_fold = grid(8, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        near_fold.positions[v] = DVec3::new(5.4, 4.3, 0.0);
+        assert!(!intersecting_pairs(&near_fold.positions, &near_fold.triangles).is_empty());
+        let (s, _) = untangle(
+            &mut near_fold,
+            &fixed,
+            1.0,
+            &UntangleParams {
+                collapse_offset_sigma_p: 1e-9,
+                ..only_collapses
+            },
+            None,
+        );
+        assert!(s.collapses >= 1, "{s:?}");
+        assert!(intersecting_pairs(&near_fold.positions, &near_fold.triangles).is_empty());
         let mut without = m.clone();
         let (s, _) = untangle(
             &mut without,

@@ -377,6 +377,20 @@ pub struct MendStats {
     pub left: FacesLeft,
 }
 
+impl MendStats {
+    /// These stats followed by those of a `later` pass on the result: the operations,
+    /// attempts and budgets of both, whether either ran out, and the faces the later one left.
+    pub fn then(&self, later: &MendStats) -> MendStats {
+        MendStats {
+            ops: self.ops + later.ops,
+            attempts: self.attempts + later.attempts,
+            budget: self.budget + later.budget,
+            exhausted: self.exhausted || later.exhausted,
+            left: later.left,
+        }
+    }
+}
+
 /// The smallest angle of the faces `t`, degrees (infinity for none).
 fn worst_angle(m: &Mesh, faces: impl IntoIterator<Item = [u32; 3]>, params: &Limits) -> f64 {
     faces
@@ -720,12 +734,7 @@ fn link_of(m: &Mesh, v: u32) -> Option<Vec<u32>> {
 /// stays within `collapse_offset` of them and none crosses another face or another new face.
 /// The vertex removal of Schroeder et al. ("Decimation of triangle meshes", SIGGRAPH 1992),
 /// here a mend: it replaces a fan folded over itself or onto a neighbour.
-fn try_remove(
-    m: &Mesh,
-    guard: &CrossingGuard,
-    v: u32,
-    params: &Limits,
-) -> Option<Removal> {
+fn try_remove(m: &Mesh, guard: &CrossingGuard, v: u32, params: &Limits) -> Option<Removal> {
     let link = link_of(m, v)?;
     let pts: Vec<DVec3> = link.iter().map(|&u| m.position(u)).collect();
     let center = pts.iter().sum::<DVec3>() / pts.len() as f64;
