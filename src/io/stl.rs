@@ -33,13 +33,15 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     let mut data = read_file(path)?;
     let parse_err = |message: String| Error::parse(path, None, message);
     let binary = is_binary(&data);
+    if !binary {
+        // Keywords in any case (`SOLID`, `FACET NORMAL`, as some exporters write them): the
+        // text lowered (numbers read the same, `1E-5` as `1e-5`).
+        data.make_ascii_lowercase();
+    }
     if binary {
         // stl_io tells ascii by a leading `solid `: blank the header (it holds nothing we use)
         // so that a binary file whose header starts so is read as binary.
         data[..HEADER].fill(0);
-    } else if data.starts_with(b"solid") && !data.starts_with(b"solid ") {
-        // `solid` alone on its line (no name): stl_io wants the space.
-        data.insert(5, b' ');
     } else if !data.starts_with(b"solid") {
         return Err(parse_err(if data.len() >= HEADER + 4 {
             let n = u32::from_le_bytes([data[80], data[81], data[82], data[83]]);
@@ -57,20 +59,30 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
             )
         }));
     }
-    let mut cursor = Cursor::new(&data[..]);
-    let triangles = stl_io::create_stl_reader(&mut cursor)
-        .map_err(|e| parse_err(format!("cannot read the STL: {}", one_line(&e.to_string()))))?;
+    // An ascii file may hold several solids (a multi-body CAD export): each is read.
+    let blocks: Vec<Vec<u8>> = if binary {
+        vec![data]
+    } else {
+        ascii_solids(&data)
+    };
     let mut positions = Vec::new();
-    for (i, t) in triangles.enumerate() {
-        let t = t.map_err(|e| {
-            parse_err(format!(
-                "triangle {} (0-based): {}",
-                i,
-                one_line(&e.to_string())
-            ))
-        })?;
-        for v in t.vertices {
-            positions.push(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64));
+    let mut i = 0usize;
+    for block in &blocks {
+        let mut cursor = Cursor::new(&block[..]);
+        let triangles = stl_io::create_stl_reader(&mut cursor)
+            .map_err(|e| parse_err(format!("cannot read the STL: {}", one_line(&e.to_string()))))?;
+        for t in triangles {
+            let t = t.map_err(|e| {
+                parse_err(format!(
+                    "triangle {} (0-based): {}",
+                    i,
+                    one_line(&e.to_string())
+                ))
+            })?;
+            for v in t.vertices {
+                positions.push(DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64));
+            }
+            i += 1;
         }
     }
     stats.vertices_read = positions.len();
@@ -79,6 +91,39 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
         .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
         .collect();
     Ok(TriMesh::new(positions, triangles))
+}
+
+/// The solids of an ascii STL (lower-cased `data` that starts with `solid`): from each line that
+/// begins with `solid` to the next, each starting with `solid ` as stl_io wants it (a `solid`
+/// without a name gets the space).
+fn ascii_solids(data: &[u8]) -> Vec<Vec<u8>> {
+    let mut starts = vec![0];
+    for (k, &b) in data.iter().enumerate() {
+        if b == b'\n' {
+            let line_start = k + 1;
+            let rest = &data[line_start..];
+            let first = rest
+                .iter()
+                .position(|c| !c.is_ascii_whitespace() || *c == b'\n');
+            if let Some(f) = first {
+                if rest[f..].starts_with(b"solid") && line_start + f > 0 {
+                    starts.push(line_start + f);
+                }
+            }
+        }
+    }
+    starts.dedup();
+    starts.push(data.len());
+    starts
+        .windows(2)
+        .map(|w| {
+            let mut block = data[w[0]..w[1]].to_vec();
+            if !block.starts_with(b"solid ") {
+                block.insert(5, b' ');
+            }
+            block
+        })
+        .collect()
 }
 
 /// Binary STL of `mesh`: a header naming the writer, one record per triangle with its unit
@@ -167,6 +212,61 @@ mod tests {
         assert_eq!(m.positions.len(), 4);
         assert_eq!(m.triangles, vec![[0, 1, 2], [1, 3, 2]]);
         assert_eq!(stats.welded_vertices, 2);
+    }
+
+    /// An ascii STL of `solids`, each a name and its triangles.
+    fn ascii(solids: &[(&str, &[[[f64; 3]; 3]])]) -> String {
+        let mut text = String::new();
+        for (name, triangles) in solids {
+            text += &format!("solid {name}\n");
+            for t in *triangles {
+                text += "  facet normal 0 0 0\n    outer loop\n";
+                for p in t {
+                    text += &format!("      vertex {} {} {}\n", p[0], p[1], p[2]);
+                }
+                text += "    endloop\n  endfacet\n";
+            }
+            text += &format!("endsolid {name}\n");
+        }
+        text
+    }
+
+    /// Issue 56, R6: an ascii STL of two `solid … endsolid` blocks (a multi-body CAD export)
+    /// was read up to the first `endsolid`, silently. Every solid is read, in order.
+    #[test]
+    fn every_solid_of_an_ascii_stl_is_read() {
+        let m = tetrahedron();
+        let corners: Vec<[[f64; 3]; 3]> = (0..m.face_count())
+            .map(|f| m.corners(f).map(|p| p.to_array()))
+            .collect();
+        let text = ascii(&[
+            ("first", &corners[..2]),
+            ("", &corners[2..3]),
+            ("third", &corners[3..]),
+        ]);
+        let (back, stats) = read_bytes(text.as_bytes()).unwrap();
+        assert_eq!(stats.faces_read, 4);
+        let read: Vec<[DVec3; 3]> = (0..back.face_count()).map(|f| back.corners(f)).collect();
+        let made: Vec<[DVec3; 3]> = (0..m.face_count()).map(|f| m.corners(f)).collect();
+        assert_eq!(read, made);
+        assert_eq!(back.positions.len(), 4, "welded across the solids");
+    }
+
+    /// Issue 56, R11: an ascii STL in upper case (`SOLID`, `FACET NORMAL`, `1E-1`) was taken for
+    /// binary. It reads as the same file in lower case.
+    #[test]
+    fn an_ascii_stl_in_upper_case_is_read() {
+        let m = tetrahedron();
+        let corners: Vec<[[f64; 3]; 3]> = (0..m.face_count())
+            .map(|f| m.corners(f).map(|p| p.to_array()))
+            .collect();
+        let lower = ascii(&[("part", &corners)]).replace("0.125", "1.25e-1");
+        let upper = lower.to_ascii_uppercase();
+        assert!(upper.contains("SOLID PART") && upper.contains("1.25E-1"));
+        let (a, _) = read_bytes(lower.as_bytes()).unwrap();
+        let (b, _) = read_bytes(upper.as_bytes()).unwrap();
+        assert_eq!(a, b);
+        assert_eq!(a.triangles.len(), 4);
     }
 
     #[test]
