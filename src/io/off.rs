@@ -80,6 +80,11 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
             })
     };
     let (nv, nf) = (count(0, "vertex")?, count(1, "face")?);
+    // Everything on the counts' line and nothing after it (`OFF 4 4 0 0 0 0 1 0 0 …`, which
+    // common readers take as a stream of tokens): the records are read from that line's tokens.
+    if counts.len() > 3 && lines.clone().next().is_none() {
+        return read_one_line(path, counts_no, &counts[3..], nv, nf, stats);
+    }
     // Record `k` of `n` (vertices or faces): the next line with content, with its number.
     let mut record = |k: usize, n: usize, what: &str| {
         lines.next().ok_or_else(|| {
@@ -160,6 +165,67 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     Ok(TriMesh::new(positions, triangles))
 }
 
+/// The `nv` vertices (three coordinates each) and `nf` faces (a corner count, then the corners)
+/// of an OFF file whose records are all on its line `no` as the `tokens` after its counts;
+/// errors as [`read`]'s, naming that line.
+fn read_one_line(
+    path: &Path,
+    no: usize,
+    tokens: &[&str],
+    nv: usize,
+    nf: usize,
+    stats: &mut ReadStats,
+) -> Result<TriMesh> {
+    let err = |message: String| Error::parse(path, Some(no), message);
+    let mut tokens = tokens.iter().copied();
+    let mut next = |what: &str| {
+        tokens
+            .next()
+            .ok_or_else(|| err(format!("the line ends before {what}")))
+    };
+    let mut positions = Vec::with_capacity(nv.min(1 << 24));
+    for k in 0..nv {
+        let mut p = [0.0f64; 3];
+        for c in &mut p {
+            let tok = next(&format!("vertex {k} of {nv} is complete"))?;
+            *c = tok
+                .parse::<f64>()
+                .map_err(|_| err(format!("`{}` is not a number", short(tok))))?;
+        }
+        positions.push(DVec3::from_array(p));
+    }
+    let mut triangles = Vec::with_capacity(nf.min(1 << 24));
+    let mut corners: Vec<u32> = Vec::new();
+    for k in 0..nf {
+        let what = format!("face {k} of {nf} is complete");
+        let size_tok = next(&what)?;
+        let size: usize = size_tok
+            .parse()
+            .map_err(|_| err(format!("`{}` is not a corner count", short(size_tok))))?;
+        corners.clear();
+        for _ in 0..size {
+            let tok = next(&what)?;
+            let i = tok
+                .parse::<u64>()
+                .map_err(|_| err(format!("`{}` is not a vertex index", short(tok))))?;
+            if i >= nv as u64 {
+                return Err(Error::invalid_mesh(
+                    path,
+                    format!("face {k} names vertex {i}, but the file has {nv} vertices"),
+                ));
+            }
+            corners.push(i as u32);
+        }
+        stats.faces_read += usize::from(size >= 3);
+        if size > 3 {
+            stats.polygons_triangulated += 1;
+        }
+        triangles.extend(triangulate_polygon(&positions, &corners));
+    }
+    stats.vertices_read = positions.len();
+    Ok(TriMesh::new(positions, triangles))
+}
+
 /// At most 40 characters of a token, for messages.
 fn short(token: &str) -> String {
     token.chars().take(40).collect()
@@ -216,6 +282,23 @@ mod tests {
         assert_eq!(m.triangles.len(), 2);
         assert_eq!(stats.polygons_triangulated, 1);
         assert!((m.area() - 1.0).abs() < 1e-12);
+    }
+
+    /// Issue 56, R11: an OFF with all its tokens on one line was refused ("the file ends after 0
+    /// of its 4 vertices"). It reads as the same file with a record per line.
+    #[test]
+    fn an_off_file_on_one_line_is_read() {
+        let lines = "OFF\n4 4 0\n0 0 0\n1.5 0 0\n0 2.25 0\n0 0 0.125\n\
+                     3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+        let one = lines.replace('\n', " ");
+        let (a, _) = read_text(lines).unwrap();
+        let (b, stats) = read_text(&one).unwrap();
+        assert_eq!(a, b);
+        assert_eq!((stats.vertices_read, stats.faces_read), (4, 4));
+        // Cut short, it is an error naming the line.
+        let short = one.trim_end().rsplit_once(' ').unwrap().0.to_string();
+        let e = read_text(&short).unwrap_err().to_string();
+        assert!(e.contains("m.off:1:") && !e.contains('\n'), "{e}");
     }
 
     #[test]
