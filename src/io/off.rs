@@ -112,55 +112,34 @@ pub(super) fn read(path: &Path, stats: &mut ReadStats) -> Result<TriMesh> {
     };
     for k in 0..nv {
         let (no, tokens) = tokens_of(k, nv, "vertices", &|_| 3)?;
-        let mut p = [0.0f64; 3];
-        let mut tokens = tokens.into_iter();
-        for c in &mut p {
-            let tok = tokens
-                .next()
-                .ok_or_else(|| err(no, "a vertex needs three coordinates".into()))?;
-            *c = tok
-                .parse::<f64>()
-                .map_err(|_| err(no, format!("`{}` is not a number", short(tok))))?;
-        }
-        positions.push(DVec3::from_array(p));
+        let missing = || err(no, "a vertex needs three coordinates".into());
+        positions.push(vertex(&mut tokens.into_iter(), &missing, &|m| err(no, m))?);
     }
-    let mut triangles = Vec::with_capacity(nf.min(1 << 24));
-    let mut corners: Vec<u32> = Vec::new();
+    let mut faces = Faces::new(nf);
     for k in 0..nf {
         let (no, tokens) = tokens_of(k, nf, "faces", &|t: &[&str]| {
             t.first()
                 .and_then(|c| c.parse::<usize>().ok())
                 .map_or(0, |size| size.saturating_add(1))
         })?;
+        // A record's line has content: its first token, the corner count, is always there.
         let mut tokens = tokens.into_iter();
-        let index = |tok: Option<&str>| -> Result<u32> {
-            let tok =
-                tok.ok_or_else(|| err(no, "the face has fewer corners than it says".into()))?;
-            let i = tok
-                .parse::<u64>()
-                .map_err(|_| err(no, format!("`{}` is not a vertex index", short(tok))))?;
-            if i >= nv as u64 {
-                return Err(Error::invalid_mesh(
+        let missing = || err(no, "the face has fewer corners than it says".into());
+        faces.push(
+            &mut tokens,
+            &positions,
+            stats,
+            &missing,
+            &|m| err(no, m),
+            &|i| {
+                Error::invalid_mesh(
                     path,
                     format!("face on line {no} names vertex {i}, but the file has {nv} vertices"),
-                ));
-            }
-            Ok(i as u32)
-        };
-        let size_tok = tokens.next().unwrap_or("");
-        let size: usize = size_tok
-            .parse()
-            .map_err(|_| err(no, format!("`{}` is not a corner count", short(size_tok))))?;
-        corners.clear();
-        for _ in 0..size {
-            corners.push(index(tokens.next())?);
-        }
-        stats.faces_read += usize::from(size >= 3);
-        if size > 3 {
-            stats.polygons_triangulated += 1;
-        }
-        triangles.extend(triangulate_polygon(&positions, &corners));
+                )
+            },
+        )?;
     }
+    let triangles = faces.triangles;
     stats.vertices_read = positions.len();
     Ok(TriMesh::new(positions, triangles))
 }
@@ -178,52 +157,98 @@ fn read_one_line(
 ) -> Result<TriMesh> {
     let err = |message: String| Error::parse(path, Some(no), message);
     let mut tokens = tokens.iter().copied();
-    let mut next = |what: &str| {
-        tokens
-            .next()
-            .ok_or_else(|| err(format!("the line ends before {what}")))
-    };
     let mut positions = Vec::with_capacity(nv.min(1 << 24));
     for k in 0..nv {
-        let mut p = [0.0f64; 3];
-        for c in &mut p {
-            let tok = next(&format!("vertex {k} of {nv} is complete"))?;
-            *c = tok
-                .parse::<f64>()
-                .map_err(|_| err(format!("`{}` is not a number", short(tok))))?;
-        }
-        positions.push(DVec3::from_array(p));
+        let missing = || {
+            err(format!(
+                "the line ends before vertex {k} of {nv} is complete"
+            ))
+        };
+        positions.push(vertex(&mut tokens, &missing, &err)?);
     }
-    let mut triangles = Vec::with_capacity(nf.min(1 << 24));
-    let mut corners: Vec<u32> = Vec::new();
+    let mut faces = Faces::new(nf);
     for k in 0..nf {
-        let what = format!("face {k} of {nf} is complete");
-        let size_tok = next(&what)?;
+        let missing = || err(format!("the line ends before face {k} of {nf} is complete"));
+        faces.push(&mut tokens, &positions, stats, &missing, &err, &|i| {
+            Error::invalid_mesh(
+                path,
+                format!("face {k} names vertex {i}, but the file has {nv} vertices"),
+            )
+        })?;
+    }
+    let triangles = faces.triangles;
+    stats.vertices_read = positions.len();
+    Ok(TriMesh::new(positions, triangles))
+}
+
+/// A vertex record's three coordinates, the first three of `tokens` (the rest of the record is
+/// left unread: colours): `missing()` when there are fewer, `bad(message)` for a token that is
+/// not a number.
+fn vertex(
+    tokens: &mut dyn Iterator<Item = &str>,
+    missing: &dyn Fn() -> Error,
+    bad: &dyn Fn(String) -> Error,
+) -> Result<DVec3> {
+    let mut p = [0.0f64; 3];
+    for c in &mut p {
+        let tok = tokens.next().ok_or_else(missing)?;
+        *c = tok
+            .parse::<f64>()
+            .map_err(|_| bad(format!("`{}` is not a number", short(tok))))?;
+    }
+    Ok(DVec3::from_array(p))
+}
+
+/// The faces read so far, triangulated ([`triangulate_polygon`]).
+struct Faces {
+    triangles: Vec<[u32; 3]>,
+    corners: Vec<u32>,
+}
+
+impl Faces {
+    fn new(nf: usize) -> Self {
+        Faces {
+            triangles: Vec::with_capacity(nf.min(1 << 24)),
+            corners: Vec::new(),
+        }
+    }
+
+    /// Reads a face record from `tokens` (a corner count, then the corners; what follows is
+    /// left unread: colours) over the vertices `positions` and adds its triangles:
+    /// `missing()` when the tokens run out, `bad(message)` for a token that is not a count or
+    /// an index, `out_of_range(i)` for a corner past the vertices.
+    fn push(
+        &mut self,
+        tokens: &mut dyn Iterator<Item = &str>,
+        positions: &[DVec3],
+        stats: &mut ReadStats,
+        missing: &dyn Fn() -> Error,
+        bad: &dyn Fn(String) -> Error,
+        out_of_range: &dyn Fn(u64) -> Error,
+    ) -> Result<()> {
+        let size_tok = tokens.next().ok_or_else(missing)?;
         let size: usize = size_tok
             .parse()
-            .map_err(|_| err(format!("`{}` is not a corner count", short(size_tok))))?;
-        corners.clear();
+            .map_err(|_| bad(format!("`{}` is not a corner count", short(size_tok))))?;
+        self.corners.clear();
         for _ in 0..size {
-            let tok = next(&what)?;
+            let tok = tokens.next().ok_or_else(missing)?;
             let i = tok
                 .parse::<u64>()
-                .map_err(|_| err(format!("`{}` is not a vertex index", short(tok))))?;
-            if i >= nv as u64 {
-                return Err(Error::invalid_mesh(
-                    path,
-                    format!("face {k} names vertex {i}, but the file has {nv} vertices"),
-                ));
+                .map_err(|_| bad(format!("`{}` is not a vertex index", short(tok))))?;
+            if i >= positions.len() as u64 {
+                return Err(out_of_range(i));
             }
-            corners.push(i as u32);
+            self.corners.push(i as u32);
         }
         stats.faces_read += usize::from(size >= 3);
         if size > 3 {
             stats.polygons_triangulated += 1;
         }
-        triangles.extend(triangulate_polygon(&positions, &corners));
+        self.triangles
+            .extend(triangulate_polygon(positions, &self.corners));
+        Ok(())
     }
-    stats.vertices_read = positions.len();
-    Ok(TriMesh::new(positions, triangles))
 }
 
 /// At most 40 characters of a token, for messages.

@@ -214,6 +214,13 @@ mod tests {
         assert_eq!(stats.welded_vertices, 2);
     }
 
+    /// The corners of each face of `m`, as arrays.
+    fn corner_arrays(m: &TriMesh) -> Vec<[[f64; 3]; 3]> {
+        (0..m.face_count())
+            .map(|f| m.corners(f).map(|p| p.to_array()))
+            .collect()
+    }
+
     /// An ascii STL of `solids`, each a name and its triangles.
     fn ascii(solids: &[(&str, &[[[f64; 3]; 3]])]) -> String {
         let mut text = String::new();
@@ -236,9 +243,7 @@ mod tests {
     #[test]
     fn every_solid_of_an_ascii_stl_is_read() {
         let m = tetrahedron();
-        let corners: Vec<[[f64; 3]; 3]> = (0..m.face_count())
-            .map(|f| m.corners(f).map(|p| p.to_array()))
-            .collect();
+        let corners = corner_arrays(&m);
         let text = ascii(&[
             ("first", &corners[..2]),
             ("", &corners[2..3]),
@@ -257,9 +262,7 @@ mod tests {
     #[test]
     fn an_ascii_stl_in_upper_case_is_read() {
         let m = tetrahedron();
-        let corners: Vec<[[f64; 3]; 3]> = (0..m.face_count())
-            .map(|f| m.corners(f).map(|p| p.to_array()))
-            .collect();
+        let corners = corner_arrays(&m);
         let lower = ascii(&[("part", &corners)]).replace("0.125", "1.25e-1");
         let upper = lower.to_ascii_uppercase();
         assert!(upper.contains("SOLID PART") && upper.contains("1.25E-1"));
