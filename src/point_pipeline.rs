@@ -255,8 +255,14 @@ pub struct PointRemeshOutput {
     pub sigma_p: f64,
     /// The target count, if one was given.
     pub target: Option<usize>,
-    /// Points read.
+    /// Points read, less the coincident and the far ones.
     pub input_points: u64,
+    /// Points merged into another at the same position.
+    pub duplicate_points: u64,
+    /// Points of far groups left out (counted in `outliers_removed` too).
+    pub far_points: u64,
+    /// What is kept when far groups were left out: the input the output is measured against.
+    pub far_groups: Option<crate::points::far_groups::FarGroups>,
     /// Whether the input had normals (else they were estimated).
     pub had_normals: bool,
     /// Isolated points dropped from the samples and the RIMLS support.
@@ -721,6 +727,14 @@ fn remesh_points_once(
     );
     let dropped_after_finishing = mesh.remove_unreferenced_vertices();
     timer.lap("untangle");
+    // An empty mesh is never a result.
+    if mesh.triangles.is_empty() {
+        return Err(Error::invalid_mesh(
+            input,
+            "no triangle is left once the faces the data does not support are removed (the \
+             points are too sparse, or not on a surface)",
+        ));
+    }
     Ok(PointRemeshOutput {
         mesh: normalization.invert_mesh(&mesh),
         mesh_normalized: mesh,
@@ -728,6 +742,9 @@ fn remesh_points_once(
         sigma_p,
         target,
         input_points: scan.input_points,
+        duplicate_points: scan.duplicate_points,
+        far_points: scan.far_points,
+        far_groups: scan.far_groups.clone(),
         had_normals: scan.had_normals,
         outliers_removed: scan.outliers_removed,
         samples: samples.len(),

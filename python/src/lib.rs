@@ -920,6 +920,12 @@ fn rows_array<'py>(py: Python<'py>, values: &[f64], d: usize) -> Bound<'py, PyAr
 ///     An array of the wrong shape or dtype, a coordinate that is not finite or a normal of
 ///     length 0 (naming its row), neither or both of sigma_p and count, a count outside 1 to n,
 ///     a finite sigma_n without normals, or a parameter out of its range.
+///
+/// Warns
+/// -----
+/// UserWarning
+///     When count is not reached (the report's `reached` is False), saying how many samples
+///     were taken and, when X repeats rows, how many distinct rows it has.
 #[pyfunction]
 #[pyo3(signature = (
     X, normals = None, *, sigma_p = None, count = None, sigma_n = None, seed = 1, epsilon = 0.5,
@@ -960,10 +966,37 @@ fn sample<'py>(
         seed: seed_value(seed)?,
         ..Default::default()
     };
+    // Coincident rows are one point to the measure: a count above theirs cannot be reached.
+    let distinct = {
+        let mut rows: Vec<Vec<u64>> = positions
+            .chunks_exact(d.max(1))
+            .map(|r| r.iter().map(|v| (v + 0.0).to_bits()).collect())
+            .collect();
+        rows.sort_unstable();
+        rows.dedup();
+        rows.len()
+    };
     let picked = without_gil(py, move || {
         let points = PointSet::new(d, positions, normals)?;
         spectral::sample_manifold(&points, &params)
     })?;
+    if let (Some(c), false) = (count, picked.reached) {
+        let why = if distinct < n {
+            format!(" (X has {distinct} distinct rows of {n}: coincident rows are one point)")
+        } else {
+            String::new()
+        };
+        let message = format!(
+            "count={c} not reached: {} samples{why}",
+            picked.indices.len()
+        );
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(message).unwrap_or_default(),
+            1,
+        )?;
+    }
     let indices = Array1::from_iter(picked.indices.iter().map(|&i| i as i64)).into_pyarray(py);
     if !return_report {
         return Ok(indices.into_any());

@@ -497,3 +497,11 @@ def test_gil_is_released(gil_released):
         sr.resample(X, indices, sigma_p=report["sigma_p"])
 
     gil_released(work)
+
+
+def test_a_count_coincident_rows_cannot_reach_is_said():
+    # 10 distinct points, each row 100 times: 10 samples at most, and a warning saying why.
+    P = circle(1, n=10)
+    with pytest.warns(UserWarning, match=r"count=50 not reached: 10 samples \(X has 10 distinct rows of 1000"):
+        picked = sr.sample(np.repeat(P, 100, axis=0), count=50)
+    assert len(np.unique(np.repeat(P, 100, axis=0)[picked], axis=0)) == len(picked) == 10

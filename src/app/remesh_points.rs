@@ -85,17 +85,30 @@ pub(super) fn run(
         let mut positions: Vec<DVec3> = Vec::new();
         while reader.read_chunk(&mut chunk, DISTANCE_CHUNK)? > 0 {
             positions.clear();
-            positions.extend(chunk.iter().map(|p| out.normalization.apply(p.position)));
+            positions.extend(
+                chunk
+                    .iter()
+                    .filter(|p| {
+                        out.far_groups
+                            .as_ref()
+                            .is_none_or(|f| f.contains(p.position))
+                    })
+                    .map(|p| out.normalization.apply(p.position)),
+            );
             distance.add_points(&positions);
         }
         report.distance = Some(distance.finish());
         let (wall, cpu) = t.elapsed();
         report.push_stage("distance (report)", wall, cpu);
-        report.notes.push(
+        report.notes.push(format!(
             "Hausdorff and RMS are to the input points (output to its nearest point, each \
-             point to the output), outliers included"
-                .into(),
-        );
+             point to the output), outliers included{}",
+            if out.far_points > 0 {
+                ", the far groups left out excluded"
+            } else {
+                ""
+            }
+        ));
     }
 
     let extra = &mut report.extra;
@@ -106,6 +119,8 @@ pub(super) fn run(
         insert_json(extra, "camera_viewpoint", v.to_array());
     }
     extra.insert("outliers_removed".into(), out.outliers_removed.into());
+    extra.insert("far_points".into(), out.far_points.into());
+    extra.insert("duplicate_points".into(), out.duplicate_points.into());
     extra.insert("samples".into(), out.samples.into());
     extra.insert("unprojected_samples".into(), out.unprojected_samples.into());
     extra.insert("rescan_rejected".into(), out.rescan_rejected.into());
@@ -144,10 +159,28 @@ pub(super) fn run(
             ),
         }
     ));
-    if out.outliers_removed > 0 {
+    if out.duplicate_points > 0 {
         report.notes.push(format!(
-            "{} isolated points (outliers) were left out of the samples and the surface",
-            out.outliers_removed
+            "{} merged into another at the same position (the input lists a position more than \
+             once)",
+            plural(
+                out.duplicate_points,
+                "coincident point was",
+                "coincident points were"
+            )
+        ));
+    }
+    if out.far_points > 0 {
+        report.notes.push(format!(
+            "{} left out, in groups far from the rest and much smaller: they would have set the \
+             scale",
+            plural(out.far_points, "point was", "points were")
+        ));
+    }
+    let isolated = out.outliers_removed as u64 - out.far_points.min(out.outliers_removed as u64);
+    if isolated > 0 {
+        report.notes.push(format!(
+            "{isolated} isolated points (outliers) were left out of the samples and the surface"
         ));
     }
     count_note(&mut report.notes, out.target, out.mesh.vertex_count());
@@ -289,4 +322,13 @@ pub fn remesh_point_set(
             message: "the point-set pipeline handed over no mesh".into(),
         })?;
     Ok(RemeshedMesh { mesh, report })
+}
+
+/// "1 `one`" or "n `many`".
+fn plural(n: u64, one: &str, many: &str) -> String {
+    if n == 1 {
+        format!("1 {one}")
+    } else {
+        format!("{n} {many}")
+    }
 }

@@ -54,11 +54,15 @@ pub struct SimplifySummary {
     pub output: PathBuf,
     /// Points read.
     pub input_points: u64,
-    /// Far isolated points left out: they would have set the scale (a stray `0 0 0` in a scan
-    /// at UTM coordinates).
+    /// Points of far groups left out: they would have set the scale (a stray `0 0 0`, or a
+    /// small cluster, in a scan at UTM coordinates).
     pub far_points: u64,
+    /// Points merged into another at the same position.
+    pub duplicate_points: u64,
     /// Points written.
     pub samples: usize,
+    /// The count asked for (`--points`), if one was.
+    pub target: Option<usize>,
     /// Whether the input had normals.
     pub had_normals: bool,
     /// The single-level run's figures, or the levels'.
@@ -139,7 +143,9 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
         seed: job.seed,
         ..Default::default()
     };
-    let (input_points, far_points, samples, had_normals, detail) = match &job.density {
+    let (input_points, (far_points, duplicate_points), samples, had_normals, detail) = match &job
+        .density
+    {
         SimplifyDensity::Levels(levels) => {
             let r = simplify_progressive(&job.input, levels, &params)?;
             let mut w = PlyPointWriter::create_with_levels(&job.output, r.samples.len() as u64)?;
@@ -152,7 +158,7 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
             };
             (
                 r.input_points,
-                r.far_points,
+                (r.far_points, r.duplicate_points),
                 r.samples.len(),
                 r.had_normals,
                 detail,
@@ -171,7 +177,7 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
             };
             (
                 r.input_points,
-                r.far_points,
+                (r.far_points, r.duplicate_points),
                 r.samples.len(),
                 r.had_normals,
                 detail,
@@ -183,7 +189,12 @@ pub fn run_simplify(job: &SimplifyJob) -> Result<SimplifySummary> {
         output: job.output.clone(),
         input_points,
         far_points,
+        duplicate_points,
         samples,
+        target: match job.density {
+            SimplifyDensity::Points(n) => Some(n),
+            _ => None,
+        },
         had_normals,
         detail,
         total_seconds: t.elapsed().as_secs_f64(),
@@ -198,10 +209,7 @@ impl fmt::Display for SimplifySummary {
             "; the input has no normals: positions only, normals estimated on the output"
         };
         let (input, output) = (self.input.display(), self.output.display());
-        let far = match self.far_points {
-            0 => String::new(),
-            n => format!(" ({n} far isolated points left out: they would have set the scale)"),
-        };
+        let far = left_out(self.far_points, self.duplicate_points);
         match &self.detail {
             SimplifyDetail::Levels {
                 sigma_p,
@@ -243,6 +251,25 @@ impl fmt::Display for SimplifySummary {
                     "{input} -> {output}: {} points{far} -> {} samples, sigma_p {sigma_p:.4} (bbox-100 units){no_normals}; {rejected_by_nearest} rejected by the nearest sample, {measured} measured",
                     self.input_points, self.samples,
                 )?;
+                if let Some(n) = self.target {
+                    let off = self.samples as f64 / n as f64 - 1.0;
+                    // (1e-9: 51 for 50 is within 2%, whatever the division rounds to.)
+                    if off.abs() > COUNT_TOLERANCE + 1e-9 {
+                        writeln!(
+                            f,
+                            "note: {} samples for --points {n} ({:+.1}%, outside the {:.0}% the count \
+                             search aims at{})",
+                            self.samples,
+                            100.0 * off,
+                            100.0 * COUNT_TOLERANCE,
+                            if self.samples < n && (self.input_points as usize) < n {
+                                format!(": the input has {} distinct points", self.input_points)
+                            } else {
+                                String::new()
+                            }
+                        )?;
+                    }
+                }
                 writeln!(
                     f,
                     "seconds: read+bucket {:.2}, sigma_p search {:.2}, scan {:.2}, normals+resample {:.2}, total {:.2}",
@@ -250,5 +277,36 @@ impl fmt::Display for SimplifySummary {
                 )
             }
         }
+    }
+}
+
+/// The share by which a `--points` count may miss before the summary says so (the README's
+/// promise for `simplify`).
+const COUNT_TOLERANCE: f64 = 0.02;
+
+/// What the reading left out, for the summary line: " (…)" or nothing.
+fn left_out(far: u64, duplicates: u64) -> String {
+    let mut parts = Vec::new();
+    if duplicates > 0 {
+        parts.push(format!("{} merged", points(duplicates, "coincident point")));
+    }
+    if far > 0 {
+        parts.push(format!(
+            "{} left out: they would have set the scale",
+            points(far, "point of far groups")
+        ));
+    }
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", parts.join("; "))
+    }
+}
+
+/// "1 point …" or "n points …": `what` names one, its first word is made plural.
+fn points(n: u64, what: &str) -> String {
+    match n {
+        1 => format!("1 {what}"),
+        _ => format!("{n} {}", what.replacen("point", "points", 1)),
     }
 }

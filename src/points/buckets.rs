@@ -1,6 +1,8 @@
 //! The input point set shuffled into random bucket files (pass 1 of the out-of-core linear
-//! scan, Sec. 6.1): its bounding box and far isolated points found on the way, every point
-//! written to a bucket chosen at random, so that each bucket is a uniform random subset.
+//! scan, Sec. 6.1): every point written to a bucket chosen by a seeded hash of its position,
+//! so that each bucket is a uniform random subset and coincident points share a bucket; then
+//! each bucket once more, merging coincident points and leaving out far groups
+//! ([`far_groups`]), which also gives the bounding box of what is kept.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -11,7 +13,7 @@ use rand::seq::SliceRandom;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
-use super::outliers::{far_isolated, flagged};
+use super::far_groups::{far_groups, kept_groups, FarGroups};
 use super::source::PointSource;
 use super::stream::{decode_record, encode_record, Point, RECORD_BYTES};
 use crate::error::{Error, Result};
@@ -30,7 +32,7 @@ fn read_bucket(dir: &Path, b: usize, limit: usize) -> Result<Vec<Point>> {
         .collect())
 }
 
-/// Points of the first bucket the far-isolation test compares with (see [`far_isolated`]).
+/// Points of the first bucket the far-group test groups (see [`far_groups`]).
 const FAR_REFERENCE_POINTS: usize = 1 << 16;
 
 /// The most bucket files of one run: open files and their write buffers are bounded whatever
@@ -44,19 +46,21 @@ pub(crate) struct Buckets {
     pub(crate) _registered: crate::io::temporaries::Registered,
     /// Number of bucket files.
     pub(crate) count: usize,
-    /// Points kept (read, less the far isolated ones).
+    /// Points kept (read, less the coincident and the far ones).
     pub(crate) total: u64,
     pub(crate) had_normals: bool,
     pub(crate) normalization: Normalization,
-    /// The box (model units) of the points kept, when far isolated points were left out
-    /// ([`far_isolated`]): points outside it are not loaded.
-    pub(crate) keep: Option<Aabb>,
-    /// Far isolated points left out.
+    /// Points of far groups left out ([`far_groups`]).
     pub(crate) far_points: u64,
+    /// Points merged into another at the same position (bit for bit; the first read is kept).
+    pub(crate) duplicate_points: u64,
+    /// What is kept when far groups were left out.
+    pub(crate) far_groups: Option<FarGroups>,
 }
 
 /// Points with the most extreme coordinate along each of the six axis directions, the most
-/// extreme first: the candidates of [`far_isolated`].
+/// extreme first: grouped by [`far_groups`] with a random subset, since a far group is where
+/// the box is decided.
 struct Extremes {
     lists: [Vec<(f64, DVec3)>; 6],
 }
@@ -81,27 +85,41 @@ impl Extremes {
             }
         }
     }
+}
 
-    /// The box of the points without those `far` says are far isolated: on each side, the
-    /// most extreme candidate that is not far. `None` when no candidate is far, or when every
-    /// candidate of some direction is (too many far points to tell the box).
-    fn box_without(&self, far: impl Fn(DVec3) -> bool) -> Option<Aabb> {
-        let mut any = false;
-        let mut bound = [0.0f64; 6];
-        for (d, list) in self.lists.iter().enumerate() {
-            any |= list.iter().any(|&(_, p)| far(p));
-            let &(v, _) = list.iter().find(|&&(_, p)| !far(p))?;
-            bound[d] = if d % 2 == 0 { v } else { -v };
-        }
-        any.then(|| Aabb {
-            min: DVec3::new(bound[1], bound[3], bound[5]),
-            max: DVec3::new(bound[0], bound[2], bound[4]),
-        })
+/// Parts of a point set far apart (each part's diagonal under this share of the whole's) are
+/// refused: one scale cannot hold both (a sample spacing of a part's size is below the
+/// precision of the whole's tolerances).
+const SEPARATE_PARTS_RATIO: f64 = 1e-3;
+
+/// A length for a message: 4 significant digits, in scientific notation when large or small.
+fn short(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e5).contains(&x.abs()) {
+        format!("{x:.3e}")
+    } else {
+        format!("{x:.4}")
     }
 }
 
-/// Far isolated points are looked for in point sets of at least this many points (in a
-/// handful of points every point is far from the others).
+/// A point's position as bits (-0 as +0): coincident points have equal keys.
+fn position_key(p: DVec3) -> [u64; 3] {
+    (p + DVec3::ZERO).to_array().map(f64::to_bits)
+}
+
+/// A seeded hash of a point's position (coincident points hash alike; splitmix64's mixer).
+fn position_hash(p: DVec3, salt: u64) -> u64 {
+    let mix = |mut z: u64| {
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    position_key(p)
+        .iter()
+        .fold(salt, |h, &k| mix(h.wrapping_add(0x9e37_79b9_7f4a_7c15) ^ k))
+}
+
+/// Far groups are looked for in point sets of at least this many points (in a handful of
+/// points every point is far from the others).
 const FAR_MIN_POINTS: u64 = 1000;
 
 impl Buckets {
@@ -137,16 +155,17 @@ impl Buckets {
             })
             .collect::<std::io::Result<_>>()
             .map_err(io_err)?;
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         let mut extremes = Extremes::new();
         let mut chunk = Vec::new();
         let mut staged: Vec<Vec<u8>> = vec![Vec::new(); count];
+        // The bucket of a point: a hash of its position salted by the seed (a uniformly
+        // random subset per bucket; coincident points in the same one).
+        let salt: u64 = rng.random();
         while reader.read_chunk(&mut chunk, 1 << 16)? > 0 {
             for p in &chunk {
-                lo = lo.min(p.position);
-                hi = hi.max(p.position);
                 extremes.offer(p.position);
-                encode_record(p, &mut staged[rng.random_range(0..count)]);
+                let b = (position_hash(p.position, salt) % count as u64) as usize;
+                encode_record(p, &mut staged[b]);
             }
             for (w, bytes) in writers.iter_mut().zip(staged.iter_mut()) {
                 w.write_all(bytes).map_err(io_err)?;
@@ -157,29 +176,87 @@ impl Buckets {
             w.flush().map_err(io_err)?;
         }
         drop(writers);
-        // Far isolated points (a stray `0 0 0` in a scan at UTM coordinates) do not set the
-        // scale: they are left out, judged against a random subset of the points (the first
-        // bucket's).
-        let mut keep = None;
-        let mut far_points = 0;
+        // Far groups (a stray `0 0 0`, or a small cluster, in a scan at UTM coordinates) do
+        // not set the scale: they are left out, judged on a random subset of the points (the
+        // first bucket's) and the most extreme ones.
+        let mut far = None;
         if total >= FAR_MIN_POINTS {
-            let reference: Vec<DVec3> = read_bucket(dir.path(), 0, FAR_REFERENCE_POINTS)?
+            let mut grouped: Vec<DVec3> = read_bucket(dir.path(), 0, FAR_REFERENCE_POINTS)?
                 .into_iter()
                 .map(|p| p.position)
                 .collect();
-            let candidates: Vec<DVec3> = extremes.lists.iter().flatten().map(|&(_, p)| p).collect();
-            let far_set = flagged(&candidates, &far_isolated(&candidates, &reference));
-            keep = extremes.box_without(|p| far_set.contains(&p.to_array().map(f64::to_bits)));
-            if let Some(b) = keep {
-                for k in 0..count {
-                    far_points += read_bucket(dir.path(), k, usize::MAX)?
-                        .iter()
-                        .filter(|p| !b.contains(p.position))
-                        .count() as u64;
+            grouped.extend(extremes.lists.iter().flatten().map(|&(_, p)| p));
+            grouped.sort_unstable_by_key(|p| position_key(*p));
+            grouped.dedup_by_key(|p| position_key(*p));
+            far = far_groups(&grouped);
+            // Parts far apart compared with their own size (two objects 10^6 apart, each 10
+            // across) cannot share one scale.
+            let kept = kept_groups(&grouped);
+            if kept.len() > 1 {
+                let whole = kept
+                    .iter()
+                    .fold(kept[0].1, |b, (_, g)| Aabb {
+                        min: b.min.min(g.min),
+                        max: b.max.max(g.max),
+                    })
+                    .diagonal();
+                let largest = kept
+                    .iter()
+                    .map(|(_, g)| g.diagonal())
+                    .fold(0.0f64, f64::max);
+                if largest < SEPARATE_PARTS_RATIO * whole {
+                    return Err(Error::invalid_mesh(
+                        input,
+                        format!(
+                            "the points form {} parts far apart ({} across in all, the largest \
+                             part {} across): mesh each part on its own",
+                            kept.len(),
+                            short(whole),
+                            short(largest),
+                        ),
+                    ));
                 }
             }
         }
-        let bbox = keep.unwrap_or(Aabb { min: lo, max: hi });
+        // Each bucket again: coincident points merged, far groups left out (the bucket file
+        // rewritten when that changed it), the box of what is kept.
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        let (mut far_points, mut duplicate_points) = (0u64, 0u64);
+        for b in 0..count {
+            let mut pts = read_bucket(dir.path(), b, usize::MAX)?;
+            let read = pts.len();
+            let mut order: Vec<u32> = (0..read as u32).collect();
+            order.sort_unstable_by_key(|&i| (position_key(pts[i as usize].position), i));
+            let mut keep = vec![true; read];
+            for w in order.windows(2) {
+                if position_key(pts[w[0] as usize].position)
+                    == position_key(pts[w[1] as usize].position)
+                {
+                    keep[w[1] as usize] = false;
+                }
+            }
+            let unique = keep.iter().filter(|&&k| k).count();
+            duplicate_points += (read - unique) as u64;
+            let mut flags = keep.into_iter();
+            pts.retain(|_| flags.next().unwrap_or(false));
+            if let Some(f) = &far {
+                pts.retain(|p| f.contains(p.position));
+                far_points += (unique - pts.len()) as u64;
+            }
+            for p in &pts {
+                lo = lo.min(p.position);
+                hi = hi.max(p.position);
+            }
+            if pts.len() < read {
+                let mut bytes = Vec::with_capacity(pts.len() * RECORD_BYTES);
+                for p in &pts {
+                    encode_record(p, &mut bytes);
+                }
+                std::fs::write(dir.path().join(format!("{b}.bin")), bytes).map_err(io_err)?;
+            }
+        }
+        let bbox = Aabb { min: lo, max: hi };
         let normalization = Normalization::for_bbox(&bbox).ok_or_else(|| {
             Error::invalid_mesh(
                 input,
@@ -194,11 +271,12 @@ impl Buckets {
             _registered: registered,
             dir,
             count,
-            total: total - far_points,
+            total: total - far_points - duplicate_points,
             had_normals,
             normalization,
-            keep,
             far_points,
+            duplicate_points,
+            far_groups: far,
         })
     }
 
@@ -241,7 +319,6 @@ impl Buckets {
     pub(crate) fn load(&self, b: usize, rng: &mut ChaCha8Rng) -> Result<Vec<Point>> {
         let mut pts: Vec<Point> = read_bucket(self.dir.path(), b, usize::MAX)?
             .into_iter()
-            .filter(|p| self.keep.is_none_or(|k| k.contains(p.position)))
             .map(|p| Point {
                 position: self.normalization.apply(p.position),
                 normal: p.normal,

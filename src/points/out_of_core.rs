@@ -11,6 +11,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::buckets::Buckets;
+use super::far_groups::FarGroups;
 use super::normals::{estimate_normals, NormalOrientation};
 use super::outliers::{off_surface, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
@@ -70,11 +71,12 @@ impl Default for OutOfCoreParams {
 pub struct OutOfCoreResult {
     /// The output set O in the input's units, in the order the scan accepted it.
     pub samples: Vec<Point>,
-    /// Points read, less the far isolated ones.
+    /// Points read, less the coincident and the far ones.
     pub input_points: u64,
-    /// Far isolated points left out (`points::outliers::far_isolated`): they would have set
-    /// the scale.
+    /// Points of far groups left out (`points::far_groups`): they would have set the scale.
     pub far_points: u64,
+    /// Points merged into another at the same position.
+    pub duplicate_points: u64,
     /// Whether the input had normals (without them the kernel uses positions only).
     pub had_normals: bool,
     /// The sigma_p used, bbox-100 units.
@@ -132,6 +134,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         support,
         input_points,
         far_points,
+        duplicate_points,
         had_normals,
         sigma_p,
         normalization,
@@ -159,6 +162,7 @@ pub fn simplify_out_of_core(input: &Path, params: &OutOfCoreParams) -> Result<Ou
         samples,
         input_points,
         far_points,
+        duplicate_points,
         had_normals,
         sigma_p,
         normalization,
@@ -182,10 +186,14 @@ pub(crate) struct ScanOutput {
     /// The first bucket's points, shuffled (a uniformly random subset of the input), up to
     /// `support_per_sample` per sample, bbox-100 units.
     pub support: Vec<Point>,
-    /// Points read, less the far isolated ones.
+    /// Points read, less the coincident and the far ones.
     pub input_points: u64,
-    /// Far isolated points left out (`points::outliers::far_isolated`).
+    /// Points of far groups left out (`points::far_groups`).
     pub far_points: u64,
+    /// Points merged into another at the same position.
+    pub duplicate_points: u64,
+    /// What is kept when far groups were left out (for measuring against the points kept).
+    pub far_groups: Option<FarGroups>,
     /// Whether the input had normals.
     pub had_normals: bool,
     /// The sigma_p used, bbox-100 units.
@@ -322,6 +330,8 @@ impl ScannedInput {
             support,
             input_points: self.buckets.total,
             far_points: self.buckets.far_points,
+            duplicate_points: self.buckets.duplicate_points,
+            far_groups: self.buckets.far_groups.clone(),
             had_normals: self.buckets.had_normals,
             sigma_p,
             normalization: self.buckets.normalization,
@@ -504,10 +514,12 @@ pub struct ProgressiveResult {
     pub level_ends: Vec<usize>,
     /// Per level, its sigma_p (bbox-100 units), largest first.
     pub sigma_p: Vec<f64>,
-    /// Points read.
+    /// Points read, less the coincident and the far ones.
     pub input_points: u64,
-    /// Far isolated points left out (`points::outliers::far_isolated`).
+    /// Points of far groups left out (`points::far_groups`).
     pub far_points: u64,
+    /// Points merged into another at the same position.
+    pub duplicate_points: u64,
     /// Whether the input had normals.
     pub had_normals: bool,
     /// Model units ↔ bbox-100 units.
@@ -596,6 +608,7 @@ pub fn simplify_progressive(
         sigma_p,
         input_points: buckets.total,
         far_points: buckets.far_points,
+        duplicate_points: buckets.duplicate_points,
         had_normals: buckets.had_normals,
         normalization: norm,
         seconds,
@@ -670,9 +683,12 @@ fn search_sigma_p(
 /// A first guess of the surface area (bbox-100 units²) of a uniformly random point subset, for
 /// the start of the sigma_p search: the number of occupied cells of a grid of cell size h, times
 /// h² / 1.5 (a plane of area A with unit normal n crosses about A (|n_x| + |n_y| + |n_z|) / h²
-/// cells, 1.5 A / h² on average over orientations).
+/// cells, 1.5 A / h² on average over orientations). h is 2, or twice the points' spacing where
+/// that is wider: cells finer than the spacing see points, not the surface (200 points of a
+/// sphere would read as 200 cells, a twentieth of its area, and the search would start where
+/// every point is a sample and the count does not answer).
 fn surface_area_guess(points: &[Point]) -> f64 {
-    let h = 2.0;
+    let h = (2.0 * median_spacing(points)).max(2.0);
     let mut cells: Vec<[i32; 3]> = points
         .iter()
         .map(|p| (p.position / h).floor().as_ivec3().to_array())
@@ -680,4 +696,28 @@ fn surface_area_guess(points: &[Point]) -> f64 {
     cells.sort_unstable();
     cells.dedup();
     (cells.len() as f64 * h * h / 1.5).max(1.0)
+}
+
+/// The median distance from a point of `points` (a uniformly random subset) to its nearest
+/// other, estimated on the first points (at most 20,000, scaled to the whole as the spacing goes
+/// with the inverse square root of the count on a surface) at up to 1,000 of them; 0 for fewer
+/// than two points.
+fn median_spacing(points: &[Point]) -> f64 {
+    let m = points.len().min(20_000);
+    if m < 2 {
+        return 0.0;
+    }
+    let positions: Vec<DVec3> = points[..m].iter().map(|p| p.position).collect();
+    let tree = crate::spatial::StaticTree::new(&positions);
+    let mut found = Vec::new();
+    let mut d: Vec<f64> = positions
+        .iter()
+        .step_by(m.div_ceil(1000))
+        .map(|&p| {
+            tree.nearest_n(p, 2, &mut found);
+            found.get(1).map_or(0.0, |&(_, d2)| d2.sqrt())
+        })
+        .collect();
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2] * (m as f64 / points.len() as f64).sqrt()
 }

@@ -146,75 +146,6 @@ impl OutlierFilter {
     }
 }
 
-/// Points that decide the bounding box of a point set are far isolated when fewer than this
-/// many other points lie within [`FAR_GAP`] of the set's size from them (see [`far_isolated`]).
-pub const FAR_NEIGHBORS: usize = 4;
-
-/// The gap, as a share of the bounding box's diagonal (without the far points), beyond which a
-/// point's [`FAR_NEIGHBORS`]-th nearest neighbour makes it far isolated.
-pub const FAR_GAP: f64 = 0.25;
-
-/// Which of `candidates` (the points that decide a point set's bounding box: the most extreme
-/// along each axis) are far isolated: their [`FAR_NEIGHBORS`]-th nearest other point, among
-/// `reference` (a uniformly random subset of the set, or all of it) and the candidates, lies
-/// farther than [`FAR_GAP`] times the diagonal of the bounding box of those points without the
-/// far ones (found again until it holds: one far point inflates the first box). Such a point
-/// (a stray `0 0 0` in a scan at UTM coordinates) would set the scale of everything. Any
-/// units; deterministic.
-pub fn far_isolated(candidates: &[DVec3], reference: &[DVec3]) -> Vec<bool> {
-    // The candidates not already in the reference, once each.
-    let mut all: Vec<DVec3> = reference.to_vec();
-    let mut seen: std::collections::HashSet<[u64; 3]> = reference
-        .iter()
-        .map(|p| p.to_array().map(f64::to_bits))
-        .collect();
-    for c in candidates {
-        if seen.insert(c.to_array().map(f64::to_bits)) {
-            all.push(*c);
-        }
-    }
-    let tree = StaticTree::new(&all);
-    let mut found = Vec::new();
-    let gap: Vec<f64> = candidates
-        .iter()
-        .map(|&c| {
-            tree.nearest_n(c, FAR_NEIGHBORS + 1, &mut found);
-            // The point itself comes first, at distance 0.
-            found
-                .get(FAR_NEIGHBORS)
-                .map_or(f64::INFINITY, |&(_, d2)| d2.sqrt())
-        })
-        .collect();
-    let mut far = vec![false; candidates.len()];
-    for _ in 0..8 {
-        let far_points = flagged(candidates, &far);
-        let (lo, hi) = all
-            .iter()
-            .filter(|p| !far_points.contains(&p.to_array().map(f64::to_bits)))
-            .fold(
-                (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-                |(lo, hi), &p| (lo.min(p), hi.max(p)),
-            );
-        let diagonal = if lo.x <= hi.x { lo.distance(hi) } else { 0.0 };
-        let next: Vec<bool> = gap.iter().map(|&g| g > FAR_GAP * diagonal).collect();
-        if next == far {
-            break;
-        }
-        far = next;
-    }
-    far
-}
-
-/// The positions of `points` that `flags` marks, as their bit patterns (exact matches).
-pub fn flagged(points: &[DVec3], flags: &[bool]) -> std::collections::HashSet<[u64; 3]> {
-    points
-        .iter()
-        .zip(flags)
-        .filter(|(_, &f)| f)
-        .map(|(p, _)| p.to_array().map(f64::to_bits))
-        .collect()
-}
-
 /// Neighbours within the radius that put a point on a sheet (see [`off_surface`]).
 pub const SHEET_NEIGHBORS: usize = 6;
 
@@ -367,56 +298,6 @@ mod tests {
                 DVec3::new(s * phi.cos(), s * phi.sin(), z) * r
             })
             .collect()
-    }
-
-    /// The points of `set` most extreme along each axis direction (the candidates the caller
-    /// passes), `k` a direction.
-    fn extremes(set: &[DVec3], k: usize) -> Vec<DVec3> {
-        let mut out = Vec::new();
-        for axis in 0..3 {
-            for sign in [1.0, -1.0] {
-                let mut sorted = set.to_vec();
-                sorted.sort_by(|a, b| (sign * b[axis]).total_cmp(&(sign * a[axis])));
-                out.extend(sorted.into_iter().take(k));
-            }
-        }
-        out
-    }
-
-    #[test]
-    fn a_far_stray_point_is_far_isolated_and_nothing_else() {
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        // A scan at UTM-like coordinates and one stray point at the origin.
-        let offset = DVec3::new(5e5, 4e6, 100.0);
-        let mut set: Vec<DVec3> = sphere(3000, 0.0, &mut rng)
-            .into_iter()
-            .map(|p| offset + 10.0 * p)
-            .collect();
-        let candidates = extremes(&set, 16);
-        assert!(far_isolated(&candidates, &set).iter().all(|&f| !f));
-        set.push(DVec3::ZERO);
-        let candidates = extremes(&set, 16);
-        let far = far_isolated(&candidates, &set);
-        for (c, f) in candidates.iter().zip(&far) {
-            assert_eq!(*f, *c == DVec3::ZERO, "{c}");
-        }
-        assert!(far.iter().any(|&f| f));
-    }
-
-    #[test]
-    fn two_parts_far_apart_are_not_isolated() {
-        let mut rng = ChaCha8Rng::seed_from_u64(4);
-        // Two spheres 100 radii apart (a scene's two objects), and a group of five points far
-        // from both: a part, not a stray point.
-        let mut set: Vec<DVec3> = sphere(2000, 0.0, &mut rng);
-        set.extend(
-            sphere(2000, 0.0, &mut rng)
-                .into_iter()
-                .map(|p| p + 100.0 * DVec3::X),
-        );
-        set.extend((0..5).map(|k| DVec3::new(0.0, 300.0, k as f64 * 0.01)));
-        let candidates = extremes(&set, 16);
-        assert!(far_isolated(&candidates, &set).iter().all(|&f| !f));
     }
 
     /// `n` points uniform in the cube [-1.5, 1.5]³ around the unit sphere, each at least 0.2 off
