@@ -295,7 +295,8 @@ pub mod internal {
     // Point sets in, meshes out (issue 19).
     pub use crate::point_pipeline::{
         is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams,
-        DOMAIN_GAP_SIGMA_P, MAX_SCANS, OPEN_GAP_SIGMA_P, RIMLS_POINTS_PER_SAMPLE,
+        DOMAIN_GAP_SIGMA_P, MAX_SCANS, MAX_SURFACE_VARIATION, OPEN_GAP_SIGMA_P,
+        RIMLS_POINTS_PER_SAMPLE,
     };
     pub use crate::points::source::ReadPoints;
     pub use crate::points::{PlyPointWriter, Point, PointReader};

@@ -761,6 +761,33 @@ fn a_simplify_count_off_by_more_than_two_percent_is_said() {
     assert!(said.contains("the input has 200 distinct points"), "{said}");
 }
 
+/// R12: 5,000 points uniform in a unit cube (not a surface) had run past 120 s (1,000 points:
+/// 11 s, 8 of them in optimize), then given a mesh. Points that are not near a surface are
+/// refused in one line (exit 3) once the surface's support is built, saying so; points near a
+/// surface with noise go on (their surface variation in the report, below the bound).
+#[test]
+fn points_filling_a_volume_are_refused() {
+    use rand::{RngExt, SeedableRng};
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(56);
+    let cube = (0..5000).map(|_| glam::DVec3::new(rng.random(), rng.random(), rng.random()));
+    let input = write(dir.path(), "cube.xyz", xyz_lines(cube, 1));
+    let out = dir.path().join("cube.obj");
+    let o = remesh(&[arg(&input), arg(&out), "--points", "500"]);
+    assert_error(&o, 3, &["cube.xyz", "not near a surface"]);
+    assert!(!out.exists());
+    // A sphere with Gaussian-like noise of 1% of its radius: a surface.
+    let noisy = fibonacci_sphere(5000, glam::DVec3::ZERO, 1.0)
+        .into_iter()
+        .map(|p| p * (1.0 + 0.01 * ((0..4).map(|_| rng.random::<f64>()).sum::<f64>() - 2.0)));
+    let input = write(dir.path(), "noisy.xyz", xyz_lines(noisy, 1));
+    let out = dir.path().join("noisy.obj");
+    let r = remesh_checked(&input, &out, &["--points", "500", "--no-distance"]);
+    let v = r["extra"]["surface_variation"].as_f64().unwrap();
+    assert!(v < spectral_remesh::internal::MAX_SURFACE_VARIATION, "{v}");
+    assert_eq!(r["topology"]["genus"].as_i64(), Some(0));
+}
+
 /// R2: exact duplicate points in sparse data (200 points of a unit sphere, each line written
 /// 10, 100 or 1,000 times) had given χ 0, 15 or 18 parts, or an empty mesh reported as "all
 /// hold". Coincident points are merged at read: the same mesh as the points written once

@@ -124,6 +124,7 @@ pub(super) fn run(
     extra.insert("samples".into(), out.samples.into());
     extra.insert("unprojected_samples".into(), out.unprojected_samples.into());
     extra.insert("rescan_rejected".into(), out.rescan_rejected.into());
+    insert_json(extra, "surface_variation", out.surface_variation);
     extra.insert("boundary_samples".into(), out.boundary_samples.into());
     extra.insert("boundary_curves".into(), out.boundary_curves.into());
     extra.insert("rimls_points".into(), out.rimls_points.into());

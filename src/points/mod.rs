@@ -5,6 +5,7 @@
 pub mod boundary;
 pub(crate) mod buckets;
 pub mod far_groups;
+pub mod flatness;
 pub mod generate;
 pub mod normals;
 pub mod out_of_core;
