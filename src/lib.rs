@@ -176,8 +176,8 @@ pub mod internal {
 
     // Reading and writing meshes (OBJ, PLY, glTF, STL, OFF), atomically.
     pub use crate::io::{
-        read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, MeshFormat,
-        ReadStats,
+        read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, FinishedFile,
+        MeshFormat, ReadStats,
     };
 
     // The meshes: the indexed triangle mesh, its normalization to bbox 100, its consistent

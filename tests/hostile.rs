@@ -723,3 +723,106 @@ fn an_element_count_that_wraps_is_an_input_error() {
         assert!(!out.exists());
     }
 }
+
+/// A resource limit [`remesh_limited`] lowers.
+#[cfg(target_os = "linux")]
+#[derive(Clone, Copy)]
+enum Limit {
+    /// `RLIMIT_FSIZE` (`ulimit -f`): a write past it fails (EFBIG) as on a full disk.
+    FileSize,
+    /// `RLIMIT_AS` (`ulimit -v`).
+    AddressSpace,
+}
+
+/// The `remesh` binary to run with the resource limit `which` lowered to `bytes` (soft and hard)
+/// before it starts, and `SIGXFSZ` ignored, so a write past the file size limit fails with an
+/// error the program sees (as a write to a full disk does) instead of killing it.
+#[cfg(target_os = "linux")]
+fn limited(which: Limit, bytes: u64) -> Command {
+    use std::os::unix::process::CommandExt;
+    let resource = match which {
+        Limit::FileSize => libc::RLIMIT_FSIZE,
+        Limit::AddressSpace => libc::RLIMIT_AS,
+    };
+    let mut command = Command::new(env!("CARGO_BIN_EXE_remesh"));
+    // SAFETY: between fork and exec the hook calls only setrlimit and signal, which are
+    // async-signal-safe, and allocates nothing.
+    unsafe {
+        command.pre_exec(move || {
+            let limit = libc::rlimit {
+                rlim_cur: bytes as libc::rlim_t,
+                rlim_max: bytes as libc::rlim_t,
+            };
+            if libc::setrlimit(resource, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            Ok(())
+        });
+    }
+    command
+}
+
+/// `remesh ARGS` under [`limited`]`(which, bytes)`.
+#[cfg(target_os = "linux")]
+fn remesh_limited(which: Limit, bytes: u64, args: &[&str]) -> Output {
+    limited(which, bytes)
+        .args(args)
+        .output()
+        .expect("run remesh")
+}
+
+/// R4: `--report r.json` on a full disk exited 4 after the existing OUTPUT had been replaced
+/// (the mesh was renamed into place before the report's bytes left their buffer). Both files
+/// are now written and synced in their temporaries before either is renamed: a report that
+/// cannot be written leaves the existing output and report as they were. The full disk is a
+/// file size limit between the mesh's size and the report's.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_report_that_cannot_be_written_leaves_the_existing_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let run = |out: &Path, report: &Path| {
+        [
+            arg(&input),
+            arg(out),
+            "--points",
+            "40",
+            "--no-distance",
+            "-q",
+            "--report",
+            arg(report),
+        ]
+        .map(str::to_string)
+    };
+    // The sizes of the two files, written without a limit.
+    let (free_out, free_report) = (dir.path().join("free.stl"), dir.path().join("free.json"));
+    let args = run(&free_out, &free_report);
+    let o = remesh(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let size = |p: &Path| std::fs::metadata(p).unwrap().len();
+    let (mesh_bytes, report_bytes) = (size(&free_out), size(&free_report));
+    assert!(
+        mesh_bytes + 200 < report_bytes,
+        "the test needs a mesh smaller than its report: {mesh_bytes} and {report_bytes} bytes"
+    );
+    let limit = (mesh_bytes + report_bytes) / 2;
+    let out = write(dir.path(), "k.stl", "KEEP\n");
+    let report = write(dir.path(), "r.json", "KEEP\n");
+    let args = run(&out, &report);
+    let o = remesh_limited(
+        Limit::FileSize,
+        limit,
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    assert_error(&o, 4, &[arg(&report)]);
+    assert!(
+        std::fs::read(&out).unwrap() == b"KEEP\n",
+        "the output was replaced"
+    );
+    assert!(
+        std::fs::read(&report).unwrap() == b"KEEP\n",
+        "the report was replaced"
+    );
+    assert_no_temporaries(dir.path());
+}

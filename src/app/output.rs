@@ -20,11 +20,14 @@ pub(super) struct Outputs {
 }
 
 impl Outputs {
-    /// Writes `report` into its file, then renames the mesh and the report into place.
+    /// Writes `report` into its file, finishes both temporary files (every byte written and
+    /// synced), and only then renames the mesh and the report into place: a disk that fills up
+    /// (or any other failure) while either is written leaves both targets as they were.
     ///
     /// # Errors
     /// [`Error::Write`] naming the file that could not be written; the temporary files are
-    /// removed (a mesh renamed before the report's rename failed stays).
+    /// removed and neither target is touched. (Only a rename can fail after the other file's
+    /// rename; a rename within a directory takes no room on the disk.)
     pub(super) fn commit(self, report: &QualityReport) -> Result<()> {
         use std::io::Write;
         let mut report_file = self.report;
@@ -32,12 +35,15 @@ impl Outputs {
             f.write_all(report.to_json().as_bytes())
                 .map_err(|e| f.error(format!("cannot write: {e}")))?;
         }
-        if let Some(mesh) = self.mesh.into_inner() {
-            if self.written.get() {
-                mesh.commit()?;
-            }
+        let mesh = match self.mesh.into_inner() {
+            Some(mesh) if self.written.get() => Some(mesh.finish()?),
+            _ => None,
+        };
+        let report_file = report_file.map(AtomicFile::finish).transpose()?;
+        for finished in [mesh, report_file].into_iter().flatten() {
+            finished.persist()?;
         }
-        report_file.map_or(Ok(()), AtomicFile::commit)
+        Ok(())
     }
 }
 

@@ -29,7 +29,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 
-pub use atomic::{write_atomically, AtomicFile};
+pub use atomic::{write_atomically, AtomicFile, FinishedFile};
 pub use temporaries::remove_temporaries;
 
 /// A mesh file format, chosen by the file's extension.
