@@ -826,3 +826,58 @@ fn a_report_that_cannot_be_written_leaves_the_existing_output() {
     );
     assert_no_temporaries(dir.path());
 }
+
+/// R5: `remesh quality` of one triangle repeated 20,000 times took a minute and 3.2 GB (every
+/// copy's box overlaps every other's: 2 · 10^8 pairs to test), and an icosphere with every face
+/// 200 times (a binary STL, its corners welded on reading) aborted. Faces on the same three
+/// vertices, in any order and winding, now enter the crossing search once, and the distance to
+/// a reference counts each face once; the report says how many duplicates there were.
+#[test]
+fn duplicate_faces_enter_the_crossing_search_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    let orders = ["1 2 3", "2 3 1", "3 1 2", "1 3 2", "3 2 1", "2 1 3"];
+    for k in 0..20_000 {
+        text += &format!("f {}\n", orders[k % orders.len()]);
+    }
+    let one = write(dir.path(), "one.obj", text);
+    let quality = |args: &[&str]| -> serde_json::Value {
+        let o = remesh(&[&["quality"], args, &["--json"]].concat());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let q = quality(&[arg(&one)]);
+    let crossings = &q["self_intersections"];
+    assert_eq!(crossings["faces"], 1, "{crossings}");
+    assert_eq!(crossings["candidates"], 0, "{crossings}");
+    assert_eq!(crossings["pairs"], 0, "{crossings}");
+    assert_eq!(q["topology"]["faces"], 20_000);
+    assert_eq!(q["topology"]["duplicate_faces"], 19_999);
+    let notes = q["notes"].to_string();
+    assert!(notes.contains("19999 faces repeat"), "{notes}");
+    // An icosphere (320 faces) with every face 200 times, as binary STL: separate corners,
+    // welded on reading, so the copies become faces on the same vertices.
+    let sphere = common::icosphere(2);
+    let mut many = sphere.clone();
+    many.triangles = sphere
+        .triangles
+        .iter()
+        .flat_map(|&t| std::iter::repeat_n(t, 200))
+        .collect();
+    let stl = dir.path().join("many.stl");
+    spectral_remesh::write_mesh(&stl, &many).unwrap();
+    let q = quality(&[arg(&stl)]);
+    let crossings = &q["self_intersections"];
+    assert_eq!(crossings["faces"], 320, "{crossings}");
+    assert_eq!(crossings["pairs"], 0, "{crossings}");
+    assert_eq!(q["topology"]["duplicate_faces"], 320 * 199);
+    // As a reference, and measured against one: the same surface as the plain sphere (up to
+    // the STL's `f32` coordinates).
+    let plain = dir.path().join("plain.obj");
+    spectral_remesh::write_mesh(&plain, &sphere).unwrap();
+    for (mesh, reference) in [(&plain, &stl), (&stl, &plain)] {
+        let q = quality(&[arg(mesh), "--ref", arg(reference)]);
+        let hausdorff = q["distance"]["hausdorff"].as_f64().unwrap();
+        assert!(hausdorff < 1e-4, "{}", q["distance"]);
+    }
+}
