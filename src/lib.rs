@@ -302,11 +302,11 @@ pub mod internal {
 
     // The jobs of the `remesh` command line: files in, files and report out.
     pub use crate::app::{
-        catch_panics, check_report_path, estimate_remesh_bytes, memory_limit, parse_bytes,
-        physical_memory, quality_mesh, remesh_mesh, remesh_point_set, run_points, run_quality,
-        run_remesh, run_simplify, write_report, PointsJob, RemeshJob, RemeshOptions, RemeshedMesh,
-        SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary, DISTANCE_SAMPLES,
-        MAX_SURFACE_POINTS, STDOUT,
+        catch_panics, check_report_path, effective_memory_limit, estimate_remesh_bytes,
+        memory_limit, parse_bytes, physical_memory, quality_mesh, remesh_mesh, remesh_point_set,
+        run_points, run_quality, run_remesh, run_simplify, write_report, PointsJob, RemeshJob,
+        RemeshOptions, RemeshedMesh, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary,
+        DISTANCE_SAMPLES, MAX_SURFACE_POINTS, STDOUT,
     };
     pub use crate::geometry::{intersecting_pairs, triangle_angles_deg};
     pub use crate::manifold::MAX_KERNEL_DIMENSION;

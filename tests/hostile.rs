@@ -772,6 +772,19 @@ fn remesh_limited(which: Limit, bytes: u64, args: &[&str]) -> Output {
         .expect("run remesh")
 }
 
+/// The run ended by itself (not by a signal such as SIGABRT), with no panic or backtrace.
+fn assert_no_abort(o: &Output) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.code().is_some(),
+        "ended by a signal: {:?}; {err}",
+        o.status
+    );
+    for word in ["panicked", "backtrace", "memory allocation", "SIGABRT"] {
+        assert!(!err.contains(word), "{err}");
+    }
+}
+
 /// R4: `--report r.json` on a full disk exited 4 after the existing OUTPUT had been replaced
 /// (the mesh was renamed into place before the report's bytes left their buffer). Both files
 /// are now written and synced in their temporaries before either is renamed: a report that
@@ -880,4 +893,55 @@ fn duplicate_faces_enter_the_crossing_search_once() {
         let hausdorff = q["distance"]["hausdorff"].as_f64().unwrap();
         assert!(hausdorff < 1e-4, "{}", q["distance"]);
     }
+}
+
+/// R8: `--max-memory 1G` under `ulimit -v` 300 MB was taken at its word, and the run aborted
+/// (SIGABRT, a backtrace) when an allocation failed. The limit given is held to what the
+/// process may take (its address-space limit less the reserve): the job is refused at once, in
+/// one line naming the address-space limit.
+#[cfg(target_os = "linux")]
+#[test]
+fn max_memory_is_held_to_the_address_space_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    let o = remesh_limited(
+        Limit::AddressSpace,
+        300 << 20,
+        &[
+            arg(&input),
+            arg(&out),
+            "--points",
+            "150000",
+            "--max-memory",
+            "1G",
+        ],
+    );
+    assert_no_abort(&o);
+    assert_error(&o, 2, &["--max-memory", "address-space limit", "ulimit -v"]);
+    assert!(!out.exists());
+}
+
+/// R13 (d): under `ulimit -v` 150 MB every job was refused with "the limit of 0.000 MB ...
+/// raise --max-memory", which cannot help: the address-space limit (less the reserve for
+/// thread stacks and arenas) is what is too small, and the message names it and its size.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_small_address_space_limit_is_named_not_max_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    let o = remesh_limited(
+        Limit::AddressSpace,
+        150_000_000,
+        &[arg(&input), arg(&out), "--points", "1000"],
+    );
+    assert_no_abort(&o);
+    assert_error(&o, 2, &["address-space limit", "ulimit -v", "150.000 MB"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !err.contains("raise `--max-memory`") && !err.contains("or raise --max-memory"),
+        "{err}"
+    );
+    assert!(!out.exists());
 }
