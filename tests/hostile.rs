@@ -922,6 +922,51 @@ fn max_memory_is_held_to_the_address_space_limit() {
     assert!(!out.exists());
 }
 
+/// R10: with `TMPDIR` missing or a regular file, `remesh points.xyz out.obj` and `remesh
+/// simplify` exited 3 (the input's code) blaming the input (`sphere.xyz: No such file or
+/// directory`). The bucket folder that cannot be made is an output error of the environment:
+/// exit 4, naming TMPDIR, and nothing written; so is a full one.
+#[test]
+fn an_unusable_tmpdir_is_named_and_not_blamed_on_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::new();
+    for p in &common::icosphere(3).positions {
+        text += &format!("{} {} {}\n", p.x, p.y, p.z);
+    }
+    let input = write(dir.path(), "sphere.xyz", text);
+    let a_file = write(dir.path(), "not-a-folder", "x");
+    let missing = dir.path().join("nonexistent").join("x");
+    let (mesh_out, points_out) = (dir.path().join("o.obj"), dir.path().join("o.ply"));
+    for tmp in [&missing, &a_file] {
+        for args in [
+            vec![arg(&input), arg(&mesh_out), "--points", "200", "-q"],
+            vec!["simplify", arg(&input), arg(&points_out), "--points", "100"],
+        ] {
+            let o = remesh_in(tmp, &args);
+            assert_error(&o, 4, &["TMPDIR", arg(tmp)]);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(!err.contains("sphere.xyz"), "the input is blamed: {err}");
+            assert!(!mesh_out.exists() && !points_out.exists());
+        }
+    }
+    // A full temporary directory: a file size limit (as in the R4 test) below the buckets'
+    // 23 KB (642 points of 36 bytes) and above the 100 points written.
+    #[cfg(target_os = "linux")]
+    {
+        let tmp = dir.path().join("tmp");
+        std::fs::create_dir(&tmp).unwrap();
+        let o = limited(Limit::FileSize, 10_000)
+            .env("TMPDIR", &tmp)
+            .args(["simplify", arg(&input), arg(&points_out), "--points", "100"])
+            .output()
+            .unwrap();
+        assert_error(&o, 4, &["TMPDIR", "remesh-buckets"]);
+        assert!(!points_out.exists());
+        assert_eq!(std::fs::read_dir(&tmp).unwrap().count(), 0, "buckets left");
+    }
+    assert_no_temporaries(dir.path());
+}
+
 /// R13 (d): under `ulimit -v` 150 MB every job was refused with "the limit of 0.000 MB ...
 /// raise --max-memory", which cannot help: the address-space limit (less the reserve for
 /// thread stacks and arenas) is what is too small, and the message names it and its size.
