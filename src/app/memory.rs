@@ -56,7 +56,7 @@ pub fn physical_memory() -> Option<u64> {
 }
 
 /// The default limit of a job: the smallest of the machine's physical memory
-/// ([`physical_memory`]) and the limits the process is held to ([`process_limit`]: its control
+/// ([`physical_memory`]) and the limits the process is held to (`process_limit`: its control
 /// group's memory limit, its address-space limit less a reserve). Under such a limit a job too
 /// large is refused before it starts instead of aborting when an allocation fails. `None` when
 /// none can be read.
@@ -68,7 +68,7 @@ pub fn memory_limit() -> Option<u64> {
 }
 
 /// The limit of a job that asks for `given` bytes (`--max-memory`; `None`: [`memory_limit`]):
-/// `given`, but never more than the process may take ([`process_limit`]), since a job past its
+/// `given`, but never more than the process may take (`process_limit`), since a job past its
 /// address-space or control-group limit aborts when an allocation fails whatever it was
 /// allowed. A `given` above the machine's physical memory stands (swap may hold it).
 pub fn effective_memory_limit(given: Option<u64>) -> Option<u64> {

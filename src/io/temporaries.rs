@@ -37,7 +37,7 @@ pub(crate) fn register(path: &Path) -> Registered {
 /// The error of a temporary file or folder of this process's own (`what`, at `path`, in the
 /// temporary directory: `TMPDIR`, else `/tmp`, where `from_tmpdir`; else the directory the caller
 /// gave) that cannot be made, written or read back: the environment's fault, not the input's,
-/// so an [`Error::Write`] (exit code 4) naming the directory, never an input error.
+/// so an [`Error::Write`](crate::error::Error::Write) (exit code 4) naming the directory, never an input error.
 pub(crate) fn temporary_error(
     path: &Path,
     what: &str,
