@@ -967,6 +967,45 @@ fn an_unusable_tmpdir_is_named_and_not_blamed_on_the_input() {
     assert_no_temporaries(dir.path());
 }
 
+/// R13 (b): a PLY of a camera element and `element vertex 0` said "no faces"; it has no
+/// vertices at all, and says so.
+#[test]
+fn a_file_without_vertices_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(
+        dir.path(),
+        "cam.ply",
+        "ply\nformat ascii 1.0\nelement camera 1\nproperty float view_px\n\
+         property float view_py\nproperty float view_pz\nelement vertex 0\nproperty float x\n\
+         property float y\nproperty float z\nend_header\n0 0 0\n",
+    );
+    let out = dir.path().join("o.obj");
+    let o = remesh(&[arg(&input), arg(&out), "--points", "100"]);
+    assert_error(&o, 3, &["cam.ply", "no vertices"]);
+    let o = remesh(&["quality", arg(&input)]);
+    assert_error(&o, 3, &["cam.ply", "no vertices"]);
+}
+
+/// R13 (c): an output that cannot be written (here past a file size limit, as on a full disk)
+/// read `out.obj: cannot write: cannot write: File too large`. Once now.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_write_error_says_cannot_write_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    let o = remesh_limited(
+        Limit::FileSize,
+        1000,
+        &[arg(&input), arg(&out), "--points", "300", "-q"],
+    );
+    assert_error(&o, 4, &[arg(&out), "cannot write"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.matches("cannot write").count(), 1, "{err}");
+    assert!(!out.exists());
+    assert_no_temporaries(dir.path());
+}
+
 /// R13 (d): under `ulimit -v` 150 MB every job was refused with "the limit of 0.000 MB ...
 /// raise --max-memory", which cannot help: the address-space limit (less the reserve for
 /// thread stacks and arenas) is what is too small, and the message names it and its size.

@@ -175,11 +175,17 @@ fn triangles(
         for (col, &v) in r.iter().enumerate() {
             t[col] = match usize::try_from(v) {
                 Ok(i) if i < vertices => i as u32,
+                _ if vertices == 0 => {
+                    return Err(PyValueError::new_err(format!(
+                        "{name}[{row}, {col}] = {v} is not a vertex index: there are no vertices \
+                         (the vertex array is empty)"
+                    )))
+                }
                 _ => {
                     return Err(PyValueError::new_err(format!(
                         "{name}[{row}, {col}] = {v} is not a vertex index: the vertices are \
                          numbered 0 to {} (0-based)",
-                        vertices as i128 - 1
+                        vertices - 1
                     )))
                 }
             };

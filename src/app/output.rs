@@ -33,7 +33,7 @@ impl Outputs {
         let mut report_file = self.report;
         if let Some(f) = &mut report_file {
             f.write_all(report.to_json().as_bytes())
-                .map_err(|e| f.error(format!("cannot write: {e}")))?;
+                .map_err(|e| f.error(e.to_string()))?;
         }
         let mesh = match self.mesh.into_inner() {
             Some(mesh) if self.written.get() => Some(mesh.finish()?),
@@ -150,7 +150,7 @@ pub(super) fn write_output(
     let bytes = encode_mesh(&job.output, mesh, format)?;
     if let Some(file) = outputs.mesh.borrow_mut().as_mut() {
         file.write_all(&bytes)
-            .map_err(|e| file.error(format!("cannot write: {e}")))?;
+            .map_err(|e| file.error(e.to_string()))?;
         outputs.written.set(true);
         Ok(())
     } else {
@@ -159,8 +159,9 @@ pub(super) fn write_output(
             .write_all(&bytes)
             .and_then(|()| stdout.flush())
             .map_err(|e| Error::Write {
-                path: job.output.clone(),
-                message: format!("cannot write to standard output: {e}"),
+                // `-: cannot write: ...` would not say where.
+                path: "- (standard output)".into(),
+                message: e.to_string(),
             })
     }
 }

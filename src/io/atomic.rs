@@ -114,10 +114,10 @@ impl AtomicFile {
         } = self;
         let file = output
             .into_inner()
-            .map_err(|e| write_error(&path, format!("cannot write: {}", e.error())))?;
+            .map_err(|e| write_error(&path, e.error().to_string()))?;
         file.as_file()
             .sync_all()
-            .map_err(|e| write_error(&path, format!("cannot write: {e}")))?;
+            .map_err(|e| write_error(&path, e.to_string()))?;
         Ok(FinishedFile {
             path,
             target,
@@ -188,7 +188,7 @@ pub fn write_atomically(
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
     let mut file = AtomicFile::create(path)?;
-    write(&mut file).map_err(|e| file.error(format!("cannot write: {e}")))?;
+    write(&mut file).map_err(|e| file.error(e.to_string()))?;
     file.commit()
 }
 
