@@ -38,8 +38,9 @@ pub enum Error {
     },
 
     /// The file parsed, but the mesh it holds cannot be used (no triangles, a non-finite
-    /// coordinate, an index out of range, a zero-size bounding box, ...).
-    #[error("{}: {message}", path.display())]
+    /// coordinate, an index out of range, a zero-size bounding box, ...). Shown as
+    /// `PATH: MESSAGE`, or the message alone for a mesh that did not come from a file.
+    #[error("{}{message}", file_prefix(path))]
     InvalidMesh {
         /// The file concerned (empty when the mesh did not come from a file).
         path: PathBuf,
@@ -122,6 +123,16 @@ impl Error {
     }
 }
 
+/// `PATH: ` for an error's message, or nothing for an empty path (a mesh given in memory, which
+/// no file names: a message never starts with a bare `: `).
+fn file_prefix(path: &std::path::Path) -> String {
+    if path.as_os_str().is_empty() {
+        String::new()
+    } else {
+        format!("{}: ", path.display())
+    }
+}
+
 /// The library's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
@@ -132,5 +143,20 @@ pub(crate) fn shown(x: f64) -> String {
         format!("{x:e}")
     } else {
         format!("{x}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 56, R13 (a): a mesh given in memory (the Python module's arrays) has no file name,
+    /// and its errors read `: no triangle of non-zero area`, an empty name before the colon.
+    #[test]
+    fn a_mesh_without_a_file_is_not_named_by_an_empty_string() {
+        let e = Error::invalid_mesh("", "no triangle of non-zero area");
+        assert_eq!(e.to_string(), "no triangle of non-zero area");
+        let e = Error::invalid_mesh("a.obj", "no faces");
+        assert_eq!(e.to_string(), "a.obj: no faces");
     }
 }

@@ -176,8 +176,8 @@ pub mod internal {
 
     // Reading and writing meshes (OBJ, PLY, glTF, STL, OFF), atomically.
     pub use crate::io::{
-        read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, MeshFormat,
-        ReadStats,
+        read_mesh, remove_temporaries, write_atomically, write_mesh, AtomicFile, FinishedFile,
+        MeshFormat, ReadStats,
     };
 
     // The meshes: the indexed triangle mesh, its normalization to bbox 100, its consistent
@@ -303,11 +303,11 @@ pub mod internal {
 
     // The jobs of the `remesh` command line: files in, files and report out.
     pub use crate::app::{
-        catch_panics, check_report_path, estimate_remesh_bytes, memory_limit, parse_bytes,
-        physical_memory, quality_mesh, remesh_mesh, remesh_point_set, run_points, run_quality,
-        run_remesh, run_simplify, write_report, PointsJob, RemeshJob, RemeshOptions, RemeshedMesh,
-        SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary, DISTANCE_SAMPLES,
-        MAX_SURFACE_POINTS, STDOUT,
+        catch_panics, check_report_path, effective_memory_limit, estimate_remesh_bytes,
+        memory_limit, parse_bytes, physical_memory, quality_mesh, remesh_mesh, remesh_point_set,
+        run_points, run_quality, run_remesh, run_simplify, write_report, PointsJob, RemeshJob,
+        RemeshOptions, RemeshedMesh, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary,
+        DISTANCE_SAMPLES, MAX_SURFACE_POINTS, STDOUT,
     };
     pub use crate::geometry::{intersecting_pairs, triangle_angles_deg};
     pub use crate::manifold::MAX_KERNEL_DIMENSION;

@@ -938,3 +938,309 @@ fn an_element_count_that_wraps_is_an_input_error() {
         assert!(!out.exists());
     }
 }
+
+/// A resource limit [`remesh_limited`] lowers.
+#[cfg(target_os = "linux")]
+#[derive(Clone, Copy)]
+enum Limit {
+    /// `RLIMIT_FSIZE` (`ulimit -f`): a write past it fails (EFBIG) as on a full disk.
+    FileSize,
+    /// `RLIMIT_AS` (`ulimit -v`).
+    AddressSpace,
+}
+
+/// The `remesh` binary to run with the resource limit `which` lowered to `bytes` (soft and hard)
+/// before it starts, and `SIGXFSZ` ignored, so a write past the file size limit fails with an
+/// error the program sees (as a write to a full disk does) instead of killing it.
+#[cfg(target_os = "linux")]
+fn limited(which: Limit, bytes: u64) -> Command {
+    use std::os::unix::process::CommandExt;
+    let resource = match which {
+        Limit::FileSize => libc::RLIMIT_FSIZE,
+        Limit::AddressSpace => libc::RLIMIT_AS,
+    };
+    let mut command = Command::new(env!("CARGO_BIN_EXE_remesh"));
+    // SAFETY: between fork and exec the hook calls only setrlimit and signal, which are
+    // async-signal-safe, and allocates nothing.
+    unsafe {
+        command.pre_exec(move || {
+            let limit = libc::rlimit {
+                rlim_cur: bytes as libc::rlim_t,
+                rlim_max: bytes as libc::rlim_t,
+            };
+            if libc::setrlimit(resource, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            Ok(())
+        });
+    }
+    command
+}
+
+/// `remesh ARGS` under [`limited`]`(which, bytes)`.
+#[cfg(target_os = "linux")]
+fn remesh_limited(which: Limit, bytes: u64, args: &[&str]) -> Output {
+    limited(which, bytes)
+        .args(args)
+        .output()
+        .expect("run remesh")
+}
+
+/// The run ended by itself (not by a signal such as SIGABRT), with no panic or backtrace.
+fn assert_no_abort(o: &Output) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.code().is_some(),
+        "ended by a signal: {:?}; {err}",
+        o.status
+    );
+    for word in ["panicked", "backtrace", "memory allocation", "SIGABRT"] {
+        assert!(!err.contains(word), "{err}");
+    }
+}
+
+/// R4: `--report r.json` on a full disk exited 4 after the existing OUTPUT had been replaced
+/// (the mesh was renamed into place before the report's bytes left their buffer). Both files
+/// are now written and synced in their temporaries before either is renamed: a report that
+/// cannot be written leaves the existing output and report as they were. The full disk is a
+/// file size limit between the mesh's size and the report's.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_report_that_cannot_be_written_leaves_the_existing_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let run = |out: &Path, report: &Path| {
+        [
+            arg(&input),
+            arg(out),
+            "--points",
+            "40",
+            "--no-distance",
+            "-q",
+            "--report",
+            arg(report),
+        ]
+        .map(str::to_string)
+    };
+    // The sizes of the two files, written without a limit.
+    let (free_out, free_report) = (dir.path().join("free.stl"), dir.path().join("free.json"));
+    let args = run(&free_out, &free_report);
+    let o = remesh(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let size = |p: &Path| std::fs::metadata(p).unwrap().len();
+    let (mesh_bytes, report_bytes) = (size(&free_out), size(&free_report));
+    assert!(
+        mesh_bytes + 200 < report_bytes,
+        "the test needs a mesh smaller than its report: {mesh_bytes} and {report_bytes} bytes"
+    );
+    let limit = (mesh_bytes + report_bytes) / 2;
+    let out = write(dir.path(), "k.stl", "KEEP\n");
+    let report = write(dir.path(), "r.json", "KEEP\n");
+    let args = run(&out, &report);
+    let o = remesh_limited(
+        Limit::FileSize,
+        limit,
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    assert_error(&o, 4, &[arg(&report)]);
+    assert!(
+        std::fs::read(&out).unwrap() == b"KEEP\n",
+        "the output was replaced"
+    );
+    assert!(
+        std::fs::read(&report).unwrap() == b"KEEP\n",
+        "the report was replaced"
+    );
+    assert_no_temporaries(dir.path());
+}
+
+/// R5: `remesh quality` of one triangle repeated 20,000 times took a minute and 3.2 GB (every
+/// copy's box overlaps every other's: 2 · 10^8 pairs to test), and an icosphere with every face
+/// 200 times (a binary STL, its corners welded on reading) aborted. Faces on the same three
+/// vertices, in any order and winding, now enter the crossing search once, and the distance to
+/// a reference counts each face once; the report says how many duplicates there were.
+#[test]
+fn duplicate_faces_enter_the_crossing_search_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    let orders = ["1 2 3", "2 3 1", "3 1 2", "1 3 2", "3 2 1", "2 1 3"];
+    for k in 0..20_000 {
+        text += &format!("f {}\n", orders[k % orders.len()]);
+    }
+    let one = write(dir.path(), "one.obj", text);
+    let quality = |args: &[&str]| -> serde_json::Value {
+        let o = remesh(&[&["quality"], args, &["--json"]].concat());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let q = quality(&[arg(&one)]);
+    let crossings = &q["self_intersections"];
+    assert_eq!(crossings["faces"], 1, "{crossings}");
+    assert_eq!(crossings["candidates"], 0, "{crossings}");
+    assert_eq!(crossings["pairs"], 0, "{crossings}");
+    assert_eq!(q["topology"]["faces"], 20_000);
+    assert_eq!(q["topology"]["duplicate_faces"], 19_999);
+    let notes = q["notes"].to_string();
+    assert!(notes.contains("19999 faces repeat"), "{notes}");
+    // An icosphere (320 faces) with every face 200 times, as binary STL: separate corners,
+    // welded on reading, so the copies become faces on the same vertices.
+    let sphere = common::icosphere(2);
+    let mut many = sphere.clone();
+    many.triangles = sphere
+        .triangles
+        .iter()
+        .flat_map(|&t| std::iter::repeat_n(t, 200))
+        .collect();
+    let stl = dir.path().join("many.stl");
+    spectral_remesh::write_mesh(&stl, &many).unwrap();
+    let q = quality(&[arg(&stl)]);
+    let crossings = &q["self_intersections"];
+    assert_eq!(crossings["faces"], 320, "{crossings}");
+    assert_eq!(crossings["pairs"], 0, "{crossings}");
+    assert_eq!(q["topology"]["duplicate_faces"], 320 * 199);
+    // As a reference, and measured against one: the same surface as the plain sphere (up to
+    // the STL's `f32` coordinates).
+    let plain = dir.path().join("plain.obj");
+    spectral_remesh::write_mesh(&plain, &sphere).unwrap();
+    for (mesh, reference) in [(&plain, &stl), (&stl, &plain)] {
+        let q = quality(&[arg(mesh), "--ref", arg(reference)]);
+        let hausdorff = q["distance"]["hausdorff"].as_f64().unwrap();
+        assert!(hausdorff < 1e-4, "{}", q["distance"]);
+    }
+}
+
+/// R8: `--max-memory 1G` under `ulimit -v` 300 MB was taken at its word, and the run aborted
+/// (SIGABRT, a backtrace) when an allocation failed. The limit given is held to what the
+/// process may take (its address-space limit less the reserve): the job is refused at once, in
+/// one line naming the address-space limit.
+#[cfg(target_os = "linux")]
+#[test]
+fn max_memory_is_held_to_the_address_space_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    let o = remesh_limited(
+        Limit::AddressSpace,
+        300 << 20,
+        &[
+            arg(&input),
+            arg(&out),
+            "--points",
+            "150000",
+            "--max-memory",
+            "1G",
+        ],
+    );
+    assert_no_abort(&o);
+    assert_error(&o, 2, &["--max-memory", "address-space limit", "ulimit -v"]);
+    assert!(!out.exists());
+}
+
+/// R10: with `TMPDIR` missing or a regular file, `remesh points.xyz out.obj` and `remesh
+/// simplify` exited 3 (the input's code) blaming the input (`sphere.xyz: No such file or
+/// directory`). The bucket folder that cannot be made is an output error of the environment:
+/// exit 4, naming TMPDIR, and nothing written; so is a full one.
+#[test]
+fn an_unusable_tmpdir_is_named_and_not_blamed_on_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::new();
+    for p in &common::icosphere(3).positions {
+        text += &format!("{} {} {}\n", p.x, p.y, p.z);
+    }
+    let input = write(dir.path(), "sphere.xyz", text);
+    let a_file = write(dir.path(), "not-a-folder", "x");
+    let missing = dir.path().join("nonexistent").join("x");
+    let (mesh_out, points_out) = (dir.path().join("o.obj"), dir.path().join("o.ply"));
+    for tmp in [&missing, &a_file] {
+        for args in [
+            vec![arg(&input), arg(&mesh_out), "--points", "200", "-q"],
+            vec!["simplify", arg(&input), arg(&points_out), "--points", "100"],
+        ] {
+            let o = remesh_in(tmp, &args);
+            assert_error(&o, 4, &["TMPDIR", arg(tmp)]);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(!err.contains("sphere.xyz"), "the input is blamed: {err}");
+            assert!(!mesh_out.exists() && !points_out.exists());
+        }
+    }
+    // A full temporary directory: a file size limit (as in the R4 test) below the buckets'
+    // 23 KB (642 points of 36 bytes) and above the 100 points written.
+    #[cfg(target_os = "linux")]
+    {
+        let tmp = dir.path().join("tmp");
+        std::fs::create_dir(&tmp).unwrap();
+        let o = limited(Limit::FileSize, 10_000)
+            .env("TMPDIR", &tmp)
+            .args(["simplify", arg(&input), arg(&points_out), "--points", "100"])
+            .output()
+            .unwrap();
+        assert_error(&o, 4, &["TMPDIR", "remesh-buckets"]);
+        assert!(!points_out.exists());
+        assert_eq!(std::fs::read_dir(&tmp).unwrap().count(), 0, "buckets left");
+    }
+    assert_no_temporaries(dir.path());
+}
+
+/// R13 (b): a PLY of a camera element and `element vertex 0` said "no faces"; it has no
+/// vertices at all, and says so.
+#[test]
+fn a_file_without_vertices_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(
+        dir.path(),
+        "cam.ply",
+        "ply\nformat ascii 1.0\nelement camera 1\nproperty float view_px\n\
+         property float view_py\nproperty float view_pz\nelement vertex 0\nproperty float x\n\
+         property float y\nproperty float z\nend_header\n0 0 0\n",
+    );
+    let out = dir.path().join("o.obj");
+    let o = remesh(&[arg(&input), arg(&out), "--points", "100"]);
+    assert_error(&o, 3, &["cam.ply", "no vertices"]);
+    let o = remesh(&["quality", arg(&input)]);
+    assert_error(&o, 3, &["cam.ply", "no vertices"]);
+}
+
+/// R13 (c): an output that cannot be written (here past a file size limit, as on a full disk)
+/// read `out.obj: cannot write: cannot write: File too large`. Once now.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_write_error_says_cannot_write_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    let o = remesh_limited(
+        Limit::FileSize,
+        1000,
+        &[arg(&input), arg(&out), "--points", "300", "-q"],
+    );
+    assert_error(&o, 4, &[arg(&out), "cannot write"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.matches("cannot write").count(), 1, "{err}");
+    assert!(!out.exists());
+    assert_no_temporaries(dir.path());
+}
+
+/// R13 (d): under `ulimit -v` 150 MB every job was refused with "the limit of 0.000 MB ...
+/// raise --max-memory", which cannot help: the address-space limit (less the reserve for
+/// thread stacks and arenas) is what is too small, and the message names it and its size.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_small_address_space_limit_is_named_not_max_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = sphere(dir.path());
+    let out = dir.path().join("o.obj");
+    let o = remesh_limited(
+        Limit::AddressSpace,
+        150_000_000,
+        &[arg(&input), arg(&out), "--points", "1000"],
+    );
+    assert_no_abort(&o);
+    assert_error(&o, 2, &["address-space limit", "ulimit -v", "150.000 MB"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !err.contains("raise `--max-memory`") && !err.contains("or raise --max-memory"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

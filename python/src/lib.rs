@@ -175,11 +175,17 @@ fn triangles(
         for (col, &v) in r.iter().enumerate() {
             t[col] = match usize::try_from(v) {
                 Ok(i) if i < vertices => i as u32,
+                _ if vertices == 0 => {
+                    return Err(PyValueError::new_err(format!(
+                        "{name}[{row}, {col}] = {v} is not a vertex index: there are no vertices \
+                         (the vertex array is empty)"
+                    )))
+                }
                 _ => {
                     return Err(PyValueError::new_err(format!(
                         "{name}[{row}, {col}] = {v} is not a vertex index: the vertices are \
                          numbered 0 to {} (0-based)",
-                        vertices as i128 - 1
+                        vertices - 1
                     )))
                 }
             };
@@ -388,22 +394,24 @@ fn quality<'py>(
 }
 
 /// `max_memory` as bytes: an int, a size such as `"8G"`, or `None` for the smallest of the
-/// machine's physical memory and the process's limits (the command line's default).
+/// machine's physical memory and the process's limits (the command line's default); a size
+/// given is held to the process's limits too (`effective_memory_limit`).
 fn memory_limit(value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<u64>> {
-    let Some(value) = value else {
-        return Ok(spectral::internal::memory_limit());
+    let given = match value {
+        None => None,
+        Some(value) => Some(if let Ok(text) = value.extract::<String>() {
+            spectral::internal::parse_bytes(&text)
+                .map_err(|e| PyValueError::new_err(format!("invalid parameter max_memory: {e}")))?
+        } else {
+            match value.extract::<i128>() {
+                Ok(n) if (0..=u64::MAX as i128).contains(&n) => n as u64,
+                _ => return Err(PyValueError::new_err(
+                    "invalid parameter max_memory: give a number of bytes >= 0 or a size such as \"8G\"",
+                )),
+            }
+        }),
     };
-    if let Ok(text) = value.extract::<String>() {
-        return spectral::internal::parse_bytes(&text)
-            .map(Some)
-            .map_err(|e| PyValueError::new_err(format!("invalid parameter max_memory: {e}")));
-    }
-    match value.extract::<i128>() {
-        Ok(n) if (0..=u64::MAX as i128).contains(&n) => Ok(Some(n as u64)),
-        _ => Err(PyValueError::new_err(
-            "invalid parameter max_memory: give a number of bytes >= 0 or a size such as \"8G\"",
-        )),
-    }
+    Ok(spectral::internal::effective_memory_limit(given))
 }
 
 /// A count option: an int >= 0 (named as the command line names it in the error).

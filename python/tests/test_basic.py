@@ -203,6 +203,8 @@ def tetrahedron():
         (tetrahedron()[0], tetrahedron()[1].astype(np.float64), r"F must hold vertex indices \(an integer dtype\), got dtype"),
         (tetrahedron()[0], tetrahedron()[1].astype(bool), r"F must hold vertex indices"),
         (tetrahedron()[0], np.array([[0, 2, 1], [0, 1, 4]]), r"F\[1, 2\] = 4 is not a vertex index: the vertices are numbered 0 to 3"),
+        # Issue 56, R13 (e): no vertices at all read "the vertices are numbered 0 to -1".
+        (np.zeros((0, 3)), tetrahedron()[1], r"^F\[0, 0\] = 0 is not a vertex index: there are no vertices \(the vertex array is empty\)$"),
         (tetrahedron()[0], np.array([[0, 2, 1], [0, -1, 3]]), r"F\[1, 1\] = -1 is not a vertex index"),
         (tetrahedron()[0], np.array([[0, 2, 1], [0, 2**40, 3]], dtype=np.uint64), r"F\[1, 1\] = 1099511627776 is not a vertex index"),
         (np.array([[0, 0, np.nan], [1, 0, 0], [0, 1, 0], [0, 0, 1]]), tetrahedron()[1], r"mesh: vertex 0 \(0-based\) has a non-finite coordinate"),

@@ -56,26 +56,99 @@ pub fn physical_memory() -> Option<u64> {
 }
 
 /// The default limit of a job: the smallest of the machine's physical memory
-/// ([`physical_memory`]), the memory limit of the process's control group (cgroup v2
-/// `memory.max` or v1 `memory.limit_in_bytes`, along its path) and its address-space limit
-/// (`RLIMIT_AS`, `ulimit -v`) less a reserve for what is mapped without being resident (thread
-/// stacks, the allocator's per-thread arenas: 128 MiB per core and as much again). Under such
-/// a limit a job too large is refused before it starts instead of aborting when an allocation
-/// fails. `None` when none can be read.
+/// ([`physical_memory`]) and the limits the process is held to (`process_limit`: its control
+/// group's memory limit, its address-space limit less a reserve). Under such a limit a job too
+/// large is refused before it starts instead of aborting when an allocation fails. `None` when
+/// none can be read.
 pub fn memory_limit() -> Option<u64> {
-    [physical_memory(), cgroup_limit(), address_space_limit()]
+    [physical_memory(), process_limit().map(|(bytes, _)| bytes)]
         .into_iter()
         .flatten()
         .min()
+}
+
+/// The limit of a job that asks for `given` bytes (`--max-memory`; `None`: [`memory_limit`]):
+/// `given`, but never more than the process may take (`process_limit`), since a job past its
+/// address-space or control-group limit aborts when an allocation fails whatever it was
+/// allowed. A `given` above the machine's physical memory stands (swap may hold it).
+pub fn effective_memory_limit(given: Option<u64>) -> Option<u64> {
+    match given {
+        None => memory_limit(),
+        Some(bytes) => Some(process_limit().map_or(bytes, |(most, _)| bytes.min(most))),
+    }
+}
+
+/// What holds the process to a memory limit of its own ([`process_limit`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ProcessLimit {
+    /// The soft `RLIMIT_AS` (`ulimit -v`) of `soft` bytes, less `reserve` bytes kept for what
+    /// is mapped without being resident ([`ADDRESS_SPACE_RESERVE_PER_THREAD`]).
+    AddressSpace {
+        /// The limit, in bytes.
+        soft: u64,
+        /// The reserve taken off it, in bytes.
+        reserve: u64,
+    },
+    /// The memory limit of the process's control group (cgroup v2 `memory.max` or v1
+    /// `memory.limit_in_bytes`, along its path).
+    ControlGroup,
+}
+
+/// The most memory the process may take whatever a job asks, and what sets it: the smaller of
+/// its control group's memory limit and its address-space limit (`RLIMIT_AS`, `ulimit -v`) less
+/// a reserve for what is mapped without being resident (thread stacks, the allocator's
+/// per-thread arenas: 128 MiB per core and as much again). `None` when neither is set or
+/// readable.
+pub(crate) fn process_limit() -> Option<(u64, ProcessLimit)> {
+    let address_space = address_space_limit().map(|(soft, reserve)| {
+        (
+            soft.saturating_sub(reserve),
+            ProcessLimit::AddressSpace { soft, reserve },
+        )
+    });
+    let group = cgroup_limit().map(|bytes| (bytes, ProcessLimit::ControlGroup));
+    [address_space, group]
+        .into_iter()
+        .flatten()
+        .min_by_key(|&(bytes, _)| bytes)
+}
+
+/// How a refusal over `limit` bytes names the limit and what would lift it: the limit given
+/// (`max_memory`), or, where the process's own limit ([`process_limit`]) sets it, that one,
+/// since raising `max_memory` cannot help then. Returns (the limit in words, what to raise).
+fn limit_words(limit: u64) -> (String, &'static str) {
+    match process_limit() {
+        Some((bytes, ProcessLimit::AddressSpace { soft, reserve })) if bytes == limit => (
+            format!(
+                "the {} this process may take (its address-space limit, `ulimit -v`, of {} \
+                 less {} kept for thread stacks and allocator arenas)",
+                format_bytes(limit),
+                format_bytes(soft),
+                format_bytes(reserve)
+            ),
+            "raise the address-space limit (`ulimit -v`; raising `max_memory` cannot help)",
+        ),
+        Some((bytes, ProcessLimit::ControlGroup)) if bytes == limit => (
+            format!(
+                "the {} this process may take (its control group's memory limit)",
+                format_bytes(limit)
+            ),
+            "raise the control group's memory limit (raising `max_memory` cannot help)",
+        ),
+        _ => (
+            format!("the limit of {}", format_bytes(limit)),
+            "raise `max_memory`",
+        ),
+    }
 }
 
 /// Address space mapped per thread beyond resident memory (a glibc malloc arena reserves 64
 /// MiB, a stack 2 to 8 MiB), for the reserve of [`memory_limit`].
 pub const ADDRESS_SPACE_RESERVE_PER_THREAD: u64 = 128 << 20;
 
-/// The soft `RLIMIT_AS` (`Max address space` of `/proc/self/limits`) less the reserve, or
-/// `None` when unlimited or unreadable.
-fn address_space_limit() -> Option<u64> {
+/// The soft `RLIMIT_AS` (`Max address space` of `/proc/self/limits`) and the reserve to take
+/// off it, or `None` when unlimited or unreadable.
+fn address_space_limit() -> Option<(u64, u64)> {
     let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
     let line = limits
         .lines()
@@ -87,7 +160,10 @@ fn address_space_limit() -> Option<u64> {
         .parse()
         .ok()?;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64 + 1;
-    Some(soft.saturating_sub(threads.saturating_mul(ADDRESS_SPACE_RESERVE_PER_THREAD)))
+    Some((
+        soft,
+        threads.saturating_mul(ADDRESS_SPACE_RESERVE_PER_THREAD),
+    ))
 }
 
 /// The smallest memory limit of the process's control group and its ancestors, or `None`
@@ -138,14 +214,14 @@ pub fn check_input_size(path: &Path, limit: u64) -> Result<()> {
         return Ok(());
     };
     if meta.len() > limit {
+        let (limit, raise) = limit_words(limit);
         return Err(Error::InvalidParameter {
             name: "max_memory",
             message: format!(
-                "{}: a file of {} cannot be remeshed within the limit of {} (its faces take \
-                 several times their file size in memory); raise `max_memory`",
+                "{}: a file of {} cannot be remeshed within {limit}: its faces take several \
+                 times their file size in memory; {raise}",
                 path.display(),
                 format_bytes(meta.len()),
-                format_bytes(limit)
             ),
         });
     }
@@ -165,13 +241,13 @@ pub fn check_remesh_budget(
 ) -> Result<()> {
     let need = estimate_remesh_bytes(input_faces, output_points, measure_distance);
     if need > limit {
+        let (limit, raise) = limit_words(limit);
         return Err(Error::InvalidParameter {
             name: "max_memory",
             message: format!(
                 "remeshing {input_faces} input faces to about {output_points:.0} points needs \
-                 about {}, more than the limit of {}; ask for fewer points or raise `max_memory`",
+                 about {}, more than {limit}; ask for fewer points or {raise}",
                 format_bytes(need),
-                format_bytes(limit)
             ),
         });
     }

@@ -8,7 +8,9 @@ mod remesh_points;
 pub use remesh_points::remesh_point_set;
 mod simplify;
 
-pub use memory::{estimate_remesh_bytes, memory_limit, parse_bytes, physical_memory};
+pub use memory::{
+    effective_memory_limit, estimate_remesh_bytes, memory_limit, parse_bytes, physical_memory,
+};
 pub use options::RemeshOptions;
 pub use simplify::{run_simplify, SimplifyDensity, SimplifyDetail, SimplifyJob, SimplifySummary};
 

@@ -20,24 +20,30 @@ pub(super) struct Outputs {
 }
 
 impl Outputs {
-    /// Writes `report` into its file, then renames the mesh and the report into place.
+    /// Writes `report` into its file, finishes both temporary files (every byte written and
+    /// synced), and only then renames the mesh and the report into place: a disk that fills up
+    /// (or any other failure) while either is written leaves both targets as they were.
     ///
     /// # Errors
     /// [`Error::Write`] naming the file that could not be written; the temporary files are
-    /// removed (a mesh renamed before the report's rename failed stays).
+    /// removed and neither target is touched. (Only a rename can fail after the other file's
+    /// rename; a rename within a directory takes no room on the disk.)
     pub(super) fn commit(self, report: &QualityReport) -> Result<()> {
         use std::io::Write;
         let mut report_file = self.report;
         if let Some(f) = &mut report_file {
             f.write_all(report.to_json().as_bytes())
-                .map_err(|e| f.error(format!("cannot write: {e}")))?;
+                .map_err(|e| f.error(e.to_string()))?;
         }
-        if let Some(mesh) = self.mesh.into_inner() {
-            if self.written.get() {
-                mesh.commit()?;
-            }
+        let mesh = match self.mesh.into_inner() {
+            Some(mesh) if self.written.get() => Some(mesh.finish()?),
+            _ => None,
+        };
+        let report_file = report_file.map(AtomicFile::finish).transpose()?;
+        for finished in [mesh, report_file].into_iter().flatten() {
+            finished.persist()?;
         }
-        report_file.map_or(Ok(()), AtomicFile::commit)
+        Ok(())
     }
 }
 
@@ -144,7 +150,7 @@ pub(super) fn write_output(
     let bytes = encode_mesh(&job.output, mesh, format)?;
     if let Some(file) = outputs.mesh.borrow_mut().as_mut() {
         file.write_all(&bytes)
-            .map_err(|e| file.error(format!("cannot write: {e}")))?;
+            .map_err(|e| file.error(e.to_string()))?;
         outputs.written.set(true);
         Ok(())
     } else {
@@ -153,8 +159,9 @@ pub(super) fn write_output(
             .write_all(&bytes)
             .and_then(|()| stdout.flush())
             .map_err(|e| Error::Write {
-                path: job.output.clone(),
-                message: format!("cannot write to standard output: {e}"),
+                // `-: cannot write: ...` would not say where.
+                path: "- (standard output)".into(),
+                message: e.to_string(),
             })
     }
 }

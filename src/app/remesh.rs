@@ -260,8 +260,9 @@ pub(super) fn remesh_read(
     if job.measure_distance {
         on_stage("distance");
         let t = Clock::start();
-        let a = MeshSurface::new(checked)?;
-        let b = MeshSurface::new(&out.input_normalized)?;
+        // Each side's error names its mesh (a surface of no area has no closest points).
+        let a = MeshSurface::new(checked).map_err(|e| with_path(e, &job.output))?;
+        let b = MeshSurface::new(&out.input_normalized).map_err(|e| with_path(e, &job.input))?;
         report.distance = Some(surface_distance_with(
             checked,
             &a,

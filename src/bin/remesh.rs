@@ -9,8 +9,8 @@ use std::time::Duration;
 use clap::{CommandFactory, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use spectral_remesh::internal::{
-    catch_panics, check_report_path, memory_limit, parse_bytes, remove_temporaries, run_points,
-    run_simplify, write_report, PointsJob, SimplifyDensity, SimplifyJob, STDOUT,
+    catch_panics, check_report_path, effective_memory_limit, parse_bytes, remove_temporaries,
+    run_points, run_simplify, write_report, PointsJob, SimplifyDensity, SimplifyJob, STDOUT,
 };
 use spectral_remesh::{run_quality, run_remesh, Error, MeshFormat, RemeshJob, RemeshOptions};
 
@@ -400,7 +400,7 @@ fn config(mut cli: Cli) -> Result<Config, Error> {
                 params,
                 measure_distance: !cli.no_distance,
                 strict: cli.strict,
-                max_memory: cli.max_memory.or_else(memory_limit),
+                max_memory: effective_memory_limit(cli.max_memory),
                 as_points: cli.as_points,
                 viewpoint: cli.viewpoint.map(glam::DVec3::from),
                 report: cli.report,

@@ -28,6 +28,10 @@ pub struct SelfIntersections {
     pub first_kind: Option<PairKind>,
     /// Pairs of faces whose bounding boxes overlap: the exact tests made.
     pub candidates: usize,
+    /// Faces that entered the search: those with every index in range, finite corners and
+    /// non-zero area, and of the faces on the same three vertices (duplicates, in any order or
+    /// winding) only the first, so that a duplicate's pairs are counted once.
+    pub faces: usize,
 }
 
 impl SelfIntersections {
@@ -43,10 +47,11 @@ impl SelfIntersections {
 
 /// Finds the pairs of faces of `mesh` that intersect (see [`SelfIntersections`]; the search is
 /// [`classified_pairs`]: a BVH and exact predicates, parallel and deterministic). Faces with an
-/// index out of range, a non-finite corner or zero area, and pairs of faces on the same three
-/// vertices, are left out (the invariant check reports them on their own).
+/// index out of range, a non-finite corner or zero area are left out, and faces on the same
+/// three vertices as an earlier face are searched once, as the first of them (the invariant
+/// check and the topology count both kinds on their own).
 pub fn self_intersections(mesh: &TriMesh) -> SelfIntersections {
-    let (pairs, candidates) = classified_pairs(&mesh.positions, &mesh.triangles);
+    let (pairs, search) = classified_pairs(&mesh.positions, &mesh.triangles);
     let count = |k: PairKind| pairs.iter().filter(|p| p.1 == k).count();
     SelfIntersections {
         pairs: pairs.len(),
@@ -55,7 +60,8 @@ pub fn self_intersections(mesh: &TriMesh) -> SelfIntersections {
         along_edge: count(PairKind::AlongEdge),
         first: pairs.first().map(|p| p.0),
         first_kind: pairs.first().map(|p| p.1),
-        candidates,
+        candidates: search.candidates,
+        faces: search.faces,
     }
 }
 

@@ -18,9 +18,13 @@ pub(crate) mod triangle_intersection;
 
 pub use face_intersection::{faces_intersect, PairKind};
 pub use plane::tangent_basis;
-pub use self_intersection::{classified_pairs, intersecting_pairs, intersecting_pairs_counted};
+pub use self_intersection::{
+    classified_pairs, intersecting_pairs, intersecting_pairs_counted, PairSearch,
+};
 pub use tolerance::{
     BURIED_OFFSET, DEGENERATE_AREA_TOLERANCE, SEARCH_BOUND_SLACK, SINGULAR_TOLERANCE,
 };
-pub use triangle::{is_degenerate_face, is_degenerate_triangle, triangle_angles_deg, triangle_q};
+pub use triangle::{
+    face_key, is_degenerate_face, is_degenerate_triangle, triangle_angles_deg, triangle_q,
+};
 pub use triangle_intersection::{segment_meets_triangle, triangles_intersect};

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 #[cfg(doc)]
 use super::face_intersection::faces_intersect;
 use super::face_intersection::{faces_within, share_a_vertex, PairKind};
-use super::triangle::is_degenerate_face;
+use super::triangle::{face_key, is_degenerate_face};
 
 /// The pairs of `boxes` (items of [`face_boxes`]: a face index and its bounding box) whose
 /// closed boxes overlap, each once as `[f, g]` with f < g (face indices), sorted. The boxes go
@@ -32,15 +32,28 @@ pub(crate) fn overlapping_box_pairs(boxes: &[(usize, Aabb)]) -> Vec<[u32; 2]> {
     pairs
 }
 
+/// What the search of [`classified_pairs`] took on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PairSearch {
+    /// Faces that entered the search: every index in range, every corner finite, not
+    /// [`is_degenerate_face`], and of the faces on the same three vertices ([`face_key`]) only
+    /// the first.
+    pub faces: usize,
+    /// Pairs of those faces whose bounding boxes overlap: the exact tests made.
+    pub candidates: usize,
+}
+
 /// The pairs of faces of `triangles` (indices into `positions`) that intersect
 /// ([`faces_intersect`]: no vertex in common and their closed triangles share a point; one in
 /// common and they meet elsewhere too; an edge in common and they overlap), each as `[f, g]`
-/// with f < g with its [`PairKind`], in lexicographic order, and the number of exact tests made
-/// (pairs of faces whose bounding boxes overlap).
+/// with f < g with its [`PairKind`], in lexicographic order, and what the search took on
+/// ([`PairSearch`]: the faces searched and the exact tests made).
 ///
 /// Triangles with an index out of range, a non-finite corner or zero area
-/// ([`is_degenerate_face`]) are left out (the invariant check reports them on their own), and so
-/// are pairs of faces with the same three vertices (duplicate faces, reported on their own too).
+/// ([`is_degenerate_face`]) are left out (the invariant check reports them on their own). Faces
+/// on the same three vertices as an earlier face, in any order and winding (duplicate faces,
+/// reported on their own too), are searched once, as the first of them: a face repeated 20,000
+/// times is one face here, not 2 · 10^8 pairs of overlapping boxes.
 ///
 /// # Runtime
 /// The pairs of overlapping bounding boxes come from a BVH traversed against itself
@@ -50,13 +63,22 @@ pub(crate) fn overlapping_box_pairs(boxes: &[(usize, Aabb)]) -> Vec<[u32; 2]> {
 pub fn classified_pairs(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
-) -> (Vec<([u32; 2], PairKind)>, usize) {
-    let candidates = box_pairs(positions, triangles, 0.0);
+) -> (Vec<([u32; 2], PairKind)>, PairSearch) {
+    let mut seen = rustc_hash::FxHashSet::default();
+    let boxes: Vec<(usize, Aabb)> = face_boxes(positions, triangles)
+        .into_iter()
+        .filter(|&(f, _)| seen.insert(face_key(triangles[f])))
+        .collect();
+    let candidates = overlapping_box_pairs(&boxes);
     let pairs: Vec<([u32; 2], PairKind)> = candidates
         .par_iter()
         .filter_map(|&[f, g]| pair_within(positions, triangles, f, g, 0.0).map(|k| ([f, g], k)))
         .collect();
-    (pairs, candidates.len())
+    let search = PairSearch {
+        faces: boxes.len(),
+        candidates: candidates.len(),
+    };
+    (pairs, search)
 }
 
 /// The intersecting pairs of [`classified_pairs`] without their kinds, and the number of exact
@@ -65,15 +87,19 @@ pub fn intersecting_pairs_counted(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
 ) -> (Vec<[u32; 2]>, usize) {
-    let (pairs, candidates) = classified_pairs(positions, triangles);
-    (pairs.into_iter().map(|(p, _)| p).collect(), candidates)
+    let (pairs, search) = classified_pairs(positions, triangles);
+    (
+        pairs.into_iter().map(|(p, _)| p).collect(),
+        search.candidates,
+    )
 }
 
 /// The pairs of [`intersecting_pairs`] and the pairs of faces that come within `near` of
 /// intersecting ([`faces_within`]; the same units as `positions`), in the same order: the faces
 /// that may intersect once their corners are rounded by up to `near / 2`. Boxes loosened by
 /// `near / 2` each; the same cost as [`intersecting_pairs_counted`] for a `near` short against
-/// the faces.
+/// the faces. Duplicate faces are not merged here (the stages' meshes have none): each copy is
+/// a face of its own.
 pub(crate) fn pairs_within(
     positions: &[DVec3],
     triangles: &[[u32; 3]],

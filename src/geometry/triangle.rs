@@ -26,6 +26,17 @@ pub fn is_degenerate_triangle(p: [DVec3; 3]) -> bool {
     )
 }
 
+/// The vertices of the indexed face `t` sorted: the same key for a face and every copy of it,
+/// in any order of its corners and either winding (a duplicate face, the second sheet of a
+/// double-sided export). How reading drops duplicate faces
+/// ([`TriMesh::remove_duplicate_and_zero_area_faces`](crate::mesh::TriMesh::remove_duplicate_and_zero_area_faces))
+/// and the crossing search counts them once ([`classified_pairs`](super::classified_pairs)).
+#[inline]
+pub fn face_key(mut t: [u32; 3]) -> [u32; 3] {
+    t.sort_unstable();
+    t
+}
+
 /// Whether the indexed triangle `t` over `positions` is degenerate: it repeats a vertex index, or
 /// its corners fail [`is_degenerate_triangle`]. A triangle with an out-of-range index is not
 /// judged here (it is `false` unless it also repeats an index); the invariant check

@@ -89,12 +89,23 @@ impl AtomicFile {
     }
 
     /// Flushes and syncs the temporary file, then renames it onto the target, replacing an
-    /// existing file there.
+    /// existing file there ([`AtomicFile::finish`], then [`FinishedFile::persist`]).
     ///
     /// # Errors
     /// [`Error::Write`] naming the target when flushing, syncing or renaming fails; the
     /// temporary file is removed and the target keeps its old content.
     pub fn commit(self) -> Result<()> {
+        self.finish()?.persist()
+    }
+
+    /// Flushes and syncs the temporary file: every byte is on disk, nothing is renamed yet. For
+    /// several files that go in together (a mesh and its report): each is finished before any is
+    /// persisted, so a disk that fills up on the last one leaves every target as it was.
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming the target when flushing or syncing fails (a full disk, a file
+    /// size limit); the temporary file is removed and the target keeps its old content.
+    pub fn finish(self) -> Result<FinishedFile> {
         let AtomicFile {
             path,
             target,
@@ -103,10 +114,40 @@ impl AtomicFile {
         } = self;
         let file = output
             .into_inner()
-            .map_err(|e| write_error(&path, format!("cannot write: {}", e.error())))?;
+            .map_err(|e| write_error(&path, e.error().to_string()))?;
         file.as_file()
             .sync_all()
-            .map_err(|e| write_error(&path, format!("cannot write: {e}")))?;
+            .map_err(|e| write_error(&path, e.to_string()))?;
+        Ok(FinishedFile {
+            path,
+            target,
+            file,
+            _registered,
+        })
+    }
+}
+
+/// A temporary file written in full and synced ([`AtomicFile::finish`]), waiting to be renamed
+/// onto its target by [`FinishedFile::persist`]. Dropped without it, it removes the temporary
+/// file and leaves the target as it was.
+pub struct FinishedFile {
+    path: PathBuf,
+    target: PathBuf,
+    file: NamedTempFile,
+    _registered: super::temporaries::Registered,
+}
+
+impl FinishedFile {
+    /// Renames the temporary file onto the target, replacing an existing file there. A rename
+    /// in one directory does not need room on the disk.
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming the target when the rename fails; the temporary file is removed
+    /// and the target keeps its old content.
+    pub fn persist(self) -> Result<()> {
+        let FinishedFile {
+            path, target, file, ..
+        } = self;
         file.persist(&target).map_err(|e| {
             write_error(
                 &path,
@@ -147,7 +188,7 @@ pub fn write_atomically(
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
     let mut file = AtomicFile::create(path)?;
-    write(&mut file).map_err(|e| file.error(format!("cannot write: {e}")))?;
+    write(&mut file).map_err(|e| file.error(e.to_string()))?;
     file.commit()
 }
 

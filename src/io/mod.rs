@@ -29,7 +29,7 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 
-pub use atomic::{write_atomically, AtomicFile};
+pub use atomic::{write_atomically, AtomicFile, FinishedFile};
 pub use temporaries::remove_temporaries;
 
 /// A mesh file format, chosen by the file's extension.
@@ -352,7 +352,13 @@ fn output_normals(mesh: &TriMesh) -> Vec<DVec3> {
 /// the face better (OBJ line, PLY face element, glTF primitive); this is the catch-all.
 fn finish(path: &Path, mut mesh: TriMesh, stats: &mut ReadStats) -> Result<TriMesh> {
     if mesh.triangles.is_empty() {
-        return Err(Error::invalid_mesh(path, "no faces"));
+        // A file of nothing at all (a PLY of `element vertex 0`) is not a mesh that lacks faces.
+        let what = if mesh.positions.is_empty() {
+            "no vertices: the file holds no points and no faces"
+        } else {
+            "no faces"
+        };
+        return Err(Error::invalid_mesh(path, what));
     }
     if u32::try_from(mesh.positions.len()).is_err() {
         return Err(Error::invalid_mesh(

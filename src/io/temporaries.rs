@@ -34,6 +34,27 @@ pub(crate) fn register(path: &Path) -> Registered {
     Registered(id)
 }
 
+/// The error of a temporary file or folder of this process's own (`what`, at `path`, in the
+/// temporary directory: `TMPDIR`, else `/tmp`, where `from_tmpdir`; else the directory the caller
+/// gave) that cannot be made, written or read back: the environment's fault, not the input's,
+/// so an [`Error::Write`](crate::error::Error::Write) (exit code 4) naming the directory, never an input error.
+pub(crate) fn temporary_error(
+    path: &Path,
+    what: &str,
+    from_tmpdir: bool,
+    e: std::io::Error,
+) -> crate::error::Error {
+    let which = if from_tmpdir {
+        "the temporary directory (TMPDIR; set it to a writable directory with room)"
+    } else {
+        "the temporary directory given"
+    };
+    crate::error::Error::Write {
+        path: path.to_path_buf(),
+        message: format!("{what} in {which}: {e}"),
+    }
+}
+
 /// Removes every temporary file and folder on the list (a folder with its content) and
 /// empties the list; returns how many paths were removed. For a signal handler: it never
 /// panics, and paths already gone are skipped.

@@ -5,6 +5,7 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::disjoint_sets::Dsu;
+use crate::geometry::triangle::face_key;
 use crate::geometry::triangle_intersection::collinear;
 use crate::mesh::edit::starting_at;
 
@@ -328,8 +329,7 @@ impl TriMesh {
                 out.zero_area += 1;
                 return false;
             }
-            let mut key = t;
-            key.sort_unstable();
+            let key = face_key(t);
             match seen.get(&key) {
                 Some(first) => {
                     out.duplicates += 1;
@@ -370,6 +370,26 @@ impl TriMesh {
             out.internal_walls = walls.len();
         }
         out
+    }
+
+    /// The mesh without the faces on the same three vertices as an earlier face (in any order
+    /// or winding: [`face_key`], as [`TriMesh::remove_duplicate_and_zero_area_faces`] finds
+    /// them), the first of each set kept, with how many were left out. The surface is the same;
+    /// what measures it (its area, the distance to it) counts each face once. O(faces).
+    pub fn without_duplicate_faces(&self) -> (TriMesh, usize) {
+        let mut seen: FxHashSet<[u32; 3]> = FxHashSet::default();
+        let triangles: Vec<[u32; 3]> = self
+            .triangles
+            .iter()
+            .copied()
+            .filter(|&t| seen.insert(face_key(t)))
+            .collect();
+        let left_out = self.triangles.len() - triangles.len();
+        let mesh = TriMesh {
+            positions: self.positions.clone(),
+            triangles,
+        };
+        (mesh, left_out)
     }
 
     /// Merges vertices with bit-identical positions (as glTF files split vertices at texture

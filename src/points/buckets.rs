@@ -17,6 +17,7 @@ use super::far_groups::{far_groups, kept_groups, FarGroups};
 use super::source::PointSource;
 use super::stream::{decode_record, encode_record, Point, RECORD_BYTES};
 use crate::error::{Error, Result};
+use crate::io::temporaries::temporary_error;
 use crate::mesh::{Aabb, Normalization};
 
 /// Bucket `b`'s points in `dir` as written (model units, in file order), the first `limit`.
@@ -25,7 +26,7 @@ fn read_bucket(dir: &Path, b: usize, limit: usize) -> Result<Vec<Point>> {
     let most = limit.saturating_mul(RECORD_BYTES) as u64;
     File::open(dir.join(format!("{b}.bin")))
         .and_then(|f| BufReader::new(f).take(most).read_to_end(&mut bytes))
-        .map_err(|e| Error::io(dir, e))?;
+        .map_err(|e| temporary_error(dir, "the points' bucket files", true, e))?;
     Ok(bytes
         .chunks_exact(RECORD_BYTES)
         .map(decode_record)
@@ -141,13 +142,25 @@ impl Buckets {
         let count = total
             .div_ceil(bucket_points.max(1) as u64)
             .clamp(1, MAX_BUCKETS) as usize;
+        // Where the buckets cannot go is the environment's fault: an output error naming the
+        // temporary directory (`TMPDIR`), not the input.
+        let tmpdir = temp_dir.map_or_else(std::env::temp_dir, Path::to_path_buf);
         let dir = tempfile::Builder::new()
             .prefix("remesh-buckets")
-            .tempdir_in(temp_dir.map_or_else(std::env::temp_dir, Path::to_path_buf))
-            .map_err(|e| Error::io(input, e))?;
+            .tempdir_in(&tmpdir)
+            .map_err(|e| {
+                temporary_error(&tmpdir, "the points' bucket folder", temp_dir.is_none(), e)
+            })?;
         // On the list from the start: an interrupt while bucketing removes it too.
         let registered = crate::io::temporaries::register(dir.path());
-        let io_err = |e: std::io::Error| Error::io(dir.path(), e);
+        let io_err = |e: std::io::Error| {
+            temporary_error(
+                dir.path(),
+                "the points' bucket files",
+                temp_dir.is_none(),
+                e,
+            )
+        };
         let mut writers: Vec<BufWriter<File>> = (0..count)
             .map(|b| {
                 File::create(dir.path().join(format!("{b}.bin")))
