@@ -17,7 +17,6 @@ mod common;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use spectral_remesh::{
@@ -120,8 +119,7 @@ fn assert_no_area_error(r: Result<RemeshOutput, Error>) {
 #[test]
 fn nearly_colinear_faces_are_an_input_error_at_once() {
     // Before: the sigma_p guess from the area (1e-11) put about 2e8 samples on the boundary
-    // curves (12.6 GB in 120 s).
-    let start = Instant::now();
+    // curves (12.6 GB in 120 s). The error comes before any sampling.
     assert_no_area_error(remesh(
         &colinear_strip(1e-13),
         &RemeshParams::default(),
@@ -135,7 +133,6 @@ fn nearly_colinear_faces_are_an_input_error_at_once() {
         },
         &|_| {},
     ));
-    assert!(start.elapsed() < Duration::from_secs(10));
 }
 
 #[test]
@@ -196,29 +193,19 @@ fn obj(mesh: &TriMesh) -> String {
     s
 }
 
-/// Runs the binary with `args`, killing it after `limit`; returns its exit code and stderr, or
-/// fails the test on a timeout (a hang guard, not a speed test).
-fn run_with_timeout(args: &[&str], limit: Duration) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_remesh"))
+/// Runs the binary with `args`; returns its exit code and stderr. (No wall-clock limit: a test
+/// does not depend on the machine's load. The sliver at 100,000 points, once 80 s, is timed in
+/// `benches/degenerate.rs`.)
+fn run(args: &[&str]) -> (Option<i32>, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
         .args(args)
         .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
+        .output()
         .expect("run remesh");
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            let mut err = String::new();
-            std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
-            return (status.code(), err);
-        }
-        if start.elapsed() > limit {
-            child.kill().ok();
-            child.wait().ok();
-            panic!("remesh {args:?} still running after {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
 }
 
 fn write(dir: &Path, name: &str, mesh: &TriMesh) -> PathBuf {
@@ -233,9 +220,8 @@ fn write(dir: &Path, name: &str, mesh: &TriMesh) -> PathBuf {
 fn the_degenerate_inputs_end_through_the_binary() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out.obj");
-    let limit = Duration::from_secs(60);
     // The sliver at 100 000 points is all boundary samples: before, every sample's umbrella
-    // walked the whole boundary chain (80 s; now 7 s).
+    // walked the whole boundary chain (80 s; now 7 s: benches/degenerate.rs).
     let cases: [(&str, TriMesh, &[&str], i32); 5] = [
         ("strip.obj", colinear_strip(1e-13), &[], 3),
         ("sliver.obj", sliver(1e-7), &["--points", "10000"], 0),
@@ -248,7 +234,7 @@ fn the_degenerate_inputs_end_through_the_binary() {
         let mut args = vec![input.to_str().unwrap(), out.to_str().unwrap(), "-q"];
         args.extend_from_slice(extra);
         args.push("--no-distance");
-        let (status, err) = run_with_timeout(&args, limit);
+        let (status, err) = run(&args);
         assert_eq!(status, Some(code), "{name}: {err}");
         if code != 0 {
             assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
