@@ -130,3 +130,93 @@ fn the_readme_table_is_the_range_of_the_bounds_it_cites() {
     }
     assert_eq!(rows, 7, "the seven shared models");
 }
+
+/// Every option each command's `--help` gives is named in the README (issue 56: `quality
+/// --seed`, four of `simplify`'s and `-V` were missing), and the help names every format the
+/// command reads and the limit `--iterations` has.
+#[test]
+fn the_readme_names_every_option_the_help_gives() {
+    let readme = read(&root().join("README.md"));
+    let help = |sub: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_remesh"))
+            .args(sub)
+            .arg("--help")
+            .output()
+            .expect("run remesh");
+        assert!(o.status.success());
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    // Where the README names a command's options: the main command's in its table (and the
+    // commands block for -V), a subcommand's on its line of the commands block (with the
+    // lines that continue it).
+    let block = &readme[readme
+        .find("remesh <INPUT> <OUTPUT> [OPTIONS]")
+        .expect("commands")..];
+    let block = &block[..block.find("```").expect("the block ends")];
+    let usage = |sub: &str| -> String {
+        let mut out = String::new();
+        let mut on = false;
+        for line in block.lines() {
+            if line.starts_with("remesh ") {
+                on = line.starts_with(&format!("remesh {sub} "));
+            }
+            if on {
+                out += line;
+                out += "\n";
+            }
+        }
+        out
+    };
+    for sub in ["", "quality", "simplify", "points"] {
+        let args: &[&str] = if sub.is_empty() { &[] } else { &[sub] };
+        let text = help(args);
+        let place = if sub.is_empty() {
+            readme
+                .lines()
+                .filter(|l| l.starts_with("| `"))
+                .collect::<Vec<_>>()
+                .join("\n")
+                + block
+        } else {
+            usage(sub)
+        };
+        for line in text.lines() {
+            let line = line.trim_start();
+            if !line.starts_with('-') {
+                continue;
+            }
+            // The option's spellings on this line (`-q, --quiet`): one of them named will do.
+            let forms: Vec<&str> = line
+                .split(|c: char| c == ',' || c.is_whitespace())
+                .take_while(|w| w.is_empty() || w.starts_with('-'))
+                .filter(|w| !w.is_empty())
+                .collect();
+            if forms.iter().any(|f| matches!(*f, "-h" | "--help")) {
+                continue;
+            }
+            let named = forms.iter().any(|option| {
+                [" ", "`", "[", "(", ","]
+                    .iter()
+                    .any(|before| place.contains(&format!("{before}{option}")))
+            });
+            assert!(
+                named,
+                "`remesh {sub} --help` gives {forms:?}; the README does not name it there"
+            );
+        }
+    }
+    let simplify = help(&["simplify"]);
+    for ext in [".ply", ".xyz", ".xyzn", ".csv", ".txt", ".pts", ".asc"] {
+        assert!(simplify.contains(ext), "simplify --help omits {ext}");
+    }
+    let points = help(&["points"]);
+    for ext in [".obj", ".ply", ".gltf", ".glb", ".stl", ".off"] {
+        assert!(points.contains(ext), "points --help omits {ext}");
+    }
+    let main = help(&[]);
+    let iterations = main
+        .lines()
+        .find(|l| l.contains("--iterations"))
+        .expect("--iterations in --help");
+    assert!(iterations.contains("at most 1000"), "{iterations}");
+}

@@ -292,7 +292,7 @@ fn shared_the_report_states_the_sharp_features_found_and_kept() {
     );
     assert!(int(&r, &["extra", "features", "edges"]) > 0);
     assert_eq!(int(&r, &["extra", "features", "sampled_edges"]), 0);
-    assert_eq!(r["extra"]["features"]["automatic"], Value::Bool(false));
+    assert_eq!(r["extra"]["features"]["automatic_kept"], Value::Bool(false));
     let (r, _) = run(
         "fandisk.obj",
         "fandisk-plain.obj",

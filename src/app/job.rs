@@ -11,7 +11,7 @@ use crate::report::QualityReport;
 /// A remeshing job: input and output files and the pipeline's parameters.
 #[derive(Debug, Clone)]
 pub struct RemeshJob {
-    /// Input mesh (.obj, .ply, .gltf, .glb).
+    /// Input mesh (.obj, .ply, .gltf, .glb, .stl, .off) or point set.
     pub input: PathBuf,
     /// Output mesh (.obj, .ply, .gltf, .glb), format by extension; `-`
     /// ([`STDOUT`](crate::internal::STDOUT)) writes it to standard output instead, in `format`.

@@ -135,7 +135,7 @@ pub(super) fn features_note(f: &crate::pipeline::FeatureStats) -> Option<String>
     if !(f.angle_deg < 180.0) {
         return None;
     }
-    if f.automatic == Some(false) {
+    if f.automatic_kept == Some(false) {
         if f.edges == 0 {
             return None;
         }

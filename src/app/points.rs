@@ -14,7 +14,7 @@ pub const MAX_SURFACE_POINTS: u64 = 1_000_000_000;
 /// normals, written to `output` as binary PLY (streamed).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointsJob {
-    /// The mesh to draw from (.obj, .ply, .gltf, .glb).
+    /// The mesh to draw from (.obj, .ply, .gltf, .glb, .stl, .off).
     pub mesh: PathBuf,
     /// The output point set (.ply).
     pub output: PathBuf,

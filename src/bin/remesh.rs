@@ -137,7 +137,7 @@ struct Cli {
     #[arg(long, default_value = "restricted", value_name = "METHOD")]
     triangulation: String,
 
-    /// Gradient-ascent sweeps (Sec. 6.2).
+    /// Gradient-ascent sweeps (Sec. 6.2), at most 1000.
     #[arg(long, default_value_t = 10, value_parser = whole::<usize>)]
     iterations: usize,
 
@@ -208,8 +208,9 @@ enum Command {
     /// memory bounded by the output plus a fixed buffer. Writes the samples as PLY with normals.
     #[command(allow_negative_numbers = true)]
     Simplify {
-        /// The input point set: .ply (ascii or binary) or XYZ/CSV text (.xyz .csv .txt .pts:
-        /// `x y z` or `x y z nx ny nz` per line, or named columns), with or without normals.
+        /// The input point set: .ply (ascii or binary) or XYZ/CSV text (.xyz .xyzn .csv .txt
+        /// .pts .asc: `x y z` or `x y z nx ny nz` per line, or named columns), with or without
+        /// normals.
         input: PathBuf,
         /// The output point set (.ply; not - : point sets need a file).
         output: PathBuf,
@@ -253,7 +254,7 @@ enum Command {
     /// binary PLY (streamed: any count fits in memory). Makes large point-cloud inputs.
     #[command(allow_negative_numbers = true)]
     Points {
-        /// The mesh to draw from (.obj, .ply, .gltf, .glb).
+        /// The mesh to draw from (.obj, .ply, .gltf, .glb, .stl, .off).
         mesh: PathBuf,
         /// The output point set (.ply; not - : point sets need a file).
         output: PathBuf,

@@ -34,7 +34,7 @@ pub(super) fn sharp_features(
         (detection == FeatureDetection::Auto).then_some(long_share >= AUTO_FEATURE_MIN_SHARE);
     let stats = FeatureStats {
         angle_deg: detection.angle_deg(),
-        automatic: auto_kept,
+        automatic_kept: auto_kept,
         long_curve_share: long_share,
         scale: feature_scale,
         edges: features.edges.len(),

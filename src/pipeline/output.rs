@@ -23,7 +23,7 @@ pub struct FeatureStats {
     /// With automatic detection
     /// ([`FeatureDetection::Auto`](crate::internal::FeatureDetection::Auto)): whether the creases
     /// found were kept (`false`: a scan's folds, left out; the counts below are what was found).
-    pub automatic: Option<bool>,
+    pub automatic_kept: Option<bool>,
     /// The share of the creases' length in curves at least
     /// [`LONG_CURVE_SPACINGS`](crate::internal::LONG_CURVE_SPACINGS) spacings long
     /// ([`long_curve_share`](crate::internal::long_curve_share)).
