@@ -344,6 +344,12 @@ def sample(
         An array of the wrong shape or dtype, a coordinate that is not finite or a normal of
         length 0 (naming its row), neither or both of sigma_p and count, a count outside 1 to n,
         a finite sigma_n without normals, or a parameter out of its range.
+
+    Warns
+    -----
+    UserWarning
+        When count is not reached (the report's `reached` is False), saying how many samples
+        were taken and, when X repeats rows, how many distinct rows it has.
     """
     ...
 
