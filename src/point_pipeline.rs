@@ -212,7 +212,7 @@ pub const POINT_UNTANGLE_COLLAPSES: usize = 100;
 pub const MAX_SCANS: usize = 3;
 
 /// Data whose median surface variation around the samples, over the support within two
-/// sigma_p, exceeds this is not near a surface and is refused ([`median_surface_variation`]).
+/// sigma_p, exceeds this is not near a surface and is refused (`points::flatness::median_surface_variation`).
 /// Measured (release build, seed 1): points filling a cube, a ball, a Gaussian blob or a slab a
 /// fifth as thick as wide 0.17-0.24 (the support's outlier rules thin a volume towards sheets,
 /// below a volume's 1/3); scans and meshes' points 0.001-0.005; the horse's points with
@@ -284,7 +284,7 @@ pub struct PointRemeshOutput {
     /// Projected samples the second linear scan rejected (they were accepted off the surface).
     pub rescan_rejected: usize,
     /// The median surface variation of the data around the samples at the output's scale
-    /// ([`median_surface_variation`]); `None` when too sparse to tell.
+    /// (`points::flatness::median_surface_variation`); `None` when too sparse to tell.
     pub surface_variation: Option<f64>,
     /// Samples placed on the data's boundary curves (fixed; see
     /// `DataEdges`, src/points/boundary.rs).
