@@ -2,11 +2,11 @@
 //! a finding exactly (as small_meshes.rs is for `remesh`): a scan-like point set shaped by the
 //! bytes, written as XYZ text, and the whole `remesh` job run on it.
 //!
-//! The set: a base of 50 to 3000 points on a sphere, a torus or a bent plane patch (0.01 to 1000
-//! across, with noise or none), then, as the bytes say: far clusters (1 to 3 groups of 1 to 50
-//! points, spread or all at one position, 0.1 to 10^7 away) or a second copy of the shape far
-//! away; points uniform in a cube around the shape (from a few up to as many as the base);
-//! exact duplicate lines (every point, or a subset, repeated 1 to 1000 times, next to the
+//! The set: a base of 50 to 3000 points on a sphere, a torus or a bent plane patch (radius or
+//! half-width 0.01 to 1000, with noise or none), then, as the bytes say: far clusters (1 to 3
+//! groups of 1 to 50 points, spread or all at one position, 0.1 to 10^7 away) or a second copy of
+//! the shape far away; points uniform in a cube around the shape (from a few up to as many as the
+//! base); exact duplicate lines (every point, or a subset, repeated 1 to 1000 times, next to the
 //! original or at the end; at most 100 000 extra lines); the lines shuffled; a UTM-like offset
 //! (hundreds of kilometres east, up to 10^7 north) added to every point; normals (noisy, some
 //! flipped) or none. The bytes after the parameters place the first points themselves; the rest
@@ -268,7 +268,11 @@ pub fn point_set(data: &[u8]) -> (String, usize, u64) {
             } else {
                 *nrm
             };
-            let _ = writeln!(text, "{} {} {} {} {} {}", p.x, p.y, p.z, nrm.x, nrm.y, nrm.z);
+            let _ = writeln!(
+                text,
+                "{} {} {} {} {} {}",
+                p.x, p.y, p.z, nrm.x, nrm.y, nrm.z
+            );
         } else {
             let _ = writeln!(text, "{} {} {}", p.x, p.y, p.z);
         }
@@ -315,7 +319,10 @@ pub fn assert_point_remesh_is_sound(data: &[u8], dir: &Path) {
                 !message.contains('\n'),
                 "an error of more than one line: {message:?}"
             );
-            assert!(!output.exists(), "an error with an output written: {message}");
+            assert!(
+                !output.exists(),
+                "an error with an output written: {message}"
+            );
         }
         Ok(report) => {
             assert!(output.exists(), "no output written");
