@@ -119,6 +119,15 @@ pub(super) fn grading_notes(
     notes
 }
 
+/// "1 `one`" or "n `many`" (a count in a note).
+pub(super) fn plural(n: u64, one: &str, many: &str) -> String {
+    if n == 1 {
+        format!("1 {one}")
+    } else {
+        format!("{n} {many}")
+    }
+}
+
 /// `n` rounded up to two significant digits (a count for a note).
 pub(super) fn round_up_2(n: f64) -> u64 {
     if !(n.is_finite() && n > 0.0) {

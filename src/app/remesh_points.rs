@@ -164,7 +164,7 @@ pub(super) fn run(
         report.notes.push(format!(
             "{} merged into another at the same position (the input lists a position more than \
              once)",
-            plural(
+            super::notes::plural(
                 out.duplicate_points,
                 "coincident point was",
                 "coincident points were"
@@ -175,7 +175,7 @@ pub(super) fn run(
         report.notes.push(format!(
             "{} left out, in groups far from the rest and much smaller: they would have set the \
              scale",
-            plural(out.far_points, "point was", "points were")
+            super::notes::plural(out.far_points, "point was", "points were")
         ));
     }
     let isolated = out.outliers_removed as u64 - out.far_points.min(out.outliers_removed as u64);
@@ -323,13 +323,4 @@ pub fn remesh_point_set(
             message: "the point-set pipeline handed over no mesh".into(),
         })?;
     Ok(RemeshedMesh { mesh, report })
-}
-
-/// "1 `one`" or "n `many`".
-fn plural(n: u64, one: &str, many: &str) -> String {
-    if n == 1 {
-        format!("1 {one}")
-    } else {
-        format!("{n} {many}")
-    }
 }

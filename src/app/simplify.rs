@@ -288,25 +288,20 @@ const COUNT_TOLERANCE: f64 = 0.02;
 fn left_out(far: u64, duplicates: u64) -> String {
     let mut parts = Vec::new();
     if duplicates > 0 {
-        parts.push(format!("{} merged", points(duplicates, "coincident point")));
+        parts.push(format!(
+            "{} merged",
+            super::notes::plural(duplicates, "coincident point", "coincident points")
+        ));
     }
     if far > 0 {
         parts.push(format!(
             "{} left out: they would have set the scale",
-            points(far, "point of far groups")
+            super::notes::plural(far, "point of far groups", "points of far groups")
         ));
     }
     if parts.is_empty() {
         String::new()
     } else {
         format!(" ({})", parts.join("; "))
-    }
-}
-
-/// "1 point …" or "n points …": `what` names one, its first word is made plural.
-fn points(n: u64, what: &str) -> String {
-    match n {
-        1 => format!("1 {what}"),
-        _ => format!("{n} {}", what.replacen("point", "points", 1)),
     }
 }

@@ -204,7 +204,7 @@ impl Buckets {
             far = far_groups(&grouped);
             // Parts far apart compared with their own size (two objects 10^6 apart, each 10
             // across) cannot share one scale.
-            let kept = kept_groups(&grouped);
+            let kept = kept_groups(&grouped, far.as_ref());
             if kept.len() > 1 {
                 let whole = kept
                     .iter()

@@ -149,15 +149,14 @@ pub fn far_groups(points: &[DVec3]) -> Option<FarGroups> {
     result
 }
 
-/// The groups of `points` as [`far_groups`] leaves them (the far ones left out): how many, and
-/// each one's bounding box, largest group first. For telling apart parts of a scene far from
-/// each other compared with their sizes (two objects 10^6 apart, each 10 across).
-pub fn kept_groups(points: &[DVec3]) -> Vec<(usize, Aabb)> {
-    let far = far_groups(points);
+/// The groups of `points` once `far` (what [`far_groups`] gave for them) is left out: how
+/// many, and each one's bounding box, largest group first. For telling apart parts of a scene
+/// far from each other compared with their sizes (two objects 10^6 apart, each 10 across).
+pub fn kept_groups(points: &[DVec3], far: Option<&FarGroups>) -> Vec<(usize, Aabb)> {
     let kept: Vec<DVec3> = points
         .iter()
         .copied()
-        .filter(|&p| p.is_finite() && far.as_ref().is_none_or(|f| f.contains(p)))
+        .filter(|&p| p.is_finite() && far.is_none_or(|f| f.contains(p)))
         .collect();
     let Some(bbox) = Aabb::of(&kept) else {
         return Vec::new();
@@ -237,7 +236,7 @@ mod tests {
         let c = sphere(130, DVec3::new(0.0, 1e3, 0.0), 1.0, &mut rng);
         let set = [a, b, c].concat();
         assert!(far_groups(&set).is_none());
-        let groups = kept_groups(&set);
+        let groups = kept_groups(&set, None);
         assert_eq!(groups.len(), 2, "{groups:?}");
         assert_eq!(groups[0].0 + groups[1].0, set.len());
     }
