@@ -11,6 +11,7 @@
 //! input.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -21,10 +22,11 @@ use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::pipeline::finish::{finish, Finishing, StrayRule};
 use crate::pipeline::{Density, RemeshParams};
 use crate::points::boundary::{local_spacings, DataEdges};
+use crate::points::far_groups::{KeptPoints, SeparateParts};
 use crate::points::flatness::median_surface_variation;
 use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{
-    rimls_of, OutOfCoreParams, RimlsSupport, ScanOutput, ScannedInput,
+    rimls_of, Opened, OutOfCoreParams, RimlsSupport, ScanOutput, ScannedInput,
 };
 use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
@@ -47,6 +49,9 @@ use crate::triangulate::stray_shells::StrayShells;
 use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
 use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
+
+mod parts;
+use parts::remesh_parts;
 
 /// Points of the RIMLS surface per output sample: random input points (the first bucket's), the
 /// samples not among them (a sample is an input point: a near outlier taken as a sample would
@@ -271,8 +276,14 @@ pub struct PointRemeshOutput {
     pub duplicate_points: u64,
     /// Points of far groups left out (counted in `outliers_removed` too).
     pub far_points: u64,
-    /// What is kept when far groups were left out: the input the output is measured against.
-    pub far_groups: Option<crate::points::far_groups::FarGroups>,
+    /// The points kept (far groups left out; in a part when there are parts far apart): the
+    /// input the output is measured against.
+    pub kept: KeptPoints,
+    /// When the points form parts far apart, meshed each on its own: each part's output
+    /// vertices, the largest part (most points) first; empty otherwise. The stage statistics
+    /// (`gradient_ascent` to `output_orientation`) are then the first part's; the counts and
+    /// times are summed over the parts.
+    pub separate_parts: Vec<usize>,
     /// Whether the input had normals (else they were estimated).
     pub had_normals: bool,
     /// Isolated points dropped from the samples and the RIMLS support.
@@ -358,18 +369,54 @@ pub fn remesh_points(
     params: &PointRemeshParams,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<PointRemeshOutput> {
-    let first = remesh_points_once(source, params, on_stage)?;
+    match remesh_points_whole(source, params, on_stage)? {
+        Run::Meshed(out) => Ok(*out),
+        Run::Parts(parts) => remesh_parts(source, params, parts, on_stage),
+    }
+}
+
+impl PointRemeshOutput {
+    /// The far groups a run over one scene left out.
+    fn kept_far(&self) -> Option<crate::points::far_groups::FarGroups> {
+        self.kept.far_of_whole()
+    }
+}
+
+/// What a run over a point source gave: the output, or the parts far apart the points form
+/// (nothing meshed).
+enum Run {
+    Meshed(Box<PointRemeshOutput>),
+    Parts(Arc<SeparateParts>),
+}
+
+/// [`remesh_points`] of points that are one scene (parts near enough to share one scale).
+fn remesh_points_whole(
+    source: &PointSource,
+    params: &PointRemeshParams,
+    on_stage: &(dyn Fn(&str) + Sync),
+) -> Result<Run> {
+    let first = match remesh_points_once(source, params, on_stage)? {
+        Run::Meshed(out) => *out,
+        parts => return Ok(parts),
+    };
     let Density::Points(n) = params.remesh.density else {
-        return Ok(first);
+        return Ok(Run::Meshed(Box::new(first)));
     };
     let miss = |o: &PointRemeshOutput| n as f64 - o.mesh.vertex_count() as f64;
     if miss(&first).abs() <= 0.01 * n as f64 {
-        return Ok(first);
+        return Ok(Run::Meshed(Box::new(first)));
     }
     let mut again = params.clone();
     again.remesh.density = Density::Points(((n as f64 + miss(&first)).round() as usize).max(4));
     on_stage("scan");
-    let second = remesh_points_once(source, &again, on_stage)?;
+    // (The same points and seed: the same buckets, so one scene again.)
+    let Run::Meshed(second) = remesh_points_once(source, &again, on_stage)? else {
+        return Err(Error::Internal {
+            stage: "remesh_points",
+            message: "a second run found parts the first did not".into(),
+        });
+    };
+    let second = *second;
     // A run whose faces still cross where untangle stopped is a worse output than one off
     // the count.
     let worse = |o: &PointRemeshOutput| (o.untangle.pairs_after, miss(o).abs());
@@ -382,7 +429,7 @@ pub fn remesh_points(
     for stage in other.stages {
         crate::timing::add_stage(&mut kept.stages, stage);
     }
-    Ok(kept)
+    Ok(Run::Meshed(Box::new(kept)))
 }
 
 /// What the scans leave on the RIMLS surface: the last scan, its kernel and surface, and the
@@ -415,7 +462,7 @@ fn remesh_points_once(
     source: &PointSource,
     params: &PointRemeshParams,
     on_stage: &(dyn Fn(&str) + Sync),
-) -> Result<PointRemeshOutput> {
+) -> Result<Run> {
     let input = source.name();
     let rp = &params.remesh;
     let refuse = |name: &'static str, what: &str| Error::InvalidParameter {
@@ -469,7 +516,10 @@ fn remesh_points_once(
         resample: 0,
         orientation: params.orientation,
     };
-    let mut source = ScannedInput::open(source, &scan_params, params.drop_outliers)?;
+    let mut source = match ScannedInput::open(source, &scan_params, params.drop_outliers)? {
+        Opened::Input(s) => *s,
+        Opened::Parts(parts) => return Ok(Run::Parts(parts)),
+    };
     let mut sigma_p = source.sigma_p;
     let mut scans = 0;
     let OnSurface {
@@ -765,7 +815,7 @@ fn remesh_points_once(
              points are too sparse, or not on a surface)",
         ));
     }
-    Ok(PointRemeshOutput {
+    Ok(Run::Meshed(Box::new(PointRemeshOutput {
         mesh: normalization.invert_mesh(&mesh),
         mesh_normalized: mesh,
         normalization,
@@ -774,7 +824,8 @@ fn remesh_points_once(
         input_points: scan.input_points,
         duplicate_points: scan.duplicate_points,
         far_points: scan.far_points,
-        far_groups: scan.far_groups.clone(),
+        kept: KeptPoints::whole(scan.far_groups.clone()),
+        separate_parts: Vec::new(),
         had_normals: scan.had_normals,
         outliers_removed: scan.outliers_removed,
         samples: samples.len(),
@@ -800,7 +851,7 @@ fn remesh_points_once(
         output_orientation: finished.orientation,
         scan_seconds: scan.seconds,
         stages: timer.take_stages(),
-    })
+    })))
 }
 
 /// Whether the file `path` is a point set for [`remesh_points`] rather than a mesh: a text

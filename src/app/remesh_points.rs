@@ -88,11 +88,7 @@ pub(super) fn run(
             positions.extend(
                 chunk
                     .iter()
-                    .filter(|p| {
-                        out.far_groups
-                            .as_ref()
-                            .is_none_or(|f| f.contains(p.position))
-                    })
+                    .filter(|p| out.kept.contains(p.position))
                     .map(|p| out.normalization.apply(p.position)),
             );
             distance.add_points(&positions);
@@ -169,6 +165,21 @@ pub(super) fn run(
                 "coincident point was",
                 "coincident points were"
             )
+        ));
+    }
+    if !out.separate_parts.is_empty() {
+        insert_json(extra, "separate_parts", &out.separate_parts);
+        report.notes.push(format!(
+            "the points form {} parts far apart compared with their sizes, which one scale cannot \
+             hold: each was meshed on its own at its share of the count by surface area ({} \
+             vertices); the figures in Extra other than counts are the first part's, and \
+             distances are in bbox-100 units of the whole",
+            out.separate_parts.len(),
+            out.separate_parts
+                .iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
         ));
     }
     if out.far_points > 0 {

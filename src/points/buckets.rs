@@ -13,12 +13,13 @@ use rand::seq::SliceRandom;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
-use super::far_groups::{far_groups, kept_groups, FarGroups};
+use super::far_groups::{far_groups, separate_parts, FarGroups, SeparateParts};
 use super::source::PointSource;
 use super::stream::{decode_record, encode_record, Point, RECORD_BYTES};
 use crate::error::{Error, Result};
 use crate::io::temporaries::temporary_error;
 use crate::mesh::{Aabb, Normalization};
+use std::sync::Arc;
 
 /// Bucket `b`'s points in `dir` as written (model units, in file order), the first `limit`.
 fn read_bucket(dir: &Path, b: usize, limit: usize) -> Result<Vec<Point>> {
@@ -88,20 +89,6 @@ impl Extremes {
     }
 }
 
-/// Parts of a point set far apart (each part's diagonal under this share of the whole's) are
-/// refused: one scale cannot hold both (a sample spacing of a part's size is below the
-/// precision of the whole's tolerances).
-const SEPARATE_PARTS_RATIO: f64 = 1e-3;
-
-/// A length for a message: 4 significant digits, in scientific notation when large or small.
-fn short(x: f64) -> String {
-    if x != 0.0 && !(1e-3..1e5).contains(&x.abs()) {
-        format!("{x:.3e}")
-    } else {
-        format!("{x:.4}")
-    }
-}
-
 /// A point's position as bits (-0 as +0): coincident points have equal keys.
 fn position_key(p: DVec3) -> [u64; 3] {
     (p + DVec3::ZERO).to_array().map(f64::to_bits)
@@ -119,18 +106,39 @@ fn position_hash(p: DVec3, salt: u64) -> u64 {
         .fold(salt, |h, &k| mix(h.wrapping_add(0x9e37_79b9_7f4a_7c15) ^ k))
 }
 
+/// What [`Buckets::write`] made of a point set.
+pub(crate) enum Bucketed {
+    /// The points, bucketed.
+    Buckets(Buckets),
+    /// Parts far apart compared with their sizes, which one scale cannot hold: nothing is
+    /// bucketed.
+    Parts(Arc<SeparateParts>),
+}
+
+impl Bucketed {
+    /// The buckets, or the parts' refusal naming `source` for a caller that does not mesh each
+    /// part on its own.
+    pub(crate) fn or_refuse(self, source: &Path) -> Result<Buckets> {
+        match self {
+            Bucketed::Buckets(b) => Ok(b),
+            Bucketed::Parts(parts) => Err(Error::invalid_mesh(source, parts.refusal())),
+        }
+    }
+}
+
 /// Far groups are looked for in point sets of at least this many points (in a handful of
 /// points every point is far from the others).
 const FAR_MIN_POINTS: u64 = 1000;
 
 impl Buckets {
-    /// Streams `source` once: its bounding box, and every point to a random bucket file.
+    /// Streams `source` once: its bounding box, and every point to a random bucket file; or,
+    /// when the points are parts far apart ([`separate_parts`]), those parts.
     pub(crate) fn write(
         source: &PointSource,
         bucket_points: usize,
         temp_dir: Option<&Path>,
         rng: &mut ChaCha8Rng,
-    ) -> Result<Buckets> {
+    ) -> Result<Bucketed> {
         let input = source.name();
         let mut reader = source.open()?;
         let total = reader.count();
@@ -203,32 +211,9 @@ impl Buckets {
             grouped.dedup_by_key(|p| position_key(*p));
             far = far_groups(&grouped);
             // Parts far apart compared with their own size (two objects 10^6 apart, each 10
-            // across) cannot share one scale.
-            let kept = kept_groups(&grouped, far.as_ref());
-            if kept.len() > 1 {
-                let whole = kept
-                    .iter()
-                    .fold(kept[0].1, |b, (_, g)| Aabb {
-                        min: b.min.min(g.min),
-                        max: b.max.max(g.max),
-                    })
-                    .diagonal();
-                let largest = kept
-                    .iter()
-                    .map(|(_, g)| g.diagonal())
-                    .fold(0.0f64, f64::max);
-                if largest < SEPARATE_PARTS_RATIO * whole {
-                    return Err(Error::invalid_mesh(
-                        input,
-                        format!(
-                            "the points form {} parts far apart ({} across in all, the largest \
-                             part {} across): mesh each part on its own",
-                            kept.len(),
-                            short(whole),
-                            short(largest),
-                        ),
-                    ));
-                }
+            // across) cannot share one scale: the caller meshes each on its own, or refuses.
+            if let Some(parts) = separate_parts(&grouped, far.as_ref()) {
+                return Ok(Bucketed::Parts(Arc::new(parts)));
             }
         }
         // Each bucket again: coincident points merged, far groups left out (the bucket file
@@ -280,7 +265,7 @@ impl Buckets {
                 ),
             )
         })?;
-        Ok(Buckets {
+        Ok(Bucketed::Buckets(Buckets {
             _registered: registered,
             dir,
             count,
@@ -290,7 +275,7 @@ impl Buckets {
             far_points,
             duplicate_points,
             far_groups: far,
-        })
+        }))
     }
 
     /// Calls `f` with each bucket's points in turn (bbox-100 units, shuffled), loading the next

@@ -149,39 +149,220 @@ pub fn far_groups(points: &[DVec3]) -> Option<FarGroups> {
     result
 }
 
-/// The groups of `points` once `far` (what [`far_groups`] gave for them) is left out: how
-/// many, and each one's bounding box, largest group first. For telling apart parts of a scene
-/// far from each other compared with their sizes (two objects 10^6 apart, each 10 across).
-pub fn kept_groups(points: &[DVec3], far: Option<&FarGroups>) -> Vec<(usize, Aabb)> {
+/// Which points of an input a run kept: not in a far group, and in a part when the points were
+/// parts far apart meshed each on its own. For measuring the output's distance to them.
+#[derive(Debug, Clone, Default)]
+pub struct KeptPoints {
+    parts: Option<std::sync::Arc<SeparateParts>>,
+    /// Each part's far groups (one entry when there are no parts).
+    far: Vec<Option<FarGroups>>,
+}
+
+impl KeptPoints {
+    /// The points of a run over the whole input, `far` left out.
+    pub fn whole(far: Option<FarGroups>) -> Self {
+        KeptPoints {
+            parts: None,
+            far: vec![far],
+        }
+    }
+
+    /// The points in `parts`, each part's own far groups (`far`, in the parts' order) left out.
+    pub fn in_parts(parts: std::sync::Arc<SeparateParts>, far: Vec<Option<FarGroups>>) -> Self {
+        KeptPoints {
+            parts: Some(parts),
+            far,
+        }
+    }
+
+    /// The far groups of a run over one scene (no parts).
+    pub(crate) fn far_of_whole(&self) -> Option<FarGroups> {
+        match self.parts {
+            None => self.far.first().cloned().flatten(),
+            Some(_) => None,
+        }
+    }
+
+    /// Whether `p` was kept.
+    pub fn contains(&self, p: DVec3) -> bool {
+        let k = match &self.parts {
+            Some(parts) => match parts.part_of(p) {
+                Some(k) => k,
+                None => return false,
+            },
+            None => 0,
+        };
+        self.far
+            .get(k)
+            .and_then(Option::as_ref)
+            .is_none_or(|f| f.contains(p))
+    }
+}
+
+/// Parts of a point set far apart are meshed each on its own when every part's diagonal is
+/// under this share of the whole's: one scale cannot hold them all (a sample spacing of a
+/// part's size is below the precision of the whole's tolerances). Two objects 10^6 apart, each
+/// 10 across, are 1e-5.
+pub const SEPARATE_PARTS_RATIO: f64 = 1e-3;
+
+/// One part of [`SeparateParts`], as the grouped subset saw it (model units).
+#[derive(Debug, Clone)]
+pub struct PartEstimate {
+    /// Points of the grouped subset in the part.
+    pub subset_points: usize,
+    /// The bounding box of those points.
+    pub bbox: Aabb,
+    /// A guess of the part's surface area (model units²): the occupied cells of a grid over the
+    /// subset's points, as the sigma_p search starts from; it shares the count out.
+    pub area: f64,
+}
+
+/// The parts of a point set far apart compared with their own sizes (each part's diagonal
+/// under [`SEPARATE_PARTS_RATIO`] of the whole's: two objects 10^6 apart, each 10 across), found
+/// on a random subset of its points with the far groups left out: which part a point is in.
+#[derive(Debug)]
+pub struct SeparateParts {
+    origin: DVec3,
+    cell: f64,
+    /// Each part's cells and their 26 neighbours, with the part's index.
+    cells: HashMap<[i64; 3], usize>,
+    /// The parts, the largest (most subset points) first.
+    pub parts: Vec<PartEstimate>,
+    /// The box of all the parts (model units).
+    pub whole: Aabb,
+}
+
+impl SeparateParts {
+    /// The part `p` is in (in, or next to, a cell of the part's points), `None` for a point in
+    /// none (a far group's).
+    pub fn part_of(&self, p: DVec3) -> Option<usize> {
+        let c = ((p - self.origin) / self.cell).floor();
+        if !c.is_finite() || c.abs().max_element() > 1e15 {
+            return None;
+        }
+        self.cells
+            .get(&[c.x as i64, c.y as i64, c.z as i64])
+            .copied()
+    }
+
+    /// How many parts.
+    pub fn len(&self) -> usize {
+        self.parts.len()
+    }
+
+    /// Never: there are two parts or more.
+    pub fn is_empty(&self) -> bool {
+        self.parts.is_empty()
+    }
+
+    /// Why the parts cannot be meshed together, in one line: for the commands that do not mesh
+    /// each part on its own.
+    pub fn refusal(&self) -> String {
+        let largest = self
+            .parts
+            .iter()
+            .map(|g| g.bbox.diagonal())
+            .fold(0.0f64, f64::max);
+        format!(
+            "the points form {} parts far apart ({} across in all, the largest part {}              across): one scale cannot hold them; give each part on its own",
+            self.len(),
+            short(self.whole.diagonal()),
+            short(largest),
+        )
+    }
+}
+
+/// A length for a message: 4 significant digits, in scientific notation when large or small.
+fn short(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e5).contains(&x.abs()) {
+        format!("{x:.3e}")
+    } else {
+        format!("{x:.4}")
+    }
+}
+
+/// The parts of `points` (the subset [`far_groups`] grouped; model units) far apart compared
+/// with their sizes, once `far` is left out; `None` when the kept points are one part or the
+/// parts are near enough to share one scale. Deterministic.
+pub fn separate_parts(points: &[DVec3], far: Option<&FarGroups>) -> Option<SeparateParts> {
     let kept: Vec<DVec3> = points
         .iter()
         .copied()
         .filter(|&p| p.is_finite() && far.is_none_or(|f| f.contains(p)))
         .collect();
-    let Some(bbox) = Aabb::of(&kept) else {
-        return Vec::new();
-    };
-    let diagonal = bbox.diagonal();
-    if !(diagonal > 0.0 && diagonal.is_finite()) {
-        return vec![(kept.len(), bbox)];
+    let bbox = Aabb::of(&kept)?;
+    let whole_diagonal = bbox.diagonal();
+    if !(whole_diagonal > 0.0 && whole_diagonal.is_finite()) {
+        return None;
     }
-    let (groups, count) = group(&kept, bbox.min, FAR_GAP * diagonal);
-    let mut out: Vec<(usize, Aabb)> = (0..count)
-        .map(|g| {
-            let members: Vec<DVec3> = kept
-                .iter()
-                .zip(&groups)
-                .filter(|&(_, &h)| h == g)
-                .map(|(&p, _)| p)
-                .collect();
-            (
-                members.len(),
-                Aabb::of(&members).expect("a group has points"),
-            )
+    let cell = FAR_GAP * whole_diagonal;
+    let (groups, count) = group(&kept, bbox.min, cell);
+    if count < 2 {
+        return None;
+    }
+    let mut members: Vec<Vec<DVec3>> = vec![Vec::new(); count];
+    for (&p, &g) in kept.iter().zip(&groups) {
+        members[g].push(p);
+    }
+    // Largest first (ties in the order of first appearance).
+    members.sort_by_key(|m| std::cmp::Reverse(m.len()));
+    let boxes: Vec<Aabb> = members
+        .iter()
+        .map(|m| Aabb::of(m).expect("a group has points"))
+        .collect();
+    let largest = boxes.iter().map(Aabb::diagonal).fold(0.0f64, f64::max);
+    if largest >= SEPARATE_PARTS_RATIO * whole_diagonal {
+        return None;
+    }
+    let mut cells = HashMap::new();
+    for (k, m) in members.iter().enumerate() {
+        for &p in m {
+            let c = ((p - bbox.min) / cell).floor();
+            let [x, y, z] = [c.x as i64, c.y as i64, c.z as i64];
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        // A cell next to two parts goes to the larger.
+                        cells.entry([x + dx, y + dy, z + dz]).or_insert(k);
+                    }
+                }
+            }
+        }
+    }
+    let parts = members
+        .iter()
+        .zip(boxes)
+        .map(|(m, bbox)| PartEstimate {
+            subset_points: m.len(),
+            area: area_guess(m, &bbox),
+            bbox,
         })
         .collect();
-    out.sort_by_key(|g| std::cmp::Reverse(g.0));
-    out
+    Some(SeparateParts {
+        origin: bbox.min,
+        cell,
+        cells,
+        parts,
+        whole: bbox,
+    })
+}
+
+/// [`surface_area_guess`](super::out_of_core::surface_area_guess) of `points` (model units,
+/// within `bbox`) in the part's own bbox-100 frame, back in model units².
+fn area_guess(points: &[DVec3], bbox: &Aabb) -> f64 {
+    let side = bbox.longest_side();
+    if !(side > 0.0 && side.is_finite()) {
+        return 0.0;
+    }
+    let scale = 100.0 / side;
+    let scaled: Vec<super::stream::Point> = points
+        .iter()
+        .map(|&p| super::stream::Point {
+            position: (p - bbox.min) * scale,
+            normal: DVec3::ZERO,
+        })
+        .collect();
+    super::out_of_core::surface_area_guess(&scaled) / (scale * scale)
 }
 
 #[cfg(test)]
@@ -236,8 +417,34 @@ mod tests {
         let c = sphere(130, DVec3::new(0.0, 1e3, 0.0), 1.0, &mut rng);
         let set = [a, b, c].concat();
         assert!(far_groups(&set).is_none());
-        let groups = kept_groups(&set, None);
-        assert_eq!(groups.len(), 2, "{groups:?}");
-        assert_eq!(groups[0].0 + groups[1].0, set.len());
+        let parts = separate_parts(&set, None).expect("parts far apart");
+        assert_eq!(parts.len(), 2, "{parts:?}");
+        assert_eq!(
+            parts.parts[0].subset_points + parts.parts[1].subset_points,
+            set.len()
+        );
+    }
+
+    #[test]
+    fn parts_far_apart_are_told_apart_with_their_share() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        // A sphere of radius 5 and one of radius 10, 10^6 apart, and a stray point between.
+        let a = sphere(3000, DVec3::ZERO, 5.0, &mut rng);
+        let b = sphere(3000, DVec3::new(1e6, 0.0, 0.0), 10.0, &mut rng);
+        let set = [a.clone(), b.clone(), vec![DVec3::new(5e5, 0.0, 0.0)]].concat();
+        let far = far_groups(&set);
+        let parts = separate_parts(&set, far.as_ref()).expect("two parts far apart");
+        assert_eq!(parts.len(), 2);
+        let (ka, kb) = (parts.part_of(a[0]).unwrap(), parts.part_of(b[0]).unwrap());
+        assert_ne!(ka, kb);
+        assert!(a.iter().all(|&p| parts.part_of(p) == Some(ka)));
+        assert!(b.iter().all(|&p| parts.part_of(p) == Some(kb)));
+        assert_eq!(parts.part_of(DVec3::new(5e5, 0.0, 0.0)), None);
+        // The larger sphere has 4 times the area: its guess is about 4 times the other's.
+        let ratio = parts.parts[kb].area / parts.parts[ka].area;
+        assert!((2.5..6.0).contains(&ratio), "area ratio {ratio}");
+        // Parts near enough to share a scale are not separate.
+        let near = [a, sphere(3000, DVec3::new(100.0, 0.0, 0.0), 5.0, &mut rng)].concat();
+        assert!(separate_parts(&near, None).is_none());
     }
 }

@@ -10,8 +10,8 @@ use glam::DVec3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use super::buckets::Buckets;
-use super::far_groups::FarGroups;
+use super::buckets::{Bucketed, Buckets};
+use super::far_groups::{FarGroups, SeparateParts};
 use super::normals::{estimate_normals, NormalOrientation};
 use super::outliers::{off_surface, OutlierFilter};
 use super::rimls::{Rimls, RimlsParams};
@@ -218,7 +218,10 @@ pub(crate) fn scan_out_of_core(
     drop_outliers: bool,
     support_per_sample: usize,
 ) -> Result<ScanOutput> {
-    let mut source = ScannedInput::open(input, params, drop_outliers)?;
+    let mut source = match ScannedInput::open(input, params, drop_outliers)? {
+        Opened::Input(s) => *s,
+        Opened::Parts(parts) => return Err(Error::invalid_mesh(input.name(), parts.refusal())),
+    };
     let sigma_p = source.sigma_p;
     source.scan(sigma_p, support_per_sample)
 }
@@ -236,8 +239,17 @@ pub(crate) struct ScannedInput {
     seconds: [f64; 2],
 }
 
+/// What [`ScannedInput::open`] made of a point set.
+pub(crate) enum Opened {
+    /// The input, ready to be scanned.
+    Input(Box<ScannedInput>),
+    /// Parts far apart compared with their sizes: each is to be meshed on its own.
+    Parts(std::sync::Arc<SeparateParts>),
+}
+
 impl ScannedInput {
-    /// Pass 1 and the sigma_p search. With `drop_outliers`, an [`OutlierFilter`] of the first
+    /// Pass 1 and the sigma_p search; or the parts far apart the points form (see
+    /// [`Bucketed::Parts`]), nothing scanned. With `drop_outliers`, an [`OutlierFilter`] of the first
     /// bucket's points removes outliers from the sigma_p search's subset, and later from each
     /// scan's samples and support (so isolated points neither raise the count the search sees
     /// nor become samples).
@@ -245,15 +257,18 @@ impl ScannedInput {
         input: &PointSource,
         params: &OutOfCoreParams,
         drop_outliers: bool,
-    ) -> Result<Self> {
+    ) -> Result<Opened> {
         let t0 = Instant::now();
         let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-        let buckets = Buckets::write(
+        let buckets = match Buckets::write(
             input,
             params.bucket_points,
             params.temp_dir.as_deref(),
             &mut rng,
-        )?;
+        )? {
+            Bucketed::Buckets(b) => b,
+            Bucketed::Parts(parts) => return Ok(Opened::Parts(parts)),
+        };
         let t1 = Instant::now();
         // sigma_p: given, or searched on a scaled-down problem (see `search_sigma_p`).
         let mut filter = None;
@@ -281,14 +296,14 @@ impl ScannedInput {
             }
         };
         let t2 = Instant::now();
-        Ok(ScannedInput {
+        Ok(Opened::Input(Box::new(ScannedInput {
             buckets,
             rng,
             params: params.clone(),
             filter,
             sigma_p,
             seconds: [(t1 - t0).as_secs_f64(), (t2 - t1).as_secs_f64()],
-        })
+        })))
     }
 
     /// Pass 2 at `sigma_p` (bbox-100 units), keeping up to `support_per_sample` points per
@@ -568,7 +583,8 @@ pub fn simplify_progressive(
         params.bucket_points,
         params.temp_dir.as_deref(),
         &mut rng,
-    )?;
+    )?
+    .or_refuse(input)?;
     let mut seconds = vec![t0.elapsed().as_secs_f64()];
     let norm = buckets.normalization;
     // P_l in bbox-100 units (for the next level's O) and in the input's units (the output).
@@ -687,7 +703,7 @@ fn search_sigma_p(
 /// that is wider: cells finer than the spacing see points, not the surface (200 points of a
 /// sphere would read as 200 cells, a twentieth of its area, and the search would start where
 /// every point is a sample and the count does not answer).
-fn surface_area_guess(points: &[Point]) -> f64 {
+pub(crate) fn surface_area_guess(points: &[Point]) -> f64 {
     let h = (2.0 * median_spacing(points)).max(2.0);
     let mut cells: Vec<[i32; 3]> = points
         .iter()

@@ -25,6 +25,22 @@ pub enum PointSource {
         /// Whether the normals are given.
         has_normals: bool,
     },
+    /// One of the parts far apart of another source (see [`PointSource::parts`]), read from it
+    /// as it goes.
+    Part(PointPart),
+}
+
+/// One part of a point source whose points form parts far apart
+/// ([`SeparateParts`](super::far_groups::SeparateParts)): its points are those of the whole
+/// source in the part, read as the whole is.
+#[derive(Debug, Clone)]
+pub struct PointPart {
+    /// The whole source's name with the part's: `in.xyz (part 2 of 3)`.
+    name: PathBuf,
+    whole: Box<PointSource>,
+    parts: Arc<super::far_groups::SeparateParts>,
+    index: usize,
+    count: u64,
 }
 
 impl PointSource {
@@ -51,6 +67,7 @@ impl PointSource {
         match self {
             PointSource::File(path) => path,
             PointSource::Memory { name, .. } => name,
+            PointSource::Part(part) => &part.name,
         }
     }
 
@@ -65,6 +82,7 @@ impl PointSource {
             PointSource::File(path) if !super::stream::is_text_extension(path) => {
                 Ok(PointReader::open(path)?.viewpoint())
             }
+            PointSource::Part(part) => part.whole.viewpoint(),
             _ => Ok(None),
         }
     }
@@ -103,7 +121,88 @@ impl PointSource {
                 has_normals: *has_normals,
                 read: 0,
             }),
+            PointSource::Part(part) => Box::new(PartPoints {
+                whole: part.whole.open()?,
+                parts: Arc::clone(&part.parts),
+                index: part.index,
+                count: part.count,
+                buffer: Vec::new(),
+            }),
         })
+    }
+
+    /// Each part of `parts` (found on this source's points) as a source of its own, in the
+    /// parts' order, after one pass over the points to count each part's; and the number of
+    /// points in no part (far groups).
+    ///
+    /// # Errors
+    /// Those of reading the points.
+    pub(crate) fn parts(
+        &self,
+        parts: &Arc<super::far_groups::SeparateParts>,
+    ) -> Result<(Vec<PointSource>, u64)> {
+        let mut counts = vec![0u64; parts.len()];
+        let mut outside = 0u64;
+        let mut reader = self.open()?;
+        let mut chunk = Vec::new();
+        while reader.read_chunk(&mut chunk, 1 << 16)? > 0 {
+            for p in &chunk {
+                match parts.part_of(p.position) {
+                    Some(k) => counts[k] += 1,
+                    None => outside += 1,
+                }
+            }
+        }
+        let name = self.name().display().to_string();
+        let sources = counts
+            .into_iter()
+            .enumerate()
+            .map(|(index, count)| {
+                PointSource::Part(PointPart {
+                    name: PathBuf::from(format!("{name} (part {} of {})", index + 1, parts.len())),
+                    whole: Box::new(self.clone()),
+                    parts: Arc::clone(parts),
+                    index,
+                    count,
+                })
+            })
+            .collect();
+        Ok((sources, outside))
+    }
+}
+
+/// The reader of one part's points: the whole source's, those in the part.
+struct PartPoints {
+    whole: Box<dyn ReadPoints>,
+    parts: Arc<super::far_groups::SeparateParts>,
+    index: usize,
+    count: u64,
+    buffer: Vec<Point>,
+}
+
+impl ReadPoints for PartPoints {
+    fn count(&self) -> u64 {
+        self.count
+    }
+    fn has_normals(&self) -> bool {
+        self.whole.has_normals()
+    }
+    fn viewpoint(&self) -> Option<DVec3> {
+        self.whole.viewpoint()
+    }
+    fn read_chunk(&mut self, out: &mut Vec<Point>, max: usize) -> Result<usize> {
+        out.clear();
+        while out.is_empty() {
+            if self.whole.read_chunk(&mut self.buffer, max)? == 0 {
+                return Ok(0);
+            }
+            out.extend(
+                self.buffer
+                    .iter()
+                    .filter(|p| self.parts.part_of(p.position) == Some(self.index)),
+            );
+        }
+        Ok(out.len())
     }
 }
 
