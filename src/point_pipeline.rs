@@ -572,7 +572,8 @@ fn remesh_points_once(
                 format!(
                     "the points are not near a surface: around the samples they spread in \
                      every direction at the output's spacing (median surface variation {v:.3}; \
-                     a surface's is near 0, a volume's 1/3)"
+                     a surface's is near 0, a volume's 1/3); noisy data may hold one at a \
+                     coarser spacing (a smaller count)"
                 ),
             ));
         }

@@ -411,27 +411,34 @@ mod tests {
     #[test]
     fn parts_of_comparable_size_are_kept_however_far() {
         let mut rng = ChaCha8Rng::seed_from_u64(4);
-        // Two spheres 10^6 apart, and a third part with 2% of the points.
+        // Two spheres 10^6 apart, and a third part with 2% of the points 2·10^3 from the first.
         let a = sphere(3000, DVec3::ZERO, 5.0, &mut rng);
         let b = sphere(3000, DVec3::new(1e6, 0.0, 0.0), 5.0, &mut rng);
-        let c = sphere(130, DVec3::new(0.0, 1e3, 0.0), 1.0, &mut rng);
-        let set = [a, b, c].concat();
+        let c = sphere(130, DVec3::new(0.0, 2e3, 0.0), 1.0, &mut rng);
+        let set = [a.clone(), b, c].concat();
         assert!(far_groups(&set).is_none());
-        let parts = separate_parts(&set, None).expect("parts far apart");
+        // Two parts 10^6 apart, one 2·10^3 across (the first sphere and the third): 2 thousandths
+        // of the whole, which one scale holds.
+        assert!(separate_parts(&set, None).is_none());
+        // Without the third, two parts each 10^-5 of the whole: separate, every point in one.
+        let two = [a, sphere(3000, DVec3::new(1e6, 0.0, 0.0), 5.0, &mut rng)].concat();
+        let parts = separate_parts(&two, None).expect("parts far apart");
         assert_eq!(parts.len(), 2, "{parts:?}");
         assert_eq!(
             parts.parts[0].subset_points + parts.parts[1].subset_points,
-            set.len()
+            two.len()
         );
     }
 
     #[test]
     fn parts_far_apart_are_told_apart_with_their_share() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        // A sphere of radius 5 and one of radius 10, 10^6 apart, and a stray point between.
+        // A sphere of radius 5 and one of radius 10, 10^6 apart, and a stray point more than a
+        // grid cell (a quarter of the diagonal) from both.
         let a = sphere(3000, DVec3::ZERO, 5.0, &mut rng);
         let b = sphere(3000, DVec3::new(1e6, 0.0, 0.0), 10.0, &mut rng);
-        let set = [a.clone(), b.clone(), vec![DVec3::new(5e5, 0.0, 0.0)]].concat();
+        let stray = DVec3::new(5e5, 1e6, 0.0);
+        let set = [a.clone(), b.clone(), vec![stray]].concat();
         let far = far_groups(&set);
         let parts = separate_parts(&set, far.as_ref()).expect("two parts far apart");
         assert_eq!(parts.len(), 2);
@@ -439,7 +446,8 @@ mod tests {
         assert_ne!(ka, kb);
         assert!(a.iter().all(|&p| parts.part_of(p) == Some(ka)));
         assert!(b.iter().all(|&p| parts.part_of(p) == Some(kb)));
-        assert_eq!(parts.part_of(DVec3::new(5e5, 0.0, 0.0)), None);
+        assert!(far.is_some_and(|f| !f.contains(stray)));
+        assert_eq!(parts.part_of(stray), None);
         // The larger sphere has 4 times the area: its guess is about 4 times the other's.
         let ratio = parts.parts[kb].area / parts.parts[ka].area;
         assert!((2.5..6.0).contains(&ratio), "area ratio {ratio}");
