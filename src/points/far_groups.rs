@@ -347,7 +347,7 @@ pub fn separate_parts(points: &[DVec3], far: Option<&FarGroups>) -> Option<Separ
     })
 }
 
-/// [`surface_area_guess`](super::out_of_core::surface_area_guess) of `points` (model units,
+/// [`surface_area_guess`](super::area_guess::surface_area_guess) of `points` (model units,
 /// within `bbox`) in the part's own bbox-100 frame, back in model units².
 fn area_guess(points: &[DVec3], bbox: &Aabb) -> f64 {
     let side = bbox.longest_side();
@@ -362,7 +362,7 @@ fn area_guess(points: &[DVec3], bbox: &Aabb) -> f64 {
             normal: DVec3::ZERO,
         })
         .collect();
-    super::out_of_core::surface_area_guess(&scaled) / (scale * scale)
+    super::area_guess::surface_area_guess(&scaled) / (scale * scale)
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! XYZ/CSV) and writing, dense random point sets drawn from meshes for tests and benchmarks, the
 //! out-of-core randomized linear scan, normal estimation, and the RIMLS surface of a point set.
 
+pub mod area_guess;
 pub mod boundary;
 pub(crate) mod buckets;
 pub mod far_groups;
