@@ -375,13 +375,6 @@ pub fn remesh_points(
     }
 }
 
-impl PointRemeshOutput {
-    /// The far groups a run over one scene left out.
-    fn kept_far(&self) -> Option<crate::points::far_groups::FarGroups> {
-        self.kept.far_of_whole()
-    }
-}
-
 /// What a run over a point source gave: the output, or the parts far apart the points form
 /// (nothing meshed).
 enum Run {

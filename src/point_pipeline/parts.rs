@@ -79,12 +79,13 @@ fn merge(
         mesh.triangles
             .extend(o.mesh.triangles.iter().map(|t| t.map(|i| i + offset)));
     }
-    let name = outs.first().map(|o| o.normalization);
-    let bbox = mesh.bbox();
-    let normalization = bbox
+    // (A mesh with no extent keeps the first part's frame.)
+    let first_frame = outs.first().map(|o| o.normalization);
+    let normalization = mesh
+        .bbox()
         .as_ref()
         .and_then(Normalization::for_bbox)
-        .or(name)
+        .or(first_frame)
         .ok_or_else(|| Error::Internal {
             stage: "remesh_points",
             message: "the parts gave no output".into(),
@@ -97,7 +98,7 @@ fn merge(
     // The first part's sigma_p in the whole's bbox-100 units.
     let sigma_p = first.sigma_p / first.normalization.scale * normalization.scale;
     let mut separate_parts = vec![first.mesh.vertex_count()];
-    let mut far = vec![first.kept_far()];
+    let mut far = vec![first.kept.far_of_whole()];
     let mut out = PointRemeshOutput {
         mesh_normalized: normalization.apply_mesh(&mesh),
         mesh,
@@ -113,7 +114,7 @@ fn merge(
     };
     for o in iter {
         separate_parts.push(o.mesh.vertex_count());
-        far.push(o.kept_far());
+        far.push(o.kept.far_of_whole());
         out.input_points += o.input_points;
         out.duplicate_points += o.duplicate_points;
         out.far_points += o.far_points;
