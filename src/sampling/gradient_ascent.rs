@@ -3,6 +3,7 @@
 
 use rayon::prelude::*;
 
+use crate::geometry::morton::morton_order;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
 use crate::sampling::crease_band::CreaseBand;
@@ -47,6 +48,12 @@ pub struct GradientAscentParams {
     /// already raises s, and at larger ones the gain was small for twice the cost of a sweep
     /// (`docs/decisions/gradient-ascent-step.md`).
     pub backtracking: usize,
+    /// Samples per window of the sequential sweeps' order (default 4096): the moving samples
+    /// are kept along a Z-curve and each sweep takes windows of this many consecutive ones in
+    /// a random order, each window's samples in a random order ([`sweep_order`]), so that the
+    /// samples and the input a window reads stay in cache. 1 visits windows of one sample: a
+    /// random order over the Z-curve's order.
+    pub window: usize,
 }
 
 impl Default for GradientAscentParams {
@@ -58,6 +65,7 @@ impl Default for GradientAscentParams {
             support_radius: SUPPORT_RADIUS,
             sequential: true,
             backtracking: 0,
+            window: 4096,
         }
     }
 }
@@ -122,8 +130,6 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
     let fixed = fixed.min(n);
     let sigma_p = kernel.sigma_p();
     let r_pos = params.support_radius * sigma_p;
-    // Neighbour lists, fixed for all sweeps.
-    let lists = neighbour_lists(samples, fixed, r_pos);
 
     let mut result = GradientAscentResult {
         mean_move: Vec::new(),
@@ -131,14 +137,20 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
         min_s: Vec::new(),
     };
     if params.sequential {
-        use rand::seq::SliceRandom;
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let mut order: Vec<usize> = (fixed..n).collect();
-        let mut embedded: Vec<KernelPoint> = samples.iter().map(embed).collect();
+        // The moving samples renumbered along a Z-curve (`local[k]` is `samples[perm[k]]`): a
+        // move reads its neighbours and the input near it, and in this numbering both sit
+        // together in memory (in the caller's order, often the scan's random one, each of a
+        // million moves missed the cache about twenty times).
+        let perm = cache_order(samples, fixed);
+        let mut local: Vec<SurfaceSample> = perm.iter().map(|&i| samples[i as usize]).collect();
+        // Neighbour lists, fixed for all sweeps.
+        let lists = neighbour_lists(&local, fixed, r_pos);
+        let mut embedded: Vec<KernelPoint> = local.iter().map(embed).collect();
         let mut batches = Batches::new(n, MAX_BATCH);
         for _ in 0..params.iterations {
-            order.shuffle(&mut rng);
+            let order = sweep_order(fixed, n, params.window, &mut rng);
             let (mut total_move, mut total_s, mut min_s) = (0.0, 0.0, f64::INFINITY);
             // The samples are taken in `order`, in batches of consecutive ones of which no two
             // are neighbours (`sampling::sweep`).
@@ -154,7 +166,7 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
                                 &embedded,
                                 &lists[i - fixed],
                                 i,
-                                samples[i],
+                                local[i],
                                 band,
                                 params,
                                 ws,
@@ -165,7 +177,7 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
                     })
                     .collect();
                 for (&i, (moved, dist, s)) in members.iter().zip(moves) {
-                    samples[i] = moved;
+                    local[i] = moved;
                     embedded[i] = embed(&moved);
                     total_move += dist;
                     total_s += s;
@@ -181,8 +193,13 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
             result.mean_s.push(total_s / m);
             result.min_s.push(min_s);
         }
+        for (k, &i) in perm.iter().enumerate() {
+            samples[i as usize] = local[k];
+        }
         return result;
     }
+    // Neighbour lists, fixed for all sweeps.
+    let lists = neighbour_lists(samples, fixed, r_pos);
     for _ in 0..params.iterations {
         let embedded: Vec<KernelPoint> = samples.par_iter().map(embed).collect();
         let moves: Vec<(SurfaceSample, f64, f64)> = (fixed..n)
@@ -247,6 +264,39 @@ fn neighbour_lists(samples: &[SurfaceSample], from: usize, radius: f64) -> Vec<V
                 .collect()
         })
         .collect()
+}
+
+/// The order in which the sequential sweeps keep the samples: `samples[..fixed]` as they are,
+/// then the moving ones along a Z-curve (`geometry::morton`). Entry k is the index in `samples`
+/// of the k-th sample kept.
+fn cache_order(samples: &[SurfaceSample], fixed: usize) -> Vec<u32> {
+    let moving: Vec<glam::DVec3> = samples[fixed..].iter().map(|s| s.position).collect();
+    (0..fixed as u32)
+        .chain(morton_order(&moving).into_iter().map(|k| k + fixed as u32))
+        .collect()
+}
+
+/// One sweep's visiting order of the samples `fixed..n` (kept in [`cache_order`]): a windowed
+/// random order. The samples are cut into windows of `window` consecutive ones (a patch of the
+/// surface each), the windows taken in a random order and the samples within each in a random
+/// order. Every sample is visited once; the order depends only on `rng`.
+fn sweep_order(
+    fixed: usize,
+    n: usize,
+    window: usize,
+    rng: &mut rand_chacha::ChaCha8Rng,
+) -> Vec<usize> {
+    use rand::seq::SliceRandom;
+    let window = window.max(1);
+    let mut starts: Vec<usize> = (fixed..n).step_by(window).collect();
+    starts.shuffle(rng);
+    let mut order = Vec::with_capacity(n - fixed.min(n));
+    for start in starts {
+        let from = order.len();
+        order.extend(start..(start + window).min(n));
+        order[from..].shuffle(rng);
+    }
+    order
 }
 
 /// One step of eq. 11 for sample `i`: the gradient of s at x_i over its neighbours `list`, a
@@ -319,11 +369,10 @@ mod tests {
     use crate::sampling::sizing::Uniform;
     use crate::surface::candidates::surface_candidates;
     use crate::surface::MeshSurface;
-    use rand::seq::SliceRandom;
     use rand::SeedableRng;
 
-    /// The sweeps one sample at a time, as Sec. 6.2 writes them: the reference the batched
-    /// sweeps must equal.
+    /// The sweeps one sample at a time, as Sec. 6.2 writes them, in the sweeps' order
+    /// ([`cache_order`], [`sweep_order`]): the reference the batched sweeps must equal.
     fn one_at_a_time(
         kernel: &Kernel,
         surface: &MeshSurface,
@@ -332,34 +381,76 @@ mod tests {
         seed: u64,
     ) {
         let n = samples.len();
-        let lists = neighbour_lists(samples, 0, params.support_radius * kernel.sigma_p());
+        let perm = cache_order(samples, 0);
+        let mut local: Vec<SurfaceSample> = perm.iter().map(|&i| samples[i as usize]).collect();
+        let lists = neighbour_lists(&local, 0, params.support_radius * kernel.sigma_p());
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let mut order: Vec<usize> = (0..n).collect();
-        let mut embedded: Vec<KernelPoint> = samples
+        let mut embedded: Vec<KernelPoint> = local
             .iter()
             .map(|s| kernel.embed(s.position, s.normal))
             .collect();
         let (mut ws, mut near, mut sorted) = (MeasureWorkspace::new(), Vec::new(), Vec::new());
         for _ in 0..params.iterations {
-            order.shuffle(&mut rng);
-            for &i in &order {
+            for i in sweep_order(0, n, params.window, &mut rng) {
                 let (moved, _, _) = move_one(
                     kernel,
                     surface,
                     &embedded,
                     &lists[i],
                     i,
-                    samples[i],
+                    local[i],
                     None,
                     params,
                     &mut ws,
                     &mut near,
                     &mut sorted,
                 );
-                samples[i] = moved;
+                local[i] = moved;
                 embedded[i] = kernel.embed(moved.position, moved.normal);
             }
         }
+        for (k, &i) in perm.iter().enumerate() {
+            samples[i as usize] = local[k];
+        }
+    }
+
+    /// A sweep's order visits every moving sample once, window by window: each run of `window`
+    /// visits is one window's samples, and different seeds give different orders.
+    #[test]
+    fn the_sweep_order_visits_each_sample_once_window_by_window() {
+        let (fixed, n, window) = (7, 7 + 1000, 64);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let order = sweep_order(fixed, n, window, &mut rng);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (fixed..n).collect::<Vec<_>>());
+        // The windows start at fixed, fixed + 64, ...; the last holds the 1000 mod 64 = 40 left.
+        let mut at = 0;
+        while at < order.len() {
+            let w = (order[at] - fixed) / window;
+            let len = window.min(n - fixed - w * window);
+            assert!(
+                order[at..at + len]
+                    .iter()
+                    .all(|&i| (i - fixed) / window == w),
+                "window {w} is not visited in one run"
+            );
+            at += len;
+        }
+        let again = sweep_order(
+            fixed,
+            n,
+            window,
+            &mut rand_chacha::ChaCha8Rng::seed_from_u64(3),
+        );
+        assert_eq!(order, again);
+        let other = sweep_order(
+            fixed,
+            n,
+            window,
+            &mut rand_chacha::ChaCha8Rng::seed_from_u64(4),
+        );
+        assert_ne!(order, other);
     }
 
     /// The sweeps give the samples of the one-at-a-time order exactly, on one thread and on
@@ -370,38 +461,44 @@ mod tests {
         let surface = MeshSurface::new(&mesh).unwrap();
         let kernel = Kernel::new(2.0, f64::INFINITY).unwrap();
         let start: Vec<SurfaceSample> = surface_candidates(&mesh, 400, 3);
-        let params = GradientAscentParams::default();
-        let mut reference = start.clone();
-        one_at_a_time(&kernel, &surface, &mut reference, &params, 5);
-        assert!(reference
-            .iter()
-            .zip(&start)
-            .all(|(a, b)| a.position != b.position));
-        for threads in [1, 2, 3] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            let mut samples = start.clone();
-            pool.install(|| {
-                gradient_ascent(
-                    &kernel,
-                    &surface,
-                    &mut samples,
-                    0,
-                    &Uniform,
-                    None,
-                    &params,
-                    5,
-                )
-            });
-            assert!(
-                samples
-                    .iter()
-                    .zip(&reference)
-                    .all(|(a, b)| a.position == b.position && a.normal == b.normal),
-                "{threads} threads"
-            );
+        // One window, and windows of 64 samples.
+        for window in [4096, 64] {
+            let params = GradientAscentParams {
+                window,
+                ..Default::default()
+            };
+            let mut reference = start.clone();
+            one_at_a_time(&kernel, &surface, &mut reference, &params, 5);
+            assert!(reference
+                .iter()
+                .zip(&start)
+                .all(|(a, b)| a.position != b.position));
+            for threads in [1, 2, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let mut samples = start.clone();
+                pool.install(|| {
+                    gradient_ascent(
+                        &kernel,
+                        &surface,
+                        &mut samples,
+                        0,
+                        &Uniform,
+                        None,
+                        &params,
+                        5,
+                    )
+                });
+                assert!(
+                    samples
+                        .iter()
+                        .zip(&reference)
+                        .all(|(a, b)| a.position == b.position && a.normal == b.normal),
+                    "{threads} threads, window {window}"
+                );
+            }
         }
     }
 }
