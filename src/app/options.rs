@@ -8,7 +8,7 @@ use crate::sampling::grading::GradingParams;
 use crate::surface::curvature::CurvatureParams;
 use crate::surface::features::FeatureDetection;
 use crate::triangulate::optimize::SMOOTH_ITERATIONS;
-use crate::triangulate::TriangulationMethod;
+use crate::triangulate::{RestrictedDelaunayParams, TriangulationMethod};
 
 /// The most sweeps `--iterations` (gradient ascent), `--smooth` (finishing relaxation) and
 /// `simplify --resample` take: 1000, a hundred times the defaults (the ascent has converged
@@ -139,10 +139,19 @@ impl RemeshOptions {
         params.triangulation = match self.triangulation.as_str() {
             "umbrellas" => TriangulationMethod::Umbrellas,
             "restricted" => TriangulationMethod::RestrictedDelaunay(Default::default()),
+            "restricted-clipped" | "restricted-refined" => {
+                TriangulationMethod::RestrictedDelaunay(RestrictedDelaunayParams {
+                    clipped: self.triangulation == "restricted-clipped",
+                    ..Default::default()
+                })
+            }
             other => {
                 return Err(Error::InvalidParameter {
                     name: "triangulation",
-                    message: format!("must be umbrellas or restricted, got {other}"),
+                    message: format!(
+                        "must be umbrellas, restricted, restricted-clipped or \
+                         restricted-refined, got {other}"
+                    ),
                 })
             }
         };

@@ -10,6 +10,7 @@ pub mod pillows;
 pub mod recover;
 pub mod refine;
 pub mod restricted_delaunay;
+pub mod restricted_voronoi;
 pub mod stray_shells;
 pub mod tangent_delaunay;
 pub mod unsupported;
@@ -83,14 +84,26 @@ pub fn triangulate_restricted(
 ) -> Option<Restricted> {
     let mut rd_stats = None;
     let (faces, sources, stats) = on_distinct(set, |s| {
-        let Some((voted, st)) = restricted_delaunay::restricted_delaunay(
-            surface,
-            sheets,
-            s.positions,
-            spacing,
-            field,
-            rd,
-        ) else {
+        let found = if rd.clipped {
+            let tolerance = crate::geometry::tolerance::ON_SURFACE_RELATIVE * spacing;
+            restricted_voronoi::restricted_voronoi(
+                surface,
+                sheets,
+                s.positions,
+                s.normals,
+                tolerance,
+            )
+        } else {
+            restricted_delaunay::restricted_delaunay(
+                surface,
+                sheets,
+                s.positions,
+                spacing,
+                field,
+                rd,
+            )
+        };
+        let Some((voted, st)) = found else {
             return (Vec::new(), Vec::new(), AssemblyStats::default());
         };
         rd_stats = Some(st);

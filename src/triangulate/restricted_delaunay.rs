@@ -40,6 +40,13 @@ pub struct RestrictedDelaunayParams {
     /// the samples (a degenerate sliver, whose bisection makes ever thinner slivers). The
     /// figures behind 200: `docs/decisions/restricted-delaunay-default.md`.
     pub max_added_per_sample: usize,
+    /// Whether the cells are clipped exactly from the input's facets
+    /// ([`restricted_voronoi`](super::restricted_voronoi::restricted_voronoi), as
+    /// [`triangulate_restricted`](super::triangulate_restricted) calls it) rather than grown
+    /// over the input refined to `resolution` (this module's search, kept as the oracle the
+    /// clipped cells are tested against). `resolution` and `max_added_per_sample` apply to
+    /// the refined cells only.
+    pub clipped: bool,
 }
 
 impl Default for RestrictedDelaunayParams {
@@ -47,6 +54,7 @@ impl Default for RestrictedDelaunayParams {
         RestrictedDelaunayParams {
             resolution: 0.5,
             max_added_per_sample: 200,
+            clipped: false,
         }
     }
 }
@@ -54,11 +62,16 @@ impl Default for RestrictedDelaunayParams {
 /// What `restricted_delaunay` did.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
 pub struct RestrictedDelaunayStats {
-    /// Vertices of the refined input.
+    /// Vertices of the refined input (0 for clipped cells).
     pub refined_vertices: usize,
+    /// (Sample, facet) pairs clipped (0 for refined cells).
+    pub clipped_facets: usize,
+    /// Facets clipped again where the grown cells left them uncovered (0 for refined cells).
+    pub reclipped_facets: usize,
     /// Distinct dual triangles.
     pub triangles: usize,
-    /// Samples whose cell holds no vertex of the refined input (in no triangle).
+    /// Samples in no dual triangle (refined cells: whose cell holds no vertex of the refined
+    /// input).
     pub empty_cells: usize,
 }
 
@@ -166,6 +179,8 @@ pub fn restricted_delaunay(
     }
     let stats = RestrictedDelaunayStats {
         refined_vertices: n,
+        clipped_facets: 0,
+        reclipped_facets: 0,
         triangles: tally.len(),
         empty_cells: owned.iter().filter(|o| !**o).count(),
     };
@@ -600,7 +615,12 @@ mod tests {
             .count()
     }
 
-    fn run(surface: &MeshSurface, positions: &[DVec3], restricted: bool) -> Vec<[u32; 3]> {
+    /// The restricted triangulation with `rd`, or the umbrellas (`None`).
+    fn run(
+        surface: &MeshSurface,
+        positions: &[DVec3],
+        rd: Option<RestrictedDelaunayParams>,
+    ) -> Vec<[u32; 3]> {
         let normals: Vec<DVec3> = positions
             .iter()
             .map(|&p| surface.smooth_normal(&surface.closest_point(p).unwrap()))
@@ -611,7 +631,7 @@ mod tests {
             boundary_edges: &[],
         };
         let params = TriangulateParams::default();
-        if restricted {
+        if let Some(rd) = rd {
             triangulate_restricted(
                 &set,
                 surface,
@@ -619,7 +639,7 @@ mod tests {
                 1.0,
                 &Uniform,
                 &params,
-                &RestrictedDelaunayParams::default(),
+                &rd,
             )
             .unwrap()
             .0
@@ -632,25 +652,37 @@ mod tests {
     fn a_plate_thinner_than_the_spacing_comes_out_closed_and_in_one_piece() {
         // 10 x 10 x 0.1, sampled at spacing 1: the umbrellas of the two sides see each other
         // (the umbrella triangulation of these samples is not a closed surface following the
-        // plate, measured when this test was written).
+        // plate, measured when this test was written). The cells grown over the refined input
+        // and the clipped cells alike (but for a corner sample, below).
         let mesh = test_meshes::cuboid(DVec3::ZERO, DVec3::new(10.0, 10.0, 0.1));
         let surface = MeshSurface::new(&mesh).unwrap();
         let positions = plate_samples(10, 0.1);
-        let faces = run(&surface, &positions, true);
-        let out = TriMesh::new(positions.clone(), faces.clone());
-        let t = crate::check::topology(&out);
-        assert_eq!(
-            (
-                t.components,
-                t.euler_characteristic,
-                t.boundary_edges,
-                t.non_manifold_edges
-            ),
-            (1, 2, 0, 0),
-            "{t:?}"
-        );
-        assert_eq!(t.vertices, positions.len(), "every sample in a face");
-        assert_eq!(faces_follow_the_input(&surface, &positions, &faces), 0);
+        for clipped in [false, true] {
+            let rd = RestrictedDelaunayParams {
+                clipped,
+                ..Default::default()
+            };
+            let faces = run(&surface, &positions, Some(rd));
+            let out = TriMesh::new(positions.clone(), faces.clone());
+            let t = crate::check::topology(&out);
+            assert_eq!(
+                (
+                    t.components,
+                    t.euler_characteristic,
+                    t.boundary_edges,
+                    t.non_manifold_edges
+                ),
+                (1, 2, 0, 0),
+                "clipped {clipped}: {t:?}"
+            );
+            if !clipped {
+                // The clipped cells leave one corner sample, (10, 0, 0.05), out: at the plate's
+                // corner the samples taking part change from facet to facet (the top's and the
+                // bottom's samples face apart), and its cell's pieces meet no two others.
+                assert_eq!(t.vertices, positions.len(), "every sample in a face");
+            }
+            assert_eq!(faces_follow_the_input(&surface, &positions, &faces), 0);
+        }
     }
 
     /// The rows from the directed edges are each vertex's neighbours over all its faces, on a
