@@ -325,28 +325,138 @@ pub(crate) fn crossing_faces(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec
 /// [`crossing_faces`]) back at `start`, until no new crossing is left: how a stage that moves
 /// vertices (the finishing relaxation, the least-squares fit, either of which can bring the two
 /// sides of a thin part together) takes back the moves that made a crossing.
+///
+/// One search over the whole mesh ([`intersecting_pairs`]); after each round of putting back,
+/// only the faces around the vertices put back are searched again (against a BVH of every
+/// face's box at its positions now and at `start`, between which the corners only go), so the
+/// answer is that of searching the whole mesh every round.
 pub(crate) fn undo_new_crossings(
     positions: &mut [DVec3],
     triangles: &[[u32; 3]],
     start: &[DVec3],
     before: &[[u32; 3]],
 ) {
+    let n = positions.len();
+    let sorted = |f: u32| {
+        let mut t = triangles[f as usize];
+        t.sort_unstable();
+        t
+    };
+    let is_new = |f: u32| before.binary_search(&sorted(f)).is_err();
+    // The first search, over the whole mesh, and its BVH (leaf data: the face index) over the
+    // faces it took, at their positions then.
+    let mut seen = rustc_hash::FxHashSet::default();
+    let first: Vec<bool> = triangles
+        .iter()
+        .map(|&t| seen.insert(face_key(t)))
+        .collect();
+    drop(seen);
+    let boxes: Vec<(usize, Aabb)> = face_boxes(positions, triangles)
+        .into_iter()
+        .filter(|&(f, _)| first[f])
+        .collect();
+    let bvh = crate::geometry::bvh::bvh_of(boxes.iter().copied());
+    let mut pairs: Vec<[u32; 2]> = if boxes.len() < 2 {
+        Vec::new()
+    } else {
+        let mut candidates: Vec<[u32; 2]> = bvh
+            .traverse_bvtt_single_tree_parallel::<false>()
+            .into_par_iter()
+            .map(|(a, b)| [a.min(b), a.max(b)])
+            .collect();
+        candidates.par_sort_unstable();
+        candidates
+            .into_par_iter()
+            .filter(|&[f, g]| pair_within(positions, triangles, f, g, 0.0).is_some())
+            .collect()
+    };
+    let mut in_bvh = vec![false; triangles.len()];
+    for &(f, _) in &boxes {
+        in_bvh[f] = true;
+    }
+    drop(boxes);
+    // Each vertex's faces, built at the first round that puts a vertex back.
+    let mut faces_of: Option<Vec<Vec<u32>>> = None;
+    // Faces whose corners were put back: their leaves in the BVH are stale.
+    let mut moved = vec![false; triangles.len()];
     loop {
-        let mut undone = false;
-        for t in crossing_faces(positions, triangles) {
-            if before.binary_search(&t).is_ok() {
-                continue;
-            }
-            for v in t.map(|v| v as usize) {
-                if positions[v] != start[v] {
-                    positions[v] = start[v];
-                    undone = true;
+        let mut undone: Vec<u32> = Vec::new();
+        for &[f, g] in &pairs {
+            for h in [f, g].into_iter().filter(|&h| is_new(h)) {
+                for v in triangles[h as usize] {
+                    let i = v as usize;
+                    if positions[i] != start[i] {
+                        positions[i] = start[i];
+                        undone.push(v);
+                    }
                 }
             }
         }
-        if !undone {
+        if undone.is_empty() {
             return;
         }
+        let faces_of = faces_of.get_or_insert_with(|| {
+            let mut of = vec![Vec::new(); n];
+            for (f, t) in triangles.iter().enumerate() {
+                for &v in t {
+                    if let Some(row) = of.get_mut(v as usize) {
+                        row.push(f as u32);
+                    }
+                }
+            }
+            of
+        });
+        let mut changed = vec![false; triangles.len()];
+        for v in undone {
+            for &f in &faces_of[v as usize] {
+                changed[f as usize] = true;
+                moved[f as usize] = true;
+            }
+        }
+        pairs.retain(|&[f, g]| !changed[f as usize] && !changed[g as usize]);
+        // The faces to search again: those whose corners ever went back (their pairs with each
+        // other are searched in a BVH of their own, at their positions now), each against the
+        // faces that never moved (in the first BVH, whose leaves for them are exact).
+        let positions = &*positions;
+        let searched = |h: u32| {
+            first[h as usize]
+                && triangles[h as usize].iter().all(|&v| (v as usize) < n)
+                && triangles[h as usize]
+                    .iter()
+                    .all(|&v| positions[v as usize].is_finite())
+                && !is_degenerate_face(positions, triangles[h as usize])
+        };
+        let face_box = |h: u32| triangle_aabb(triangles[h as usize].map(|v| positions[v as usize]));
+        let again: Vec<u32> = (0..triangles.len() as u32)
+            .filter(|&h| moved[h as usize] && searched(h))
+            .collect();
+        let local = crate::geometry::bvh::bvh_of(again.iter().map(|&h| (h as usize, face_box(h))));
+        let (changed, moved, in_bvh) = (&changed, &moved, &in_bvh);
+        let (bvh, local) = (&bvh, &local);
+        let found: Vec<[u32; 2]> = again
+            .par_iter()
+            .flat_map_iter(|&f| {
+                let aabb = face_box(f);
+                // Unmoved faces, and moved faces after f: one of each pair changed this round.
+                let unmoved = bvh.intersect_aabb(&aabb).filter(move |&g| {
+                    in_bvh.get(g as usize).copied().unwrap_or(false) && !moved[g as usize]
+                });
+                let other_moved = local
+                    .intersect_aabb(&aabb)
+                    .filter(move |&g| (g as usize) < triangles.len() && g > f);
+                unmoved
+                    .chain(other_moved)
+                    .filter(move |&g| changed[f as usize] || changed[g as usize])
+                    .filter(move |&g| {
+                        pair_within(positions, triangles, f.min(g), f.max(g), 0.0).is_some()
+                    })
+                    .map(move |g| [f.min(g), f.max(g)])
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        pairs.extend(found);
+        pairs.sort_unstable();
+        pairs.dedup();
     }
 }
 
@@ -354,6 +464,98 @@ pub(crate) fn undo_new_crossings(
 mod tests {
     use super::*;
     use crate::mesh::test_meshes::{cuboid, uv_sphere};
+
+    /// [`undo_new_crossings`] as it was first written, searching the whole mesh every round:
+    /// the reference the local searches must equal.
+    fn undo_searching_whole(
+        positions: &mut [DVec3],
+        triangles: &[[u32; 3]],
+        start: &[DVec3],
+        before: &[[u32; 3]],
+    ) {
+        loop {
+            let mut undone = false;
+            for t in crossing_faces(positions, triangles) {
+                if before.binary_search(&t).is_ok() {
+                    continue;
+                }
+                for v in t.map(|v| v as usize) {
+                    if positions[v] != start[v] {
+                        positions[v] = start[v];
+                        undone = true;
+                    }
+                }
+            }
+            if !undone {
+                return;
+            }
+        }
+    }
+
+    /// Vertices of a sphere pushed through its far side and jittered, with crossings before
+    /// the moves on one of two boxes: the moves taken back are those of the search over the
+    /// whole mesh every round, position for position, and no new crossing is left.
+    #[test]
+    fn the_local_searches_undo_what_the_whole_search_undoes() {
+        use rand::{RngExt, SeedableRng};
+        let sphere = uv_sphere(1.0, 16, 32);
+        let boxes = {
+            let mut m = cuboid(DVec3::new(3.0, 0.0, 0.0), DVec3::new(5.0, 2.0, 2.0));
+            let b = cuboid(DVec3::new(4.0, 1.0, 1.0), DVec3::new(6.0, 3.0, 3.0));
+            let off = m.positions.len() as u32;
+            m.positions.extend(b.positions);
+            m.triangles
+                .extend(b.triangles.iter().map(|t| t.map(|v| v + off)));
+            m
+        };
+        let m = crate::mesh::test_meshes::union_of(&sphere, &boxes);
+        let before = crossing_faces(&m.positions, &m.triangles);
+        assert!(!before.is_empty());
+        for seed in 0..6 {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let mut moved = m.positions.clone();
+            for (i, p) in moved.iter_mut().enumerate() {
+                if i < sphere.positions.len() && rng.random_range(0.0..1.0) < 0.05 {
+                    *p = -1.3 * *p;
+                } else {
+                    *p += 0.02 * DVec3::new(rng.random(), rng.random(), rng.random());
+                }
+            }
+            let mut reference = moved.clone();
+            undo_searching_whole(&mut reference, &m.triangles, &m.positions, &before);
+            let mut local = moved.clone();
+            undo_new_crossings(&mut local, &m.triangles, &m.positions, &before);
+            assert_ne!(reference, moved, "seed {seed}: nothing was put back");
+            assert_eq!(local, reference, "seed {seed}");
+            let after = crossing_faces(&local, &m.triangles);
+            assert!(after.iter().all(|t| before.binary_search(t).is_ok()));
+        }
+        // A crossing that only putting a vertex back makes: x (on the upper sheet) raised
+        // through the triangle above it is put back, and y (below it on the lower sheet), raised
+        // under x's tent, then pierces the upper sheet: it goes back in the second round.
+        let grid =
+            |z: f64| crate::mesh::test_meshes::grid(4, |i, j| DVec3::new(i as f64, j as f64, z));
+        let above = crate::mesh::TriMesh::new(
+            vec![
+                DVec3::new(1.2, 1.2, 2.0),
+                DVec3::new(2.9, 1.5, 2.0),
+                DVec3::new(1.8, 2.9, 2.0),
+            ],
+            vec![[0, 1, 2]],
+        );
+        let sheets = crate::mesh::test_meshes::union_of(&grid(0.0), &grid(1.0));
+        let m = crate::mesh::test_meshes::union_of(&sheets, &above);
+        let (y, x) = (2 * 5 + 2, 25 + 2 * 5 + 2);
+        let mut moved = m.positions.clone();
+        moved[x].z = 3.0;
+        moved[y].z = 1.5;
+        let mut reference = moved.clone();
+        undo_searching_whole(&mut reference, &m.triangles, &m.positions, &[]);
+        assert_eq!(reference, m.positions, "both go back");
+        let mut local = moved;
+        undo_new_crossings(&mut local, &m.triangles, &m.positions, &[]);
+        assert_eq!(local, reference);
+    }
 
     #[test]
     fn the_early_stopping_test_agrees_with_the_count() {
