@@ -212,7 +212,8 @@ def remesh(
     features : bool
         False: no crease detection (`--no-features`; not with feature_angle).
     triangulation : str or None
-        "restricted" (restricted Delaunay, the default) or "umbrellas".
+        "restricted" (restricted Delaunay, the default; also "restricted-refined"),
+        "restricted-clipped" (its cells clipped exactly from the input's facets) or "umbrellas".
     distance : bool
         Measure the Hausdorff and RMS distance to the input (False is `--no-distance`).
     strict : bool

@@ -243,7 +243,7 @@ def test_bad_reference_raises_value_error():
         ({"max_angle": 50}, r"invalid parameter max_angle"),
         ({"feature_angle": 200}, r"invalid parameter feature_angle"),
         ({"feature_angle": 30, "features": False}, r"give `feature_angle` or `no_features`"),
-        ({"triangulation": "voronoi"}, r"invalid parameter triangulation: must be umbrellas or restricted"),
+        ({"triangulation": "voronoi"}, r"invalid parameter triangulation: must be umbrellas, restricted"),
         ({"lfs_factor": -1.0}, r"invalid parameter lfs_factor"),
         ({"chord_error": float("inf")}, r"invalid parameter chord_error"),
         ({"seed": -1}, r"invalid parameter seed"),

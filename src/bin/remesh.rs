@@ -132,8 +132,10 @@ struct Cli {
 
     /// How the samples are connected: `restricted`, the default (the restricted Delaunay
     /// triangulation on the input mesh: the dual of the samples' Voronoi cells grown over the
-    /// input, which keeps thin parts whole), or `umbrellas` (tangent-plane Delaunay umbrellas
-    /// merged by votes, as before).
+    /// input, which keeps thin parts whole; also `restricted-refined`), `restricted-clipped`
+    /// (the same dual, the cells clipped exactly from the input's facets: faster, but it leaves
+    /// holes at thin tips that the refined cells close), or `umbrellas` (tangent-plane Delaunay
+    /// umbrellas merged by votes, as before).
     #[arg(long, default_value = "restricted", value_name = "METHOD")]
     triangulation: String,
 

@@ -25,7 +25,7 @@ pub enum PointSource {
         /// Whether the normals are given.
         has_normals: bool,
     },
-    /// One of the parts far apart of another source (see [`PointSource::parts`]), read from it
+    /// One of the parts far apart of another source (see `PointSource::parts`), read from it
     /// as it goes.
     Part(PointPart),
 }

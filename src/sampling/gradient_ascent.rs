@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use crate::geometry::morton::morton_order;
+use crate::geometry::morton::morton_code;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
 use crate::sampling::crease_band::CreaseBand;
@@ -50,7 +50,7 @@ pub struct GradientAscentParams {
     pub backtracking: usize,
     /// Samples per window of the sequential sweeps' order (default 4096): the moving samples
     /// are kept along a Z-curve and each sweep takes windows of this many consecutive ones in
-    /// a random order, each window's samples in a random order ([`sweep_order`]), so that the
+    /// a random order, each window's samples in a random order (`sweep_order`), so that the
     /// samples and the input a window reads stay in cache. 1 visits windows of one sample: a
     /// random order over the Z-curve's order.
     pub window: usize,
@@ -139,11 +139,11 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
     if params.sequential {
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        // The moving samples renumbered along a Z-curve (`local[k]` is `samples[perm[k]]`): a
-        // move reads its neighbours and the input near it, and in this numbering both sit
-        // together in memory (in the caller's order, often the scan's random one, each of a
+        // The moving samples renumbered along a Z-curve over cells of side sigma_p (`local[k]`
+        // is `samples[perm[k]]`): a move reads its neighbours and the input near it, and in
+        // this numbering both sit together in memory (in the caller's order, often the scan's random one, each of a
         // million moves missed the cache about twenty times).
-        let perm = cache_order(samples, fixed);
+        let perm = cache_order(samples, fixed, sigma_p);
         let mut local: Vec<SurfaceSample> = perm.iter().map(|&i| samples[i as usize]).collect();
         // Neighbour lists, fixed for all sweeps.
         let lists = neighbour_lists(&local, fixed, r_pos);
@@ -267,12 +267,47 @@ fn neighbour_lists(samples: &[SurfaceSample], from: usize, radius: f64) -> Vec<V
 }
 
 /// The order in which the sequential sweeps keep the samples: `samples[..fixed]` as they are,
-/// then the moving ones along a Z-curve (`geometry::morton`). Entry k is the index in `samples`
-/// of the k-th sample kept.
-fn cache_order(samples: &[SurfaceSample], fixed: usize) -> Vec<u32> {
-    let moving: Vec<glam::DVec3> = samples[fixed..].iter().map(|s| s.position).collect();
+/// then the moving ones along a Z-curve over cells of side `cell` (bbox-100 units; the sweeps
+/// take sigma_p), in index order within a cell. Entry k is the index in `samples` of the k-th
+/// sample kept.
+///
+/// The cells are coarse (about one sample each) and on a grid fixed to multiples of `cell`, so
+/// that the order does not turn on the last bits of the positions: the same surface given in
+/// f32 and in f64 (a `.glb` and an `.obj`) puts its samples in the same order unless one lies
+/// within the rounding of a cell's side (at the finest Morton grid, 2^21 cells over the box, a
+/// sample's f32 rounding crosses a cell's side about once in five).
+fn cache_order(samples: &[SurfaceSample], fixed: usize, cell: f64) -> Vec<u32> {
+    let moving = &samples[fixed..];
+    let cell = if cell > 0.0 && cell.is_finite() {
+        cell
+    } else {
+        1.0
+    };
+    let lo = moving
+        .iter()
+        .map(|s| s.position)
+        .filter(|p| p.is_finite())
+        .fold(glam::DVec3::splat(f64::INFINITY), |a, p| a.min(p));
+    let origin = if lo.is_finite() {
+        (lo / cell).floor() * cell
+    } else {
+        glam::DVec3::ZERO
+    };
+    let mut keyed: Vec<(u64, u32)> = moving
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let code = if s.position.is_finite() {
+                morton_code((s.position - origin) / cell)
+            } else {
+                u64::MAX
+            };
+            (code, k as u32)
+        })
+        .collect();
+    keyed.sort_unstable();
     (0..fixed as u32)
-        .chain(morton_order(&moving).into_iter().map(|k| k + fixed as u32))
+        .chain(keyed.into_iter().map(|(_, k)| k + fixed as u32))
         .collect()
 }
 
@@ -381,7 +416,7 @@ mod tests {
         seed: u64,
     ) {
         let n = samples.len();
-        let perm = cache_order(samples, 0);
+        let perm = cache_order(samples, 0, kernel.sigma_p());
         let mut local: Vec<SurfaceSample> = perm.iter().map(|&i| samples[i as usize]).collect();
         let lists = neighbour_lists(&local, 0, params.support_radius * kernel.sigma_p());
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);

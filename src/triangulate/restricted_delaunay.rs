@@ -41,7 +41,7 @@ pub struct RestrictedDelaunayParams {
     /// figures behind 200: `docs/decisions/restricted-delaunay-default.md`.
     pub max_added_per_sample: usize,
     /// Whether the cells are clipped exactly from the input's facets
-    /// ([`restricted_voronoi`](super::restricted_voronoi::restricted_voronoi), as
+    /// (`restricted_voronoi::restricted_voronoi`, as
     /// [`triangulate_restricted`](super::triangulate_restricted) calls it) rather than grown
     /// over the input refined to `resolution` (this module's search, kept as the oracle the
     /// clipped cells are tested against). `resolution` and `max_added_per_sample` apply to

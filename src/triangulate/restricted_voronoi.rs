@@ -65,13 +65,13 @@ const UNCOVERED_RELATIVE: f64 = 1e-9;
 /// (closed parts that meet at a non-manifold edge are kept apart: no cell grows from one onto
 /// the other). `positions`: the samples (units of the mesh, on or near the surface), distinct;
 /// `normals`: the surface's unit normal at each (which side of a thin part a sample is on:
-/// [`SAME_SIDE_COS`]); `tolerance`: about how far a sample lies from the surface (same units; a
+/// `SAME_SIDE_COS`); `tolerance`: about how far a sample lies from the surface (same units; a
 /// hint to the closest point search). `None` when no three cells meet.
 ///
 /// Where the grown cells leave part of a facet uncovered (the sample nearest there reaches it
 /// only across a thin part), the facet is clipped again among the samples whose cells reach it
 /// or a facet beside it, as the refined oracle gives such a place to the nearest sample whose
-/// cell reaches it over the mesh; up to [`RECLIP_ROUNDS`] times, each reaching one facet
+/// cell reaches it over the mesh; up to `RECLIP_ROUNDS` times, each reaching one facet
 /// further.
 ///
 /// The stats' `refined_vertices` is 0 (nothing is refined); `clipped_facets` counts the
@@ -285,7 +285,7 @@ struct Cells<'a> {
 const SAME_SIDE_COS: f64 = -0.5;
 
 impl Cells<'_> {
-    /// Whether sample `j` takes part in the diagram on facet `f` ([`SAME_SIDE_COS`]).
+    /// Whether sample `j` takes part in the diagram on facet `f` (`SAME_SIDE_COS`).
     fn on_side(&self, j: u32, f: u32) -> bool {
         self.normals[j as usize].dot(self.facet_normals[f as usize]) > SAME_SIDE_COS
     }
