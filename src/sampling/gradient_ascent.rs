@@ -54,6 +54,12 @@ pub struct GradientAscentParams {
     /// samples and the input a window reads stay in cache. 1 visits windows of one sample: a
     /// random order over the Z-curve's order.
     pub window: usize,
+    /// Moving samples from which the sweeps keep them along a Z-curve and visit them window by
+    /// window (default 65,536, about where the samples and the input near them outgrow the
+    /// cache: at 8,600 samples on the horse the two orders took the same time). Below, each
+    /// sweep visits them in a seeded random permutation of the last sweep's order, the order
+    /// before issue 57, and gives the same bytes as before.
+    pub cache_order_from: usize,
 }
 
 impl Default for GradientAscentParams {
@@ -66,6 +72,7 @@ impl Default for GradientAscentParams {
             sequential: true,
             backtracking: 0,
             window: 4096,
+            cache_order_from: 65_536,
         }
     }
 }
@@ -139,18 +146,25 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
     if params.sequential {
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        // The moving samples renumbered along a Z-curve over cells of side sigma_p (`local[k]`
-        // is `samples[perm[k]]`): a move reads its neighbours and the input near it, and in
-        // this numbering both sit together in memory (in the caller's order, often the scan's random one, each of a
-        // million moves missed the cache about twenty times).
-        let perm = cache_order(samples, fixed, sigma_p);
+        // From `cache_order_from` moving samples, they are renumbered along a Z-curve over
+        // cells of side sigma_p (`local[k]` is `samples[perm[k]]`): a move reads its neighbours
+        // and the input near it, and in this numbering both sit together in memory (in the
+        // caller's order, often the scan's random one, each of a million moves missed the cache
+        // about twenty times).
+        let cached = n - fixed >= params.cache_order_from;
+        let perm: Vec<u32> = if cached {
+            cache_order(samples, fixed, sigma_p)
+        } else {
+            (0..n as u32).collect()
+        };
         let mut local: Vec<SurfaceSample> = perm.iter().map(|&i| samples[i as usize]).collect();
         // Neighbour lists, fixed for all sweeps.
         let lists = neighbour_lists(&local, fixed, r_pos);
         let mut embedded: Vec<KernelPoint> = local.iter().map(embed).collect();
         let mut batches = Batches::new(n, MAX_BATCH);
+        let mut order: Vec<usize> = (fixed..n).collect();
         for _ in 0..params.iterations {
-            let order = sweep_order(fixed, n, params.window, &mut rng);
+            next_sweep(&mut order, cached, fixed, params.window, &mut rng);
             let (mut total_move, mut total_s, mut min_s) = (0.0, 0.0, f64::INFINITY);
             // The samples are taken in `order`, in batches of consecutive ones of which no two
             // are neighbours (`sampling::sweep`).
@@ -311,6 +325,23 @@ fn cache_order(samples: &[SurfaceSample], fixed: usize, cell: f64) -> Vec<u32> {
         .collect()
 }
 
+/// The next sweep's visiting `order` of the samples `fixed..` in place: [`sweep_order`] when
+/// the samples are kept in cache order (`cached`), else a seeded shuffle of the last order.
+fn next_sweep(
+    order: &mut Vec<usize>,
+    cached: bool,
+    fixed: usize,
+    window: usize,
+    rng: &mut rand_chacha::ChaCha8Rng,
+) {
+    if cached {
+        *order = sweep_order(fixed, fixed + order.len(), window, rng);
+    } else {
+        use rand::seq::SliceRandom;
+        order.shuffle(rng);
+    }
+}
+
 /// One sweep's visiting order of the samples `fixed..n` (kept in [`cache_order`]): a windowed
 /// random order. The samples are cut into windows of `window` consecutive ones (a patch of the
 /// surface each), the windows taken in a random order and the samples within each in a random
@@ -416,7 +447,12 @@ mod tests {
         seed: u64,
     ) {
         let n = samples.len();
-        let perm = cache_order(samples, 0, kernel.sigma_p());
+        let cached = n >= params.cache_order_from;
+        let perm: Vec<u32> = if cached {
+            cache_order(samples, 0, kernel.sigma_p())
+        } else {
+            (0..n as u32).collect()
+        };
         let mut local: Vec<SurfaceSample> = perm.iter().map(|&i| samples[i as usize]).collect();
         let lists = neighbour_lists(&local, 0, params.support_radius * kernel.sigma_p());
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
@@ -425,8 +461,10 @@ mod tests {
             .map(|s| kernel.embed(s.position, s.normal))
             .collect();
         let (mut ws, mut near, mut sorted) = (MeasureWorkspace::new(), Vec::new(), Vec::new());
+        let mut order: Vec<usize> = (0..n).collect();
         for _ in 0..params.iterations {
-            for i in sweep_order(0, n, params.window, &mut rng) {
+            next_sweep(&mut order, cached, 0, params.window, &mut rng);
+            for &i in &order {
                 let (moved, _, _) = move_one(
                     kernel,
                     surface,
@@ -496,10 +534,11 @@ mod tests {
         let surface = MeshSurface::new(&mesh).unwrap();
         let kernel = Kernel::new(2.0, f64::INFINITY).unwrap();
         let start: Vec<SurfaceSample> = surface_candidates(&mesh, 400, 3);
-        // One window, and windows of 64 samples.
-        for window in [4096, 64] {
+        // The caller's order; cache order in one window, and in windows of 64 samples.
+        for (window, cache_order_from) in [(4096, usize::MAX), (4096, 0), (64, 0)] {
             let params = GradientAscentParams {
                 window,
+                cache_order_from,
                 ..Default::default()
             };
             let mut reference = start.clone();
@@ -531,7 +570,7 @@ mod tests {
                         .iter()
                         .zip(&reference)
                         .all(|(a, b)| a.position == b.position && a.normal == b.normal),
-                    "{threads} threads, window {window}"
+                    "{threads} threads, window {window}, from {cache_order_from}"
                 );
             }
         }

@@ -138,39 +138,13 @@ pub fn restricted_delaunay(
     };
     let label = labels.grow();
     // Dual triangles: refined faces with three labels, counted per triple and orientation.
-    let mut seen: Vec<([u32; 3], bool)> = refined
-        .triangles
-        .iter()
-        .map(|t| t.map(|v| label[v as usize]))
-        .filter(|l| l[0] != l[1] && l[1] != l[2] && l[0] != l[2] && !l.contains(&u32::MAX))
-        .map(|l| {
-            // Rotate the smallest label first; the orientation is whether the rest ascend.
-            let k = (0..3).min_by_key(|&k| l[k]).unwrap_or(0);
-            let r = [l[k], l[(k + 1) % 3], l[(k + 2) % 3]];
-            if r[1] < r[2] {
-                (r, true)
-            } else {
-                ([r[0], r[2], r[1]], false)
-            }
-        })
-        .collect();
-    seen.sort_unstable();
-    // Per triple, the orientation most of its faces give (the ascending one on a tie).
-    let mut tally: Vec<(usize, [u32; 3])> = seen
-        .chunk_by(|a, b| a.0 == b.0)
-        .map(|group| {
-            let t = group[0].0;
-            let forward = group.iter().filter(|x| x.1).count();
-            let backward = group.len() - forward;
-            let corners = if forward >= backward {
-                t
-            } else {
-                [t[0], t[2], t[1]]
-            };
-            (forward.max(backward), corners)
-        })
-        .collect();
-    tally.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    let tally = tally_triples(
+        refined
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| label[v as usize]))
+            .filter(|l| l[0] != l[1] && l[1] != l[2] && l[0] != l[2] && !l.contains(&u32::MAX)),
+    );
     let mut owned = vec![false; positions.len()];
     for &l in &label {
         if l != u32::MAX {
@@ -186,13 +160,53 @@ pub fn restricted_delaunay(
     };
     let voted = tally
         .into_iter()
-        .map(|(_, corners)| VotedTriangle {
+        .map(|(_, corners, _)| VotedTriangle {
             corners,
             votes: 3,
             orientation_conflict: false,
         })
         .collect();
     Some((voted, stats))
+}
+
+/// Dual triangles as they were met (each its three samples, counter-clockwise about the input),
+/// one per distinct triple: how many met it in the orientation most of them give, its corners
+/// in that orientation (the ascending one, after rotating the smallest first, on a tie), and
+/// whether the other orientation was met too; the most met first, then by corners.
+pub(super) fn tally_triples(
+    met: impl IntoIterator<Item = [u32; 3]>,
+) -> Vec<(usize, [u32; 3], bool)> {
+    // Each triple with its orientation: whether its corners ascend after rotating the smallest
+    // first.
+    let mut seen: Vec<([u32; 3], bool)> = met
+        .into_iter()
+        .map(|l| {
+            let k = (0..3).min_by_key(|&k| l[k]).unwrap_or(0);
+            let r = [l[k], l[(k + 1) % 3], l[(k + 2) % 3]];
+            if r[1] < r[2] {
+                (r, true)
+            } else {
+                ([r[0], r[2], r[1]], false)
+            }
+        })
+        .collect();
+    seen.par_sort_unstable();
+    let mut tally: Vec<(usize, [u32; 3], bool)> = seen
+        .chunk_by(|a, b| a.0 == b.0)
+        .map(|group| {
+            let t = group[0].0;
+            let forward = group.iter().filter(|x| x.1).count();
+            let backward = group.len() - forward;
+            let corners = if forward >= backward {
+                t
+            } else {
+                [t[0], t[2], t[1]]
+            };
+            (forward.max(backward), corners, forward > 0 && backward > 0)
+        })
+        .collect();
+    tally.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    tally
 }
 
 /// The search of `restricted_delaunay` for each refined vertex's sample: the nearest sample

@@ -21,7 +21,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashSet;
 
-use super::restricted_delaunay::RestrictedDelaunayStats;
+use super::restricted_delaunay::{tally_triples, RestrictedDelaunayStats};
 use super::tangent_delaunay::VotedTriangle;
 use crate::mesh::sheets::Sheets;
 use crate::mesh::TriMesh;
@@ -61,7 +61,7 @@ const UNCOVERED_RELATIVE: f64 = 1e-9;
 
 /// The dual triangles of the samples' restricted Voronoi cells on `surface`'s mesh, clipped
 /// exactly (see the module), as candidates for [`assemble`](super::assemble): each with 3 votes,
-/// oriented like the input, the ones more cells met first. `sheets`: those of `surface`'s mesh
+/// oriented like the input, the ones more cells met in that orientation first. `sheets`: those of `surface`'s mesh
 /// (closed parts that meet at a non-manifold edge are kept apart: no cell grows from one onto
 /// the other). `positions`: the samples (units of the mesh, on or near the surface), distinct;
 /// `normals`: the surface's unit normal at each (which side of a thin part a sample is on:
@@ -166,38 +166,8 @@ pub fn restricted_voronoi(
     if triangles.is_empty() {
         return None;
     }
-    // Each triple with its orientation: whether its corners ascend after rotating the smallest
-    // first.
-    let mut seen: Vec<([u32; 3], bool)> = triangles
-        .into_iter()
-        .map(|(_, l)| {
-            let k = (0..3).min_by_key(|&k| l[k]).unwrap_or(0);
-            let r = [l[k], l[(k + 1) % 3], l[(k + 2) % 3]];
-            if r[1] < r[2] {
-                (r, true)
-            } else {
-                ([r[0], r[2], r[1]], false)
-            }
-        })
-        .collect();
-    seen.par_sort_unstable();
-    // Per triple, the orientation most cells give (the ascending one on a tie), and how many
-    // cells met it.
-    let mut tally: Vec<(usize, [u32; 3], bool)> = seen
-        .chunk_by(|a, b| a.0 == b.0)
-        .map(|group| {
-            let t = group[0].0;
-            let forward = group.iter().filter(|x| x.1).count();
-            let backward = group.len() - forward;
-            let corners = if forward >= backward {
-                t
-            } else {
-                [t[0], t[2], t[1]]
-            };
-            (group.len(), corners, forward > 0 && backward > 0)
-        })
-        .collect();
-    tally.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    // Per triple, the orientation most cells give and how many gave it.
+    let tally = tally_triples(triangles.into_iter().map(|(_, t)| t));
     let stats = RestrictedDelaunayStats {
         refined_vertices: 0,
         clipped_facets,
