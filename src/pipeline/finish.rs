@@ -199,7 +199,10 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             later_dropped += mesh.remove_unreferenced_vertices();
         }
         // The second stage only where the first left the output's own folds or crossings.
-        if !has_own_crossings(mesh, f.input_crossings) {
+        // Untangle's pairs at the end are those within its `near` (0 or more) of the mesh as it
+        // is when it collapsed nothing: none of them, no face crossing either (no search).
+        let none_left = stats.collapses == 0 && stats.pairs_after == 0;
+        if none_left || !has_own_crossings(mesh, f.input_crossings) {
             break;
         }
     }
