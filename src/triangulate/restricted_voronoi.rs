@@ -273,7 +273,13 @@ impl Cells<'_> {
         s.neighbours.clear();
         self.tree.nearest_n(p, FIRST_NEIGHBOURS, &mut s.neighbours);
         s.neighbours.retain(|&(j, _)| j != i);
-        let mut all = self.positions.len() <= FIRST_NEIGHBOURS;
+        // The squared radius within which `s.neighbours` holds every sample (0: only the
+        // nearest ones asked for first, unless that was all of them).
+        let mut fetched = if self.positions.len() <= FIRST_NEIGHBOURS {
+            f64::INFINITY
+        } else {
+            0.0
+        };
         s.visited.clear();
         s.stack.clear();
         s.stack.push(anchor.face);
@@ -284,26 +290,26 @@ impl Cells<'_> {
             }
             cell.clipped += 1;
             let neighbours = std::mem::take(&mut s.neighbours);
-            let mut complete = self.clip_facet(i, f, &neighbours, s);
+            let complete = self.clip_facet(i, f, &neighbours, s);
             s.neighbours = neighbours;
-            if !complete && !all {
-                // More samples: all within twice the farthest corner of the facet, and the
-                // facet clipped again from the start by them.
-                all = true;
-                let t = self.mesh.triangles[f as usize];
-                let reach = (0..3)
+            // The samples ran out before the security radius held: all samples within twice
+            // the facet's farthest corner (no piece of it is farther), unless the list holds
+            // them already, and the facet clipped again from the start by them.
+            let t = self.mesh.triangles[f as usize];
+            let reach = 4.0
+                * (0..3)
                     .map(|k| self.mesh.positions[t[k] as usize].distance_squared(p))
-                    .fold(0.0, f64::max);
-                self.tree
-                    .within(p, 4.0 * reach * (1.0 + 1e-9), &mut s.neighbours);
+                    .fold(0.0, f64::max)
+                * (1.0 + 1e-9);
+            if !complete && reach > fetched {
+                fetched = reach;
+                self.tree.within(p, reach, &mut s.neighbours);
                 s.neighbours.retain(|&(j, _)| j != i);
                 let neighbours = std::mem::take(&mut s.neighbours);
-                complete = self.clip_facet(i, f, &neighbours, s);
+                self.clip_facet(i, f, &neighbours, s);
                 s.neighbours = neighbours;
             }
-            let _ = complete;
             if self.emit(i, f, s, &mut cell) {
-                let t = self.mesh.triangles[f as usize];
                 for k in 0..s.polygon.len() {
                     let label = s.polygon[k].1;
                     if label >= FACET_EDGE {
@@ -483,19 +489,12 @@ mod tests {
         [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
     }
 
-    /// On a plane the cells are the plane's Voronoi cells cut to the square: their duals are the
-    /// Delaunay triangles (spade's) whose circumcentres lie in the square, counter-clockwise as
-    /// the square's facets.
-    #[test]
-    fn on_a_plane_the_duals_are_the_delaunay_triangles_centred_on_it() {
+    /// The Delaunay triangles (spade's) of `positions` (on z = 0) whose circumcentres lie in the
+    /// square [0, 10]², each rotated to put the smallest first.
+    fn delaunay_centred_in_the_square(positions: &[DVec3]) -> BTreeSet<[u32; 3]> {
         use spade::{DelaunayTriangulation, Point2, Triangulation};
-        let mesh = test_meshes::grid(8, |i, j| DVec3::new(i as f64 * 1.25, j as f64 * 1.25, 0.0));
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-        let positions: Vec<DVec3> = (0..150)
-            .map(|_| DVec3::new(rng.random_range(0.5..9.5), rng.random_range(0.5..9.5), 0.0))
-            .collect();
         let mut dt = DelaunayTriangulation::<Point2<f64>>::new();
-        for p in &positions {
+        for p in positions {
             dt.insert(Point2::new(p.x, p.y)).unwrap();
         }
         let mut expected = BTreeSet::new();
@@ -518,12 +517,38 @@ mod tests {
                 expected.insert(rotated(v));
             }
         }
-        let got: BTreeSet<[u32; 3]> = clipped(&mesh, &positions)
-            .into_iter()
-            .map(rotated)
+        expected
+    }
+
+    /// On a plane the cells are the plane's Voronoi cells cut to the square: their duals are the
+    /// Delaunay triangles (spade's) whose circumcentres lie in the square, counter-clockwise as
+    /// the square's facets. Samples spread evenly, and a dense cluster with a few samples far
+    /// from it (whose cells reach over many facets, past the first nearest samples asked for).
+    #[test]
+    fn on_a_plane_the_duals_are_the_delaunay_triangles_centred_on_it() {
+        let mesh = test_meshes::grid(8, |i, j| DVec3::new(i as f64 * 1.25, j as f64 * 1.25, 0.0));
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let spread: Vec<DVec3> = (0..150)
+            .map(|_| DVec3::new(rng.random_range(0.5..9.5), rng.random_range(0.5..9.5), 0.0))
             .collect();
-        assert!(expected.len() > 200, "{}", expected.len());
-        assert_eq!(got, expected);
+        let mut clustered: Vec<DVec3> = (0..80)
+            .map(|_| DVec3::new(rng.random_range(0.3..2.5), rng.random_range(0.3..2.5), 0.0))
+            .collect();
+        clustered.extend([
+            DVec3::new(8.1, 7.9, 0.0),
+            DVec3::new(8.6, 2.2, 0.0),
+            DVec3::new(2.3, 8.7, 0.0),
+            DVec3::new(5.6, 5.2, 0.0),
+        ]);
+        for (what, positions, least) in [("spread", spread, 200), ("clustered", clustered, 100)] {
+            let expected = delaunay_centred_in_the_square(&positions);
+            let got: BTreeSet<[u32; 3]> = clipped(&mesh, &positions)
+                .into_iter()
+                .map(rotated)
+                .collect();
+            assert!(expected.len() > least, "{what}: {}", expected.len());
+            assert_eq!(got, expected, "{what}");
+        }
     }
 
     /// Samples spread over a sphere: the duals close into a sphere (every edge on two faces, in
