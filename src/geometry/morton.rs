@@ -45,20 +45,43 @@ pub fn morton_order(points: &[DVec3]) -> Vec<u32> {
     let lo = finite().fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
     let hi = finite().fold(DVec3::splat(f64::NEG_INFINITY), |a, p| a.max(*p));
     let scale = morton_scale((hi - lo).max_element());
+    by_code(points, |p| morton_code((p - lo) * scale))
+}
+
+/// The indices of `points` sorted by `code` of each finite point (ties in index order), the
+/// points that are not finite last.
+fn by_code(points: &[DVec3], code: impl Fn(DVec3) -> u64) -> Vec<u32> {
     let mut order: Vec<(u64, u32)> = points
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            let code = if p.is_finite() {
-                morton_code((*p - lo) * scale)
-            } else {
-                u64::MAX
-            };
-            (code, i as u32)
-        })
+        .map(|(i, &p)| (if p.is_finite() { code(p) } else { u64::MAX }, i as u32))
         .collect();
     order.sort_unstable();
     order.into_iter().map(|(_, i)| i).collect()
+}
+
+/// The indices of `points` in Morton (Z-curve) order over cells of side `cell` (same units; a
+/// grid at multiples of `cell`, so that a point's cell does not move with the other points),
+/// in index order within a cell, the points that are not finite last. Coarse cells keep the
+/// order from turning on the last bits of the positions (the same surface in f32 and in f64
+/// gives the same order unless a point lies within the rounding of a cell's side). `cell` not
+/// a positive finite number counts as 1.
+pub fn morton_order_in_cells(points: &[DVec3], cell: f64) -> Vec<u32> {
+    let cell = if cell > 0.0 && cell.is_finite() {
+        cell
+    } else {
+        1.0
+    };
+    let lo = points
+        .iter()
+        .filter(|p| p.is_finite())
+        .fold(DVec3::splat(f64::INFINITY), |a, p| a.min(*p));
+    let origin = if lo.is_finite() {
+        (lo / cell).floor() * cell
+    } else {
+        DVec3::ZERO
+    };
+    by_code(points, |p| morton_code((p - origin) / cell))
 }
 
 #[cfg(test)]

@@ -22,7 +22,12 @@ pub(crate) fn overlapping_box_pairs(boxes: &[(usize, Aabb)]) -> Vec<[u32; 2]> {
     if boxes.len() < 2 {
         return Vec::new();
     }
-    let bvh = crate::geometry::bvh::bvh_of(boxes.iter().copied());
+    box_pairs_in(&crate::geometry::bvh::bvh_of(boxes.iter().copied()))
+}
+
+/// The pairs of [`overlapping_box_pairs`] in a BVH already built over the boxes (leaf data: the
+/// face index; at least two boxes).
+fn box_pairs_in(bvh: &Bvh) -> Vec<[u32; 2]> {
     let mut pairs: Vec<[u32; 2]> = bvh
         .traverse_bvtt_single_tree_parallel::<false>()
         .into_par_iter()
@@ -359,13 +364,7 @@ pub(crate) fn undo_new_crossings(
     let mut pairs: Vec<[u32; 2]> = if boxes.len() < 2 {
         Vec::new()
     } else {
-        let mut candidates: Vec<[u32; 2]> = bvh
-            .traverse_bvtt_single_tree_parallel::<false>()
-            .into_par_iter()
-            .map(|(a, b)| [a.min(b), a.max(b)])
-            .collect();
-        candidates.par_sort_unstable();
-        candidates
+        box_pairs_in(&bvh)
             .into_par_iter()
             .filter(|&[f, g]| pair_within(positions, triangles, f, g, 0.0).is_some())
             .collect()

@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use crate::geometry::morton::morton_code;
+use crate::geometry::morton::morton_order_in_cells;
 use crate::kernel::{Kernel, KernelPoint, SUPPORT_RADIUS};
 use crate::measure::{measure_and_gradient, MeasureWorkspace};
 use crate::sampling::crease_band::CreaseBand;
@@ -291,37 +291,13 @@ fn neighbour_lists(samples: &[SurfaceSample], from: usize, radius: f64) -> Vec<V
 /// within the rounding of a cell's side (at the finest Morton grid, 2^21 cells over the box, a
 /// sample's f32 rounding crosses a cell's side about once in five).
 fn cache_order(samples: &[SurfaceSample], fixed: usize, cell: f64) -> Vec<u32> {
-    let moving = &samples[fixed..];
-    let cell = if cell > 0.0 && cell.is_finite() {
-        cell
-    } else {
-        1.0
-    };
-    let lo = moving
-        .iter()
-        .map(|s| s.position)
-        .filter(|p| p.is_finite())
-        .fold(glam::DVec3::splat(f64::INFINITY), |a, p| a.min(p));
-    let origin = if lo.is_finite() {
-        (lo / cell).floor() * cell
-    } else {
-        glam::DVec3::ZERO
-    };
-    let mut keyed: Vec<(u64, u32)> = moving
-        .iter()
-        .enumerate()
-        .map(|(k, s)| {
-            let code = if s.position.is_finite() {
-                morton_code((s.position - origin) / cell)
-            } else {
-                u64::MAX
-            };
-            (code, k as u32)
-        })
-        .collect();
-    keyed.sort_unstable();
+    let moving: Vec<glam::DVec3> = samples[fixed..].iter().map(|s| s.position).collect();
     (0..fixed as u32)
-        .chain(keyed.into_iter().map(|(_, k)| k + fixed as u32))
+        .chain(
+            morton_order_in_cells(&moving, cell)
+                .into_iter()
+                .map(|k| k + fixed as u32),
+        )
         .collect()
 }
 

@@ -158,15 +158,21 @@ pub fn restricted_delaunay(
         triangles: tally.len(),
         empty_cells: owned.iter().filter(|o| !**o).count(),
     };
-    let voted = tally
+    Some((voted(tally, false), stats))
+}
+
+/// The tallied dual triangles ([`tally_triples`]) as candidates of 3 votes each, in order;
+/// `conflicts`: whether a triple met in both orientations is marked so (the refined cells
+/// never mark it).
+pub(super) fn voted(tally: Vec<(usize, [u32; 3], bool)>, conflicts: bool) -> Vec<VotedTriangle> {
+    tally
         .into_iter()
-        .map(|(_, corners, _)| VotedTriangle {
+        .map(|(_, corners, conflict)| VotedTriangle {
             corners,
             votes: 3,
-            orientation_conflict: false,
+            orientation_conflict: conflicts && conflict,
         })
-        .collect();
-    Some((voted, stats))
+        .collect()
 }
 
 /// Dual triangles as they were met (each its three samples, counter-clockwise about the input),

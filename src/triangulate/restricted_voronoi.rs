@@ -21,7 +21,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashSet;
 
-use super::restricted_delaunay::{tally_triples, RestrictedDelaunayStats};
+use super::restricted_delaunay::{tally_triples, voted, RestrictedDelaunayStats};
 use super::tangent_delaunay::VotedTriangle;
 use crate::mesh::sheets::Sheets;
 use crate::mesh::TriMesh;
@@ -175,15 +175,7 @@ pub fn restricted_voronoi(
         triangles: tally.len(),
         empty_cells,
     };
-    let voted = tally
-        .into_iter()
-        .map(|(_, corners, conflict)| VotedTriangle {
-            corners,
-            votes: 3,
-            orientation_conflict: conflict,
-        })
-        .collect();
-    Some((voted, stats))
+    Some((voted(tally, true), stats))
 }
 
 /// The facets across each facet edge: facets that share the edge's two vertices.
