@@ -7,8 +7,8 @@ reference of issue 38 (horse -> 8600: ours at most 0.5x CGAL).
 The two are alternated in one sitting (the machine is shared) and timed by GNU time as whole
 processes. CGAL's process reads the OBJ, writes and reads an OFF (its Python bindings' only
 reader), remeshes once at the edge length of `--points` equilateral vertices over the input's
-area, and writes OFF. Ours is `remesh IN OUT --points N --no-distance --seed 1 -q`. Prints each
-run and the medians and their ratio.
+area, and writes OFF (eval/references.py's `cgal`). Ours is `remesh IN OUT --points N
+--no-distance --seed 1 -q`. Prints each run and the medians and their ratio.
 """
 
 import argparse
@@ -16,32 +16,8 @@ import statistics
 import subprocess
 import sys
 import tempfile
-from pathlib import Path
 
-
-def cgal_child(src, dst, n):
-    import numpy as np
-    from CGAL import CGAL_Polygon_mesh_processing as PMP
-    from CGAL.CGAL_Polyhedron_3 import Polyhedron_3
-
-    V, F = [], []
-    for line in open(src):
-        if line.startswith("v "):
-            V.append([float(x) for x in line.split()[1:4]])
-        elif line.startswith("f "):
-            F.append([int(x.split("/")[0]) - 1 for x in line.split()[1:4]])
-    V, F = np.array(V), np.array(F)
-    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1).sum()
-    h = (2 * area / (3**0.5 * n)) ** 0.5  # 2n equilateral triangles of side h cover the area
-    off = Path(dst).with_suffix(".in.off")
-    with open(off, "w") as f:
-        f.write(f"OFF\n{len(V)} {len(F)} 0\n")
-        f.writelines(f"{v[0]} {v[1]} {v[2]}\n" for v in V)
-        f.writelines(f"3 {t[0]} {t[1]} {t[2]}\n" for t in F)
-    P = Polyhedron_3(str(off))
-    PMP.isotropic_remeshing([f for f in P.facets()], float(h), P, 1)
-    P.write_to_file(str(dst))
-    print(P.size_of_vertices())
+from references import cgal_child  # the CGAL process, shared with eval/scale
 
 
 def timed(cmd):
