@@ -64,12 +64,18 @@ def triangle_angles(V, F):
     return angles
 
 
-def measures(V, F):
+def triangle_qualities(V, F):
+    """Every triangle's quality Q = 6 A / (sqrt(3) p h), A its area, p its half-perimeter and h its
+    longest edge: 1 for an equilateral triangle, 0 for a degenerate one."""
     T = V[F]
-    angles = triangle_angles(V, F)
     lengths = np.linalg.norm(T[:, [1, 2, 0]] - T, axis=2)
     area = 0.5 * np.linalg.norm(np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]), axis=1)
-    q = 6 * area / (np.sqrt(3) * 0.5 * lengths.sum(1) * lengths.max(1))
+    return 6 * area / (np.sqrt(3) * 0.5 * lengths.sum(1) * lengths.max(1))
+
+
+def measures(V, F):
+    angles = triangle_angles(V, F)
+    q = triangle_qualities(V, F)
     amin = angles.min(1)
     edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
     uniq, counts = np.unique(edges, axis=0, return_counts=True)

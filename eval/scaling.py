@@ -17,6 +17,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import statistics
 import subprocess
 import sys
@@ -43,17 +44,48 @@ def parse_args():
     return p.parse_args()
 
 
-def timed(cmd):
-    """Runs cmd under GNU time -v; returns (wall seconds, peak RSS in MiB, stdout)."""
-    r = subprocess.run(["/usr/bin/time", "-v"] + cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit(f"{Path(sys.argv[0]).stem}: {' '.join(cmd)} failed:\n{r.stderr}")
-    wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", r.stderr).group(1)
+class RunFailed(Exception):
+    """A timed command that exited non-zero or ran out of time: the message is one line, `stderr`
+    all that the command wrote there."""
+
+    def __init__(self, line, stderr=""):
+        super().__init__(line)
+        self.stderr = stderr
+
+
+def run_timed(cmd, timeout=None):
+    """Runs cmd under GNU time -v (its figures written to a file of their own, apart from the
+    command's stderr); returns (wall seconds, peak RSS in MiB, stdout). Raises RunFailed when the
+    command exits non-zero (with the last line of its stderr) or is still running after `timeout`
+    seconds (then its whole process group is killed)."""
+    with tempfile.NamedTemporaryFile("r", prefix="gnu-time-", suffix=".txt") as figures:
+        p = subprocess.Popen(["/usr/bin/time", "-v", "-o", figures.name] + cmd, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, start_new_session=True)
+        try:
+            stdout, stderr = p.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.communicate()
+            raise RunFailed(f"still running after {timeout:g} s, stopped")
+        report = figures.read()
+    if p.returncode != 0:
+        # The command's last words, else GNU time's ("Command terminated by signal 11").
+        lines = [l.strip() for l in stderr.splitlines() if l.strip()] or [report.split("\n")[0].strip()]
+        raise RunFailed((lines[-1] or f"exit status {p.returncode}")[:200], stderr)
+    wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", report).group(1)
     seconds = 0.0
     for part in wall.split(":"):
         seconds = seconds * 60 + float(part)
-    rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", r.stderr).group(1))
-    return seconds, rss_kb / 1024, r.stdout
+    rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", report).group(1))
+    return seconds, rss_kb / 1024, stdout
+
+
+def timed(cmd):
+    """run_timed(cmd), exiting the script with the command's error when it fails."""
+    try:
+        return run_timed(cmd)
+    except RunFailed as e:
+        sys.exit(f"{Path(sys.argv[0]).stem}: {' '.join(cmd)} failed: {e}\n{e.stderr}")
 
 
 def stages(stdout):
