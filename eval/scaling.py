@@ -45,12 +45,13 @@ def parse_args():
 
 
 class RunFailed(Exception):
-    """A timed command that exited non-zero or ran out of time: the message is one line, `stderr`
-    all that the command wrote there."""
+    """A timed command that exited non-zero or ran out of time (`timed_out`): the message is one
+    line, `stderr` all that the command wrote there."""
 
-    def __init__(self, line, stderr=""):
+    def __init__(self, line, stderr="", timed_out=False):
         super().__init__(line)
         self.stderr = stderr
+        self.timed_out = timed_out
 
 
 def run_timed(cmd, timeout=None):
@@ -66,7 +67,7 @@ def run_timed(cmd, timeout=None):
         except subprocess.TimeoutExpired:
             os.killpg(p.pid, signal.SIGKILL)
             p.communicate()
-            raise RunFailed(f"still running after {timeout:g} s, stopped")
+            raise RunFailed(f"still running after {timeout:g} s, stopped", timed_out=True)
         report = figures.read()
     if p.returncode != 0:
         # The command's last words, else GNU time's ("Command terminated by signal 11").
