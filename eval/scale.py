@@ -259,6 +259,7 @@ def plot_tools(sizes, key, ylabel, title, path: Path):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter
 
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     for tool in TOOLS:
@@ -269,6 +270,13 @@ def plot_tools(sizes, key, ylabel, title, path: Path):
             ax.plot(xs, ys, "o-", label=TOOLS[tool], color=COLORS[tool])
     ax.set_xscale("log")
     ax.set_yscale("log")
+    # Plain numbers on both log axes (1,000,000 and 300, not 10^6 and 3x10^2); between the powers
+    # of ten, only 2 and 5 times them over more than a decade, none over more than three.
+    for axis, fmt, (lo, hi) in ((ax.xaxis, "{:,.0f}", ax.get_xlim()), (ax.yaxis, "{:g}", ax.get_ylim())):
+        decades = np.log10(hi / lo)
+        shown = (lambda v: True) if decades <= 1 else (lambda v: decades <= 3 and f"{v:.0e}"[0] in "25")
+        axis.set_major_formatter(FuncFormatter(lambda v, _, fmt=fmt: fmt.format(v)))
+        axis.set_minor_formatter(FuncFormatter(lambda v, _, fmt=fmt, shown=shown: fmt.format(v) if shown(v) else ""))
     ax.set_xlabel("output vertices")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
