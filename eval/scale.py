@@ -176,7 +176,7 @@ def sitting(path, n, tools, repeats, seed, work, geogram_tool, args, unavailable
             except Exception as e:  # RunFailed, or the output unreadable
                 failed[tool] = str(e) if isinstance(e, RunFailed) else f"{type(e).__name__}: {e}".splitlines()[0][:200]
                 if isinstance(e, RunFailed) and e.timed_out:
-                    unavailable[tool] = f"skipped: ran out of time ({args.timeout:g} s) at {n:,}"
+                    unavailable[tool] = f"ran out of time ({args.timeout:g} s) at {n:,}, not run"
                 print(f"  {n:,} run {k + 1}: {TOOLS[tool]} failed: {failed[tool]}", flush=True)
                 continue
             finally:
