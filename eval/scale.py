@@ -223,6 +223,18 @@ def ours_row(n, result, reports):
 # ----------------------------------------------------------------------------- plots
 
 
+def plain_log_labels(axis, fmt, limits):
+    """Plain numbers on a log axis (1,000,000 and 300, not 10^6 and 3x10^2): every power of ten,
+    and between them 2, 3, 4 and 5 times one over at most a decade, 2 and 5 times one over at
+    most three, none over more."""
+    from matplotlib.ticker import FuncFormatter
+
+    decades = np.log10(limits[1] / limits[0])
+    digits = "2345" if decades <= 1 else "25" if decades <= 3 else ""
+    axis.set_major_formatter(FuncFormatter(lambda v, _: fmt.format(v)))
+    axis.set_minor_formatter(FuncFormatter(lambda v, _: fmt.format(v) if f"{v:.0e}"[0] in digits else ""))
+
+
 def plot_stages(rows, path: Path, input_name: str):
     """Ours' microseconds per output vertex stacked by stage (the report's wall seconds), with the
     whole process's wall time over them."""
@@ -242,6 +254,7 @@ def plot_stages(rows, path: Path, input_name: str):
         bottom += vals
     ax.plot(xs, [r["us_per_vertex"] for r in rows], "ko-", label="whole process (wall)")
     ax.set_xscale("log")
+    plain_log_labels(ax.xaxis, "{:,.0f}", ax.get_xlim())
     ax.set_xlabel("output vertices")
     ax.set_ylabel("microseconds per output vertex (wall)")
     ax.set_title(f"remesh {input_name} --points N: cost per output vertex, stacked by stage")
@@ -259,7 +272,6 @@ def plot_tools(sizes, key, ylabel, title, path: Path):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import FuncFormatter
 
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     for tool in TOOLS:
@@ -270,13 +282,8 @@ def plot_tools(sizes, key, ylabel, title, path: Path):
             ax.plot(xs, ys, "o-", label=TOOLS[tool], color=COLORS[tool])
     ax.set_xscale("log")
     ax.set_yscale("log")
-    # Plain numbers on both log axes (1,000,000 and 300, not 10^6 and 3x10^2); between the powers
-    # of ten, only 2 and 5 times them over more than a decade, none over more than three.
-    for axis, fmt, (lo, hi) in ((ax.xaxis, "{:,.0f}", ax.get_xlim()), (ax.yaxis, "{:g}", ax.get_ylim())):
-        decades = np.log10(hi / lo)
-        shown = (lambda v: True) if decades <= 1 else (lambda v: decades <= 3 and f"{v:.0e}"[0] in "25")
-        axis.set_major_formatter(FuncFormatter(lambda v, _, fmt=fmt: fmt.format(v)))
-        axis.set_minor_formatter(FuncFormatter(lambda v, _, fmt=fmt, shown=shown: fmt.format(v) if shown(v) else ""))
+    plain_log_labels(ax.xaxis, "{:,.0f}", ax.get_xlim())
+    plain_log_labels(ax.yaxis, "{:g}", ax.get_ylim())
     ax.set_xlabel("output vertices")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
