@@ -1,4 +1,4 @@
-# Sourced by eval/run, eval/scaling and eval/reconstruction: sets up eval/.venv from the pinned eval/requirements.txt
+# Sourced by eval/run, eval/scale, eval/scaling and eval/reconstruction: sets up eval/.venv from the pinned eval/requirements.txt
 # (first run only, or when the file changes), builds remesh in release mode, and exports
 # REMESH_BIN and PYTHON.
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
