@@ -86,8 +86,8 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     let own = |m: &Mesh, t: [u32; 3]| input_crossings.is_some_and(|r| r.meets(m.corners(t)));
     let bound = params.final_theta_deg;
     // The faces to mend: those with a small angle, smallest first, then those that cross
-    // another face.
-    let targets = |m: &Mesh| -> Vec<u32> {
+    // another face (of `pairs`, the intersecting pairs of live slots).
+    let targets = |m: &Mesh, pairs: &[[u32; 2]]| -> Vec<u32> {
         let (live, slots) = m.live_faces();
         let mut small: Vec<(f64, u32)> = live
             .iter()
@@ -98,21 +98,36 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             .collect();
         small.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let mut out: Vec<u32> = small.into_iter().map(|x| x.1).collect();
-        let mut crossing: Vec<u32> = intersecting_pairs(m.positions(), &live)
-            .into_iter()
-            .filter(|&[f, g]| {
-                let (t, u) = (live[f as usize], live[g as usize]);
+        let mut crossing: Vec<u32> = pairs
+            .iter()
+            .filter(|&&[f, g]| {
+                let (t, u) = (face(m, f), face(m, g));
                 share_a_vertex(t, u) || !own(m, t) || !own(m, u)
             })
             .flatten()
-            .map(|i| slots[i as usize])
+            .copied()
             .collect();
         crossing.sort_unstable();
         crossing.dedup();
         out.extend(crossing);
         out
     };
-    let mut faces = targets(m);
+    // The intersecting pairs (slots, the smaller first, sorted): searched over the whole mesh
+    // once, then after each round only around the faces the round made or moved (the pairs of
+    // faces it left alone stand), through the guard.
+    let mut pairs: Vec<[u32; 2]> = {
+        let (live, slots) = m.live_faces();
+        let mut pairs: Vec<[u32; 2]> = intersecting_pairs(m.positions(), &live)
+            .into_iter()
+            .map(|[f, g]| {
+                let (a, b) = (slots[f as usize], slots[g as usize]);
+                [a.min(b), a.max(b)]
+            })
+            .collect();
+        pairs.sort_unstable();
+        pairs
+    };
+    let mut faces = targets(m, &pairs);
     let mut stats = MendStats {
         budget: MEND_BUDGET_PER_FACE * m.live_faces().0.len() + MEND_BUDGET_BASE,
         ..MendStats::default()
@@ -132,6 +147,8 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     'rounds: for _ in 0..params.final_rounds {
         let mut made = 0;
         let mut touched = vec![false; m.vertex_count()];
+        // The slots the round's operations made or moved.
+        let mut changed: Vec<u32> = Vec::new();
         for &f in &faces {
             let Some(t) = m.face(f) else {
                 continue;
@@ -277,6 +294,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             };
             if let Ok(slots) = applied {
                 guard.changed(m, &slots);
+                changed.extend_from_slice(&slots);
                 made += 1;
                 touched.resize(m.vertex_count(), false);
                 // The changed faces' corners and their rings: every face whose candidate
@@ -299,7 +317,16 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             break;
         }
         touched_before = Some(touched);
-        faces = targets(m);
+        changed.sort_unstable();
+        changed.dedup();
+        pairs.retain(|p| {
+            p.iter()
+                .all(|&f| m.face(f).is_some() && changed.binary_search(&f).is_err())
+        });
+        pairs.extend(guard.pairs_with(m, &changed));
+        pairs.sort_unstable();
+        pairs.dedup();
+        faces = targets(m, &pairs);
         if faces.is_empty() {
             break;
         }
