@@ -267,8 +267,11 @@ pub fn untangle(
     let mut pairs_after = pairs.len();
     if !pairs.is_empty() && params.max_collapses > 0 {
         let offset = params.collapse_offset_sigma_p * sigma_p;
+        // The rounds' guard and pairs are those of the mesh as it is now (when every face is
+        // live, as here, a face's slot is its index): no search again.
+        let found = guard.map(|g| (g, pairs.clone()));
         let (collapses, left) =
-            collapse_folds(&mut m, fixed, params.max_collapses, near, offset, &own);
+            collapse_folds(&mut m, fixed, params.max_collapses, near, offset, &own, found);
         stats.collapses = collapses;
         pairs_after = left;
     }
@@ -304,8 +307,11 @@ const COLLAPSE_CANDIDATES: usize = 16;
 /// those the best smallest angle among the faces it makes; until no pair is left to `own`, none
 /// helps, or `max` collapses are made. The faces are in a [`CrossingGuard`] (a BVH whose leaves
 /// follow the collapses), and the crossing pairs are updated around each collapse: a collapse
-/// costs O(log F) per face it tries, not O(F). Returns the collapses made and the crossing
-/// pairs left. Deterministic.
+/// costs O(log F) per face it tries, not O(F). `found`: such a guard of `m` (built with the same
+/// `near`) and the pairs of slots it gives, when the caller has them (else both are made here,
+/// with one search of the whole mesh). Returns the collapses made and the crossing pairs left.
+/// Deterministic.
+#[allow(clippy::too_many_arguments)] // the mesh, its bounds, and what the caller found
 fn collapse_folds(
     m: &mut Mesh,
     fixed: &[bool],
@@ -313,19 +319,27 @@ fn collapse_folds(
     near: f64,
     offset: f64,
     own: &dyn Fn(&Mesh, [u32; 2]) -> bool,
+    found: Option<(CrossingGuard, Vec<[u32; 2]>)>,
 ) -> (usize, usize) {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
-    let (live, slots) = m.live_faces();
-    let mut guard = CrossingGuard::within(m, near);
     // Crossing pairs of slots, each as [f, g] with f < g.
-    let mut pairs: Vec<[u32; 2]> = pairs_within(m.positions(), &live, near)
-        .into_iter()
-        .map(|[f, g]| {
-            let (a, b) = (slots[f as usize], slots[g as usize]);
-            [a.min(b), a.max(b)]
-        })
-        .collect();
-    drop((live, slots));
+    let (mut guard, mut pairs) = match found {
+        Some((guard, pairs)) => {
+            let pairs = pairs.into_iter().map(|[f, g]| [f.min(g), f.max(g)]).collect();
+            (guard, pairs)
+        }
+        None => {
+            let (live, slots) = m.live_faces();
+            let pairs: Vec<[u32; 2]> = pairs_within(m.positions(), &live, near)
+                .into_iter()
+                .map(|[f, g]| {
+                    let (a, b) = (slots[f as usize], slots[g as usize]);
+                    [a.min(b), a.max(b)]
+                })
+                .collect();
+            (CrossingGuard::within(m, near), pairs)
+        }
+    };
     let mut made = 0;
     while made < max {
         let folds: Vec<[u32; 2]> = pairs.iter().copied().filter(|&p| own(m, p)).collect();
