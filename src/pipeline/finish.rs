@@ -161,6 +161,8 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     // undo keeps its vertices), then, where folds are left, any collapse that removes them.
     let mut untangle_stats = UntangleStats::default();
     let mut mend_after_untangle = MendStats::default();
+    // The intersecting pairs of the mesh as the mending after untangle left it (no search).
+    let mut intersecting: Option<Vec<[u32; 2]>> = None;
     for (stage, offset) in [f.untangle.collapse_offset_sigma_p, f64::INFINITY]
         .into_iter()
         .enumerate()
@@ -182,7 +184,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             // around them, under its guards (no new crossing, near the surface).
             if let Some(op) = f.optimize {
                 let near = around_changed_faces(mesh, &origin);
-                let (stats, origin) = mend_near(
+                let mended = mend_near(
                     mesh,
                     f.surface,
                     &fixed,
@@ -193,8 +195,9 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
                     op,
                     &near,
                 );
-                *face_sources = carried_sources(&origin, face_sources);
-                mend_after_untangle = mend_after_untangle.then(&stats);
+                *face_sources = carried_sources(&mended.origin, face_sources);
+                mend_after_untangle = mend_after_untangle.then(&mended.stats);
+                intersecting = Some(mended.intersecting);
             }
             later_dropped += mesh.remove_unreferenced_vertices();
         }
@@ -202,7 +205,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
         // Untangle's pairs at the end are those within its `near` (0 or more) of the mesh as it
         // is when it collapsed nothing: none of them, no face crossing either (no search).
         let none_left = stats.collapses == 0 && stats.pairs_after == 0;
-        if none_left || !has_own_crossings(mesh, f.input_crossings) {
+        if none_left || !has_own_crossings(mesh, intersecting.take(), f.input_crossings) {
             break;
         }
     }
@@ -244,12 +247,17 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     }
 }
 
-/// Whether faces of `mesh` intersect ([`classified_pairs`]) other than where the input's own
-/// faces cross (a pair that shares a vertex, a fold, always counts: as
-/// [`CrossingRegions::holds_faces`] says).
-fn has_own_crossings(mesh: &TriMesh, regions: Option<&CrossingRegions>) -> bool {
+/// Whether faces of `mesh` intersect ([`intersecting_pairs`]; `known`: those pairs, when the
+/// caller has them) other than where the input's own faces cross (a pair that shares a vertex,
+/// a fold, always counts: as [`CrossingRegions::holds_faces`] says).
+fn has_own_crossings(
+    mesh: &TriMesh,
+    known: Option<Vec<[u32; 2]>>,
+    regions: Option<&CrossingRegions>,
+) -> bool {
     let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
-    intersecting_pairs(&mesh.positions, &mesh.triangles)
+    known
+        .unwrap_or_else(|| intersecting_pairs(&mesh.positions, &mesh.triangles))
         .iter()
         .any(|&[f, g]| {
             let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);

@@ -270,8 +270,15 @@ pub fn untangle(
         // The rounds' guard and pairs are those of the mesh as it is now (when every face is
         // live, as here, a face's slot is its index): no search again.
         let found = guard.map(|g| (g, pairs.clone()));
-        let (collapses, left) =
-            collapse_folds(&mut m, fixed, params.max_collapses, near, offset, &own, found);
+        let (collapses, left) = collapse_folds(
+            &mut m,
+            fixed,
+            params.max_collapses,
+            near,
+            offset,
+            &own,
+            found,
+        );
         stats.collapses = collapses;
         pairs_after = left;
     }
@@ -325,7 +332,10 @@ fn collapse_folds(
     // Crossing pairs of slots, each as [f, g] with f < g.
     let (mut guard, mut pairs) = match found {
         Some((guard, pairs)) => {
-            let pairs = pairs.into_iter().map(|[f, g]| [f.min(g), f.max(g)]).collect();
+            let pairs = pairs
+                .into_iter()
+                .map(|[f, g]| [f.min(g), f.max(g)])
+                .collect();
             (guard, pairs)
         }
         None => {

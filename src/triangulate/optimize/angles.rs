@@ -65,7 +65,8 @@ enum Op {
 ///
 /// Returns what was done ([`MendStats`]): the operations made and the attempts against the
 /// pass's budget ([`MEND_BUDGET_PER_FACE`] per face, at most [`MEND_TRIES_PER_FACE`] failed
-/// attempts a face). Deterministic.
+/// attempts a face); and the pairs of faces (slots, the smaller first, sorted) that intersect
+/// at the end, as [`intersecting_pairs`] over the live faces gives them. Deterministic.
 pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
@@ -74,7 +75,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     params: &Limits,
     near: Option<&[bool]>,
-) -> MendStats {
+) -> (MendStats, Vec<[u32; 2]>) {
     let marked = |t: [u32; 3]| {
         near.is_none_or(|n| {
             t.iter()
@@ -134,7 +135,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     };
     if faces.is_empty() {
         stats.left = faces_left(m, params, |t| own(m, t));
-        return stats;
+        return (stats, pairs);
     }
     let mut guard = CrossingGuard::new(m);
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
@@ -144,11 +145,24 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     // round before it touched.
     let mut tries: Vec<u8> = vec![0; m.slots()];
     let mut touched_before: Option<Vec<bool>> = None;
+    // The slots the round's operations made or moved, and the update of the pairs around them.
+    let mut changed: Vec<u32> = Vec::new();
+    let update =
+        |m: &Mesh, guard: &CrossingGuard, pairs: &mut Vec<[u32; 2]>, changed: &mut Vec<u32>| {
+            changed.sort_unstable();
+            changed.dedup();
+            pairs.retain(|p| {
+                p.iter()
+                    .all(|&f| m.face(f).is_some() && changed.binary_search(&f).is_err())
+            });
+            pairs.extend(guard.pairs_with(m, changed));
+            pairs.sort_unstable();
+            pairs.dedup();
+            changed.clear();
+        };
     'rounds: for _ in 0..params.final_rounds {
         let mut made = 0;
         let mut touched = vec![false; m.vertex_count()];
-        // The slots the round's operations made or moved.
-        let mut changed: Vec<u32> = Vec::new();
         for &f in &faces {
             let Some(t) = m.face(f) else {
                 continue;
@@ -317,22 +331,18 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             break;
         }
         touched_before = Some(touched);
-        changed.sort_unstable();
-        changed.dedup();
-        pairs.retain(|p| {
-            p.iter()
-                .all(|&f| m.face(f).is_some() && changed.binary_search(&f).is_err())
-        });
-        pairs.extend(guard.pairs_with(m, &changed));
-        pairs.sort_unstable();
-        pairs.dedup();
+        update(m, &guard, &mut pairs, &mut changed);
         faces = targets(m, &pairs);
         if faces.is_empty() {
             break;
         }
     }
+    // A round the budget cut short: its changes too.
+    if !changed.is_empty() {
+        update(m, &guard, &mut pairs, &mut changed);
+    }
     stats.left = faces_left(m, params, |t| own(m, t));
-    stats
+    (stats, pairs)
 }
 
 /// The faces still outside the angle bounds, each counted once under the first reason that

@@ -377,7 +377,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
             break;
         }
     }
-    stats.mend = mend_faces(
+    (stats.mend, _) = mend_faces(
         &mut m,
         surface,
         boundary,
@@ -413,8 +413,7 @@ fn write_back(m: Mesh, mesh: &mut TriMesh) -> Vec<Option<u32>> {
 /// The last pass of [`optimize`] alone, on the faces of small angle with a corner marked in
 /// `near` (`V` flags; the faces a later stage changed, such as untangle's collapses, and their
 /// neighbours) and on every face that crosses another, with the same guards (same arguments
-/// and units as [`optimize`]). Returns what it did and, for each face of the result, the index
-/// of the face of `mesh` it still is (`None` for a new or changed face). Deterministic.
+/// and units as [`optimize`]). Returns what it did ([`Mended`]). Deterministic.
 #[allow(clippy::too_many_arguments)] // optimize's arguments, and where to work
 pub fn mend_near<S: SurfaceQuery + ?Sized>(
     mesh: &mut TriMesh,
@@ -426,10 +425,10 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
     sigma_p: f64,
     params: &OptimizeParams,
     near: &[bool],
-) -> (MendStats, Vec<Option<u32>>) {
+) -> Mended {
     let params = &Limits::new(params, sigma_p);
     let (mut m, fixed) = editable(mesh, fixed, protected);
-    let stats = mend_faces(
+    let (stats, pairs) = mend_faces(
         &mut m,
         surface,
         boundary,
@@ -438,7 +437,26 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
         params,
         Some(near),
     );
-    (stats, write_back(m, mesh))
+    // Slots to the indices of the faces written (the live ones in slot order).
+    let (_, slots) = m.live_faces();
+    let index = |f: u32| slots.binary_search(&f).map_or(u32::MAX, |i| i as u32);
+    let intersecting = pairs.iter().map(|p| p.map(index)).collect();
+    Mended {
+        stats,
+        origin: write_back(m, mesh),
+        intersecting,
+    }
+}
+
+/// What [`mend_near`] did and left.
+pub struct Mended {
+    pub stats: MendStats,
+    /// For each face of the result, the index of the face of the mesh before it still is
+    /// (`None` for a new or changed face).
+    pub origin: Vec<Option<u32>>,
+    /// The pairs of faces of the result that intersect (indices, the smaller first, sorted):
+    /// those [`intersecting_pairs`](crate::geometry::intersecting_pairs) finds.
+    pub intersecting: Vec<[u32; 2]>,
 }
 
 /// The vertices of the faces with Q below `q_below`, sorted.

@@ -19,6 +19,21 @@ fn flat(n: usize) -> (TriMesh, MeshSurface) {
     (g, surface)
 }
 
+/// The intersecting pairs of `m`'s live faces ([`intersecting_pairs`]), as slots, the smaller
+/// first, sorted: a search of the whole mesh.
+fn slot_pairs(m: &Mesh) -> Vec<[u32; 2]> {
+    let (live, slots) = m.live_faces();
+    let mut pairs: Vec<[u32; 2]> = intersecting_pairs(m.positions(), &live)
+        .into_iter()
+        .map(|p| {
+            let [a, b] = p.map(|i| slots[i as usize]);
+            [a.min(b), a.max(b)]
+        })
+        .collect();
+    pairs.sort_unstable();
+    pairs
+}
+
 fn limits() -> Limits {
     Limits::new(&OptimizeParams::default(), 1.0)
 }
@@ -64,7 +79,7 @@ fn a_vertex_of_three_faces_near_an_edge_is_collapsed_away() {
     let before = theta_min(&m);
     assert!(before < 20.0, "{before}");
     let fixed = vec![false; m.vertex_count()];
-    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    let (made, _) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
     assert!(made.ops >= 1);
     assert_eq!(m.degree(v), 0, "the vertex is gone");
     assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
@@ -105,7 +120,9 @@ fn a_mesh_without_small_angles_is_left_alone() {
     let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
     let fixed = vec![false; m.vertex_count()];
     assert_eq!(
-        mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None).ops,
+        mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None)
+            .0
+            .ops,
         0
     );
     assert_eq!(m.to_trimesh(), g);
@@ -196,11 +213,14 @@ fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
     let fixed = vec![false; m.vertex_count()];
     // sigma_p 4: the pass may move the mesh by up to 1 off the surface, more than the poke.
     let wide = Limits::new(&OptimizeParams::default(), 4.0);
-    let made = mend_faces(&mut m, &surface, None, None, &fixed, &wide, None);
+    let (made, left) = mend_faces(&mut m, &surface, None, None, &fixed, &wide, None);
     assert!(made.ops >= 1);
     let out = m.to_trimesh();
     let pairs = intersecting_pairs(&out.positions, &out.triangles);
     assert!(pairs.is_empty(), "{pairs:?}");
+    // The pairs the pass kept up to date are what a search finds (none: those of the start
+    // are gone).
+    assert_eq!(left, slot_pairs(&m));
     assert!(
         m.position(poke as u32).z > 0.0,
         "{}",
@@ -210,7 +230,8 @@ fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
     assert_eq!(m.sanity_check(), Ok(()));
     // Without moves that far (sigma_p 1: 0.25), nothing is made that would cross.
     let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
-    mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    let (_, left) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    assert_eq!(left, slot_pairs(&m));
     let out = m.to_trimesh();
     assert!(
         intersecting_pairs(&out.positions, &out.triangles).len()
@@ -286,7 +307,7 @@ fn a_reflex_boundary_corner_with_two_faces_gets_its_edge_split() {
     // neighbours on the boundary have two faces each (no collapse): no flip, collapse or move
     // mends the corner's faces, whose angles at it add up to 206°.
     let fixed = vec![true; m.vertex_count()];
-    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    let (made, _) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
     assert!(made.ops >= 1);
     assert!(m.vertex_count() > 7, "no vertex added");
     assert!(m.degree(v) >= 3, "the corner has {} faces", m.degree(v));
@@ -318,7 +339,7 @@ fn a_boundary_vertex_slides_along_the_boundary_to_mend_its_face() {
     // Without the boundary's lines, vertex 1 stays and nothing mends the face.
     mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
     assert_eq!(m.position(1), DVec3::new(0.12, 0.0, 0.0));
-    let made = mend_faces(
+    let (made, _) = mend_faces(
         &mut m,
         &surface,
         Some(&boundary),
@@ -419,10 +440,60 @@ fn mending_near_marked_vertices_leaves_the_other_faces_as_they_are() {
     let mut near = vec![false; m.vertex_count()];
     near[a as usize] = true;
     let fixed = vec![false; m.vertex_count()];
-    let made = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), Some(&near));
+    let (made, _) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), Some(&near));
     assert!(made.ops >= 1);
     assert!(m.degree(a) == 0 || worst_at(&m, a) >= 30.0);
     assert_eq!(m.position(b), before_b);
     assert!(worst_at(&m, b) < 20.0);
     assert_eq!(m.sanity_check(), Ok(()));
+}
+
+#[test]
+fn mend_near_says_which_faces_of_its_result_intersect() {
+    // Two sheets, a vertex of the upper one poked through the lower. In the lower sheet, whose
+    // faces come first, a diagonal is split very near its end: the pass collapses the short
+    // edge, and leaves the crossing (sigma_p 1: moves of at most 0.25, short of the poke). The
+    // faces written after the collapse are numbered anew, and the pairs given must be.
+    let (surface, mut mesh, _) = poked_sheets();
+    let (a, b) = (8u32, 16u32);
+    let v = mesh.positions.len() as u32;
+    mesh.positions
+        .push(mesh.positions[a as usize].lerp(mesh.positions[b as usize], 0.05));
+    let mut split = Vec::new();
+    for t in &mut mesh.triangles {
+        if t.contains(&a) && t.contains(&b) {
+            // From a: [a, b, c] becomes [a, v, c] (in place) and [v, b, c] (at the end);
+            // [a, c, b] becomes [a, c, v] and [v, c, b].
+            let [x, y, z] = starting_at(*t, a);
+            if y == b {
+                *t = [x, v, z];
+                split.push([v, y, z]);
+            } else {
+                *t = [x, y, v];
+                split.push([v, y, z]);
+            }
+        }
+    }
+    mesh.triangles.extend(split);
+    let (n, faces) = (mesh.positions.len(), mesh.triangles.len());
+    let mended = mend_near(
+        &mut mesh,
+        &surface,
+        &vec![false; n],
+        &[],
+        None,
+        None,
+        1.0,
+        &OptimizeParams::default(),
+        &vec![true; n],
+    );
+    assert!(mesh.triangles.len() < faces, "the test case: a collapse");
+    let mut found: Vec<[u32; 2]> = intersecting_pairs(&mesh.positions, &mesh.triangles)
+        .into_iter()
+        .map(|[f, g]| [f.min(g), f.max(g)])
+        .collect();
+    found.sort_unstable();
+    assert!(!found.is_empty(), "the test case: a crossing left");
+    assert_eq!(mended.intersecting, found);
+    assert_eq!(mended.origin.len(), mesh.triangles.len());
 }
