@@ -312,10 +312,16 @@ pub fn intersecting_pairs(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u
 /// The faces of `triangles` that cross another face ([`intersecting_pairs`]), each as its corners
 /// sorted (so a face keeps its name when an edit mesh moves it to another slot), sorted.
 pub(crate) fn crossing_faces(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
-    let mut faces: Vec<[u32; 3]> = intersecting_pairs(positions, triangles)
-        .into_iter()
+    faces_of_pairs(triangles, &intersecting_pairs(positions, triangles))
+}
+
+/// The faces of `triangles` in `pairs` (indices), as [`crossing_faces`] names them: each as its
+/// corners sorted, sorted, once.
+pub(crate) fn faces_of_pairs(triangles: &[[u32; 3]], pairs: &[[u32; 2]]) -> Vec<[u32; 3]> {
+    let mut faces: Vec<[u32; 3]> = pairs
+        .iter()
         .flatten()
-        .map(|i| {
+        .map(|&i| {
             let mut t = triangles[i as usize];
             t.sort_unstable();
             t

@@ -99,10 +99,12 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     timer: &mut StageTimer,
 ) -> Finished {
     on_stage("optimize");
+    // The intersecting pairs of the mesh as the optimization left it (`None`: not known).
+    let mut intersecting: Option<Vec<[u32; 2]>> = None;
     let fixed_prefix = |n: usize| -> Vec<bool> { (0..n).map(|i| i < f.fixed).collect() };
     let optimize_stats = match f.optimize {
         Some(op) => {
-            let (st, origin) = optimize(
+            let (st, edited) = optimize(
                 mesh,
                 f.surface,
                 f.cover_points,
@@ -113,7 +115,8 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
                 f.sigma_p,
                 op,
             );
-            *face_sources = carried_sources(&origin, face_sources);
+            *face_sources = carried_sources(&edited.origin, face_sources);
+            intersecting = Some(edited.intersecting);
             st
         }
         None => OptimizeStats::default(),
@@ -144,6 +147,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             &fixed,
             f.fit_iterations,
             f.optimize.map(OptimizeParams::angle_bounds),
+            intersecting.as_deref(),
         )
     });
     // Faces that still cross (where the surface's sheets lie closer than the output's chords
@@ -162,7 +166,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     let mut untangle_stats = UntangleStats::default();
     let mut mend_after_untangle = MendStats::default();
     // The intersecting pairs of the mesh as the mending after untangle left it (no search).
-    let mut intersecting: Option<Vec<[u32; 2]>> = None;
+    intersecting = None;
     for (stage, offset) in [f.untangle.collapse_offset_sigma_p, f64::INFINITY]
         .into_iter()
         .enumerate()
@@ -184,7 +188,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             // around them, under its guards (no new crossing, near the surface).
             if let Some(op) = f.optimize {
                 let near = around_changed_faces(mesh, &origin);
-                let mended = mend_near(
+                let (stats, mended) = mend_near(
                     mesh,
                     f.surface,
                     &fixed,
@@ -196,7 +200,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
                     &near,
                 );
                 *face_sources = carried_sources(&mended.origin, face_sources);
-                mend_after_untangle = mend_after_untangle.then(&mended.stats);
+                mend_after_untangle = mend_after_untangle.then(&stats);
                 intersecting = Some(mended.intersecting);
             }
             later_dropped += mesh.remove_unreferenced_vertices();

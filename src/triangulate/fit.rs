@@ -21,7 +21,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::geometry::self_intersection::{crossing_faces, undo_new_crossings};
+use crate::geometry::self_intersection::{crossing_faces, faces_of_pairs, undo_new_crossings};
 use crate::geometry::triangle::AngleBounds;
 use crate::mesh::TriMesh;
 use crate::surface::{SurfacePoint, SurfaceQuery};
@@ -77,18 +77,25 @@ pub struct FitStats {
 /// Moves the vertices of `mesh` not `fixed` along their normals so that the faces approximate
 /// `surface` in the least-squares sense (see the module), in `iterations` Jacobi steps. With
 /// `bounds`, a step's move is undone for the corners of every face it would take out of the
-/// angle bounds (or further out). Parallel and deterministic. `fixed` has one entry per vertex.
+/// angle bounds (or further out). The fit makes no new crossing: the moves that would are undone.
+/// `intersecting`: the pairs of faces (indices) that intersect before, when the caller knows
+/// them (else they are searched for). Parallel and deterministic. `fixed` has one entry per
+/// vertex.
 pub fn fit_to_surface<S: SurfaceQuery + ?Sized>(
     mesh: &mut TriMesh,
     surface: &S,
     fixed: &[bool],
     iterations: usize,
     bounds: Option<AngleBounds>,
+    intersecting: Option<&[[u32; 2]]>,
 ) -> FitStats {
     let n = mesh.positions.len();
     let start = mesh.positions.clone();
     // The faces that cross another before the fit: the fit makes no new crossing.
-    let crossing_before = crossing_faces(&mesh.positions, &mesh.triangles);
+    let crossing_before = match intersecting {
+        Some(pairs) => faces_of_pairs(&mesh.triangles, pairs),
+        None => crossing_faces(&mesh.positions, &mesh.triangles),
+    };
     // Each face's angle score before the fit: what the bounds keep.
     let score_before: Vec<f64> = match &bounds {
         Some(b) => (0..mesh.triangles.len())
@@ -320,7 +327,7 @@ mod tests {
         let free = vec![false; coarse.positions.len()];
         let before = coarse.positions.clone();
         let (worst0, rms0) = distances(&coarse, &free, r);
-        let stats = fit_to_surface(&mut coarse, &surface, &free, 3, None);
+        let stats = fit_to_surface(&mut coarse, &surface, &free, 3, None, None);
         let (worst1, rms1) = distances(&coarse, &free, r);
         // A parabolic sag of δ: largest distance δ → 2/3 δ, RMS 0.73 δ → 0.30 δ.
         assert!(worst1 < 0.75 * worst0, "largest {worst0} -> {worst1}");
@@ -336,7 +343,7 @@ mod tests {
         // A fixed vertex (the bottom ring, a boundary) stays where it is.
         let mut coarse = cylinder(r, 24, 4, 4.0);
         let fixed: Vec<bool> = (0..coarse.positions.len()).map(|v| v < 24).collect();
-        let stats = fit_to_surface(&mut coarse, &surface, &fixed, 3, None);
+        let stats = fit_to_surface(&mut coarse, &surface, &fixed, 3, None, None);
         assert_eq!(coarse.positions[..24], before[..24]);
         assert_eq!(stats.moved, coarse.positions.len() - 24);
     }
@@ -360,7 +367,7 @@ mod tests {
         let mut coarse = cylinder(r, 24, 4, 4.0);
         let free = vec![false; coarse.positions.len()];
         let (worst0, rms0) = distances(&coarse, &free, r);
-        let stats = fit_to_surface(&mut coarse, &surface, &free, 3, None);
+        let stats = fit_to_surface(&mut coarse, &surface, &free, 3, None, None);
         let (worst1, rms1) = distances(&coarse, &free, r);
         // The chords' sag δ (0.085) against RIMLS's own offset from a cylinder (sigma_p^2 / 4r,
         // 0.025 outward): the fit to the true cylinder (largest 2/3 δ) moved out by that offset.
@@ -384,7 +391,14 @@ mod tests {
         let surface = MeshSurface::new(&plane(20)).unwrap();
         let mut out = plane(5);
         let before = out.positions.clone();
-        let stats = fit_to_surface(&mut out, &surface, &vec![false; before.len()], 3, None);
+        let stats = fit_to_surface(
+            &mut out,
+            &surface,
+            &vec![false; before.len()],
+            3,
+            None,
+            None,
+        );
         assert_eq!(out.positions, before);
         assert_eq!(stats.moved, 0);
     }

@@ -304,8 +304,8 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// flipped, and the `protected` edges (the creases kept as edges) are neither flipped nor
 /// collapsed. New vertices are appended, so
 /// existing indices stay valid; vertices merged away by a collapse are left unreferenced.
-/// Returns what was done and, for each face of the result, the index of the face of `mesh` it
-/// still is (`None` for a new or changed face). Deterministic.
+/// Returns what was done, and the faces' origins (the index of the face of `mesh` each face of
+/// the result still is) and intersecting pairs ([`Edited`]). Deterministic.
 ///
 /// # Operations
 ///
@@ -345,7 +345,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
     input_crossings: Option<&CrossingRegions>,
     sigma_p: f64,
     params: &OptimizeParams,
-) -> (OptimizeStats, Vec<Option<u32>>) {
+) -> (OptimizeStats, Edited) {
     let params = &Limits::new(params, sigma_p);
     let mut stats = OptimizeStats::default();
     let (mut m, mut fixed) = editable(mesh, fixed, protected);
@@ -377,7 +377,8 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
             break;
         }
     }
-    (stats.mend, _) = mend_faces(
+    let pairs;
+    (stats.mend, pairs) = mend_faces(
         &mut m,
         surface,
         boundary,
@@ -387,7 +388,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
         None,
     );
     stats.mends = stats.mend.ops;
-    (stats, write_back(m, mesh))
+    (stats, written(m, mesh, &pairs))
 }
 
 /// `mesh` as the mesh the operations edit (each face labelled with its index), its `protected`
@@ -402,18 +403,36 @@ fn editable(mesh: &TriMesh, fixed: &[bool], protected: &[[u32; 2]]) -> (Mesh, Ve
     (m, fixed)
 }
 
-/// Writes the edited `m` back into `mesh`; returns, for each face, the index of the face of
-/// `mesh` it still is (`None` for a new or changed face).
-fn write_back(m: Mesh, mesh: &mut TriMesh) -> Vec<Option<u32>> {
+/// Writes the edited `m` back into `mesh`, with `pairs` (slots of `m`) as the indices of the
+/// faces written.
+fn written(m: Mesh, mesh: &mut TriMesh, pairs: &[[u32; 2]]) -> Edited {
+    // Slots to the indices of the faces written (the live ones in slot order).
+    let (_, slots) = m.live_faces();
+    let index = |f: u32| slots.binary_search(&f).map_or(u32::MAX, |i| i as u32);
+    let intersecting = pairs.iter().map(|p| p.map(index)).collect();
     let (positions, faces, origin) = m.into_parts();
     *mesh = TriMesh::new(positions, faces);
-    origin
+    Edited {
+        origin,
+        intersecting,
+    }
+}
+
+/// What [`optimize`] and [`mend_near`] leave besides their stats.
+pub struct Edited {
+    /// For each face of the result, the index of the face of the mesh before it still is
+    /// (`None` for a new or changed face).
+    pub origin: Vec<Option<u32>>,
+    /// The pairs of faces of the result that intersect (indices, the smaller first, sorted):
+    /// those [`intersecting_pairs`](crate::geometry::intersecting_pairs) finds.
+    pub intersecting: Vec<[u32; 2]>,
 }
 
 /// The last pass of [`optimize`] alone, on the faces of small angle with a corner marked in
 /// `near` (`V` flags; the faces a later stage changed, such as untangle's collapses, and their
 /// neighbours) and on every face that crosses another, with the same guards (same arguments
-/// and units as [`optimize`]). Returns what it did ([`Mended`]). Deterministic.
+/// and units as [`optimize`]). Returns what it did, and the faces' origins and intersecting
+/// pairs ([`Edited`]). Deterministic.
 #[allow(clippy::too_many_arguments)] // optimize's arguments, and where to work
 pub fn mend_near<S: SurfaceQuery + ?Sized>(
     mesh: &mut TriMesh,
@@ -425,7 +444,7 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
     sigma_p: f64,
     params: &OptimizeParams,
     near: &[bool],
-) -> Mended {
+) -> (MendStats, Edited) {
     let params = &Limits::new(params, sigma_p);
     let (mut m, fixed) = editable(mesh, fixed, protected);
     let (stats, pairs) = mend_faces(
@@ -437,26 +456,7 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
         params,
         Some(near),
     );
-    // Slots to the indices of the faces written (the live ones in slot order).
-    let (_, slots) = m.live_faces();
-    let index = |f: u32| slots.binary_search(&f).map_or(u32::MAX, |i| i as u32);
-    let intersecting = pairs.iter().map(|p| p.map(index)).collect();
-    Mended {
-        stats,
-        origin: write_back(m, mesh),
-        intersecting,
-    }
-}
-
-/// What [`mend_near`] did and left.
-pub struct Mended {
-    pub stats: MendStats,
-    /// For each face of the result, the index of the face of the mesh before it still is
-    /// (`None` for a new or changed face).
-    pub origin: Vec<Option<u32>>,
-    /// The pairs of faces of the result that intersect (indices, the smaller first, sorted):
-    /// those [`intersecting_pairs`](crate::geometry::intersecting_pairs) finds.
-    pub intersecting: Vec<[u32; 2]>,
+    (stats, written(m, mesh, &pairs))
 }
 
 /// The vertices of the faces with Q below `q_below`, sorted.
@@ -523,7 +523,9 @@ mod tests {
         surface: &MeshSurface,
         fixed: &[bool],
     ) -> (OptimizeStats, Vec<Option<u32>>) {
-        optimize(mesh, surface, &[], fixed, &[], None, None, 1.0, &no_cover())
+        let (stats, edited) =
+            optimize(mesh, surface, &[], fixed, &[], None, None, 1.0, &no_cover());
+        (stats, edited.origin)
     }
 
     fn no_cover() -> OptimizeParams {
