@@ -476,7 +476,7 @@ fn mend_near_says_which_faces_of_its_result_intersect() {
     }
     mesh.triangles.extend(split);
     let (n, faces) = (mesh.positions.len(), mesh.triangles.len());
-    let (stats, mended) = mend_near(
+    let (_, mended) = mend_near(
         &mut mesh,
         &surface,
         &vec![false; n],
