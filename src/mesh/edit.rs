@@ -189,6 +189,20 @@ pub struct EditMesh<L: Copy = ()> {
     /// Vertex → the live faces around it.
     around: Vec<Vec<u32>>,
     policy: SlotPolicy,
+    /// What changed since [`EditMesh::track_changes`] or the last [`EditMesh::take_changes`]
+    /// (`None`: not tracked).
+    changes: Option<Changes>,
+}
+
+/// What changed in an [`EditMesh`] while it tracked its changes ([`EditMesh::track_changes`]),
+/// each in the order it happened, with repeats: what a pass that keeps a set of faces up to
+/// date (the finishing stage's poor faces) looks at again, instead of every face.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Changes {
+    /// Face slots whose face was made, replaced or removed.
+    pub faces: Vec<u32>,
+    /// Vertices given a new position (moves tried and taken back too).
+    pub vertices: Vec<u32>,
 }
 
 impl<L: Copy> EditMesh<L> {
@@ -205,6 +219,33 @@ impl<L: Copy> EditMesh<L> {
             protected: FxHashSet::default(),
             around: vec![Vec::new(); n],
             policy,
+            changes: None,
+        }
+    }
+
+    /// From now on, records the faces made, replaced or removed and the vertices moved
+    /// ([`Changes`]), until [`EditMesh::take_changes`] takes them.
+    pub fn track_changes(&mut self) {
+        self.changes = Some(Changes::default());
+    }
+
+    /// The changes recorded since [`EditMesh::track_changes`] or the last call (none when not
+    /// tracking); the record starts again empty.
+    pub fn take_changes(&mut self) -> Changes {
+        self.changes
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+
+    /// Stops recording changes (and drops those not taken).
+    pub fn stop_tracking(&mut self) {
+        self.changes = None;
+    }
+
+    fn record_move(&mut self, v: u32) {
+        if let Some(c) = &mut self.changes {
+            c.vertices.push(v);
         }
     }
 
@@ -399,6 +440,7 @@ impl<L: Copy> EditMesh<L> {
             return Err(EditError::NonFinitePosition { vertex: v });
         }
         self.positions[v as usize] = p;
+        self.record_move(v);
         Ok(())
     }
 
@@ -619,6 +661,7 @@ impl<L: Copy> EditMesh<L> {
             self.replace(g, t, label);
         }
         self.positions[kept as usize] = position;
+        self.record_move(kept);
         Ok(())
     }
 
@@ -773,6 +816,9 @@ impl<L: Copy> EditMesh<L> {
     }
 
     fn link(&mut self, f: u32) {
+        if let Some(c) = &mut self.changes {
+            c.faces.push(f);
+        }
         let t = self.faces[f as usize];
         for k in 0..3 {
             self.edge.insert((t[k], t[(k + 1) % 3]), f);
@@ -782,6 +828,9 @@ impl<L: Copy> EditMesh<L> {
 
     /// Removes `f` from the tables (an edge entry only where it names `f`).
     fn unlink(&mut self, f: u32) {
+        if let Some(c) = &mut self.changes {
+            c.faces.push(f);
+        }
         let t = self.faces[f as usize];
         for k in 0..3 {
             let e = (t[k], t[(k + 1) % 3]);

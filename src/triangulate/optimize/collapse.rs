@@ -5,7 +5,7 @@ use glam::DVec3;
 
 use super::*;
 
-/// Collapses the interior edges of poor triangles shorter than `short`, shortest first: one end
+/// Collapses the interior edges of the poor triangles `poor` shorter than `short`, shortest first: one end
 /// merges into the other, at the kept end's position (a fixed end is always the kept one) or at
 /// the surface point nearest the edge's midpoint, whichever leaves the best smallest Q. A
 /// collapse is made only when it keeps the mesh manifold (the link condition: the two ends share
@@ -18,13 +18,11 @@ pub(super) fn collapse_short<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     short: f64,
     params: &Limits,
+    poor: &PoorFaces,
 ) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let mut edges: Vec<(f64, u32, u32)> = Vec::new();
-    for t in m.live_faces().0 {
-        if !is_poor(m, t, params) {
-            continue;
-        }
+    for t in poor.slots().map(|f| face(m, f)) {
         for k in 0..3 {
             let (x, y) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
             let l = m.position(x).distance(m.position(y));

@@ -352,6 +352,8 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
     let short = params.short_edge_ratio * median_edge_length(&m);
     let mut watch = None;
     stats.smooth = smooth(&mut m, surface, &fixed, params, params.smooth_iterations);
+    // The sweeps' poor faces, kept up to date as covering and the sweeps change the mesh.
+    let mut poor = PoorFaces::new(&mut m, params);
     for round in 0..params.cover_rounds.max(1) {
         if params.cover_distance.is_finite() {
             let added = cover(&mut m, cover_points, &mut watch, params);
@@ -363,9 +365,14 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
             }
         }
         for _ in 0..params.sweeps {
-            let c = collapse_short(&mut m, surface, &fixed, short, params);
-            let f = flip_poor(&mut m, surface, params);
-            let r = relax_poor(&mut m, surface, &fixed, params);
+            poor.refresh(&mut m, params);
+            let c = collapse_short(&mut m, surface, &fixed, short, params, &poor);
+            poor.refresh(&mut m, params);
+            let vertices = poor.vertices(&m);
+            let f = flip_poor(&mut m, surface, params, &vertices);
+            poor.refresh(&mut m, params);
+            let vertices = poor.vertices(&m);
+            let r = relax_poor(&mut m, surface, &fixed, params, &vertices);
             stats.collapses += c;
             stats.flips += f;
             stats.moves += r;
@@ -377,6 +384,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
             break;
         }
     }
+    m.stop_tracking();
     let pairs;
     (stats.mend, pairs) = mend_faces(
         &mut m,
@@ -459,18 +467,58 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
     (stats, written(m, mesh, &pairs))
 }
 
-/// The vertices of the faces with Q below `q_below`, sorted.
-pub(super) fn poor_vertices(m: &Mesh, params: &Limits) -> Vec<u32> {
-    let mut v: Vec<u32> = m
-        .live_faces()
-        .0
-        .into_iter()
-        .filter(|&t| is_poor(m, t, params))
-        .flatten()
-        .collect();
-    v.sort_unstable();
-    v.dedup();
-    v
+/// The faces the sweeps work on ([`is_poor`]), kept up to date from the changes the mesh
+/// records ([`EditMesh::track_changes`]) instead of being found again over every face: after
+/// an operation, only the faces it made, replaced or removed and the faces around the vertices
+/// it moved are looked at again. The set is that of a scan of every live face.
+pub(super) struct PoorFaces {
+    /// The poor faces' slots.
+    poor: std::collections::BTreeSet<u32>,
+}
+
+impl PoorFaces {
+    /// The poor faces of `m`, which from now on records its changes.
+    pub(super) fn new(m: &mut Mesh, params: &Limits) -> Self {
+        m.track_changes();
+        let (live, slots) = m.live_faces();
+        let poor = live
+            .into_iter()
+            .zip(slots)
+            .filter(|&(t, _)| is_poor(m, t, params))
+            .map(|(_, f)| f)
+            .collect();
+        PoorFaces { poor }
+    }
+
+    /// Brings the set up to date with the changes `m` recorded since the last call.
+    pub(super) fn refresh(&mut self, m: &mut Mesh, params: &Limits) {
+        let changes = m.take_changes();
+        let mut look = changes.faces;
+        for v in changes.vertices {
+            look.extend_from_slice(m.faces_around(v));
+        }
+        look.sort_unstable();
+        look.dedup();
+        for f in look {
+            match m.face(f) {
+                Some(t) if is_poor(m, t, params) => self.poor.insert(f),
+                _ => self.poor.remove(&f),
+            };
+        }
+    }
+
+    /// The poor faces' slots, in order.
+    pub(super) fn slots(&self) -> impl Iterator<Item = u32> + '_ {
+        self.poor.iter().copied()
+    }
+
+    /// The vertices of the poor faces, sorted.
+    pub(super) fn vertices(&self, m: &Mesh) -> Vec<u32> {
+        let mut v: Vec<u32> = self.poor.iter().flat_map(|&f| face(m, f)).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
 }
 
 /// The median edge length of the live faces (0 for an empty mesh).
@@ -533,6 +581,52 @@ mod tests {
             cover_distance_sigma_p: f64::INFINITY,
             ..Default::default()
         }
+    }
+
+    /// The poor faces of a scan of every live face of `m`.
+    fn scanned_poor(m: &Mesh, params: &Limits) -> Vec<u32> {
+        let (live, slots) = m.live_faces();
+        live.into_iter()
+            .zip(slots)
+            .filter(|&(t, _)| is_poor(m, t, params))
+            .map(|(_, f)| f)
+            .collect()
+    }
+
+    #[test]
+    fn the_poor_faces_kept_up_to_date_are_those_a_scan_finds() {
+        let params = Limits::new(&OptimizeParams::default(), 1.0);
+        let mut m: Mesh = EditMesh::from_trimesh(&grid(8, 1.0), Some, SlotPolicy::Reuse);
+        let mut poor = PoorFaces::new(&mut m, &params);
+        assert!(
+            poor.slots().next().is_none(),
+            "a grid of right triangles is not poor"
+        );
+        let check = |m: &mut Mesh, poor: &mut PoorFaces, what: &str| {
+            poor.refresh(m, &params);
+            let kept: Vec<u32> = poor.slots().collect();
+            assert_eq!(kept, scanned_poor(m, &params), "after {what}");
+            kept.len()
+        };
+        // A move makes faces poor, a move back mends them.
+        let v = 3 * 9 + 3;
+        let p = m.position(v);
+        m.relocate_vertex(v, p + DVec3::new(0.7, 0.2, 0.0)).unwrap();
+        assert!(check(&mut m, &mut poor, "a move") > 0);
+        m.relocate_vertex(v, p).unwrap();
+        assert_eq!(check(&mut m, &mut poor, "a move back"), 0);
+        // A flip, a split, a collapse (which removes faces, whose slots a split then reuses).
+        m.flip_edge(4 * 9 + 4, 5 * 9 + 5, None).unwrap();
+        check(&mut m, &mut poor, "a flip");
+        let w = m.add_vertex(m.position(6 * 9 + 1).lerp(m.position(6 * 9 + 2), 0.1));
+        m.split_edge(6 * 9 + 1, 6 * 9 + 2, w, None).unwrap();
+        assert!(check(&mut m, &mut poor, "a split") > 0);
+        m.collapse_edge(w, 6 * 9 + 1, m.position(6 * 9 + 1), None)
+            .unwrap();
+        check(&mut m, &mut poor, "a collapse");
+        let u = m.add_vertex(m.position(2 * 9 + 6).lerp(m.position(2 * 9 + 7), 0.05));
+        m.split_edge(2 * 9 + 6, 2 * 9 + 7, u, None).unwrap();
+        assert!(check(&mut m, &mut poor, "a split into free slots") > 0);
     }
 
     #[test]

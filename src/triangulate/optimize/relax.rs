@@ -5,16 +5,17 @@ use glam::DVec3;
 
 use super::*;
 
-/// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around poor triangles'
-/// vertices, where the new faces face the way the old ones did and stay within `max_offset` of
+/// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around `poor_vertices`
+/// (the poor triangles' vertices, [`PoorFaces::vertices`]), where the new faces face the way the old ones did and stay within `max_offset` of
 /// the surface. Returns the number of flips.
 pub(super) fn flip_poor<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
     params: &Limits,
+    poor_vertices: &[u32],
 ) -> usize {
     let mut edges: Vec<(u32, u32)> = Vec::new();
-    for v in poor_vertices(m, params) {
+    for &v in poor_vertices {
         for &f in m.faces_around(v) {
             let t = face(m, f);
             for k in 0..3 {
@@ -62,18 +63,20 @@ pub(super) fn flip_all<S: SurfaceQuery + ?Sized>(
     })
 }
 
-/// One sweep of relaxation over the vertices of poor triangles (see [`optimize`]).
+/// One sweep of relaxation over `poor_vertices` (the poor triangles' vertices,
+/// [`PoorFaces::vertices`]; see [`optimize`]).
 /// Returns the number of moves.
 pub(super) fn relax_poor<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
     fixed: &[bool],
     params: &Limits,
+    poor_vertices: &[u32],
 ) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let mut moves = 0;
     let mut ring: Vec<u32> = Vec::new();
-    for v in poor_vertices(m, params) {
+    for &v in poor_vertices {
         if fixed.get(v as usize).copied().unwrap_or(false) {
             continue;
         }
