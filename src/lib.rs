@@ -119,6 +119,7 @@ mod app;
 mod check;
 mod disjoint_sets;
 mod error;
+mod finish;
 #[doc(hidden)]
 pub mod geometry;
 mod io;
@@ -231,23 +232,26 @@ pub mod internal {
     pub use crate::sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
     pub use crate::surface::candidates::surface_candidates;
 
-    // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
-    // optimization against the input, the separation of crossing faces.
-    pub use crate::geometry::self_intersection::CrossingRegions;
-    pub use crate::geometry::triangle::AngleBounds;
-    pub use crate::triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
-    pub use crate::triangulate::optimize::{
-        optimize, FacesLeft, MendStats, OptimizeParams, OptimizeStats, SmoothStats,
-        SMOOTH_ITERATIONS,
-    };
-    pub use crate::triangulate::stray_shells::StrayShells;
+    // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the faces
+    // without support removed.
     pub use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
-    pub use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
     pub use crate::triangulate::{
         assemble, triangulate, triangulate_restricted, vote_triangles, AssemblyParams,
         AssemblyStats, FaceSource, RefineParams, RestrictedDelaunayParams, RestrictedDelaunayStats,
         SampleSet, TangentDelaunayParams, TriangulateParams, TriangulationMethod, VotedTriangle,
     };
+
+    // The finishing stage: the local optimization against the input, the fit, the separation of
+    // crossing faces, the stray shells.
+    pub use crate::finish::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
+    pub use crate::finish::optimize::{
+        optimize, FacesLeft, MendStats, OptimizeParams, OptimizeStats, SmoothStats,
+        SMOOTH_ITERATIONS,
+    };
+    pub use crate::finish::stray_shells::StrayShells;
+    pub use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
+    pub use crate::geometry::self_intersection::CrossingRegions;
+    pub use crate::geometry::triangle::AngleBounds;
 
     // The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).
     pub use crate::kernel::{GaussianKernel, Kernel, KernelPoint, UnitKernel, SUPPORT_RADIUS};

@@ -17,6 +17,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::finish::optimize::{MendStats, OptimizeStats};
+use crate::finish::stray_shells::StrayShells;
+use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::kernel::Kernel;
 use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::pipeline::finish::{finish, Finishing, StrayRule};
@@ -43,11 +46,8 @@ use crate::surface::features::FeatureDetection;
 use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
-use crate::triangulate::optimize::{MendStats, OptimizeStats};
 use crate::triangulate::pillows::{open_pillows, FaceSide, Pillows};
-use crate::triangulate::stray_shells::StrayShells;
 use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
-use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
 
 mod parts;

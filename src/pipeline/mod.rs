@@ -15,12 +15,12 @@ mod sizing;
 mod triangulation;
 
 use crate::error::{Error, Result};
+use crate::finish::untangle::UntangleParams;
 use crate::geometry::self_intersection::CrossingRegions;
 use crate::mesh::{Normalization, TriMesh};
 use crate::sampling::spacing::sigma_p_for_count;
 use crate::surface::features::Features;
 use crate::timing::StageTimer;
-use crate::triangulate::untangle::UntangleParams;
 use ascent::{ascend, Ascended};
 use finish::{finish, Finished, Finishing, StrayRule};
 use input::{Candidates, InputIndex, NormalizedInput};

@@ -10,13 +10,13 @@ use glam::DVec3;
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 
-use super::flip::max_min_flips;
 use crate::geometry::triangle::{triangle_min_angle_deg, triangle_q, AngleBounds};
 use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::mesh_projection::MeshSurface;
 use crate::surface::SurfaceQuery;
+use crate::triangulate::flip::max_min_flips;
 
 mod angles;
 mod collapse;
