@@ -129,7 +129,6 @@ pub mod manifold;
 mod measure;
 mod mesh;
 mod pipeline;
-mod point_pipeline;
 mod points;
 mod report;
 mod sampling;
@@ -158,7 +157,7 @@ pub use check::{check_invariants, topology, Topology, Violation};
 pub use report::{QualityReport, SurfaceDistance, TriangleQuality};
 // Point sets: a scan to a mesh, and the out-of-core linear scan.
 pub use app::remesh_point_set;
-pub use point_pipeline::{remesh_points, PointRemeshOutput, PointRemeshParams, OPEN_GAP_SIGMA_P};
+pub use pipeline::points::{remesh_points, PointRemeshOutput, PointRemeshParams, OPEN_GAP_SIGMA_P};
 pub use points::out_of_core::{simplify_out_of_core, OutOfCoreParams, OutOfCoreResult};
 pub use points::source::PointSource;
 // Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.
@@ -297,7 +296,7 @@ pub mod internal {
     pub use crate::points::rimls::{Rimls, RimlsParams, RimlsProjection};
 
     // Point sets in, meshes out (issue 19).
-    pub use crate::point_pipeline::{
+    pub use crate::pipeline::points::{
         is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams,
         DOMAIN_GAP_SIGMA_P, MAX_SCANS, MAX_SURFACE_VARIATION, OPEN_GAP_SIGMA_P,
         RIMLS_POINTS_PER_SAMPLE,

@@ -243,7 +243,7 @@ fn the_reader_sees_the_known_arrows() {
     for (from, to) in [
         ("pipeline::scan", "sampling::linear_scan"),
         ("pipeline::finish", "finish::untangle"),
-        ("point_pipeline", "pipeline::finish"),
+        ("pipeline::points", "pipeline::finish"),
         ("sampling::features", "sampling::curves"),
         ("surface::front_regions", "surface::winding_number"),
         ("finish::optimize", "mesh::edit"),
@@ -312,14 +312,7 @@ fn no_file_imports_a_file_that_imports_it() {
 #[test]
 fn the_never_arrows_do_not_exist() {
     // (from, to, why): no module of the first group names one of the second.
-    let pipeline = [
-        "pipeline",
-        "point_pipeline",
-        "sampling",
-        "triangulate",
-        "finish",
-        "app",
-    ];
+    let pipeline = ["pipeline", "sampling", "triangulate", "finish", "app"];
     let stages = [
         "geometry",
         "spatial",
@@ -343,14 +336,7 @@ fn the_never_arrows_do_not_exist() {
         ),
         (
             &["surface", "check", "report"],
-            &[
-                "sampling",
-                "triangulate",
-                "finish",
-                "pipeline",
-                "point_pipeline",
-                "app",
-            ],
+            &["sampling", "triangulate", "finish", "pipeline", "app"],
             "the input surface and the analysis never reach into the stages that use them",
         ),
         (
@@ -363,11 +349,7 @@ fn the_never_arrows_do_not_exist() {
             &["finish"],
             "the triangulation never imports the finishing stage that runs after it",
         ),
-        (
-            &stages,
-            &["pipeline", "point_pipeline", "app"],
-            "no stage knows what runs it",
-        ),
+        (&stages, &["pipeline", "app"], "no stage knows what runs it"),
         (&stages, &analysis, "check and report feed no stage"),
     ];
     let mut broken = Vec::new();
