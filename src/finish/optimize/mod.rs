@@ -305,7 +305,7 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// collapsed. New vertices are appended, so
 /// existing indices stay valid; vertices merged away by a collapse are left unreferenced.
 /// Returns what was done, and the faces' origins (the index of the face of `mesh` each face of
-/// the result still is) and intersecting pairs ([`Edited`]). Deterministic.
+/// the result still is) and intersecting pairs (`Edited`). Deterministic.
 ///
 /// # Operations
 ///
