@@ -119,6 +119,7 @@ mod app;
 mod check;
 mod disjoint_sets;
 mod error;
+mod finish;
 #[doc(hidden)]
 pub mod geometry;
 mod io;
@@ -128,7 +129,6 @@ pub mod manifold;
 mod measure;
 mod mesh;
 mod pipeline;
-mod point_pipeline;
 mod points;
 mod report;
 mod sampling;
@@ -157,7 +157,7 @@ pub use check::{check_invariants, topology, Topology, Violation};
 pub use report::{QualityReport, SurfaceDistance, TriangleQuality};
 // Point sets: a scan to a mesh, and the out-of-core linear scan.
 pub use app::remesh_point_set;
-pub use point_pipeline::{remesh_points, PointRemeshOutput, PointRemeshParams, OPEN_GAP_SIGMA_P};
+pub use pipeline::points::{remesh_points, PointRemeshOutput, PointRemeshParams, OPEN_GAP_SIGMA_P};
 pub use points::out_of_core::{simplify_out_of_core, OutOfCoreParams, OutOfCoreResult};
 pub use points::source::PointSource;
 // Point sets near a manifold of any dimension in R^d: the linear scan and the gradient ascent.
@@ -231,23 +231,26 @@ pub mod internal {
     pub use crate::sampling::target_count::{find_sigma_p, TargetCountParams, TargetCountResult};
     pub use crate::surface::candidates::surface_candidates;
 
-    // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the local
-    // optimization against the input, the separation of crossing faces.
-    pub use crate::geometry::self_intersection::CrossingRegions;
-    pub use crate::geometry::triangle::AngleBounds;
-    pub use crate::triangulate::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
-    pub use crate::triangulate::optimize::{
-        optimize, FacesLeft, MendStats, OptimizeParams, OptimizeStats, SmoothStats,
-        SMOOTH_ITERATIONS,
-    };
-    pub use crate::triangulate::stray_shells::StrayShells;
+    // Triangulation stages: local Delaunay umbrellas and votes, assembly and clean-up, the faces
+    // without support removed.
     pub use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
-    pub use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
     pub use crate::triangulate::{
         assemble, triangulate, triangulate_restricted, vote_triangles, AssemblyParams,
         AssemblyStats, FaceSource, RefineParams, RestrictedDelaunayParams, RestrictedDelaunayStats,
         SampleSet, TangentDelaunayParams, TriangulateParams, TriangulationMethod, VotedTriangle,
     };
+
+    // The finishing stage: the local optimization against the input, the fit, the separation of
+    // crossing faces, the stray shells.
+    pub use crate::finish::fit::{fit_to_surface, FitStats, FIT_MAX_SHIFT};
+    pub use crate::finish::optimize::{
+        optimize, FacesLeft, MendStats, OptimizeParams, OptimizeStats, SmoothStats,
+        SMOOTH_ITERATIONS,
+    };
+    pub use crate::finish::stray_shells::StrayShells;
+    pub use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
+    pub use crate::geometry::self_intersection::CrossingRegions;
+    pub use crate::geometry::triangle::AngleBounds;
 
     // The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).
     pub use crate::kernel::{GaussianKernel, Kernel, KernelPoint, UnitKernel, SUPPORT_RADIUS};
@@ -293,7 +296,7 @@ pub mod internal {
     pub use crate::points::rimls::{Rimls, RimlsParams, RimlsProjection};
 
     // Point sets in, meshes out (issue 19).
-    pub use crate::point_pipeline::{
+    pub use crate::pipeline::points::{
         is_point_set, remesh_points, rimls_params, PointRemeshOutput, PointRemeshParams,
         DOMAIN_GAP_SIGMA_P, MAX_SCANS, MAX_SURFACE_VARIATION, OPEN_GAP_SIGMA_P,
         RIMLS_POINTS_PER_SAMPLE,

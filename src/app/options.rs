@@ -3,11 +3,11 @@
 //! [`RemeshOptions::params`], so the same options give the same pipeline, byte for byte.
 
 use crate::error::{Error, Result};
+use crate::finish::optimize::SMOOTH_ITERATIONS;
 use crate::pipeline::{Density, RemeshParams, FIT_ITERATIONS};
 use crate::sampling::grading::GradingParams;
 use crate::surface::curvature::CurvatureParams;
 use crate::surface::features::FeatureDetection;
-use crate::triangulate::optimize::SMOOTH_ITERATIONS;
 use crate::triangulate::{RestrictedDelaunayParams, TriangulationMethod};
 
 /// The most sweeps `--iterations` (gradient ascent), `--smooth` (finishing relaxation) and

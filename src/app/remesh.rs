@@ -92,7 +92,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         report: job.report.as_deref().map(AtomicFile::create).transpose()?,
     };
     let write = |mesh: &TriMesh| write_output(job, format, mesh, &outputs);
-    let report = if job.as_points || crate::point_pipeline::is_point_set(&job.input)? {
+    let report = if job.as_points || crate::pipeline::points::is_point_set(&job.input)? {
         remesh_points::run(
             job,
             &PointSource::File(job.input.clone()),

@@ -16,9 +16,9 @@ use super::DISTANCE_SAMPLES;
 use crate::error::{Error, Result};
 use crate::io::{as_written, MeshFormat};
 use crate::mesh::TriMesh;
+use crate::pipeline::points::{remesh_points, PointRemeshParams};
 use crate::pipeline::RemeshParams;
 use crate::pipeline::{Density, MAX_POINTS};
-use crate::point_pipeline::{remesh_points, PointRemeshParams};
 use crate::points::source::PointSource;
 use crate::report::{PointSetDistance, QualityReport};
 use crate::surface::MeshSurface;
@@ -199,7 +199,7 @@ pub(super) fn run(
     if let Some(n) = out.target {
         let v = out.mesh.vertex_count() as f64;
         let per_vertex = out.input_points as f64 / n as f64;
-        let sparse = per_vertex < crate::point_pipeline::RIMLS_POINTS_PER_SAMPLE as f64;
+        let sparse = per_vertex < crate::pipeline::points::RIMLS_POINTS_PER_SAMPLE as f64;
         if (v - n as f64).abs() > 0.01 * n as f64 && sparse {
             report.notes.push(format!(
                 "the input has {per_vertex:.2} points per vertex asked: samples are lost where \
@@ -217,7 +217,7 @@ pub(super) fn run(
             "the points leave {} boundary loops open (gaps in the data wider than {} sigma_p: \
              {} faces across them were removed)",
             report.topology.boundary_loops,
-            crate::point_pipeline::OPEN_GAP_SIGMA_P,
+            crate::pipeline::points::OPEN_GAP_SIGMA_P,
             out.unsupported.faces
                 + out.unsupported.pinched_faces
                 + out.unsupported_after_finishing.faces

@@ -6,16 +6,16 @@
 
 use glam::DVec3;
 
+use crate::finish::degenerate::{mend_degenerate_faces, DegenerateStats};
+use crate::finish::fit::{fit_to_surface, FitStats};
+use crate::finish::optimize::{mend_near, optimize, MendStats, OptimizeParams, OptimizeStats};
+use crate::finish::stray_shells::{remove_stray_shells, StrayShells};
+use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::mesh::{orient_consistently, OrientStats, TriMesh};
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::SurfaceQuery;
 use crate::timing::StageTimer;
-use crate::triangulate::degenerate::{mend_degenerate_faces, DegenerateStats};
-use crate::triangulate::fit::{fit_to_surface, FitStats};
-use crate::triangulate::optimize::{mend_near, optimize, MendStats, OptimizeParams, OptimizeStats};
-use crate::triangulate::stray_shells::{remove_stray_shells, StrayShells};
-use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::FaceSource;
 
 /// The most vertices of a shell [`remove_stray_shells`] removes: a few samples closing on

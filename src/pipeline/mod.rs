@@ -3,6 +3,9 @@
 //! field ([`sizing`]) → the linear scan with the sigma_p search for a count ([`scan`]) → the
 //! gradient ascent ([`ascent`]) → the triangulation ([`triangulation`]) → the finishing stage
 //! shared with point sets ([`finish`]) → back to model units ([`output`]).
+//!
+//! The pipeline for a point set (a scan), on the RIMLS surface of its points, is [`points`]
+//! (parts far apart each on its own: `points/parts.rs`).
 
 mod ascent;
 mod features;
@@ -10,17 +13,18 @@ pub(crate) mod finish;
 mod input;
 mod output;
 mod params;
+pub(crate) mod points;
 mod scan;
 mod sizing;
 mod triangulation;
 
 use crate::error::{Error, Result};
+use crate::finish::untangle::UntangleParams;
 use crate::geometry::self_intersection::CrossingRegions;
 use crate::mesh::{Normalization, TriMesh};
 use crate::sampling::spacing::sigma_p_for_count;
 use crate::surface::features::Features;
 use crate::timing::StageTimer;
-use crate::triangulate::untangle::UntangleParams;
 use ascent::{ascend, Ascended};
 use finish::{finish, Finished, Finishing, StrayRule};
 use input::{Candidates, InputIndex, NormalizedInput};

@@ -4,14 +4,14 @@ use super::input::{Candidates, NormalizedInput};
 use super::params::Target;
 use super::sizing::Sizing;
 use super::Run;
+use crate::finish::optimize::{MendStats, OptimizeStats};
+use crate::finish::stray_shells::StrayShells;
+use crate::finish::untangle::UntangleStats;
 use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::sampling::gradient_ascent::GradientAscentResult;
 use crate::sampling::grading::GradingStats;
 use crate::surface::features::Features;
 use crate::timing::{Stage, StageTimer};
-use crate::triangulate::optimize::{MendStats, OptimizeStats};
-use crate::triangulate::stray_shells::StrayShells;
-use crate::triangulate::untangle::UntangleStats;
 use crate::triangulate::AssemblyStats;
 
 /// The sharp features [`remesh`](super::remesh) found on its input
@@ -103,7 +103,7 @@ pub struct RemeshOutput {
     /// The optimization's last pass again around the faces untangle's collapses changed.
     pub mend_after_untangle: MendStats,
     /// What the mending of faces of no area did.
-    pub degenerate: crate::triangulate::degenerate::DegenerateStats,
+    pub degenerate: crate::finish::degenerate::DegenerateStats,
     /// The pairs of `input_normalized`'s faces that cross (looked for only when the input
     /// passes through itself), as `geometry::self_intersection::intersecting_pairs` gives them.
     pub input_crossing_pairs: Vec<[u32; 2]>,
@@ -113,7 +113,7 @@ pub struct RemeshOutput {
     /// crossings are the input's own.
     pub junction_faces: Vec<u32>,
     /// What the least-squares fit to the input did (`None` when it was off).
-    pub fit: Option<crate::triangulate::fit::FitStats>,
+    pub fit: Option<crate::finish::fit::FitStats>,
     /// How each face of `mesh` came in.
     pub face_sources: Vec<crate::triangulate::FaceSource>,
     /// What the restricted Delaunay triangulation did; `None` when the umbrellas made the

@@ -1,6 +1,8 @@
 //! The parameters of [`remesh`](super::remesh) and the density they ask for.
 
 use crate::error::{Error, Result};
+use crate::finish::optimize::OptimizeParams;
+use crate::finish::untangle::UntangleParams;
 use crate::kernel::Kernel;
 use crate::mesh::TriMesh;
 use crate::sampling::gradient_ascent::GradientAscentParams;
@@ -8,8 +10,6 @@ use crate::sampling::grading::GradingParams;
 use crate::sampling::linear_scan::LinearScanParams;
 use crate::surface::curvature::CurvatureParams;
 use crate::surface::features::FeatureDetection;
-use crate::triangulate::optimize::OptimizeParams;
-use crate::triangulate::untangle::UntangleParams;
 use crate::triangulate::{TriangulateParams, TriangulationMethod};
 
 /// How dense the output is: a vertex count, or sigma_p directly.

@@ -1,20 +1,16 @@
 //! Triangulating surface samples: local tangent-plane Delaunay umbrellas merged by votes, then a
-//! manifold clean-up.
+//! manifold clean-up. The finishing stage's operators on the triangulated samples are in
+//! [`crate::finish`].
 
 pub mod cleanup;
-pub mod degenerate;
-pub mod fit;
-mod flip;
-pub mod optimize;
+pub(crate) mod flip;
 pub mod pillows;
 pub mod recover;
 pub mod refine;
 pub mod restricted_delaunay;
 pub mod restricted_voronoi;
-pub mod stray_shells;
 pub mod tangent_delaunay;
 pub mod unsupported;
-pub mod untangle;
 
 pub use cleanup::{assemble, AssemblyParams, AssemblyStats, FaceSource};
 pub use refine::RefineParams;

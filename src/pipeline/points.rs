@@ -3,12 +3,12 @@
 //! tangent-plane umbrellas → local optimization and fit against it → untangle → outward orientation
 //! → model units. The paper's Figure 1 path (Sec. 6.1, 6.2 and 7).
 //!
-//! The mesh pipeline ([`crate::pipeline`]) has an input surface to project onto, measure against
-//! and take boundaries, creases and local feature size from; here the surface is the RIMLS surface
-//! ([`Rimls`](crate::internal::Rimls), Öztireli, Guennebaud, Gross 2009) of a uniformly random
-//! subset of the points (the first bucket of the out-of-core scan) and the samples, with the
-//! sampling's sigma_p and sigma_n, so memory stays bounded by the output and one bucket, not by the
-//! input.
+//! The mesh pipeline (the rest of [`crate::pipeline`]) has an input surface to project onto,
+//! measure against and take boundaries, creases and local feature size from; here the surface is
+//! the RIMLS surface ([`Rimls`](crate::internal::Rimls), Öztireli, Guennebaud, Gross 2009) of a
+//! uniformly random subset of the points (the first bucket of the out-of-core scan) and the
+//! samples, with the sampling's sigma_p and sigma_n, so memory stays bounded by the output and one
+//! bucket, not by the input.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -17,6 +17,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::finish::optimize::{MendStats, OptimizeStats};
+use crate::finish::stray_shells::StrayShells;
+use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::kernel::Kernel;
 use crate::mesh::{Normalization, OrientStats, TriMesh};
 use crate::pipeline::finish::{finish, Finishing, StrayRule};
@@ -43,11 +46,8 @@ use crate::surface::features::FeatureDetection;
 use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
-use crate::triangulate::optimize::{MendStats, OptimizeStats};
 use crate::triangulate::pillows::{open_pillows, FaceSide, Pillows};
-use crate::triangulate::stray_shells::StrayShells;
 use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
-use crate::triangulate::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
 
 mod parts;

@@ -10,13 +10,13 @@ use glam::DVec3;
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 
-use super::flip::max_min_flips;
 use crate::geometry::triangle::{triangle_min_angle_deg, triangle_q, AngleBounds};
 use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::mesh_projection::MeshSurface;
 use crate::surface::SurfaceQuery;
+use crate::triangulate::flip::max_min_flips;
 
 mod angles;
 mod collapse;
@@ -305,7 +305,7 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// collapsed. New vertices are appended, so
 /// existing indices stay valid; vertices merged away by a collapse are left unreferenced.
 /// Returns what was done, and the faces' origins (the index of the face of `mesh` each face of
-/// the result still is) and intersecting pairs ([`Edited`]). Deterministic.
+/// the result still is) and intersecting pairs (`Edited`). Deterministic.
 ///
 /// # Operations
 ///
