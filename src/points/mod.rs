@@ -1,5 +1,5 @@
 //! Point sets without connectivity, the paper's native input (Sec. 3): streaming reading (PLY,
-//! XYZ/CSV) and writing, dense random point sets drawn from meshes for tests and benchmarks, the
+//! XYZ/CSV; PCD read whole) and writing, dense random point sets drawn from meshes for tests and benchmarks, the
 //! out-of-core randomized linear scan, normal estimation, and the RIMLS surface of a point set.
 
 pub mod area_guess;
@@ -11,6 +11,7 @@ pub mod generate;
 pub mod normals;
 pub mod out_of_core;
 pub mod outliers;
+pub mod pcd;
 pub mod rimls;
 pub mod source;
 pub mod stream;

@@ -31,6 +31,8 @@ enum Encoding {
     BinaryBig,
     /// XYZ/CSV text: one point per line, values separated by commas, semicolons or blanks.
     Text,
+    /// Read whole when opened (PCD): the points are in `loaded`.
+    Loaded,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,6 +112,8 @@ fn camera_viewpoint(slots: &[usize], values: &[f64]) -> Option<DVec3> {
 ///   as a range map's `camera`, are skipped; in binary they must hold scalars only); its
 ///   properties must be scalars; `x y z` are required, `nx ny nz` are
 ///   used when all three are present, everything else is skipped;
+/// - PCD (`.pcd`; `points::pcd::read_pcd`: ascii, binary or binary_compressed, points
+///   without depth left out, `VIEWPOINT` as the viewpoint), read whole when opened;
 /// - XYZ/CSV text (`.xyz .csv .txt .pts .asc .xyzn`): one point per line, `x y z` or
 ///   `x y z nx ny nz` (further columns skipped), separated by commas, semicolons or blanks. A
 ///   first line of names (`x,y,z,nx,ny,nz` in any order, any case) picks the columns; blank lines
@@ -130,6 +134,8 @@ pub struct PointReader {
     buffer: Vec<u8>,
     line: String,
     line_number: usize,
+    /// The points of a file read whole (PCD), in order.
+    loaded: Vec<Point>,
 }
 
 impl PointReader {
@@ -144,6 +150,9 @@ impl PointReader {
     pub fn open(path: &Path) -> Result<Self> {
         if is_text_extension(path) {
             return Self::open_text(path);
+        }
+        if super::pcd::is_pcd_extension(path) {
+            return Self::open_pcd(path);
         }
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let mut input = BufReader::with_capacity(1 << 20, file);
@@ -328,6 +337,28 @@ impl PointReader {
             buffer: Vec::new(),
             line: String::new(),
             line_number,
+            loaded: Vec::new(),
+        })
+    }
+
+    /// Opens a PCD file and reads it whole (`points::pcd::read_pcd`).
+    fn open_pcd(path: &Path) -> Result<Self> {
+        let pcd = super::pcd::read_pcd(path)?;
+        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        Ok(PointReader {
+            path: path.to_path_buf(),
+            input: BufReader::new(file),
+            encoding: Encoding::Loaded,
+            count: pcd.points.len() as u64,
+            read: 0,
+            properties: Vec::new(),
+            record_size: 0,
+            has_normals: pcd.has_normals,
+            viewpoint: Some(pcd.viewpoint),
+            buffer: Vec::new(),
+            line: String::new(),
+            line_number: 0,
+            loaded: pcd.points,
         })
     }
 
@@ -428,6 +459,7 @@ impl PointReader {
             buffer: Vec::new(),
             line,
             line_number: skipped_head,
+            loaded: Vec::new(),
         })
     }
 
@@ -462,6 +494,11 @@ impl PointReader {
         }
         let mut values = [0.0f64; 6];
         match self.encoding {
+            Encoding::Loaded => {
+                let from = self.read as usize;
+                out.extend_from_slice(&self.loaded[from..from + n]);
+                self.read += n as u64;
+            }
             Encoding::Ascii | Encoding::Text => {
                 let text = self.encoding == Encoding::Text;
                 let mut got = 0;
@@ -605,7 +642,7 @@ fn fill(input: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
 /// A file that cannot be read or is not PLY is not a point set (reading it as a mesh then says
 /// what is wrong); this never fails.
 pub(crate) fn is_point_set(path: &Path) -> Result<bool> {
-    if is_text_extension(path) {
+    if is_text_extension(path) || super::pcd::is_pcd_extension(path) {
         return Ok(true);
     }
     let is_ply = path

@@ -1,0 +1,95 @@
+use super::*;
+use pcd_rs::{DataKind, DynRecord, DynWriter, Schema, ValueKind, WriterInit};
+
+/// Writes `rows` (x y z, and a fourth float field `intensity`) as a PCD of `kind`, `width` ×
+/// `height`, with the sensor at `viewpoint`.
+fn write(path: &Path, kind: DataKind, rows: &[[f32; 4]], width: u64, viewpoint: [f64; 3]) {
+    let schema = Schema::from_iter([
+        ("x", ValueKind::F32, 1),
+        ("y", ValueKind::F32, 1),
+        ("z", ValueKind::F32, 1),
+        ("intensity", ValueKind::F32, 1),
+    ]);
+    let mut writer: DynWriter<_> = WriterInit {
+        width,
+        height: rows.len() as u64 / width,
+        viewpoint: pcd_rs::ViewPoint {
+            tx: viewpoint[0],
+            ty: viewpoint[1],
+            tz: viewpoint[2],
+            ..Default::default()
+        },
+        data_kind: kind,
+        schema: Some(schema),
+        version: None,
+    }
+    .create(path)
+    .unwrap();
+    for r in rows {
+        let record = DynRecord(r.iter().map(|&v| Field::F32(vec![v])).collect());
+        writer.push(&record).unwrap();
+    }
+    writer.finish().unwrap();
+}
+
+#[test]
+fn the_three_encodings_read_back_the_points_written_and_leave_out_the_pixels_without_depth() {
+    let dir = tempfile::tempdir().unwrap();
+    // An organized 3 × 2 frame: two pixels without depth (NaN), as a depth camera writes them.
+    let nan = f32::NAN;
+    let rows = [
+        [0.5, -1.25, 2.0, 7.0],
+        [nan, nan, nan, 0.0],
+        [1.5, 0.25, 2.5, 1.0],
+        [-0.75, 3.0, 1.0, 2.0],
+        [nan, 1.0, nan, 3.0],
+        [2.0, 2.0, 4.0, 4.0],
+    ];
+    let finite: Vec<DVec3> = rows
+        .iter()
+        .filter(|r| r[..3].iter().all(|v| v.is_finite()))
+        .map(|r| DVec3::new(r[0] as f64, r[1] as f64, r[2] as f64))
+        .collect();
+    for kind in [
+        DataKind::Ascii,
+        DataKind::Binary,
+        DataKind::BinaryCompressed,
+    ] {
+        let path = dir.path().join(format!("{kind:?}.pcd"));
+        write(&path, kind, &rows, 3, [0.25, -2.0, 10.0]);
+        let read = read_pcd(&path).unwrap();
+        let positions: Vec<DVec3> = read.points.iter().map(|p| p.position).collect();
+        assert_eq!(positions, finite, "{kind:?}");
+        assert_eq!(read.left_out, 2, "{kind:?}");
+        assert!(!read.has_normals);
+        assert_eq!(read.viewpoint, DVec3::new(0.25, -2.0, 10.0));
+        // The same through the point reader the pipeline uses.
+        let mut reader = crate::points::PointReader::open(&path).unwrap();
+        assert_eq!(reader.count(), 4);
+        assert_eq!(reader.viewpoint(), Some(DVec3::new(0.25, -2.0, 10.0)));
+        let (mut all, mut chunk) = (Vec::new(), Vec::new());
+        while reader.read_chunk(&mut chunk, 3).unwrap() > 0 {
+            all.extend(chunk.iter().map(|p| p.position));
+        }
+        assert_eq!(all, finite);
+        assert!(crate::points::stream::is_point_set(&path).unwrap());
+    }
+}
+
+#[test]
+fn a_file_without_x_y_z_or_not_pcd_is_an_error_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scan.pcd");
+    std::fs::write(
+        &path,
+        "VERSION .7\nFIELDS a b c\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n\
+         VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n",
+    )
+    .unwrap();
+    let e = read_pcd(&path).unwrap_err().to_string();
+    assert!(e.contains("scan.pcd") && e.contains("x y z"), "{e}");
+    std::fs::write(&path, "ply\nformat ascii 1.0\n").unwrap();
+    let e = read_pcd(&path).unwrap_err().to_string();
+    assert!(e.contains("scan.pcd") && e.contains("PCD"), "{e}");
+    assert!(!e.contains('\n'), "one line: {e}");
+}
