@@ -1,5 +1,5 @@
 //! Point sets without connectivity, the paper's native input (Sec. 3): streaming reading (PLY,
-//! XYZ/CSV; PCD read whole) and writing, dense random point sets drawn from meshes for tests and benchmarks, the
+//! XYZ/CSV, LAS; PCD read whole) and writing, dense random point sets drawn from meshes for tests and benchmarks, the
 //! out-of-core randomized linear scan, normal estimation, and the RIMLS surface of a point set.
 
 pub mod area_guess;
@@ -8,6 +8,7 @@ pub(crate) mod buckets;
 pub mod far_groups;
 pub mod flatness;
 pub mod generate;
+pub(crate) mod las;
 pub mod normals;
 pub mod out_of_core;
 pub mod outliers;

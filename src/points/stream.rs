@@ -33,6 +33,8 @@ enum Encoding {
     Text,
     /// Read whole when opened (PCD): the points are in `loaded`.
     Loaded,
+    /// LAS, read in chunks through `las`.
+    Las,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -114,6 +116,7 @@ fn camera_viewpoint(slots: &[usize], values: &[f64]) -> Option<DVec3> {
 ///   used when all three are present, everything else is skipped;
 /// - PCD (`.pcd`; `points::pcd::read_pcd`: ascii, binary or binary_compressed, points
 ///   without depth left out, `VIEWPOINT` as the viewpoint), read whole when opened;
+/// - LAS (`.las`; `points::las`: the points' `x y z`, scaled), in chunks;
 /// - XYZ/CSV text (`.xyz .csv .txt .pts .asc .xyzn`): one point per line, `x y z` or
 ///   `x y z nx ny nz` (further columns skipped), separated by commas, semicolons or blanks. A
 ///   first line of names (`x,y,z,nx,ny,nz` in any order, any case) picks the columns; blank lines
@@ -136,6 +139,8 @@ pub struct PointReader {
     line_number: usize,
     /// The points of a file read whole (PCD), in order.
     loaded: Vec<Point>,
+    /// A LAS file's reader.
+    las: Option<super::las::LasPoints>,
 }
 
 impl PointReader {
@@ -153,6 +158,9 @@ impl PointReader {
         }
         if super::pcd::is_pcd_extension(path) {
             return Self::open_pcd(path);
+        }
+        if super::las::is_las_extension(path) {
+            return Self::open_las(path);
         }
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let mut input = BufReader::with_capacity(1 << 20, file);
@@ -338,6 +346,29 @@ impl PointReader {
             line: String::new(),
             line_number,
             loaded: Vec::new(),
+            las: None,
+        })
+    }
+
+    /// Opens a LAS file (`points::las`), read in chunks.
+    fn open_las(path: &Path) -> Result<Self> {
+        let las = super::las::LasPoints::open(path)?;
+        let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        Ok(PointReader {
+            path: path.to_path_buf(),
+            input: BufReader::new(file),
+            encoding: Encoding::Las,
+            count: las.count(),
+            read: 0,
+            properties: Vec::new(),
+            record_size: 0,
+            has_normals: false,
+            viewpoint: None,
+            buffer: Vec::new(),
+            line: String::new(),
+            line_number: 0,
+            loaded: Vec::new(),
+            las: Some(las),
         })
     }
 
@@ -359,6 +390,7 @@ impl PointReader {
             line: String::new(),
             line_number: 0,
             loaded: pcd.points,
+            las: None,
         })
     }
 
@@ -460,6 +492,7 @@ impl PointReader {
             line,
             line_number: skipped_head,
             loaded: Vec::new(),
+            las: None,
         })
     }
 
@@ -494,6 +527,19 @@ impl PointReader {
         }
         let mut values = [0.0f64; 6];
         match self.encoding {
+            Encoding::Las => {
+                let mut positions = Vec::with_capacity(n);
+                if let Some(las) = &self.las {
+                    las.read(&self.path, self.read, n, &mut positions)?;
+                }
+                if positions.len() < n {
+                    self.read += positions.len() as u64;
+                    return Err(self.truncated());
+                }
+                for p in positions {
+                    self.push(out, &[p.x, p.y, p.z, 0.0, 0.0, 0.0])?;
+                }
+            }
             Encoding::Loaded => {
                 let from = self.read as usize;
                 out.extend_from_slice(&self.loaded[from..from + n]);
@@ -642,7 +688,10 @@ fn fill(input: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
 /// A file that cannot be read or is not PLY is not a point set (reading it as a mesh then says
 /// what is wrong); this never fails.
 pub(crate) fn is_point_set(path: &Path) -> Result<bool> {
-    if is_text_extension(path) || super::pcd::is_pcd_extension(path) {
+    if is_text_extension(path)
+        || super::pcd::is_pcd_extension(path)
+        || super::las::is_las_extension(path)
+    {
         return Ok(true);
     }
     let is_ply = path
