@@ -20,15 +20,15 @@ use std::path::Path;
 use glam::DVec3;
 use pcd_rs::{DynReader, Field};
 
-use super::stream::Point;
 use crate::error::{Error, Result};
 
 /// The points of a PCD file (see the module).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PcdPoints {
-    /// The points with finite coordinates, in file order (the file's units; unit normals, or
-    /// zero without normals).
-    pub points: Vec<Point>,
+    /// The points with finite coordinates, in file order (the file's units).
+    pub positions: Vec<DVec3>,
+    /// Their unit normals (zero where not finite), or none without normals.
+    pub normals: Vec<DVec3>,
     /// Whether the file has normals (`normal_x normal_y normal_z`).
     pub has_normals: bool,
     /// The sensor's position (`VIEWPOINT`'s translation; the origin by default), the file's
@@ -72,7 +72,9 @@ pub fn read_pcd(path: &Path) -> Result<PcdPoints> {
     if !viewpoint.is_finite() {
         return Err(parse("a VIEWPOINT that is not finite".into()));
     }
-    let mut points = Vec::with_capacity(meta.num_points.min(1 << 26) as usize);
+    let capacity = meta.num_points.min(1 << 26) as usize;
+    let mut positions = Vec::with_capacity(capacity);
+    let mut normals = Vec::new();
     let mut left_out = 0;
     for (i, record) in reader.enumerate() {
         let record = record.map_err(|e| parse(format!("point {}: {e}", i + 1)))?;
@@ -85,14 +87,22 @@ pub fn read_pcd(path: &Path) -> Result<PcdPoints> {
             left_out += 1;
             continue;
         }
-        let normal = normal
-            .and_then(|[a, b, c]| Some(DVec3::new(value(a)?, value(b)?, value(c)?)))
-            .filter(|n| n.is_finite())
-            .map_or(DVec3::ZERO, DVec3::normalize_or_zero);
-        points.push(Point { position, normal });
+        positions.push(position);
+        if let Some([a, b, c]) = normal {
+            let n = match (value(a), value(b), value(c)) {
+                (Some(x), Some(y), Some(z)) => DVec3::new(x, y, z),
+                _ => DVec3::ZERO,
+            };
+            normals.push(if n.is_finite() {
+                n.normalize_or_zero()
+            } else {
+                DVec3::ZERO
+            });
+        }
     }
     Ok(PcdPoints {
-        points,
+        positions,
+        normals,
         has_normals: normal.is_some(),
         viewpoint,
         left_out,

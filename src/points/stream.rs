@@ -380,7 +380,7 @@ impl PointReader {
             path: path.to_path_buf(),
             input: BufReader::new(file),
             encoding: Encoding::Loaded,
-            count: pcd.points.len() as u64,
+            count: pcd.positions.len() as u64,
             read: 0,
             properties: Vec::new(),
             record_size: 0,
@@ -389,7 +389,15 @@ impl PointReader {
             buffer: Vec::new(),
             line: String::new(),
             line_number: 0,
-            loaded: pcd.points,
+            loaded: pcd
+                .positions
+                .iter()
+                .enumerate()
+                .map(|(i, &position)| Point {
+                    position,
+                    normal: pcd.normals.get(i).copied().unwrap_or(DVec3::ZERO),
+                })
+                .collect(),
             las: None,
         })
     }
