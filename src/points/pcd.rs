@@ -109,6 +109,23 @@ pub fn read_pcd(path: &Path) -> Result<PcdPoints> {
     })
 }
 
+/// The sensor's position a PCD file's header gives ([`PcdPoints::viewpoint`]), the payload not
+/// read.
+///
+/// # Errors
+/// As [`read_pcd`] for the header.
+pub fn read_pcd_viewpoint(path: &Path) -> Result<DVec3> {
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let meta =
+        pcd_rs::PcdMeta::from_reader(std::io::BufReader::new(file)).map_err(|e| Error::Parse {
+            path: path.to_path_buf(),
+            line: None,
+            message: format!("not a PCD file pcd-rs can read: {e}"),
+        })?;
+    let v = &meta.viewpoint;
+    Ok(DVec3::new(v.tx, v.ty, v.tz))
+}
+
 /// The first value of a field, as f64 (`None` for a field of no values).
 fn first_value(field: &Field) -> Option<f64> {
     Some(match field {

@@ -72,13 +72,16 @@ impl PointSource {
     }
 
     /// The scanner's position the source gives: a PLY range map's `camera`
-    /// ([`PointReader::viewpoint`], the file's units; only the header is read). `None` for text
-    /// files (not read) and points in memory.
+    /// ([`PointReader::viewpoint`]) or a PCD file's `VIEWPOINT`, the file's units; only the
+    /// header is read. `None` for text and LAS files (which give none) and points in memory.
     ///
     /// # Errors
     /// Those of [`PointReader::open`].
     pub fn viewpoint(&self) -> Result<Option<DVec3>> {
         match self {
+            PointSource::File(path) if super::pcd::is_pcd_extension(path) => {
+                super::pcd::read_pcd_viewpoint(path).map(Some)
+            }
             PointSource::File(path) if !super::stream::is_text_extension(path) => {
                 Ok(PointReader::open(path)?.viewpoint())
             }

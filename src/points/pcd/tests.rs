@@ -63,6 +63,7 @@ fn the_three_encodings_read_back_the_points_written_and_leave_out_the_pixels_wit
         assert_eq!(read.left_out, 2, "{kind:?}");
         assert!(!read.has_normals);
         assert_eq!(read.viewpoint, DVec3::new(0.25, -2.0, 10.0));
+        assert_eq!(read_pcd_viewpoint(&path).unwrap(), read.viewpoint);
         // The same through the point reader the pipeline uses.
         let mut reader = crate::points::PointReader::open(&path).unwrap();
         assert_eq!(reader.count(), 4);
