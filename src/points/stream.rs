@@ -353,12 +353,39 @@ impl PointReader {
     /// Opens a LAS file (`points::las`), read in chunks.
     fn open_las(path: &Path) -> Result<Self> {
         let las = super::las::LasPoints::open(path)?;
+        let mut reader = Self::decoded_elsewhere(path, Encoding::Las, las.count())?;
+        reader.las = Some(las);
+        Ok(reader)
+    }
+
+    /// Opens a PCD file and reads it whole (`points::pcd::read_pcd`).
+    fn open_pcd(path: &Path) -> Result<Self> {
+        let pcd = super::pcd::read_pcd(path)?;
+        let count = pcd.positions.len() as u64;
+        let mut reader = Self::decoded_elsewhere(path, Encoding::Loaded, count)?;
+        reader.has_normals = pcd.has_normals;
+        reader.viewpoint = Some(pcd.viewpoint);
+        reader.loaded = pcd
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(i, &position)| Point {
+                position,
+                normal: pcd.normals.get(i).copied().unwrap_or(DVec3::ZERO),
+            })
+            .collect();
+        Ok(reader)
+    }
+
+    /// A reader of `count` points of a format a crate decodes (PCD, LAS): no properties, records
+    /// or lines of its own, no normals or viewpoint until the caller sets them.
+    fn decoded_elsewhere(path: &Path, encoding: Encoding, count: u64) -> Result<Self> {
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         Ok(PointReader {
             path: path.to_path_buf(),
             input: BufReader::new(file),
-            encoding: Encoding::Las,
-            count: las.count(),
+            encoding,
+            count,
             read: 0,
             properties: Vec::new(),
             record_size: 0,
@@ -368,36 +395,6 @@ impl PointReader {
             line: String::new(),
             line_number: 0,
             loaded: Vec::new(),
-            las: Some(las),
-        })
-    }
-
-    /// Opens a PCD file and reads it whole (`points::pcd::read_pcd`).
-    fn open_pcd(path: &Path) -> Result<Self> {
-        let pcd = super::pcd::read_pcd(path)?;
-        let file = File::open(path).map_err(|e| Error::io(path, e))?;
-        Ok(PointReader {
-            path: path.to_path_buf(),
-            input: BufReader::new(file),
-            encoding: Encoding::Loaded,
-            count: pcd.positions.len() as u64,
-            read: 0,
-            properties: Vec::new(),
-            record_size: 0,
-            has_normals: pcd.has_normals,
-            viewpoint: Some(pcd.viewpoint),
-            buffer: Vec::new(),
-            line: String::new(),
-            line_number: 0,
-            loaded: pcd
-                .positions
-                .iter()
-                .enumerate()
-                .map(|(i, &position)| Point {
-                    position,
-                    normal: pcd.normals.get(i).copied().unwrap_or(DVec3::ZERO),
-                })
-                .collect(),
             las: None,
         })
     }
