@@ -133,6 +133,8 @@ pub(super) fn run(
         out.unsupported_after_finishing,
     );
     insert_json(extra, "pillows", out.pillows);
+    insert_json(extra, "off_data", out.off_data);
+    insert_json(extra, "crossing_faces", out.crossing_faces);
     insert_json(extra, "optimize", out.optimize);
     insert_json(extra, "untangle", out.untangle);
     if out.mend_after_untangle.attempts > 0 {
@@ -238,6 +240,23 @@ pub(super) fn run(
              side: both sides of a strip of data a sample or two wide, a flap at the data's edge)",
             out.pillows.opened,
             out.pillows.faces + out.pillows.pinched_faces
+        ));
+    }
+    let off = &out.off_data;
+    if off.faces > 0 {
+        report.notes.push(format!(
+            "{} faces with a corner farther than the mean edge length from every point were \
+             removed (the data's edge)",
+            off.faces + off.pinched_faces
+        ));
+    }
+    let crossing = &out.crossing_faces;
+    if crossing.pairs > 0 {
+        report.notes.push(format!(
+            "{} faces that still crossed another ({} pairs, where the data holds sheets closer \
+             than the spacing) were removed, leaving holes",
+            crossing.faces + crossing.pinched_faces,
+            crossing.pairs
         ));
     }
     if out.assembly.holes_left > 0 {

@@ -9,11 +9,13 @@
 //! - [`fit`]: the least-squares fit of the vertices to the surface, along their normals;
 //! - [`untangle`]: faces that cross each other moved apart;
 //! - [`degenerate`]: faces of no area mended;
-//! - [`stray_shells`]: the tiny closed shells left at unresolved tips removed.
+//! - [`stray_shells`]: the tiny closed shells left at unresolved tips removed;
+//! - [`crossing_faces`]: on an open output (a point set's), the faces that still cross removed.
 //!
 //! `pipeline/finish.rs` runs them in that order, for meshes and point sets alike. The flips they
 //! share with the triangulation's clean-up are `triangulate/flip.rs`.
 
+pub mod crossing_faces;
 pub mod degenerate;
 pub mod fit;
 pub mod optimize;

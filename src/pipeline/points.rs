@@ -17,6 +17,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::finish::crossing_faces::{remove_crossing_faces, CrossingFaces};
 use crate::finish::optimize::{MendStats, OptimizeStats};
 use crate::finish::stray_shells::StrayShells;
 use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
@@ -47,7 +48,9 @@ use crate::surface::{Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 pub use crate::timing::Stage;
 use crate::timing::StageTimer;
 use crate::triangulate::pillows::{open_pillows, FaceSide, Pillows};
-use crate::triangulate::unsupported::{remove_unsupported_faces, UnsupportedFaces};
+use crate::triangulate::unsupported::{
+    remove_faces_off_data, remove_unsupported_faces, UnsupportedFaces,
+};
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
 
 mod parts;
@@ -317,6 +320,11 @@ pub struct PointRemeshOutput {
     /// sides of a strip of one-sided data, a flap at the data's edge), after the finishing and
     /// the gap rule.
     pub pillows: Pillows,
+    /// Faces with a corner farther from every data point than the output's mean edge length
+    /// (a vertex the finishing left off the data's edge) removed, after the folds.
+    pub off_data: UnsupportedFaces,
+    /// Faces that still crossed removed, last ([`remove_crossing_faces`]).
+    pub crossing_faces: CrossingFaces,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,
     /// The separation of crossing faces of the umbrellas (before the optimization).
@@ -799,6 +807,17 @@ fn remesh_points_once(
             }
         },
     );
+    // Every output vertex within one output spacing (the mean edge length) of the data: a face
+    // with a corner farther off spans empty space at the data's edge.
+    let spacing = mean_edge_length(&mesh);
+    let off_data = remove_faces_off_data(&mut mesh, &mut sources, |p| {
+        rimls
+            .nearest(p)
+            .is_some_and(|(_, d2)| d2 <= spacing * spacing)
+    });
+    // Last, no two faces cross: those untangle could not separate (sheets of the data closer
+    // than the spacing) go, leaving holes.
+    let crossing_faces = remove_crossing_faces(&mut mesh, &mut sources);
     let dropped_after_finishing = mesh.remove_unreferenced_vertices();
     timer.lap("untangle");
     // An empty mesh is never a result.
@@ -834,6 +853,8 @@ fn remesh_points_once(
         unsupported,
         unsupported_after_finishing,
         pillows,
+        off_data,
+        crossing_faces,
         optimize: finished.optimize,
         untangle_umbrellas,
         untangle: finished.untangle,
@@ -846,6 +867,27 @@ fn remesh_points_once(
         scan_seconds: scan.seconds,
         stages: timer.take_stages(),
     })))
+}
+
+/// The mean length of the edges of `mesh` (each edge once; 0 for a mesh without faces), its
+/// position units.
+fn mean_edge_length(mesh: &TriMesh) -> f64 {
+    let mut edges: Vec<(u32, u32)> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    if edges.is_empty() {
+        return 0.0;
+    }
+    let p = &mesh.positions;
+    edges
+        .iter()
+        .map(|&(a, b)| p[a as usize].distance(p[b as usize]))
+        .sum::<f64>()
+        / edges.len() as f64
 }
 
 /// Whether the file `path` is a point set for [`remesh_points`] rather than a mesh: a text

@@ -86,6 +86,35 @@ pub fn remove_unsupported_faces(
     }
 }
 
+/// Removes the faces of `mesh` with a corner that `near` says has no data near it (a vertex the
+/// finishing left off the data, at the data's edge, where the centroid and edge midpoints of its
+/// faces still are near some), then the smaller fans at pinched vertices, as
+/// [`remove_unsupported_faces`] does (hole fills are not followed: the faces themselves are
+/// the fault). Vertices stay; `sources` (one per face, or empty) is filtered along.
+/// Deterministic.
+pub fn remove_faces_off_data(
+    mesh: &mut TriMesh,
+    sources: &mut Vec<FaceSource>,
+    near: impl Fn(DVec3) -> bool + Sync,
+) -> UnsupportedFaces {
+    use rayon::prelude::*;
+    let off: Vec<bool> = mesh.positions.par_iter().map(|&p| !near(p)).collect();
+    let drop: Vec<bool> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.iter().any(|&v| off[v as usize]))
+        .collect();
+    let faces = drop.iter().filter(|&&d| d).count();
+    if faces == 0 {
+        return UnsupportedFaces::default();
+    }
+    let pinched_faces = remove_faces_keeping_manifold(mesh, sources, &drop);
+    UnsupportedFaces {
+        faces,
+        pinched_faces,
+    }
+}
+
 /// Removes the faces `drop` marks (one flag per face), then the smaller fans at the vertices
 /// the removal pinched (two fans meeting at one vertex: the assembly's own repair), until every
 /// vertex has one fan. Returns how many faces that repair removed. Vertices stay; `sources`
@@ -175,6 +204,19 @@ mod tests {
                 / 3.0;
             assert!(c.distance(DVec3::new(10.0, 10.0, 0.0)) > 2.5);
         }
+    }
+
+    #[test]
+    fn faces_with_a_corner_off_the_data_go() {
+        let mut mesh = grid(10);
+        // The data covers x <= 6.5: the faces with a corner at x >= 7 go, the rest stay.
+        let stats = remove_faces_off_data(&mut mesh, &mut Vec::new(), |p| p.x <= 6.5);
+        assert_eq!(stats.faces, 2 * 10 * 4);
+        assert_eq!(mesh.triangles.len(), 2 * 10 * 6);
+        for t in &mesh.triangles {
+            assert!(t.iter().all(|&v| mesh.positions[v as usize].x <= 6.0));
+        }
+        assert!(topology(&mesh).is_manifold());
     }
 
     #[test]
