@@ -41,7 +41,8 @@ pub struct RemeshJob {
     pub as_points: bool,
     /// For a point set without normals: the estimated normals face this point (model units; a
     /// single scan's sensor) instead of being oriented outward by a spanning tree. `None`: a PLY
-    /// range map's own camera when it has one ([`PointReader::viewpoint`](crate::points::PointReader::viewpoint)),
+    /// range map's camera or a PCD's `VIEWPOINT` ([`PointReader::viewpoint`](crate::points::PointReader::viewpoint))
+    /// when the points look seen from there ([`PointSource::orientation`](crate::points::source::PointSource::orientation)),
     /// else the spanning tree. Not used for meshes.
     pub viewpoint: Option<glam::DVec3>,
     /// Where the JSON report goes as well (`--report`): written with the mesh, both only once

@@ -111,8 +111,10 @@ pub(super) fn run(
     insert_kernel_extras(extra, out.sigma_p, &job.params, out.target);
     extra.insert("input_points".into(), out.input_points.into());
     extra.insert("had_normals".into(), out.had_normals.into());
-    if let Some(v) = camera.filter(|_| !out.had_normals) {
-        insert_json(extra, "camera_viewpoint", v.to_array());
+    if let Some(c) = camera.filter(|_| !out.had_normals) {
+        insert_json(extra, "camera_viewpoint", c.position.to_array());
+        insert_json(extra, "camera_hidden_fraction", c.hidden);
+        extra.insert("camera_used".into(), c.used.into());
     }
     extra.insert("outliers_removed".into(), out.outliers_removed.into());
     extra.insert("far_points".into(), out.far_points.into());
@@ -149,13 +151,26 @@ pub(super) fn run(
         match (out.had_normals, camera) {
             (true, _) => "with normals".to_string(),
             (false, None) => "normals estimated".to_string(),
-            (false, Some(v)) => format!(
-                "normals estimated, oriented towards the range map's camera at ({}, {}, {})",
+            (false, Some(c)) => {
+                let v = c.position;
                 // (as the file's single precision, and no negative zero)
-                v.x as f32 + 0.0,
-                v.y as f32 + 0.0,
-                v.z as f32 + 0.0
-            ),
+                let at = format!(
+                    "({}, {}, {})",
+                    v.x as f32 + 0.0,
+                    v.y as f32 + 0.0,
+                    v.z as f32 + 0.0
+                );
+                if c.used {
+                    format!("normals estimated, oriented towards the file's viewpoint at {at}")
+                } else {
+                    format!(
+                        "normals estimated; the file's viewpoint {at} was not used: from there \
+                         {:.1}% of the points lie behind others, where a single view hides \
+                         almost none, so the scanner did not stand there",
+                        100.0 * c.hidden
+                    )
+                }
+            }
         }
     ));
     if out.duplicate_points > 0 {

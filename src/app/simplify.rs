@@ -40,8 +40,9 @@ pub struct SimplifyJob {
     /// Seed of every random choice.
     pub seed: u64,
     /// For an input without normals: orient the estimated normals towards this point (model
-    /// units) instead of outward by a spanning tree. `None`: a PLY range map's own camera when
-    /// it has one ([`PointReader::viewpoint`]), else the spanning tree.
+    /// units) instead of outward by a spanning tree. `None`: a PLY range map's camera or a PCD's
+    /// `VIEWPOINT` ([`PointReader::viewpoint`]) when the points look seen from there
+    /// ([`PointSource::orientation`]), else the spanning tree.
     pub viewpoint: Option<DVec3>,
 }
 

@@ -177,7 +177,9 @@ struct Cli {
 
     /// For a point set without normals: orient the estimated normals towards this point
     /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
-    /// Without it, a PLY range map's own camera (`view_px view_py view_pz`) is used.
+    /// Without it, a PLY range map's camera (`view_px view_py view_pz`) or a PCD's `VIEWPOINT`
+    /// is used when the points look seen from there (few lie behind others on its lines of
+    /// sight).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
     viewpoint: Option<[f64; 3]>,
 
@@ -246,7 +248,9 @@ enum Command {
         seed: u64,
         /// For an input without normals: orient the estimated normals towards this point
         /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
-        /// Without it, a PLY range map's own camera (`view_px view_py view_pz`) is used.
+        /// Without it, a PLY range map's camera (`view_px view_py view_pz`) or a PCD's `VIEWPOINT`
+        /// is used when the points look seen from there (few lie behind others on its lines of
+        /// sight).
         #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
         viewpoint: Option<[f64; 3]>,
         /// Print nothing but errors.

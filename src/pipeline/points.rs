@@ -323,7 +323,7 @@ pub struct PointRemeshOutput {
     /// Faces with a corner farther from every data point than the output's mean edge length
     /// (a vertex the finishing left off the data's edge) removed, after the folds.
     pub off_data: UnsupportedFaces,
-    /// Faces that still crossed removed, last ([`remove_crossing_faces`]).
+    /// Faces that still crossed removed, last (`finish::crossing_faces`).
     pub crossing_faces: CrossingFaces,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,

@@ -16,5 +16,6 @@ pub mod pcd;
 pub mod rimls;
 pub mod source;
 pub mod stream;
+pub mod visibility;
 
 pub use stream::{PlyPointWriter, Point, PointReader};

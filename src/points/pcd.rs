@@ -8,7 +8,9 @@
 //!   a depth or stereo camera's grid) marks pixels without depth by NaN.
 //! - `VIEWPOINT tx ty tz qw qx qy qz` is where the sensor was, in the points' frame (PCL's
 //!   convention, the origin when the line is absent): its translation is the point set's
-//!   viewpoint, which the normals are oriented towards, as a PLY range map's camera is.
+//!   viewpoint, which the normals are oriented towards, as a PLY range map's camera is, when
+//!   the points look seen from it (PCL writes the origin by default, also for clouds in a world
+//!   frame: [`super::visibility`]).
 //!
 //! The whole payload is read at once (a `binary_compressed` payload is one compressed block):
 //! memory grows with the file, as for the scanner frames PCD holds.

@@ -8,6 +8,7 @@ use glam::DVec3;
 
 use super::normals::NormalOrientation;
 use super::stream::{Point, PointReader};
+use super::visibility::{hidden_fraction, MAX_HIDDEN_FRACTION};
 use crate::error::Result;
 
 /// Where a point set comes from: a point file, read in chunks (out of core), or points already in
@@ -28,6 +29,21 @@ pub enum PointSource {
     /// One of the parts far apart of another source (see `PointSource::parts`), read from it
     /// as it goes.
     Part(PointPart),
+}
+
+/// How many points, from the first, [`PointSource::orientation`] tests against a file's
+/// viewpoint.
+pub const CAMERA_TEST_POINTS: usize = 200_000;
+
+/// A file's viewpoint and whether the points look seen from it ([`PointSource::orientation`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    /// The viewpoint, model units.
+    pub position: DVec3,
+    /// The fraction (0–1) of the points tested that others hide from it ([`hidden_fraction`]).
+    pub hidden: f64,
+    /// Whether it was taken as the scanner's position (the normals face it).
+    pub used: bool,
 }
 
 /// One part of a point source whose points form parts far apart
@@ -91,21 +107,45 @@ impl PointSource {
     }
 
     /// How normals estimated for these points are oriented: towards `given` (model units) when
-    /// there is one, else towards the range map's camera ([`PointSource::viewpoint`]) when
-    /// there is one, else by the spanning tree. Also returns the camera when it is the one used.
+    /// there is one, else towards the file's viewpoint ([`PointSource::viewpoint`]) when there
+    /// is one and it saw the points (at most `MAX_HIDDEN_FRACTION` (5%) of the first
+    /// `CAMERA_TEST_POINTS` hidden from it, `points::visibility`), else by the spanning tree.
+    /// Also returns the file's viewpoint and the test's verdict when there is one.
     ///
     /// # Errors
-    /// Those of [`PointSource::viewpoint`].
-    pub fn orientation(&self, given: Option<DVec3>) -> Result<(NormalOrientation, Option<DVec3>)> {
-        let camera = match given {
-            Some(_) => None,
-            None => self.viewpoint()?,
+    /// Those of [`PointSource::viewpoint`] and of reading the points.
+    pub fn orientation(&self, given: Option<DVec3>) -> Result<(NormalOrientation, Option<Camera>)> {
+        if let Some(v) = given {
+            return Ok((NormalOrientation::Viewpoint(v), None));
+        }
+        let Some(position) = self.viewpoint()? else {
+            return Ok((NormalOrientation::SpanningTree, None));
         };
-        let orientation = match given.or(camera) {
-            Some(v) => NormalOrientation::Viewpoint(v),
-            None => NormalOrientation::SpanningTree,
+        let mut reader = self.open()?;
+        let mut points = Vec::new();
+        let mut positions = Vec::new();
+        while positions.len() < CAMERA_TEST_POINTS {
+            let n = reader.read_chunk(&mut points, CAMERA_TEST_POINTS - positions.len())?;
+            if n == 0 {
+                break;
+            }
+            positions.extend(points.iter().map(|p| p.position));
+        }
+        let hidden = hidden_fraction(&positions, position);
+        let used = hidden <= MAX_HIDDEN_FRACTION;
+        let orientation = if used {
+            NormalOrientation::Viewpoint(position)
+        } else {
+            NormalOrientation::SpanningTree
         };
-        Ok((orientation, camera))
+        Ok((
+            orientation,
+            Some(Camera {
+                position,
+                hidden,
+                used,
+            }),
+        ))
     }
 
     /// A reader from the first point.

@@ -94,3 +94,56 @@ fn a_file_without_x_y_z_or_not_pcd_is_an_error_naming_the_file() {
     assert!(e.contains("scan.pcd") && e.contains("PCD"), "{e}");
     assert!(!e.contains('\n'), "one line: {e}");
 }
+
+/// A grid of `n` × `n` points in the plane z = `z`, spacing `h`, centred on the z axis, with
+/// `offset` added.
+fn grid(n: usize, z: f32, h: f32, offset: [f32; 2]) -> Vec<[f32; 4]> {
+    (0..n)
+        .flat_map(|j| {
+            (0..n).map(move |i| {
+                let c = (n as f32 - 1.0) / 2.0;
+                [
+                    (i as f32 - c) * h + offset[0],
+                    (j as f32 - c) * h + offset[1],
+                    z,
+                    0.0,
+                ]
+            })
+        })
+        .collect()
+}
+
+#[test]
+fn a_viewpoint_that_did_not_see_the_points_is_not_used_for_their_normals() {
+    use crate::points::normals::NormalOrientation;
+    use crate::points::source::PointSource;
+    let dir = tempfile::tempdir().unwrap();
+    // A sheet seen from its VIEWPOINT: taken as the sensor's position.
+    let seen = dir.path().join("seen.pcd");
+    write(
+        &seen,
+        DataKind::Binary,
+        &grid(60, 10.0, 0.1, [0.0, 0.0]),
+        3600,
+        [0.0, 0.0, 0.0],
+    );
+    let (orientation, camera) = PointSource::File(seen).orientation(None).unwrap();
+    assert_eq!(orientation, NormalOrientation::Viewpoint(DVec3::ZERO));
+    assert!(camera.unwrap().used);
+    // Two sheets one behind the other as seen from it (a world frame with the default
+    // VIEWPOINT): the spanning tree orients the normals, and the camera is reported unused.
+    let mut rows = grid(60, 10.0, 0.1, [0.0, 0.0]);
+    rows.extend(grid(60, 20.0, 0.2, [0.05, 0.05]));
+    let layered = dir.path().join("layered.pcd");
+    write(&layered, DataKind::Binary, &rows, 7200, [0.0, 0.0, 0.0]);
+    let (orientation, camera) = PointSource::File(layered).orientation(None).unwrap();
+    assert_eq!(orientation, NormalOrientation::SpanningTree);
+    let camera = camera.unwrap();
+    assert!(!camera.used && camera.hidden > 0.1, "{camera:?}");
+    // A viewpoint the user gives is used as given.
+    let (orientation, camera) = PointSource::File(dir.path().join("layered.pcd"))
+        .orientation(Some(DVec3::Z))
+        .unwrap();
+    assert_eq!(orientation, NormalOrientation::Viewpoint(DVec3::Z));
+    assert!(camera.is_none());
+}
