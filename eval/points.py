@@ -7,6 +7,8 @@ Run through eval/points (it sets up the venv and builds remesh):
     eval/points                          # horse, 1M points, -> 10k, with normals / without / noisy
     eval/points --quick                  # spot, 200k points -> 3k, with normals (seconds)
     eval/points --scans default          # issue 39's scan inputs (eval/scans.py's cases), all three methods
+    eval/points --real                   # issue 58's real scans beside MeshLab and Open3D, seeds 1-5
+                                         # (eval/points_real.py; writes eval/results/scans/real.md)
 
 With --scans CASES (comma-separated names of eval/scans.py's CASES, or `default` for its default
 list: face000, square, hemisphere, band, spot-2000, spot-4000), the point sets are made by
@@ -121,28 +123,33 @@ def run_ours(points, n, seed, out, extra=()):
     return seconds
 
 
-def meshlab_set(points, has_normals):
+def meshlab_set(points, has_normals, viewpoint=None):
+    """The points in a MeshSet, with normals estimated (k = 10) when they have none: turned towards
+    `viewpoint` (x, y, z: a single scan's sensor) when given, else MeshLab's own orientation."""
     import pymeshlab
 
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(str(points))
     if not has_normals:
-        ms.compute_normal_for_point_clouds(k=10)
+        if viewpoint is None:
+            ms.compute_normal_for_point_clouds(k=10)
+        else:
+            ms.compute_normal_for_point_clouds(k=10, flipflag=True, viewpos=np.asarray(viewpoint, dtype=np.float64))
     return ms
 
 
-def run_poisson_isotropic(points, n, has_normals, out):
+def run_poisson_isotropic(points, n, has_normals, out, viewpoint=None, tries=2):
     """Screened Poisson (depth 10) then isotropic remeshing at the edge length that gives about n
-    vertices (one correction from the first try's count)."""
+    vertices (at most `tries` edge lengths, each corrected from the last try's count)."""
     import pymeshlab
 
     t = time.perf_counter()
-    ms = meshlab_set(points, has_normals)
+    ms = meshlab_set(points, has_normals, viewpoint)
     ms.generate_surface_reconstruction_screened_poisson(depth=10, preclean=True)
     poisson = ms.current_mesh_id()
     area = ms.get_geometric_measures()["surface_area"]
     h = math.sqrt(2.0 * area / (math.sqrt(3.0) * n))
-    for _ in range(2):
+    for _ in range(tries):
         ms.set_current_mesh(poisson)
         ms.generate_copy_of_current_mesh()
         ms.meshing_isotropic_explicit_remeshing(targetlen=pymeshlab.PureValue(h), iterations=10)
@@ -155,10 +162,10 @@ def run_poisson_isotropic(points, n, has_normals, out):
     return seconds
 
 
-def run_ball_pivoting(points, n, has_normals, out):
+def run_ball_pivoting(points, n, has_normals, out, viewpoint=None):
     """Ball pivoting on a Poisson-disk subset of n points (MeshLab's point-cloud simplification)."""
     t = time.perf_counter()
-    ms = meshlab_set(points, has_normals)
+    ms = meshlab_set(points, has_normals, viewpoint)
     ms.generate_simplified_point_cloud(samplenum=int(n))
     ms.generate_surface_reconstruction_ball_pivoting()
     seconds = time.perf_counter() - t
@@ -430,13 +437,31 @@ def main():
     ap.add_argument("--scans", metavar="CASES",
                     help="instead: eval/scans.py's cases (comma-separated, or `default`), all three methods; "
                          "writes scans.md and scans.json")
-    ap.add_argument("--timeout", type=float, help="seconds a MeshLab method may take (default: no limit)")
+    ap.add_argument("--real", nargs="?", const="default", metavar="SCANS",
+                    help="instead: the real scans (eval/points_real.py: milk, car6, table, bun000, face000; "
+                         "comma-separated, or `default` for all) with ours at --seeds and MeshLab's and Open3D's "
+                         "references once; writes eval/results/scans/NAME.md and NAME.json")
+    ap.add_argument("--seeds", default="1-5", help="with --real: ours' seeds (1-5, or 1,3)")
+    ap.add_argument("--name", default="real", help="with --real: the results' file name (default: real)")
+    ap.add_argument("--no-references", dest="references", action="store_false",
+                    help="with --real: ours only")
+    ap.add_argument("--timeout", type=float, help="seconds a MeshLab method may take (default: no limit; "
+                                                  "with --real, every run: default 600)")
     ap.add_argument("--built-from", help="the commit the remesh binary was built from (for the tables; default: "
                                          "from a binary named remesh-<hash>, else HEAD)")
     ap.add_argument("--out", default=str(ROOT / "eval" / "results" / "points"))
     a = ap.parse_args()
     if a.quick:
         a.models, a.count, a.points, a.variants = "spot", 200_000, 3000, "normals"
+    if a.real:
+        import points_real
+        import scans
+
+        a.real_scans = points_real.DEFAULT_SCANS if a.real == "default" else a.real
+        out = Path(a.out) if a.out != ap.get_default("out") else ROOT / "eval" / "results" / "scans"
+        out.mkdir(parents=True, exist_ok=True)
+        points_real.run_real(a, out, scans.parse_seeds, command_line(), built_from(a.built_from))
+        return
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     if a.scans:
