@@ -137,6 +137,11 @@ pub(super) fn run(
     insert_json(extra, "pillows", out.pillows);
     insert_json(extra, "off_data", out.off_data);
     insert_json(extra, "crossing_faces", out.crossing_faces);
+    insert_json(
+        extra,
+        "tiny_pieces",
+        serde_json::json!({"pieces": out.tiny_pieces.shells, "vertices": out.tiny_pieces.vertices}),
+    );
     insert_json(extra, "optimize", out.optimize);
     insert_json(extra, "untangle", out.untangle);
     if out.mend_after_untangle.attempts > 0 {
@@ -272,6 +277,14 @@ pub(super) fn run(
              than the spacing) were removed, leaving holes",
             crossing.faces + crossing.pinched_faces,
             crossing.pairs
+        ));
+    }
+    let tiny = &out.tiny_pieces;
+    if tiny.shells > 0 {
+        report.notes.push(format!(
+            "{} pieces no larger than 4 sigma_p across ({} vertices: stray points meshed on \
+             their own) were left out",
+            tiny.shells, tiny.vertices
         ));
     }
     if out.assembly.holes_left > 0 {

@@ -3,7 +3,9 @@
 //! into a tiny shell of their own (four samples, a tetrahedron) apart from the surface. When
 //! the output has more components than the input, such shells are removed, smallest first,
 //! down to the input's count: the tip comes out blunted (the report says where) instead of as
-//! an extra component.
+//! an extra component. On a point set, pieces open or closed too small to be a surface at the
+//! output's spacing (a few stray points meshed on their own) go too, all but the largest
+//! piece ([`remove_tiny_pieces`]).
 
 use glam::DVec3;
 
@@ -36,6 +38,32 @@ pub fn remove_stray_shells(
     max_vertices: usize,
     stray: impl Fn(&[DVec3]) -> bool,
 ) -> StrayShells {
+    remove_parts(mesh, face_sources, keep, |closed, points| {
+        closed && points.len() <= max_vertices && stray(points)
+    })
+}
+
+/// Removes the pieces of `mesh`, open or closed, that `tiny(positions of its vertices)` calls
+/// too small to be a surface at the output's spacing (on a point set: a few stray points, such
+/// as flying pixels at a depth jump, meshed on their own), smallest first, while more than one
+/// piece is left: the largest always stays. `face_sources` (one per face) is filtered along;
+/// the removed vertices stay in `positions` unreferenced.
+pub fn remove_tiny_pieces(
+    mesh: &mut TriMesh,
+    face_sources: &mut Vec<FaceSource>,
+    tiny: impl Fn(&[DVec3]) -> bool,
+) -> StrayShells {
+    remove_parts(mesh, face_sources, 1, |_, points| tiny(points))
+}
+
+/// Removes the parts of `mesh` that `eligible(closed, positions of its vertices)` selects,
+/// smallest first (ties: the smallest vertex index), while `mesh` has more parts than `keep`.
+fn remove_parts(
+    mesh: &mut TriMesh,
+    face_sources: &mut Vec<FaceSource>,
+    keep: usize,
+    eligible: impl Fn(bool, &[DVec3]) -> bool,
+) -> StrayShells {
     let mut record = StrayShells {
         min: DVec3::splat(f64::INFINITY),
         max: DVec3::splat(f64::NEG_INFINITY),
@@ -47,15 +75,12 @@ pub fn remove_stray_shells(
     }
     let mut small: Vec<(usize, u32, usize)> = Vec::new();
     for (k, part) in parts.iter().enumerate() {
-        if part.vertices.len() > max_vertices || !part.closed {
-            continue;
-        }
         let points: Vec<DVec3> = part
             .vertices
             .iter()
             .map(|&v| mesh.positions[v as usize])
             .collect();
-        if stray(&points) {
+        if eligible(part.closed, &points) {
             // Ties broken by the smallest vertex index (deterministic, whatever the order).
             small.push((part.vertices.len(), part.vertices[0], k));
         }
@@ -147,5 +172,28 @@ mod tests {
             0
         );
         assert_eq!(m.triangles.len(), 16);
+    }
+
+    #[test]
+    fn tiny_open_pieces_go_and_the_largest_stays() {
+        // The box, the tiny tetrahedron and a tiny open triangle: both tiny pieces go.
+        let (mut m, mut sources) = two_parts();
+        let o = m.positions.len() as u32;
+        m.positions.extend([
+            DVec3::new(-2.0, 0.0, 0.0),
+            DVec3::new(-2.1, 0.0, 0.0),
+            DVec3::new(-2.0, 0.1, 0.0),
+        ]);
+        m.triangles.push([o, o + 1, o + 2]);
+        sources.push(FaceSource::Refined);
+        let tiny = |s: &[DVec3]| s.len() < 8;
+        let r = remove_tiny_pieces(&mut m, &mut sources, tiny);
+        assert_eq!((r.shells, r.vertices), (2, 7));
+        assert_eq!(m.triangles.len(), 12);
+        assert_eq!(sources.len(), 12);
+        // The largest piece stays even when it is called tiny.
+        let r = remove_tiny_pieces(&mut m, &mut sources, |_| true);
+        assert_eq!(r.shells, 0);
+        assert_eq!(m.triangles.len(), 12);
     }
 }

@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::finish::crossing_faces::{remove_crossing_faces, CrossingFaces};
 use crate::finish::optimize::{MendStats, OptimizeStats};
-use crate::finish::stray_shells::StrayShells;
+use crate::finish::stray_shells::{remove_tiny_pieces, StrayShells};
 use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::kernel::Kernel;
 use crate::mesh::{Normalization, OrientStats, TriMesh};
@@ -325,6 +325,8 @@ pub struct PointRemeshOutput {
     pub off_data: UnsupportedFaces,
     /// Faces that still crossed removed, last (`finish::crossing_faces`).
     pub crossing_faces: CrossingFaces,
+    /// Pieces no larger than 4 sigma_p across removed, last (all but the largest piece).
+    pub tiny_pieces: StrayShells,
     /// The local optimization against the RIMLS surface.
     pub optimize: OptimizeStats,
     /// The separation of crossing faces of the umbrellas (before the optimization).
@@ -818,6 +820,10 @@ fn remesh_points_once(
     // Last, no two faces cross: those untangle could not separate (sheets of the data closer
     // than the spacing) go, leaving holes.
     let crossing_faces = remove_crossing_faces(&mut mesh, &mut sources);
+    // Pieces no larger than a stray shell (4 sigma_p across, a dozen samples at most), open or
+    // closed, are stray points meshed on their own (flying pixels at a depth jump, stray
+    // returns), or what the removals above left of a fold: no surface the output resolves.
+    let tiny_pieces = remove_tiny_pieces(&mut mesh, &mut sources, stray);
     let dropped_after_finishing = mesh.remove_unreferenced_vertices();
     timer.lap("untangle");
     // An empty mesh is never a result.
@@ -855,6 +861,7 @@ fn remesh_points_once(
         pillows,
         off_data,
         crossing_faces,
+        tiny_pieces,
         optimize: finished.optimize,
         untangle_umbrellas,
         untangle: finished.untangle,
