@@ -144,6 +144,9 @@ pub(super) fn run(
     );
     insert_json(extra, "optimize", out.optimize);
     insert_json(extra, "untangle", out.untangle);
+    if out.mend_after_removals.attempts > 0 {
+        insert_json(extra, "mend_after_removals", out.mend_after_removals);
+    }
     if out.mend_after_untangle.attempts > 0 {
         insert_json(extra, "mend_after_untangle", out.mend_after_untangle);
     }

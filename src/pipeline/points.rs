@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::finish::crossing_faces::{remove_crossing_faces, CrossingFaces};
-use crate::finish::optimize::{MendStats, OptimizeStats};
+use crate::finish::optimize::{mend_near, MendStats, OptimizeStats};
 use crate::finish::stray_shells::{remove_tiny_pieces, StrayShells};
 use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::kernel::Kernel;
@@ -325,6 +325,9 @@ pub struct PointRemeshOutput {
     pub off_data: UnsupportedFaces,
     /// Faces that still crossed removed, last (`finish::crossing_faces`).
     pub crossing_faces: CrossingFaces,
+    /// The optimization's last pass again around the boundary the removals after the
+    /// finishing opened.
+    pub mend_after_removals: MendStats,
     /// Pieces no larger than 4 sigma_p across removed, last (all but the largest piece).
     pub tiny_pieces: StrayShells,
     /// The local optimization against the RIMLS surface.
@@ -812,6 +815,7 @@ fn remesh_points_once(
     // Every output vertex within one output spacing (the mean edge length) of the data: a face
     // with a corner farther off spans empty space at the data's edge.
     let spacing = mean_edge_length(&mesh);
+    let boundary_before = boundary_vertices(&mesh);
     let off_data = remove_faces_off_data(&mut mesh, &mut sources, |p| {
         rimls
             .nearest(p)
@@ -819,7 +823,35 @@ fn remesh_points_once(
     });
     // Last, no two faces cross: those untangle could not separate (sheets of the data closer
     // than the spacing) go, leaving holes.
-    let crossing_faces = remove_crossing_faces(&mut mesh, &mut sources);
+    let mut crossing_faces = remove_crossing_faces(&mut mesh, &mut sources);
+    // The faces beside the boundary those removals opened were shaped with neighbours now gone:
+    // the optimization's last pass mends those of small angle again (the vertices of the new
+    // boundary and their neighbours), under its guards (no new crossing, on the surface).
+    let mut mend_after_removals = MendStats::default();
+    if let Some(op) = rp.optimize.as_ref() {
+        let near = around_new_boundary(&mesh, &boundary_before);
+        if near.iter().any(|&n| n) {
+            let fixed_now: Vec<bool> = (0..mesh.positions.len()).map(|i| i < fixed).collect();
+            let (stats, mended) = mend_near(
+                &mut mesh,
+                &domain,
+                &fixed_now,
+                &[],
+                boundary_lines.as_ref(),
+                None,
+                sigma_p,
+                op,
+                &near,
+            );
+            sources = crate::pipeline::finish::carried_sources(&mended.origin, &sources);
+            mend_after_removals = stats;
+            if !mended.intersecting.is_empty() {
+                let again = remove_crossing_faces(&mut mesh, &mut sources);
+                crossing_faces.faces += again.faces;
+                crossing_faces.pinched_faces += again.pinched_faces;
+            }
+        }
+    }
     // Pieces no larger than a stray shell (4 sigma_p across, a dozen samples at most), open or
     // closed, are stray points meshed on their own (flying pixels at a depth jump, stray
     // returns), or what the removals above left of a fold: no surface the output resolves.
@@ -862,6 +894,7 @@ fn remesh_points_once(
         off_data,
         crossing_faces,
         tiny_pieces,
+        mend_after_removals,
         optimize: finished.optimize,
         untangle_umbrellas,
         untangle: finished.untangle,
@@ -874,6 +907,50 @@ fn remesh_points_once(
         scan_seconds: scan.seconds,
         stages: timer.take_stages(),
     })))
+}
+
+/// `V` flags: the vertices of `mesh` on a boundary edge (an edge of one face).
+fn boundary_vertices(mesh: &TriMesh) -> Vec<bool> {
+    let mut edges: Vec<(u32, u32)> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    let mut flags = vec![false; mesh.positions.len()];
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
+        }
+        if j - i == 1 {
+            flags[edges[i].0 as usize] = true;
+            flags[edges[i].1 as usize] = true;
+        }
+        i = j;
+    }
+    flags
+}
+
+/// `V` flags: the vertices of `mesh` on its boundary that `before` (flags of the same
+/// vertices) did not have there, and the vertices of the faces around them.
+fn around_new_boundary(mesh: &TriMesh, before: &[bool]) -> Vec<bool> {
+    let now = boundary_vertices(mesh);
+    let new: Vec<bool> = now
+        .iter()
+        .enumerate()
+        .map(|(v, &b)| b && !before.get(v).copied().unwrap_or(false))
+        .collect();
+    let mut near = new.clone();
+    for t in &mesh.triangles {
+        if t.iter().any(|&v| new[v as usize]) {
+            for &v in t {
+                near[v as usize] = true;
+            }
+        }
+    }
+    near
 }
 
 /// The mean length of the edges of `mesh` (each edge once; 0 for a mesh without faces), its
