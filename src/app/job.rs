@@ -36,8 +36,8 @@ pub struct RemeshJob {
     /// no limit.
     pub max_memory: Option<u64>,
     /// Whether the input is read as a point set (its faces ignored) even when it has faces:
-    /// `--as-points` (a PLY file). A text, PCD or LAS point file or a PLY file without faces is read
-    /// as a point set either way ([`is_point_set`](crate::internal::is_point_set)).
+    /// `--as-points` (a PLY file). A text, PCD, LAS or LAZ point file or a PLY file without faces
+    /// is read as a point set either way ([`is_point_set`](crate::internal::is_point_set)).
     pub as_points: bool,
     /// For a point set without normals: the estimated normals face this point (model units; a
     /// single scan's sensor) instead of being oriented outward by a spanning tree. `None`: a PLY

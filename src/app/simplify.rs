@@ -27,7 +27,8 @@ pub enum SimplifyDensity {
 /// A `remesh simplify` job.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimplifyJob {
-    /// The input point set: PLY (ascii or binary), PCD, LAS or XYZ/CSV text, with or without normals.
+    /// The input point set: PLY (ascii or binary), PCD, LAS, LAZ or XYZ/CSV text, with or without
+    /// normals.
     pub input: PathBuf,
     /// The output point set (binary PLY with normals; with levels, a `uchar level` property).
     pub output: PathBuf,

@@ -41,8 +41,9 @@ struct Cli {
 
     /// Input mesh: .obj, .ply, .gltf, .glb, .stl (binary or ascii) or .off; or a point set (a
     /// scan): a .ply without faces, a .pcd (the Point Cloud Library's; its VIEWPOINT is the
-    /// sensor), a .las (LiDAR; not LAZ), or text .xyz .xyzn .csv .txt .pts .asc (x y z [nx ny nz] per line), with or
-    /// without normals, read out of core (PCD read whole); it needs --points or --sigma-p.
+    /// sensor), a .las or .laz (LiDAR), or text .xyz .xyzn .csv .txt .pts .asc (x y z [nx ny nz]
+    /// per line), with or without normals, read out of core (PCD read whole); it needs --points
+    /// or --sigma-p.
     #[arg(required = true)]
     input: Option<PathBuf>,
 
@@ -212,8 +213,8 @@ enum Command {
     #[command(allow_negative_numbers = true)]
     Simplify {
         /// The input point set: .ply (ascii or binary), .pcd (ascii, binary or
-        /// binary_compressed), .las or XYZ/CSV text (.xyz .xyzn .csv .txt .pts .asc: `x y z` or
-        /// `x y z nx ny nz` per line, or named columns), with or without normals.
+        /// binary_compressed), .las, .laz or XYZ/CSV text (.xyz .xyzn .csv .txt .pts .asc: `x y z`
+        /// or `x y z nx ny nz` per line, or named columns), with or without normals.
         input: PathBuf,
         /// The output point set (.ply; not - : point sets need a file).
         output: PathBuf,

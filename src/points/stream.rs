@@ -33,7 +33,7 @@ enum Encoding {
     Text,
     /// Read whole when opened (PCD): the points are in `loaded`.
     Loaded,
-    /// LAS, read in chunks through `las`.
+    /// LAS or LAZ, read in chunks through `las`.
     Las,
 }
 
@@ -116,7 +116,7 @@ fn camera_viewpoint(slots: &[usize], values: &[f64]) -> Option<DVec3> {
 ///   used when all three are present, everything else is skipped;
 /// - PCD (`.pcd`; `points::pcd::read_pcd`: ascii, binary or binary_compressed, points
 ///   without depth left out, `VIEWPOINT` as the viewpoint), read whole when opened;
-/// - LAS (`.las`; `points::las`: the points' `x y z`, scaled), in chunks;
+/// - LAS and LAZ (`.las .laz`; `points::las`: the points' `x y z`, scaled), in chunks;
 /// - XYZ/CSV text (`.xyz .csv .txt .pts .asc .xyzn`): one point per line, `x y z` or
 ///   `x y z nx ny nz` (further columns skipped), separated by commas, semicolons or blanks. A
 ///   first line of names (`x,y,z,nx,ny,nz` in any order, any case) picks the columns; blank lines
