@@ -616,7 +616,7 @@ fn a_range_maps_camera_orients_its_points() {
         report
             .notes
             .iter()
-            .any(|n| n.contains("oriented towards the range map's camera")),
+            .any(|n| n.contains("oriented towards the sensor the file gives")),
         "{:?}",
         report.notes
     );

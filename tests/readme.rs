@@ -207,7 +207,7 @@ fn the_readme_names_every_option_the_help_gives() {
     }
     let simplify = help(&["simplify"]);
     let point_formats = [
-        ".ply", ".pcd", ".las", ".laz", ".xyz", ".xyzn", ".csv", ".txt", ".pts", ".asc",
+        ".ply", ".pcd", ".las", ".laz", ".e57", ".xyz", ".xyzn", ".csv", ".txt", ".pts", ".asc",
     ];
     for ext in point_formats {
         assert!(simplify.contains(ext), "simplify --help omits {ext}");

@@ -148,7 +148,7 @@ pub(super) fn run(
             (true, _) => "with normals".to_string(),
             (false, None) => "normals estimated".to_string(),
             (false, Some(v)) => format!(
-                "normals estimated, oriented towards the range map's camera at ({}, {}, {})",
+                "normals estimated, oriented towards the sensor the file gives at ({}, {}, {})",
                 // (as the file's single precision, and no negative zero)
                 v.x as f32 + 0.0,
                 v.y as f32 + 0.0,
