@@ -206,7 +206,10 @@ fn the_readme_names_every_option_the_help_gives() {
         }
     }
     let simplify = help(&["simplify"]);
-    for ext in [".ply", ".xyz", ".xyzn", ".csv", ".txt", ".pts", ".asc"] {
+    let point_formats = [
+        ".ply", ".pcd", ".las", ".laz", ".e57", ".xyz", ".xyzn", ".csv", ".txt", ".pts", ".asc",
+    ];
+    for ext in point_formats {
         assert!(simplify.contains(ext), "simplify --help omits {ext}");
     }
     let points = help(&["points"]);
@@ -214,6 +217,12 @@ fn the_readme_names_every_option_the_help_gives() {
         assert!(points.contains(ext), "points --help omits {ext}");
     }
     let main = help(&[]);
+    for ext in point_formats {
+        assert!(
+            main.contains(ext),
+            "--help omits the point set format {ext}"
+        );
+    }
     let iterations = main
         .lines()
         .find(|l| l.contains("--iterations"))

@@ -36,13 +36,14 @@ pub struct RemeshJob {
     /// no limit.
     pub max_memory: Option<u64>,
     /// Whether the input is read as a point set (its faces ignored) even when it has faces:
-    /// `--as-points` (a PLY file). A text, PCD or LAS point file or a PLY file without faces is read
-    /// as a point set either way ([`is_point_set`](crate::internal::is_point_set)).
+    /// `--as-points` (a PLY file). A text, PCD, LAS, LAZ or E57 point file or a PLY file without
+    /// faces is read as a point set either way ([`is_point_set`](crate::internal::is_point_set)).
     pub as_points: bool,
     /// For a point set without normals: the estimated normals face this point (model units; a
-    /// single scan's sensor) instead of being oriented outward by a spanning tree. `None`: a PLY
-    /// range map's camera or a PCD's `VIEWPOINT` ([`PointReader::viewpoint`](crate::points::PointReader::viewpoint))
-    /// when the points look seen from there ([`PointSource::orientation`](crate::points::source::PointSource::orientation)),
+    /// single scan's sensor) instead of being oriented outward by a spanning tree. `None`: the
+    /// sensor the file gives when it gives one (a PLY range map's camera, a PCD's `VIEWPOINT`, an
+    /// E57's single scan: [`PointSource::viewpoint`](crate::PointSource::viewpoint)) and the
+    /// points look seen from there ([`PointSource::orientation`](crate::PointSource::orientation)),
     /// else the spanning tree. Not used for meshes.
     pub viewpoint: Option<glam::DVec3>,
     /// Where the JSON report goes as well (`--report`): written with the mesh, both only once

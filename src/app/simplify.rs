@@ -27,7 +27,8 @@ pub enum SimplifyDensity {
 /// A `remesh simplify` job.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimplifyJob {
-    /// The input point set: PLY (ascii or binary), PCD, LAS or XYZ/CSV text, with or without normals.
+    /// The input point set: PLY (ascii or binary), PCD, LAS, LAZ, E57 or XYZ/CSV text, with or
+    /// without normals.
     pub input: PathBuf,
     /// The output point set (binary PLY with normals; with levels, a `uchar level` property).
     pub output: PathBuf,
@@ -40,8 +41,9 @@ pub struct SimplifyJob {
     /// Seed of every random choice.
     pub seed: u64,
     /// For an input without normals: orient the estimated normals towards this point (model
-    /// units) instead of outward by a spanning tree. `None`: a PLY range map's camera or a PCD's
-    /// `VIEWPOINT` ([`PointReader::viewpoint`]) when the points look seen from there
+    /// units) instead of outward by a spanning tree. `None`: the sensor the file gives when it
+    /// gives one (a PLY range map's camera, a PCD's `VIEWPOINT`, an E57's single scan:
+    /// [`PointSource::viewpoint`]) and the points look seen from there
     /// ([`PointSource::orientation`]), else the spanning tree.
     pub viewpoint: Option<DVec3>,
 }

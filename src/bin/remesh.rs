@@ -41,8 +41,10 @@ struct Cli {
 
     /// Input mesh: .obj, .ply, .gltf, .glb, .stl (binary or ascii) or .off; or a point set (a
     /// scan): a .ply without faces, a .pcd (the Point Cloud Library's; its VIEWPOINT is the
-    /// sensor), a .las (LiDAR; not LAZ), or text .xyz .xyzn .csv .txt .pts .asc (x y z [nx ny nz] per line), with or
-    /// without normals, read out of core (PCD read whole); it needs --points or --sigma-p.
+    /// sensor), a .las or .laz (LiDAR), an .e57 (laser scans, posed into one frame; a single
+    /// scan's sensor is the viewpoint), or text .xyz .xyzn .csv .txt .pts .asc (x y z [nx ny nz]
+    /// per line), with or without normals, read out of core (PCD and E57 read whole); it needs
+    /// --points or --sigma-p.
     #[arg(required = true)]
     input: Option<PathBuf>,
 
@@ -177,9 +179,9 @@ struct Cli {
 
     /// For a point set without normals: orient the estimated normals towards this point
     /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
-    /// Without it, a PLY range map's camera (`view_px view_py view_pz`) or a PCD's `VIEWPOINT`
-    /// is used when the points look seen from there (few lie behind others on its lines of
-    /// sight).
+    /// Without it, the sensor the file gives is used (a PLY range map's camera `view_px view_py
+    /// view_pz`, a PCD's VIEWPOINT, or the sensor of an E57 of one scan) when the points look
+    /// seen from there (few lie behind others on its lines of sight).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
     viewpoint: Option<[f64; 3]>,
 
@@ -214,8 +216,8 @@ enum Command {
     #[command(allow_negative_numbers = true)]
     Simplify {
         /// The input point set: .ply (ascii or binary), .pcd (ascii, binary or
-        /// binary_compressed), .las or XYZ/CSV text (.xyz .xyzn .csv .txt .pts .asc: `x y z` or
-        /// `x y z nx ny nz` per line, or named columns), with or without normals.
+        /// binary_compressed), .las, .laz, .e57 or XYZ/CSV text (.xyz .xyzn .csv .txt .pts .asc:
+        /// `x y z` or `x y z nx ny nz` per line, or named columns), with or without normals.
         input: PathBuf,
         /// The output point set (.ply; not - : point sets need a file).
         output: PathBuf,
@@ -248,9 +250,9 @@ enum Command {
         seed: u64,
         /// For an input without normals: orient the estimated normals towards this point
         /// (`x,y,z`, model units; a single scan's sensor) instead of outward by a spanning tree.
-        /// Without it, a PLY range map's camera (`view_px view_py view_pz`) or a PCD's `VIEWPOINT`
-        /// is used when the points look seen from there (few lie behind others on its lines of
-        /// sight).
+        /// Without it, the sensor the file gives is used (a PLY range map's camera `view_px
+        /// view_py view_pz`, a PCD's VIEWPOINT, or the sensor of an E57 of one scan) when the
+        /// points look seen from there (few lie behind others on its lines of sight).
         #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
         viewpoint: Option<[f64; 3]>,
         /// Print nothing but errors.

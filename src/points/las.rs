@@ -1,10 +1,19 @@
-//! LAS, the ASPRS LiDAR exchange format, read as a point set through the `las` crate (versions
-//! 1.0–1.4, every point format): the points' `x y z` with the header's scale and offset applied,
-//! in chunks (a LiDAR survey may hold more points than memory). LAS has no normals and no single
-//! sensor position (an airborne scanner moves), so the normals are estimated and oriented
-//! without a viewpoint.
+//! LAS, the ASPRS LiDAR exchange format, and LAZ, its LASzip compression, read as a point set
+//! through the `las` crate (versions 1.0–1.4, every point format; LAZ through its `laz`
+//! feature): the points' `x y z` with the header's scale and offset applied (the file's units,
+//! metres or feet as its coordinate reference system says), in chunks (a LiDAR survey may hold
+//! more points than memory). LAS has no normals and no single sensor position (an airborne
+//! scanner moves), so the normals are estimated and oriented without a viewpoint.
 //!
-//! Source: ASPRS, "LAS Specification 1.4 – R15" (2019).
+//! LAZ is read in chunks too: LASzip compresses the points in chunks (50,000 points by default)
+//! listed in a chunk table, so a seek decompresses from the start of the chunk holding the point,
+//! at most one LASzip chunk more than the points asked for. A LAZ without a chunk table (a
+//! writer that did not finish) cannot seek: it reads when its points fit in the first chunk asked
+//! for, and a larger one is an error naming the file.
+//!
+//! Sources: ASPRS, "LAS Specification 1.4 – R15" (2019); M. Isenburg, "LASzip: lossless
+//! compression of LiDAR data", Photogrammetric Engineering & Remote Sensing 79(2), 2013, and the
+//! LASzip format as `laz` implements it.
 
 use std::path::Path;
 
@@ -24,8 +33,8 @@ impl LasPoints {
     /// Opens the LAS file at `path` and reads its header.
     ///
     /// # Errors
-    /// [`Error::Parse`] naming the file for a file the `las` crate cannot read (not LAS, a
-    /// damaged header; LAZ, which this build does not decompress).
+    /// [`Error::Parse`] naming the file for a file the `las` crate cannot read (not LAS or LAZ,
+    /// a damaged header, a LAZ without its LASzip record).
     pub(crate) fn open(path: &Path) -> Result<Self> {
         let count = reader(path)?.header().number_of_points();
         Ok(LasPoints { count })
@@ -54,7 +63,11 @@ impl LasPoints {
             message: format!("a point record the las crate cannot read: {e}"),
         };
         let mut reader = reader(path)?;
-        reader.seek(from).map_err(bad)?;
+        // A fresh reader is at the first point; seeking there would fail for a LAZ without a
+        // chunk table.
+        if from > 0 {
+            reader.seek(from).map_err(bad)?;
+        }
         let data = reader.read_points(n as u64).map_err(bad)?;
         let before = out.len();
         out.extend(
@@ -72,15 +85,16 @@ fn reader(path: &Path) -> Result<las::Reader> {
     las::Reader::from_path(path).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
         line: None,
-        message: format!("not a LAS file the las crate can read: {e}"),
+        message: format!("not a LAS or LAZ file the las crate can read: {e}"),
     })
 }
 
-/// Whether `path`'s extension is `.las` (any case).
+/// Whether `path`'s extension is `.las` or `.laz` (any case): the `las` crate reads both, and
+/// tells them apart by the header's point format, not by the name.
 pub(crate) fn is_las_extension(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("las"))
+        .is_some_and(|e| e.eq_ignore_ascii_case("las") || e.eq_ignore_ascii_case("laz"))
 }
 
 #[cfg(test)]

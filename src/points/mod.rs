@@ -1,10 +1,12 @@
 //! Point sets without connectivity, the paper's native input (Sec. 3): streaming reading (PLY,
-//! XYZ/CSV, LAS; PCD read whole) and writing, dense random point sets drawn from meshes for tests and benchmarks, the
-//! out-of-core randomized linear scan, normal estimation, and the RIMLS surface of a point set.
+//! XYZ/CSV, LAS and LAZ; PCD and E57 read whole) and writing, dense random point sets drawn from
+//! meshes for tests and benchmarks, the out-of-core randomized linear scan, normal estimation,
+//! and the RIMLS surface of a point set.
 
 pub mod area_guess;
 pub mod boundary;
 pub(crate) mod buckets;
+pub mod e57;
 pub mod far_groups;
 pub mod flatness;
 pub mod generate;

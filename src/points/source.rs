@@ -88,8 +88,10 @@ impl PointSource {
     }
 
     /// The scanner's position the source gives: a PLY range map's `camera`
-    /// ([`PointReader::viewpoint`]) or a PCD file's `VIEWPOINT`, the file's units; only the
-    /// header is read. `None` for text and LAS files (which give none) and points in memory.
+    /// ([`PointReader::viewpoint`]), a PCD file's `VIEWPOINT` or the sensor of an E57 file of
+    /// one scan, the file's units; only the header (E57: its XML section) is read. `None` for
+    /// text and LAS/LAZ files (which give none), E57 files of several scans (one sensor each,
+    /// not one viewpoint: `points::e57::read_e57`) and points in memory.
     ///
     /// # Errors
     /// Those of [`PointReader::open`].
@@ -97,6 +99,9 @@ impl PointSource {
         match self {
             PointSource::File(path) if super::pcd::is_pcd_extension(path) => {
                 super::pcd::read_pcd_viewpoint(path).map(Some)
+            }
+            PointSource::File(path) if super::e57::is_e57_extension(path) => {
+                super::e57::read_e57_viewpoint(path)
             }
             PointSource::File(path) if !super::stream::is_text_extension(path) => {
                 Ok(PointReader::open(path)?.viewpoint())

@@ -31,9 +31,9 @@ enum Encoding {
     BinaryBig,
     /// XYZ/CSV text: one point per line, values separated by commas, semicolons or blanks.
     Text,
-    /// Read whole when opened (PCD): the points are in `loaded`.
+    /// Read whole when opened (PCD, E57): the points are in `loaded`.
     Loaded,
-    /// LAS, read in chunks through `las`.
+    /// LAS or LAZ, read in chunks through `las`.
     Las,
 }
 
@@ -116,7 +116,9 @@ fn camera_viewpoint(slots: &[usize], values: &[f64]) -> Option<DVec3> {
 ///   used when all three are present, everything else is skipped;
 /// - PCD (`.pcd`; `points::pcd::read_pcd`: ascii, binary or binary_compressed, points
 ///   without depth left out, `VIEWPOINT` as the viewpoint), read whole when opened;
-/// - LAS (`.las`; `points::las`: the points' `x y z`, scaled), in chunks;
+/// - LAS and LAZ (`.las .laz`; `points::las`: the points' `x y z`, scaled), in chunks;
+/// - E57 (`.e57`; `points::e57::read_e57`: every scan posed into the file's frame, invalid
+///   points left out, a single scan's sensor as the viewpoint), read whole when opened;
 /// - XYZ/CSV text (`.xyz .csv .txt .pts .asc .xyzn`): one point per line, `x y z` or
 ///   `x y z nx ny nz` (further columns skipped), separated by commas, semicolons or blanks. A
 ///   first line of names (`x,y,z,nx,ny,nz` in any order, any case) picks the columns; blank lines
@@ -161,6 +163,9 @@ impl PointReader {
         }
         if super::las::is_las_extension(path) {
             return Self::open_las(path);
+        }
+        if super::e57::is_e57_extension(path) {
+            return Self::open_e57(path);
         }
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let mut input = BufReader::with_capacity(1 << 20, file);
@@ -361,24 +366,51 @@ impl PointReader {
     /// Opens a PCD file and reads it whole (`points::pcd::read_pcd`).
     fn open_pcd(path: &Path) -> Result<Self> {
         let pcd = super::pcd::read_pcd(path)?;
-        let count = pcd.positions.len() as u64;
+        Self::loaded(
+            path,
+            &pcd.positions,
+            pcd.has_normals.then_some(&pcd.normals[..]),
+            Some(pcd.viewpoint),
+        )
+    }
+
+    /// Opens an E57 file and reads it whole (`points::e57::read_e57`).
+    fn open_e57(path: &Path) -> Result<Self> {
+        let e57 = super::e57::read_e57(path)?;
+        Self::loaded(
+            path,
+            &e57.positions,
+            e57.has_normals.then_some(&e57.normals[..]),
+            e57.viewpoint(),
+        )
+    }
+
+    /// A reader of points a crate has read whole: `positions`, with their unit `normals` (one
+    /// per position) when the file has normals, and the sensor's position when it says one.
+    fn loaded(
+        path: &Path,
+        positions: &[DVec3],
+        normals: Option<&[DVec3]>,
+        viewpoint: Option<DVec3>,
+    ) -> Result<Self> {
+        let count = positions.len() as u64;
         let mut reader = Self::decoded_elsewhere(path, Encoding::Loaded, count)?;
-        reader.has_normals = pcd.has_normals;
-        reader.viewpoint = Some(pcd.viewpoint);
-        reader.loaded = pcd
-            .positions
+        reader.has_normals = normals.is_some();
+        reader.viewpoint = viewpoint;
+        let normals = normals.unwrap_or_default();
+        reader.loaded = positions
             .iter()
             .enumerate()
             .map(|(i, &position)| Point {
                 position,
-                normal: pcd.normals.get(i).copied().unwrap_or(DVec3::ZERO),
+                normal: normals.get(i).copied().unwrap_or(DVec3::ZERO),
             })
             .collect();
         Ok(reader)
     }
 
-    /// A reader of `count` points of a format a crate decodes (PCD, LAS): no properties, records
-    /// or lines of its own, no normals or viewpoint until the caller sets them.
+    /// A reader of `count` points of a format a crate decodes (PCD, LAS, E57): no properties,
+    /// records or lines of its own, no normals or viewpoint until the caller sets them.
     fn decoded_elsewhere(path: &Path, encoding: Encoding, count: u64) -> Result<Self> {
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         Ok(PointReader {
@@ -511,10 +543,11 @@ impl PointReader {
         self.has_normals
     }
 
-    /// The scanner's position when the file is a range map that says it: a PLY `camera`
-    /// element of scalars before `vertex` with `view_px view_py view_pz` (VCG's layout, as MeshLab writes
-    /// range maps; the first camera when there are several), in the points' units. `None`
-    /// otherwise, or when those values are not finite.
+    /// The scanner's position when the file says it, in the points' units: a PLY `camera`
+    /// element of scalars before `vertex` with `view_px view_py view_pz` (VCG's layout, as
+    /// MeshLab writes range maps; the first camera when there are several), a PCD's `VIEWPOINT`,
+    /// or the sensor of an E57 file of one scan (its pose's translation). `None` otherwise (E57
+    /// files of several scans among them), or when a PLY camera's values are not finite.
     pub fn viewpoint(&self) -> Option<DVec3> {
         self.viewpoint
     }
@@ -696,6 +729,7 @@ pub(crate) fn is_point_set(path: &Path) -> Result<bool> {
     if is_text_extension(path)
         || super::pcd::is_pcd_extension(path)
         || super::las::is_las_extension(path)
+        || super::e57::is_e57_extension(path)
     {
         return Ok(true);
     }

@@ -1,11 +1,9 @@
 use super::*;
 
-#[test]
-fn a_las_file_written_reads_back_its_points_in_chunks() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("survey.las");
-    // Coordinates as a survey's (UTM metres), at the header's scale of a millimetre.
-    let written: Vec<DVec3> = (0..1000)
+/// Writes `n` points at a survey's coordinates (UTM metres, the header's scale a millimetre) to
+/// `path` with the crate's writer, LASzip-compressed when the name ends in `.laz`; returns them.
+fn write_survey(path: &Path, n: usize) -> Vec<DVec3> {
+    let written: Vec<DVec3> = (0..n)
         .map(|i| {
             let t = i as f64;
             DVec3::new(
@@ -30,7 +28,7 @@ fn a_las_file_written_reads_back_its_points_in_chunks() {
             offset: 0.0,
         },
     };
-    let mut writer = las::Writer::from_path(&path, header.into_header().unwrap()).unwrap();
+    let mut writer = las::Writer::from_path(path, header.into_header().unwrap()).unwrap();
     for p in &written {
         writer
             .write_point(las::Point {
@@ -43,19 +41,52 @@ fn a_las_file_written_reads_back_its_points_in_chunks() {
     }
     writer.close().unwrap();
     drop(writer);
-    let mut reader = crate::points::PointReader::open(&path).unwrap();
-    assert_eq!(reader.count(), 1000);
+    written
+}
+
+/// Reads `path` through the point reader the pipeline uses, in chunks of `chunk`, and checks
+/// the points against `written` within the millimetre scale.
+fn read_back(path: &Path, written: &[DVec3], chunk: usize) {
+    let mut reader = crate::points::PointReader::open(path).unwrap();
+    assert_eq!(reader.count(), written.len() as u64);
     assert_eq!(reader.viewpoint(), None);
     assert!(!reader.has_normals());
-    let (mut all, mut chunk) = (Vec::new(), Vec::new());
-    while reader.read_chunk(&mut chunk, 300).unwrap() > 0 {
-        all.extend(chunk.iter().map(|p| p.position));
+    let (mut all, mut points) = (Vec::new(), Vec::new());
+    while reader.read_chunk(&mut points, chunk).unwrap() > 0 {
+        all.extend(points.iter().map(|p| p.position));
     }
     assert_eq!(all.len(), written.len());
-    for (a, b) in all.iter().zip(&written) {
+    for (a, b) in all.iter().zip(written) {
         assert!(a.distance(*b) <= 0.001, "{a} against {b}");
     }
-    assert!(crate::points::stream::is_point_set(&path).unwrap());
+    assert!(crate::points::stream::is_point_set(path).unwrap());
+}
+
+#[test]
+fn a_las_file_written_reads_back_its_points_in_chunks() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("survey.las");
+    let written = write_survey(&path, 1000);
+    read_back(&path, &written, 300);
+}
+
+#[test]
+fn a_laz_file_written_reads_back_its_points_in_chunks_across_laszip_chunks() {
+    let dir = tempfile::tempdir().unwrap();
+    // More than two LASzip chunks (50,000 points each by default), read in chunks of 30,000:
+    // every read after the first seeks into the middle of a LASzip chunk.
+    let path = dir.path().join("survey.laz");
+    let written = write_survey(&path, 120_000);
+    let header = las::Reader::from_path(&path).unwrap().header().clone();
+    assert!(header.point_format().is_compressed, "written as LAZ");
+    // Compressed: well below the 20 bytes a point of format 0 takes in a LAS file.
+    let size = std::fs::metadata(&path).unwrap().len();
+    assert!(size < 120_000 * 20 / 2, "{size} bytes");
+    read_back(&path, &written, 30_000);
+    // The same name in capitals, and a small file read in one chunk.
+    let path = dir.path().join("SMALL.LAZ");
+    let written = write_survey(&path, 10);
+    read_back(&path, &written, 1 << 16);
 }
 
 #[test]
@@ -68,5 +99,18 @@ fn a_file_that_is_not_las_is_an_error_naming_the_file() {
     };
     let e = e.to_string();
     assert!(e.contains("scan.las") && e.contains("LAS"), "{e}");
+    assert!(!e.contains('\n'), "one line: {e}");
+}
+
+#[test]
+fn a_file_that_is_not_laz_is_an_error_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scan.laz");
+    std::fs::write(&path, [0u8; 400]).unwrap();
+    let Err(e) = crate::points::PointReader::open(&path) else {
+        panic!("read as LAZ");
+    };
+    let e = e.to_string();
+    assert!(e.contains("scan.laz") && e.contains("LAZ"), "{e}");
     assert!(!e.contains('\n'), "one line: {e}");
 }
