@@ -268,8 +268,8 @@ pub(super) fn run(
     let off = &out.off_data;
     if off.faces > 0 {
         report.notes.push(format!(
-            "{} faces with a corner farther than the mean edge length from every point were \
-             removed (the data's edge)",
+            "{} faces with a corner farther than the mean edge length from every point (two of \
+             the data's own spacings where it is sparser) were removed (the data's edge)",
             off.faces + off.pinched_faces
         ));
     }

@@ -75,15 +75,7 @@ pub fn remove_unsupported_faces(
             }
         }
     }
-    let faces = drop.iter().filter(|&&d| d).count();
-    if faces == 0 {
-        return UnsupportedFaces::default();
-    }
-    let pinched_faces = remove_faces_keeping_manifold(mesh, sources, &drop);
-    UnsupportedFaces {
-        faces,
-        pinched_faces,
-    }
+    remove_marked(mesh, sources, &drop)
 }
 
 /// Removes the faces of `mesh` with a corner that `near` says has no data near it (a vertex the
@@ -104,11 +96,20 @@ pub fn remove_faces_off_data(
         .iter()
         .map(|t| t.iter().any(|&v| off[v as usize]))
         .collect();
+    remove_marked(mesh, sources, &drop)
+}
+
+/// [`remove_faces_keeping_manifold`] with what it removed counted.
+fn remove_marked(
+    mesh: &mut TriMesh,
+    sources: &mut Vec<FaceSource>,
+    drop: &[bool],
+) -> UnsupportedFaces {
     let faces = drop.iter().filter(|&&d| d).count();
     if faces == 0 {
         return UnsupportedFaces::default();
     }
-    let pinched_faces = remove_faces_keeping_manifold(mesh, sources, &drop);
+    let pinched_faces = remove_faces_keeping_manifold(mesh, sources, drop);
     UnsupportedFaces {
         faces,
         pinched_faces,
