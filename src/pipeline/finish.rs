@@ -280,9 +280,15 @@ fn around_changed_faces(mesh: &TriMesh, origin: &[Option<u32>]) -> Vec<bool> {
             }
         }
     }
-    let mut near = changed.clone();
+    with_their_faces(mesh, changed)
+}
+
+/// `flags` (`V` flags of `mesh`'s vertices) with the vertices of every face that has a flagged
+/// vertex set too.
+pub(crate) fn with_their_faces(mesh: &TriMesh, flags: Vec<bool>) -> Vec<bool> {
+    let mut near = flags.clone();
     for t in &mesh.triangles {
-        if t.iter().any(|&v| changed[v as usize]) {
+        if t.iter().any(|&v| flags[v as usize]) {
             for &v in t {
                 near[v as usize] = true;
             }

@@ -945,15 +945,7 @@ fn around_new_boundary(mesh: &TriMesh, before: &[bool]) -> Vec<bool> {
         .enumerate()
         .map(|(v, &b)| b && !before.get(v).copied().unwrap_or(false))
         .collect();
-    let mut near = new.clone();
-    for t in &mesh.triangles {
-        if t.iter().any(|&v| new[v as usize]) {
-            for &v in t {
-                near[v as usize] = true;
-            }
-        }
-    }
-    near
+    crate::pipeline::finish::with_their_faces(mesh, new)
 }
 
 /// The mean length of the edges of `mesh` (each edge once; 0 for a mesh without faces), its
