@@ -33,22 +33,27 @@ pub struct CrossingFaces {
 /// face, or empty) is filtered along. Vertices stay (unreferenced ones are left for the caller).
 /// Deterministic: the same mesh gives the same faces removed.
 pub fn remove_crossing_faces(mesh: &mut TriMesh, sources: &mut Vec<FaceSource>) -> CrossingFaces {
-    let mut stats = CrossingFaces::default();
-    // Removal makes no new pair: one round leaves none. The loop is a guard against a pair the
-    // search finds only once its neighbours are gone (it never has).
-    for _ in 0..4 {
-        let pairs = intersecting_pairs(&mesh.positions, &mesh.triangles);
-        if pairs.is_empty() {
-            break;
-        }
-        if stats.pairs == 0 {
-            stats.pairs = pairs.len();
-        }
-        let drop = cover(&pairs, mesh.triangles.len());
-        stats.faces += drop.iter().filter(|&&d| d).count();
-        stats.pinched_faces += remove_faces_keeping_manifold(mesh, sources, &drop);
+    let pairs = intersecting_pairs(&mesh.positions, &mesh.triangles);
+    remove_faces_of_pairs(mesh, sources, &pairs)
+}
+
+/// [`remove_crossing_faces`] with the intersecting pairs of `mesh` known (face indices, as
+/// [`intersecting_pairs`] gives them). Removing faces makes no new pair: the faces left cross
+/// none.
+pub fn remove_faces_of_pairs(
+    mesh: &mut TriMesh,
+    sources: &mut Vec<FaceSource>,
+    pairs: &[[u32; 2]],
+) -> CrossingFaces {
+    if pairs.is_empty() {
+        return CrossingFaces::default();
     }
-    stats
+    let drop = cover(pairs, mesh.triangles.len());
+    CrossingFaces {
+        pairs: pairs.len(),
+        faces: drop.iter().filter(|&&d| d).count(),
+        pinched_faces: remove_faces_keeping_manifold(mesh, sources, &drop),
+    }
 }
 
 /// A greedy cover of `pairs` (face indices below `faces`): one flag per face, set for the faces

@@ -17,7 +17,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::finish::crossing_faces::{remove_crossing_faces, CrossingFaces};
+use crate::finish::crossing_faces::{remove_crossing_faces, remove_faces_of_pairs, CrossingFaces};
 use crate::finish::optimize::{mend_near, MendStats, OptimizeStats};
 use crate::finish::stray_shells::{remove_tiny_pieces, StrayShells};
 use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
@@ -818,8 +818,7 @@ fn remesh_points_once(
     // than the samples, its own chance gaps are wider: the gap rule's local spacings widen the
     // reach as they do for the faces (5,000 points of spot meshed at 4,000: a vertex a mean edge
     // from every point is no edge of the data there).
-    let spacing = mean_edge_length(&mesh);
-    let boundary_before = boundary_vertices(&mesh);
+    let (spacing, boundary_before) = edge_figures(&mesh);
     let off_data = remove_faces_off_data(&mut mesh, &mut sources, |p| {
         domain.within(p, spacing / sigma_p, OPEN_GAP_SPACINGS)
     });
@@ -847,11 +846,9 @@ fn remesh_points_once(
             );
             sources = crate::pipeline::finish::carried_sources(&mended.origin, &sources);
             mend_after_removals = stats;
-            if !mended.intersecting.is_empty() {
-                let again = remove_crossing_faces(&mut mesh, &mut sources);
-                crossing_faces.faces += again.faces;
-                crossing_faces.pinched_faces += again.pinched_faces;
-            }
+            let again = remove_faces_of_pairs(&mut mesh, &mut sources, &mended.intersecting);
+            crossing_faces.faces += again.faces;
+            crossing_faces.pinched_faces += again.pinched_faces;
         }
     }
     // Pieces no larger than a stray shell (4 sigma_p across, a dozen samples at most), open or
@@ -911,57 +908,42 @@ fn remesh_points_once(
     })))
 }
 
-/// The edges of `mesh`'s faces, each as (smaller vertex, larger), once per face using it,
-/// sorted: an edge of one face appears once.
-fn face_edges(mesh: &TriMesh) -> Vec<(u32, u32)> {
-    let mut edges: Vec<(u32, u32)> = mesh
-        .triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
-        .collect();
-    edges.sort_unstable();
-    edges
-}
-
-/// `V` flags: the vertices of `mesh` on a boundary edge (an edge of one face).
-fn boundary_vertices(mesh: &TriMesh) -> Vec<bool> {
-    let edges = face_edges(mesh);
-    let mut flags = vec![false; mesh.positions.len()];
-    for run in edges.chunk_by(|a, b| a == b) {
-        if let [(a, b)] = run {
-            flags[*a as usize] = true;
-            flags[*b as usize] = true;
+/// The mean length of `mesh`'s edges (each once, summed in the order of their vertex pairs; 0
+/// for a mesh without faces), position units, and `V` flags of the vertices on a boundary edge
+/// (an edge of one face), from [`TriMesh::edge_uses`].
+fn edge_figures(mesh: &TriMesh) -> (f64, Vec<bool>) {
+    let uses = mesh.edge_uses();
+    let mut boundary = vec![false; mesh.positions.len()];
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(uses.len());
+    for (&(a, b), &(_, n)) in &uses {
+        if n == 1 {
+            boundary[a as usize] = true;
+            boundary[b as usize] = true;
         }
+        edges.push((a, b));
     }
-    flags
+    if edges.is_empty() {
+        return (0.0, boundary);
+    }
+    edges.sort_unstable();
+    let p = &mesh.positions;
+    let total: f64 = edges
+        .iter()
+        .map(|&(a, b)| p[a as usize].distance(p[b as usize]))
+        .sum();
+    (total / edges.len() as f64, boundary)
 }
 
 /// `V` flags: the vertices of `mesh` on its boundary that `before` (flags of the same
 /// vertices) did not have there, and the vertices of the faces around them.
 fn around_new_boundary(mesh: &TriMesh, before: &[bool]) -> Vec<bool> {
-    let now = boundary_vertices(mesh);
+    let (_, now) = edge_figures(mesh);
     let new: Vec<bool> = now
         .iter()
         .enumerate()
         .map(|(v, &b)| b && !before.get(v).copied().unwrap_or(false))
         .collect();
     crate::pipeline::finish::with_their_faces(mesh, new)
-}
-
-/// The mean length of the edges of `mesh` (each edge once; 0 for a mesh without faces), its
-/// position units.
-fn mean_edge_length(mesh: &TriMesh) -> f64 {
-    let mut edges = face_edges(mesh);
-    edges.dedup();
-    if edges.is_empty() {
-        return 0.0;
-    }
-    let p = &mesh.positions;
-    edges
-        .iter()
-        .map(|&(a, b)| p[a as usize].distance(p[b as usize]))
-        .sum::<f64>()
-        / edges.len() as f64
 }
 
 /// Whether the file `path` is a point set for [`remesh_points`] rather than a mesh: a text

@@ -21,3 +21,18 @@ pub mod stream;
 pub mod visibility;
 
 pub use stream::{PlyPointWriter, Point, PointReader};
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    /// A xorshift generator (Marsaglia 2003) from a fixed state: the same numbers every run,
+    /// for the readers' corruption tests.
+    pub(crate) fn xorshift() -> impl FnMut() -> usize {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state as usize
+        }
+    }
+}

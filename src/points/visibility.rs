@@ -52,12 +52,12 @@ pub fn hidden_fraction(points: &[DVec3], viewpoint: DVec3) -> f64 {
         .zip(&depth)
         .map(|(p, d)| (*p - viewpoint) / d)
         .collect();
-    let spacing = median_nearest(&points);
-    let angle = median_nearest(&rays);
+    let spacing = median_nearest(&StaticTree::new(&points), &points);
+    let tree = StaticTree::new(&rays);
+    let angle = median_nearest(&tree, &rays);
     if !(spacing > 0.0 && angle > 0.0) {
         return 0.0;
     }
-    let tree = StaticTree::new(&rays);
     let hidden = rays
         .par_iter()
         .zip(&depth)
@@ -71,9 +71,9 @@ pub fn hidden_fraction(points: &[DVec3], viewpoint: DVec3) -> f64 {
     hidden as f64 / points.len() as f64
 }
 
-/// The median distance from each of `points` to its nearest other point (0 when all coincide).
-fn median_nearest(points: &[DVec3]) -> f64 {
-    let tree = StaticTree::new(points);
+/// The median distance from each of `points` to its nearest other point (0 when all coincide);
+/// `tree` holds `points`.
+fn median_nearest(tree: &StaticTree, points: &[DVec3]) -> f64 {
     let mut d: Vec<f64> = points
         .par_iter()
         .map_init(Vec::new, |near, &p| {

@@ -288,13 +288,7 @@ fn corrupted_e57_files_never_panic() {
     let (scans, _) = two_scans();
     write(&source, &scans);
     let bytes = std::fs::read(&source).unwrap();
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        state as usize
-    };
+    let mut next = crate::points::test_support::xorshift();
     for round in 0..200 {
         // Cut short, or bytes changed anywhere (a page's checksum finds most of those).
         let mut b = if round % 2 == 0 {

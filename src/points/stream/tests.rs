@@ -295,13 +295,7 @@ fn corrupted_point_files_never_panic() {
     w.finish().unwrap();
     let bytes = std::fs::read(&source).unwrap();
     let header_len = 250.min(bytes.len());
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        state as usize
-    };
+    let mut next = crate::points::test_support::xorshift();
     for round in 0..200 {
         let mut b = bytes[..(next() % bytes.len()).max(1)].to_vec();
         for _ in 0..round % 4 {
