@@ -219,15 +219,21 @@ def run_meshlab(key, points, n, has_normals, out, timeout=None):
     timeout raises, so it becomes an error row."""
     args = [sys.executable, "-c", CHILD, str(Path(__file__).resolve().parent), key, str(points), str(n),
             "1" if has_normals else "0", str(out)]
+    return float(child_last_line(args, timeout, "MeshLab child"))
+
+
+def child_last_line(args, timeout, who):
+    """The last line a child process (`args`) prints: a timeout, a signal or a non-zero exit raises
+    RuntimeError (`who` names the child in a signal's message)."""
     try:
         r = subprocess.run(args, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         raise RuntimeError(f"timed out after {timeout:.0f} s") from None
     if r.returncode != 0:
         if r.returncode < 0:
-            raise RuntimeError(f"MeshLab child killed by signal {-r.returncode}")
+            raise RuntimeError(f"{who} killed by signal {-r.returncode}")
         raise RuntimeError((r.stderr.strip().splitlines() or [f"exit status {r.returncode}"])[-1])
-    return float(r.stdout.strip().splitlines()[-1])
+    return r.stdout.strip().splitlines()[-1]
 
 
 def run_method(key, points, n, seed, has_normals, out, extra=(), timeout=None):

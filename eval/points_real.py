@@ -223,17 +223,10 @@ CHILD = ("import sys, json; sys.path.insert(0, sys.argv[1]); import points_real 
 
 def run_child(key, points, n, viewpoint, out, timeout):
     """A reference in a child process: its result dict; a crash or a timeout raises."""
+    import points as pts
+
     arg = json.dumps({"f": key, "kw": {"points": str(points), "n": n, "viewpoint": viewpoint, "out": str(out)}})
-    try:
-        r = subprocess.run([sys.executable, "-c", CHILD, str(HERE), arg], capture_output=True, text=True,
-                           timeout=timeout)
-    except subprocess.TimeoutExpired:
-        raise RuntimeError(f"timed out after {timeout:.0f} s") from None
-    if r.returncode != 0:
-        if r.returncode < 0:
-            raise RuntimeError(f"child killed by signal {-r.returncode}")
-        raise RuntimeError((r.stderr.strip().splitlines() or [f"exit status {r.returncode}"])[-1])
-    return json.loads(r.stdout.strip().splitlines()[-1])
+    return json.loads(pts.child_last_line([sys.executable, "-c", CHILD, str(HERE), arg], timeout, "child"))
 
 
 def run_ours(path, n, seed, out, extra, timeout):
