@@ -208,8 +208,9 @@ pub mod internal {
         CURVATURE_MAX_BEND_DEG,
     };
     pub use crate::surface::features::{
-        detect_features, long_curve_share, FeatureCurve, FeatureDetection, FeatureParams, Features,
-        AUTO_FEATURE_MIN_SHARE, CAD_FEATURE_ANGLE_DEG, LONG_CURVE_SPACINGS,
+        detect_features, junction_curve_share, long_curve_share, FeatureCurve, FeatureDetection,
+        FeatureParams, Features, AUTO_FEATURE_MIN_SHARE, CAD_FEATURE_ANGLE_DEG, GAP_ANGLE_DEG,
+        LONG_CURVE_SPACINGS, MAX_CREASE_DENSITY, MAX_GAP_RATIO,
     };
     pub use crate::surface::{MeshSurface, Projection, SurfacePoint, SurfaceQuery, SurfaceSample};
 

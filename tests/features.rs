@@ -457,3 +457,114 @@ fn the_least_squares_fit_lowers_the_sag_and_leaves_rims_and_flat_caps_in_place()
         }
     }
 }
+
+/// A gear made in code (issue 59): `teeth` trapezoidal teeth between radii 18 and 22 (each tooth
+/// a root, a flank up, a tip land and a flank down), extruded 8 high, the caps fanned from the
+/// axis. Its creases are short straight pieces from junction to junction: the flanks, lands and
+/// roots, each a few sample spacings long or less at 2,000 vertices.
+fn gear(teeth: usize) -> TriMesh {
+    let mut ring = Vec::new();
+    for k in 0..teeth {
+        let w = std::f64::consts::TAU / teeth as f64;
+        for (frac, r) in [
+            (0.0, 18.0),
+            (0.25, 18.0),
+            (0.4, 22.0),
+            (0.6, 22.0),
+            (0.75, 18.0),
+        ] {
+            let a = (k as f64 + frac) * w;
+            ring.push((r * a.cos(), r * a.sin()));
+        }
+    }
+    let n = ring.len() as u32;
+    let mut positions: Vec<DVec3> = Vec::new();
+    for z in [0.0, 8.0] {
+        positions.extend(ring.iter().map(|&(x, y)| DVec3::new(x, y, z)));
+    }
+    positions.push(DVec3::ZERO);
+    positions.push(DVec3::new(0.0, 0.0, 8.0));
+    let (bottom, top) = (2 * n, 2 * n + 1);
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        let j = (i + 1) % n;
+        triangles.push([bottom, j, i]);
+        triangles.push([top, n + i, n + j]);
+        triangles.push([i, j, n + j]);
+        triangles.push([i, n + j, n + i]);
+    }
+    TriMesh::new(positions, triangles)
+}
+
+#[test]
+fn a_gears_short_creases_are_judged_a_parts_and_kept() {
+    // The default (automatic) detection: the long curves alone fall short of the share, the
+    // curves from junction to junction make it, and nothing gentler bends beside them.
+    let out = remesh(
+        &gear(20),
+        &RemeshParams {
+            density: Density::Points(2000),
+            seed: 1,
+            ..Default::default()
+        },
+        &|_| {},
+    )
+    .expect("remesh");
+    let f = &out.features;
+    assert_eq!(f.automatic_kept, Some(true), "{f:?}");
+    assert!(f.long_curve_share < 0.9, "{f:?}");
+    assert!(f.junction_curve_share.is_some_and(|s| s >= 0.9), "{f:?}");
+    assert!(f.crease_density.is_some_and(|d| d <= 1.0), "{f:?}");
+    assert!(f.gap_ratio.is_some_and(|r| r <= 1.3), "{f:?}");
+    assert_every_crease_edge_kept(f, 1);
+}
+
+#[test]
+fn a_surface_crumpled_at_the_spacing_keeps_no_creases() {
+    // A sphere whose vertices are moved in and out by up to 8% of its radius: a crease along
+    // most of its edges at the spacing, from junction to junction (short pieces that pass the
+    // junction share) but far closer than a spacing apart: a scan's noise, not a part.
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let mut m = common::icosphere(4);
+    for p in &mut m.positions {
+        *p *= 1.0 + rng.random_range(-0.08..0.08);
+    }
+    let out = remesh(
+        &m,
+        &RemeshParams {
+            density: Density::Points(1500),
+            seed: 1,
+            ..Default::default()
+        },
+        &|_| {},
+    )
+    .expect("remesh");
+    let f = &out.features;
+    assert!(f.junction_curve_share.is_some_and(|s| s >= 0.9), "{f:?}");
+    assert!(f.crease_density.is_some_and(|d| d > 1.0), "{f:?}");
+    assert_eq!(f.automatic_kept, Some(false), "{f:?}");
+    assert_eq!(f.sampled_edges, 0, "{f:?}");
+}
+
+/// Issue 59: the beetle (a scan) at 13,000 vertices has 84% of its folds' length in long curves
+/// and 93% in those or between junctions, more than a spacing apart: only the gentler bends
+/// beside them (detection at 10° finds 1.6 times the length) tell them from a part's creases.
+#[test]
+fn the_beetles_folds_stay_a_scans_where_only_the_gap_tells() {
+    let input = spectral_remesh::read_mesh(&common::model("beetle.obj"))
+        .expect("beetle")
+        .0;
+    let params = RemeshParams {
+        density: Density::Points(13_000),
+        seed: 1,
+        ..Default::default()
+    };
+    let out = remesh(&input, &params, &|_| {}).expect("remesh");
+    let f = &out.features;
+    assert!(f.junction_curve_share.is_some_and(|s| s >= 0.9), "{f:?}");
+    assert!(f.crease_density.is_some_and(|d| d <= 1.0), "{f:?}");
+    assert!(f.gap_ratio.is_some_and(|r| r > 1.3), "{f:?}");
+    assert_eq!(f.automatic_kept, Some(false), "{f:?}");
+    assert_eq!(f.sampled_edges, 0, "{f:?}");
+}

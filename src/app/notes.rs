@@ -149,14 +149,13 @@ pub(super) fn features_note(f: &crate::pipeline::FeatureStats) -> Option<String>
             return None;
         }
         return Some(format!(
-            "sharp features (automatic, at {}°): {} crease edges in {} curves, {:.0}% of their \
-             length in curves of {} spacings or more: a scan's folds, not a part's creases, so \
-             they are sampled like the rest (--feature-angle {} keeps them)",
+            "sharp features (automatic, at {}°): {} crease edges in {} curves, {}: a scan's \
+             folds, not a part's creases, so they are sampled like the rest (--feature-angle {} \
+             keeps them)",
             f.angle_deg,
             f.edges,
             f.curves,
-            100.0 * f.long_curve_share,
-            crate::surface::features::LONG_CURVE_SPACINGS,
+            auto_reason(f),
             f.angle_deg
         ));
     }
@@ -183,8 +182,58 @@ pub(super) fn features_note(f: &crate::pipeline::FeatureStats) -> Option<String>
             d.max
         )
     });
+    let why = match f.automatic_kept {
+        Some(true) => format!(" (automatic: {}: a part's creases)", auto_reason(f)),
+        _ => String::new(),
+    };
     Some(format!(
-        "sharp features at {}°: {} crease edges in {} curves ({} closed), {} corners; {kept}{distance}",
+        "sharp features at {}°{why}: {} crease edges in {} curves ({} closed), {} corners; \
+         {kept}{distance}",
         f.angle_deg, f.edges, f.curves, f.closed_curves, f.corners
     ))
+}
+
+/// What the automatic decision on the creases went by ([`FeatureDetection::Auto`]
+/// (crate::internal::FeatureDetection::Auto)): the share in long curves, and where that fell
+/// short, the share in curves from junction to junction and the gentler bends beside them.
+fn auto_reason(f: &crate::pipeline::FeatureStats) -> String {
+    use crate::surface::features::{
+        GAP_ANGLE_DEG, LONG_CURVE_SPACINGS, MAX_CREASE_DENSITY, MAX_GAP_RATIO,
+    };
+    let long = format!(
+        "{:.0}% of their length in curves of {} spacings or more",
+        100.0 * f.long_curve_share,
+        LONG_CURVE_SPACINGS
+    );
+    let Some(junction) = f.junction_curve_share else {
+        return long;
+    };
+    let junction = format!(
+        "{long}, {:.0}% in those or from junction to junction",
+        100.0 * junction
+    );
+    let Some(density) = f.crease_density else {
+        return junction;
+    };
+    let junction = format!(
+        "{junction}, their length times the spacing over the area {density:.2} ({} \
+         {MAX_CREASE_DENSITY})",
+        if density <= MAX_CREASE_DENSITY {
+            "at most"
+        } else {
+            "more than"
+        }
+    );
+    match f.gap_ratio {
+        None => junction,
+        Some(r) => format!(
+            "{junction}, and detection at {GAP_ANGLE_DEG}° finds {r:.2} times their length \
+             ({} {MAX_GAP_RATIO})",
+            if r <= MAX_GAP_RATIO {
+                "at most"
+            } else {
+                "more than"
+            }
+        ),
+    }
 }

@@ -123,9 +123,11 @@ struct Cli {
     /// at least DEG degrees, between its two faces and still at the sample spacing (so a scan's
     /// folds are not creases); creases are sampled evenly like the boundary and kept as output
     /// edges, every one found. Without it (the default) creases are found at 20° and kept when
-    /// they are a part's: at least 90% of their length in curves of 3 sample spacings or more
-    /// (a scan's folds come in short pieces and are sampled like the rest). 180 turns detection
-    /// off, as does --no-features.
+    /// they are a part's: at least 90% of their length in curves of 3 sample spacings or more,
+    /// or in those and curves from junction to junction when the creases lie more than a
+    /// spacing apart and detection at 10° finds at most 1.3 times their length (a scan's folds
+    /// come in short pieces among gentler bends and are sampled like the rest; the report says
+    /// what decided). 180 turns detection off, as does --no-features.
     #[arg(long, value_name = "DEG", conflicts_with = "no_features")]
     feature_angle: Option<f64>,
 

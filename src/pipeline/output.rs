@@ -28,6 +28,17 @@ pub struct FeatureStats {
     /// [`LONG_CURVE_SPACINGS`](crate::internal::LONG_CURVE_SPACINGS) spacings long
     /// ([`long_curve_share`](crate::internal::long_curve_share)).
     pub long_curve_share: f64,
+    /// With automatic detection, when the long curves fell short: the share of the creases'
+    /// length in curves that are long, closed or run from junction to junction
+    /// ([`junction_curve_share`](crate::internal::junction_curve_share)).
+    pub junction_curve_share: Option<f64>,
+    /// When that share was enough: the creases' length times the spacing over the surface's
+    /// area ([`MAX_CREASE_DENSITY`](crate::internal::MAX_CREASE_DENSITY) at most keeps them).
+    pub crease_density: Option<f64>,
+    /// When the density was low enough: the length of the creases found at
+    /// [`GAP_ANGLE_DEG`](crate::internal::GAP_ANGLE_DEG) over that found at the feature angle
+    /// (at most [`MAX_GAP_RATIO`](crate::internal::MAX_GAP_RATIO) keeps them).
+    pub gap_ratio: Option<f64>,
     /// The scale the creases were tested at (the sample spacing of the first sigma_p).
     pub scale: f64,
     /// Feature edges of the input.

@@ -27,10 +27,16 @@ pub enum FeatureDetection {
     Off,
     /// Detection at [`CAD_FEATURE_ANGLE_DEG`], the creases kept when they are a part's: when at
     /// least [`AUTO_FEATURE_MIN_SHARE`] of their length lies in curves at least
-    /// [`LONG_CURVE_SPACINGS`] sample spacings long ([`long_curve_share`]). The creases of a
-    /// CAD part run from corner to corner; a scan's folds are sharp at its own scale in short
-    /// pieces, and sampled as creases they leave poor triangles and no closer surface (the shares
-    /// and figures: `docs/decisions/feature-angle-auto.md`). The default.
+    /// [`LONG_CURVE_SPACINGS`] sample spacings long ([`long_curve_share`]); or when that share
+    /// of their length lies in curves that are long or run from junction to junction
+    /// ([`junction_curve_share`]), the creases lie more than a spacing apart on average (length
+    /// times spacing over area at most [`MAX_CREASE_DENSITY`]) and the surface shows a gap
+    /// between its creases and the rest: detection at [`GAP_ANGLE_DEG`] finds at most
+    /// [`MAX_GAP_RATIO`] times the length it finds at the feature angle. The creases of a CAD part run from corner to corner, and between
+    /// them the surface is smooth; a scan's folds are sharp at its own scale in short pieces, the
+    /// sharp end of bends of every angle, and sampled as creases they leave poor triangles and
+    /// no closer surface (the shares and figures: `docs/decisions/feature-angle-auto.md`). The
+    /// default.
     #[default]
     Auto,
     /// Detection at this feature angle (degrees; 180 or more: off), every crease kept.
@@ -55,23 +61,69 @@ pub const LONG_CURVE_SPACINGS: f64 = 3.0;
 /// them.
 pub const AUTO_FEATURE_MIN_SHARE: f64 = 0.9;
 
+/// The angle (degrees) of the second detection that tells a part's creases from a scan's folds
+/// ([`FeatureDetection::Auto`]): half the feature angle, where a scan's bends are still found
+/// and a part's smooth surfaces show nothing.
+pub const GAP_ANGLE_DEG: f64 = 10.0;
+
+/// The most crease length times the sample spacing over the surface's area for short creases
+/// to be a part's ([`FeatureDetection::Auto`]): creases more than one spacing apart on average,
+/// their samples under half of all. A surface crumpled at the spacing has a crease along most
+/// of its edges (2.8-3.0 on a noisy sphere); the gear of eval/cad_parts.py at 3,000 vertices 0.33.
+pub const MAX_CREASE_DENSITY: f64 = 1.0;
+
+/// The most length detection at [`GAP_ANGLE_DEG`] may find, relative to that at the feature
+/// angle, for the creases to stand apart from the rest of the surface. Measured at the sample
+/// spacing of 3,000 and 13,000 vertices: the CAD parts 1.00-1.12 (fandisk, bracket, flange and
+/// the parts of eval/cad_parts.py), the scans 1.6-5.6 (beetle 1.6, cow 2.0, spot 2.6, pymeshlab's
+/// airplane 2.9, horse 4.2, bunny 4.6, bone 5.5).
+pub const MAX_GAP_RATIO: f64 = 1.3;
+
 /// The share of the total length of `features`' curves (positions `positions`) that lies in
 /// curves at least [`LONG_CURVE_SPACINGS`] · `spacing` long; 0 without curves.
 pub fn long_curve_share(features: &Features, positions: &[DVec3], spacing: f64) -> f64 {
-    let lengths: Vec<f64> = features
-        .curves
-        .iter()
-        .map(|c| c.length(positions))
-        .collect();
-    let total: f64 = lengths.iter().sum();
+    curve_share(features, positions, |_, l| {
+        l >= LONG_CURVE_SPACINGS * spacing
+    })
+}
+
+/// The share of the total length of `features`' curves (positions `positions`) that lies in
+/// curves that are closed, at least [`LONG_CURVE_SPACINGS`] · `spacing` long, or run from
+/// junction to junction (both ends at vertices where three or more feature edges meet): the
+/// short edges of a part, such as a gear's tooth flanks, run between such junctions. 0 without
+/// curves.
+pub fn junction_curve_share(features: &Features, positions: &[DVec3], spacing: f64) -> f64 {
+    let mut valence = vec![0u8; positions.len()];
+    for v in features.edges.iter().flatten() {
+        valence[*v as usize] = valence[*v as usize].saturating_add(1);
+    }
+    let junction = |v: Option<&u32>| v.is_some_and(|&v| valence[v as usize] >= 3);
+    curve_share(features, positions, |c, l| {
+        c.closed
+            || l >= LONG_CURVE_SPACINGS * spacing
+            || (junction(c.vertices.first()) && junction(c.vertices.last()))
+    })
+}
+
+/// The share of the total length of `features`' curves in those `counts` takes (given the curve
+/// and its length); 0 without curves.
+fn curve_share(
+    features: &Features,
+    positions: &[DVec3],
+    counts: impl Fn(&FeatureCurve, f64) -> bool,
+) -> f64 {
+    let (mut total, mut counted) = (0.0, 0.0);
+    for c in &features.curves {
+        let l = c.length(positions);
+        total += l;
+        if counts(c, l) {
+            counted += l;
+        }
+    }
     if !(total > 0.0) {
         return 0.0;
     }
-    let long: f64 = lengths
-        .iter()
-        .filter(|&&l| l >= LONG_CURVE_SPACINGS * spacing)
-        .sum();
-    long / total
+    counted / total
 }
 
 /// The feature angle (degrees) measured for CAD parts: on fandisk the Hausdorff distance falls
@@ -669,5 +721,38 @@ mod tests {
             .iter()
             .all(|c| !c.closed && c.vertices.len() == n + 1));
         assert_eq!(resolved.corners.len(), 6);
+    }
+
+    #[test]
+    fn short_curves_count_towards_the_junction_share_only_between_junctions() {
+        // Vertices on a line 1 apart, a junction at 0 (edges to 1, 2 and 3) and at 4 (to 5, 6
+        // and 7); a curve's length is the distance between its ends.
+        let positions: Vec<DVec3> = (0..8).map(|k| DVec3::new(k as f64, 0.0, 0.0)).collect();
+        let curve = |vertices: Vec<u32>| FeatureCurve {
+            faces: vec![0; vertices.len() - 1],
+            vertices,
+            closed: false,
+        };
+        let mut edges = vec![[0, 1], [0, 2], [0, 3], [4, 5], [4, 6], [4, 7]];
+        edges.sort_unstable();
+        // 0 -> 1, 0 -> 2 and 0 -> 3 end free (at 1, 2, 3), none long at a spacing of 2 (6).
+        let free = Features {
+            edges: edges.clone(),
+            curves: vec![curve(vec![0, 1]), curve(vec![0, 2]), curve(vec![0, 3])],
+            corners: vec![],
+        };
+        assert_eq!(junction_curve_share(&free, &positions, 2.0), 0.0);
+        assert_eq!(long_curve_share(&free, &positions, 2.0), 0.0);
+        // A curve from junction 0 to junction 4 counts (length 4 of the 4 + 1 + 2 = 7), and
+        // would as a long one at a spacing of 1 (4 >= 3); at a spacing of 2 only as between
+        // junctions.
+        let between = Features {
+            edges,
+            curves: vec![curve(vec![0, 4]), curve(vec![0, 1]), curve(vec![0, 2])],
+            corners: vec![],
+        };
+        assert!((junction_curve_share(&between, &positions, 2.0) - 4.0 / 7.0).abs() < 1e-12);
+        assert_eq!(long_curve_share(&between, &positions, 2.0), 0.0);
+        assert!((long_curve_share(&between, &positions, 1.0) - 4.0 / 7.0).abs() < 1e-12);
     }
 }
