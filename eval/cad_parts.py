@@ -5,8 +5,8 @@ between neighbouring facets) that none of their edges is a crease, so the expect
 exactly the edges where the construction puts two surfaces together.
 
 - `hex_nut`: a hexagonal prism (across flats 17.3) with a through bore, its corners chamfered by a
-  30° cone at both ends (the chamfer's crease curves are arcs made of many short edges, like
-  the nut that issue 59 found judged a scan's folds);
+  30° cone at both ends, which meets the end faces in a circle of 0.95 times the across-flats
+  radius (the chamfer's crease curves are arcs made of many short edges);
 - `chamfered_block`: a 40 × 30 × 15 block, 45° chamfers on its four vertical and four top
   edges, three vertical through holes and one horizontal;
 - `gear`: 20 trapezoidal teeth extruded 8 high, a bore through it;
@@ -39,15 +39,17 @@ def hex_nut():
     height = 8.0
     prism = Manifold.cylinder(height, r_corner, r_corner, 6)
     bore = Manifold.cylinder(height + 2.0, 5.0, 5.0, SEGMENTS).translate((0, 0, -1.0))
-    # The 30° chamfer: a cone meeting each end face at the across-flats circle, widening inwards.
+    # The 30° chamfer: a cone meeting each end face in a circle of 0.95 times the across-flats
+    # radius (as a nut's bearing face), widening inwards past the corners.
     flats = r_corner * math.cos(math.pi / 6)
-    rise = (r_corner - flats + 1.0) * math.tan(math.radians(30.0))
+    r0 = 0.95 * flats
+    slope = math.tan(math.radians(30.0))
+    rise = (r_corner + 1.0 - r0) * slope
     steps = 4 * SEGMENTS
-    low = Manifold.cylinder(rise, flats, flats + rise / math.tan(math.radians(30.0)), steps)
-    mid = Manifold.cylinder(height - 2 * rise, 2 * r_corner, 2 * r_corner, steps).translate((0, 0, rise))
-    high = Manifold.cylinder(rise, flats + rise / math.tan(math.radians(30.0)), flats, steps).translate(
-        (0, 0, height - rise)
-    )
+    wide = r0 + rise / slope
+    low = Manifold.cylinder(rise, r0, wide, steps)
+    mid = Manifold.cylinder(height - 2 * rise, wide, wide, steps).translate((0, 0, rise))
+    high = Manifold.cylinder(rise, wide, r0, steps).translate((0, 0, height - rise))
     return _mesh((prism ^ (low + mid + high)) - bore)
 
 
