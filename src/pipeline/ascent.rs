@@ -50,7 +50,10 @@ pub(super) fn ascend(
     let boundary_count = scan.result.initial;
     let before_ascent = index.buried_test.as_ref().map(|_| samples.clone());
     let corner_term = scanned.corner_term();
-    let field = scanned.widths.with_corners(&corner_term);
+    let field = scanned
+        .widths
+        .with_corners(&corner_term)
+        .with(&scanned.scan.separation);
     // Surface samples keep out of a band along the sampled creases.
     let band = {
         let positions: Vec<DVec3> = samples[..boundary_count]

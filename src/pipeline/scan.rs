@@ -4,6 +4,7 @@
 
 use std::borrow::Cow;
 
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::input::{Candidates, NormalizedInput};
@@ -12,14 +13,15 @@ use super::sizing::{Sizing, Widths};
 use super::{RemeshParams, MAX_POINTS};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
-use crate::sampling::curves::{boundary_sample_count, sample_curves_and_features};
+use crate::sampling::crease_separation::CreaseSeparation;
+use crate::sampling::curves::{boundary_sample_count, sample_curves_and_features, FeaturePiece};
 use crate::sampling::features::{feature_pieces, graded_corners, Corners, GradedCorner};
 use crate::sampling::linear_scan::{linear_scan, LinearScanResult};
 use crate::sampling::sizing::{SizingField, Uniform};
 use crate::sampling::spacing::{BOUNDARY_SPACING_PER_SIGMA, FEATURE_SPACING_PER_SIGMA};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::surface::curvature::CurvatureWidths;
-use crate::surface::features::Features;
+use crate::surface::features::{Features, LONG_CURVE_SPACINGS};
 
 /// Rounds of the search at most when grading moves the widths with sigma_p (see [`scan`]).
 const MAX_WIDTH_ROUNDS: usize = 3;
@@ -32,6 +34,8 @@ pub(super) struct CurveScan {
     pub boundary_edges: Vec<[u32; 2]>,
     pub feature_edges: Vec<[u32; 2]>,
     pub corners: Vec<GradedCorner>,
+    /// The grading beside creases closer than their samples' gap (at the creases' spacing).
+    pub separation: CreaseSeparation,
 }
 
 /// The state of the count search across the pipeline's attempts: the count aimed at, where the
@@ -99,13 +103,32 @@ impl ScanInputs<'_> {
         // The boundary curves, cut where creases end on them, and the creases long enough to
         // take samples at their spacing.
         let field = widths.field();
-        let (boundary_pieces, feature_curves) = feature_pieces(
+        let (mut boundary_pieces, mut feature_curves) = feature_pieces(
             normalized,
             &self.input.curves,
             self.features,
             feature_spacing,
             &field,
         );
+        // Where creases were left out for running closer to others than their samples' gap,
+        // the spacing is lowered beside them (crease_separation) and the curves taken again.
+        let crowded = left_out(
+            self.features,
+            &feature_curves,
+            &normalized.positions,
+            feature_spacing,
+        );
+        let separation =
+            CreaseSeparation::new(normalized, self.features, &crowded, feature_spacing);
+        if !separation.is_uniform() {
+            (boundary_pieces, feature_curves) = feature_pieces(
+                normalized,
+                &self.input.curves,
+                self.features,
+                feature_spacing,
+                &widths.field().with(&separation),
+            );
+        }
         let boundary_count = boundary_sample_count(normalized, &boundary_pieces, spacing)
             + boundary_sample_count(
                 normalized,
@@ -119,7 +142,7 @@ impl ScanInputs<'_> {
         // samples are graded too (corner_width).
         let corners = graded_corners(normalized, &feature_curves, feature_spacing);
         let corner_term = Corners::new(&corners, feature_spacing);
-        let field = widths.with_corners(&corner_term);
+        let field = widths.with_corners(&corner_term).with(&separation);
         let b = sample_curves_and_features(
             normalized,
             &boundary_pieces,
@@ -130,7 +153,7 @@ impl ScanInputs<'_> {
         );
         let r = if !field.is_uniform() {
             // The candidates' widths: the round's, lowered around the graded corners.
-            let pool_w: Option<Cow<[f64]>> = if corners.is_empty() {
+            let pool_w: Option<Cow<[f64]>> = if corners.is_empty() && separation.is_uniform() {
                 pool_widths.map(Cow::Borrowed)
             } else {
                 Some(Cow::Owned(
@@ -141,6 +164,7 @@ impl ScanInputs<'_> {
                             pool_widths
                                 .map_or(1.0, |pw| pw[i])
                                 .min(corner_term.width(c.position))
+                                .min(separation.width(c.position))
                         })
                         .collect(),
                 ))
@@ -169,6 +193,7 @@ impl ScanInputs<'_> {
             boundary_edges: b.edges,
             feature_edges: b.feature_edges,
             corners,
+            separation,
         };
         Ok((count, Some(scan)))
     }
@@ -287,4 +312,27 @@ pub(super) fn scan<'s>(
         scan,
         widths,
     })
+}
+
+/// Per curve of `features`: whether it is long ([`LONG_CURVE_SPACINGS`] `spacing`s or more,
+/// bbox-100 units) and not among the `kept` pieces, so left out for crowding, not for its
+/// length. Only those are worth the finer spacing beside them: a long crease lost costs its
+/// whole length; a short one (a gear's tooth land beside its flanks at a coarse spacing) costs
+/// a spacing, and grading its crowded neighbourhood costs more triangles of worse shape.
+fn left_out(
+    features: &Features,
+    kept: &[FeaturePiece],
+    positions: &[DVec3],
+    spacing: f64,
+) -> Vec<bool> {
+    let kept: rustc_hash::FxHashSet<&[u32]> =
+        kept.iter().map(|p| p.curve.vertices.as_slice()).collect();
+    features
+        .curves
+        .iter()
+        .map(|c| {
+            c.length(positions) >= LONG_CURVE_SPACINGS * spacing
+                && !kept.contains(c.vertices.as_slice())
+        })
+        .collect()
 }

@@ -1,0 +1,209 @@
+//! The grading beside creases that run closer together than their samples may come (issue 59).
+//! Two feature curves closer than [`CURVE_SAMPLE_GAP`] spacings would crowd each other's
+//! samples, and [`feature_pieces`](crate::sampling::features::feature_pieces) leaves the
+//! shorter out: a hex nut's chamfer arc where it dips towards the chamfer's circle, a rib's two
+//! edges. Here the spacing is lowered where that happens, to the width at which the two curves'
+//! samples keep the gap (down to [`SEPARATION_MIN_WIDTH`]), and graded back to the spacing
+//! around it ([`CURVATURE_GRADATION`], the spacing's Lipschitz constant), so both curves are
+//! sampled and the sheet between them gets samples as close as theirs.
+//!
+//! Curves that share a corner are not each other's neighbours here: near the corner they come as
+//! close as the angle between them makes them, which the corner grading
+//! ([`Corners`](crate::sampling::features::Corners)) answers.
+
+use glam::DVec3;
+
+use crate::mesh::TriMesh;
+use crate::sampling::features::CURVE_SAMPLE_GAP;
+use crate::sampling::sizing::SizingField;
+use crate::spatial::StaticTree;
+use crate::surface::curvature::CURVATURE_GRADATION;
+use crate::surface::features::Features;
+
+/// The smallest relative width the separation grading gives (as the corner grading's
+/// `CORNER_MIN_WIDTH`): creases closer than half the gap stay crowded, and the shorter is left
+/// out as before.
+pub const SEPARATION_MIN_WIDTH: f64 = 0.5;
+
+/// Points along each curve per spacing, where the separation is measured.
+const POINTS_PER_SPACING: f64 = 4.0;
+
+/// The widths the creases' separation asks for, at points along the creases where it is below
+/// 1 (bbox-100 units), graded around them.
+pub struct CreaseSeparation {
+    tree: StaticTree,
+    widths: Vec<f64>,
+    /// The creases' spacing where the width is 1.
+    spacing: f64,
+    /// The farthest a point's width reaches before the grading brings it to 1, squared.
+    reach_2: f64,
+}
+
+impl CreaseSeparation {
+    /// The grading for `features`' curves on `mesh` sampled at `spacing` (bbox-100 units), for
+    /// the curves marked in `crowded` (those the even sampling left out for crowding): at a point
+    /// of such a curve whose nearest point on another curve (one sharing no corner with it) is
+    /// `d` away, and at that nearest point, the width `d / (CURVE_SAMPLE_GAP · spacing)`,
+    /// slightly less (so samples of the two at that width keep the gap), at least
+    /// [`SEPARATION_MIN_WIDTH`]. Curves that were kept are graded only beside a crowded one: a
+    /// gear's tooth flanks, closer than the gap but sampled without crowding, keep the spacing.
+    /// Uniform when nothing is crowded. Deterministic.
+    pub fn new(mesh: &TriMesh, features: &Features, crowded: &[bool], spacing: f64) -> Self {
+        let step = spacing / POINTS_PER_SPACING;
+        let mut points: Vec<DVec3> = Vec::new();
+        let mut owner: Vec<u32> = Vec::new();
+        for (i, c) in features.curves.iter().enumerate() {
+            let nv = c.vertices.len();
+            let pos = |k: usize| mesh.positions[c.vertices[k % nv] as usize];
+            for k in 0..c.faces.len() {
+                let (a, b) = (pos(k), pos(k + 1));
+                let n = (a.distance(b) / step).ceil().max(1.0) as usize;
+                for s in 0..n {
+                    points.push(a.lerp(b, s as f64 / n as f64));
+                    owner.push(i as u32);
+                }
+            }
+            if !c.closed {
+                points.push(pos(nv - 1));
+                owner.push(i as u32);
+            }
+        }
+        let ends = |i: u32| {
+            let c = &features.curves[i as usize];
+            (!c.closed).then(|| [c.vertices[0], c.vertices[c.vertices.len() - 1]])
+        };
+        let share_a_corner = |i: u32, j: u32| match (ends(i), ends(j)) {
+            (Some(a), Some(b)) => a.iter().any(|v| b.contains(v)),
+            _ => false,
+        };
+        let gap = CURVE_SAMPLE_GAP * spacing;
+        let all = StaticTree::new(&points);
+        let mut near = Vec::new();
+        let mut kept_points = Vec::new();
+        let mut widths = Vec::new();
+        for (k, &p) in points.iter().enumerate() {
+            if !crowded.get(owner[k] as usize).copied().unwrap_or(false) {
+                continue;
+            }
+            all.within(p, gap * gap, &mut near);
+            let nearest = near
+                .iter()
+                .filter(|&&(j, _)| {
+                    let (a, b) = (owner[k], owner[j as usize]);
+                    a != b && !share_a_corner(a, b)
+                })
+                .map(|&(j, d2)| (j, d2.sqrt()))
+                .min_by(|x, y| x.1.total_cmp(&y.1));
+            if let Some((j, d)) = nearest {
+                // A step's worth less: the curves' samples fall anywhere along them.
+                let w = ((d - step).max(0.0) / gap).max(SEPARATION_MIN_WIDTH);
+                if w < 1.0 {
+                    kept_points.extend([p, points[j as usize]]);
+                    widths.extend([w, w]);
+                }
+            }
+        }
+        let least = widths.iter().copied().fold(1.0f64, f64::min);
+        let reach = (1.0 - least) / CURVATURE_GRADATION * spacing;
+        CreaseSeparation {
+            tree: StaticTree::new(&kept_points),
+            widths,
+            spacing,
+            reach_2: (reach * (1.0 + 1e-9)).powi(2),
+        }
+    }
+}
+
+impl SizingField for CreaseSeparation {
+    fn width(&self, p: DVec3) -> f64 {
+        let mut w = 1.0f64;
+        self.tree.visit_within(p, self.reach_2, |i, d2| {
+            w = w.min(self.widths[i as usize] + CURVATURE_GRADATION * d2.sqrt() / self.spacing);
+        });
+        w
+    }
+
+    fn is_uniform(&self) -> bool {
+        self.widths.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::features::FeatureCurve;
+
+    /// Two straight open curves along x, `d` apart in y, from 0 to 10, on a mesh of their
+    /// vertices only (the curves need positions, not faces).
+    fn two_lines(d: f64) -> (TriMesh, Features) {
+        let positions = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(10.0, 0.0, 0.0),
+            DVec3::new(0.0, d, 0.0),
+            DVec3::new(10.0, d, 0.0),
+        ];
+        let line = |a: u32, b: u32| FeatureCurve {
+            vertices: vec![a, b],
+            faces: vec![0],
+            closed: false,
+        };
+        let features = Features {
+            edges: vec![[0, 1], [2, 3]],
+            curves: vec![line(0, 1), line(2, 3)],
+            corners: vec![0, 1, 2, 3],
+        };
+        (TriMesh::new(positions, vec![]), features)
+    }
+
+    #[test]
+    fn creases_closer_than_the_gap_beside_a_crowded_one_get_the_width_that_keeps_it() {
+        let spacing = 1.0;
+        let gap = CURVE_SAMPLE_GAP * spacing;
+        let (mesh, features) = two_lines(0.7 * gap);
+        // Nothing crowded: no grading.
+        assert!(CreaseSeparation::new(&mesh, &features, &[false, false], spacing).is_uniform());
+        let s = CreaseSeparation::new(&mesh, &features, &[false, true], spacing);
+        assert!(!s.is_uniform());
+        let w = s.width(DVec3::new(5.0, 0.0, 0.0));
+        // The two curves' samples at w · spacing keep w · gap between them.
+        assert!(w * gap <= 0.7 * gap && w >= SEPARATION_MIN_WIDTH, "{w}");
+        assert!(w > 0.7 - 0.3, "{w}");
+        // Graded back to 1 a few spacings away.
+        assert_eq!(s.width(DVec3::new(5.0, 10.0, 0.0)), 1.0);
+        let between = s.width(DVec3::new(5.0, 1.0, 0.0));
+        assert!(between > w && between <= 1.0, "{between}");
+        let (mesh, features) = two_lines(1.2 * gap);
+        assert!(CreaseSeparation::new(&mesh, &features, &[true, true], spacing).is_uniform());
+    }
+
+    #[test]
+    fn curves_sharing_a_corner_do_not_grade_each_other() {
+        // Two curves leaving the corner 0 at 30°: close near it, but that is the corner's.
+        let positions = vec![
+            DVec3::ZERO,
+            DVec3::new(10.0, 0.0, 0.0),
+            DVec3::new(
+                10.0 * 30f64.to_radians().cos(),
+                10.0 * 30f64.to_radians().sin(),
+                0.0,
+            ),
+        ];
+        let line = |a: u32, b: u32| FeatureCurve {
+            vertices: vec![a, b],
+            faces: vec![0],
+            closed: false,
+        };
+        let features = Features {
+            edges: vec![[0, 1], [0, 2]],
+            curves: vec![line(0, 1), line(0, 2)],
+            corners: vec![0, 1, 2],
+        };
+        let s = CreaseSeparation::new(
+            &TriMesh::new(positions, vec![]),
+            &features,
+            &[true, true],
+            1.0,
+        );
+        assert!(s.is_uniform());
+    }
+}
