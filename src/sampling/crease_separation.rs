@@ -25,6 +25,10 @@ use crate::surface::features::Features;
 /// out as before.
 pub const SEPARATION_MIN_WIDTH: f64 = 0.5;
 
+/// The largest share of a crowded curve's length that may be crowded for the grading to take
+/// it: beyond, the curve runs beside another along its length (see [`CreaseSeparation::new`]).
+pub const MAX_CROWDED_SHARE: f64 = 0.5;
+
 /// Points along each curve per spacing, where the separation is measured.
 const POINTS_PER_SPACING: f64 = 4.0;
 
@@ -81,26 +85,45 @@ impl CreaseSeparation {
         let mut near = Vec::new();
         let mut kept_points = Vec::new();
         let mut widths = Vec::new();
-        for (k, &p) in points.iter().enumerate() {
-            if !crowded.get(owner[k] as usize).copied().unwrap_or(false) {
+        // Per point of a crowded curve, its nearest point on another curve within the gap.
+        let nearest: Vec<Option<(u32, f64)>> = points
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| {
+                if !crowded.get(owner[k] as usize).copied().unwrap_or(false) {
+                    return None;
+                }
+                all.within(p, gap * gap, &mut near);
+                near.iter()
+                    .filter(|&&(j, _)| {
+                        let (a, b) = (owner[k], owner[j as usize]);
+                        a != b && !share_a_corner(a, b)
+                    })
+                    .map(|&(j, d2)| (j, d2.sqrt()))
+                    .min_by(|x, y| x.1.total_cmp(&y.1))
+            })
+            .collect();
+        // A curve crowded along most of its length runs beside another as a strip narrower
+        // than the spacing (a gear's tooth land, a rib): grading it would take the strip's
+        // whole length down, for triangles of worse shape. Only a stretch is graded.
+        let mut share = vec![(0usize, 0usize); features.curves.len()];
+        for (k, n) in nearest.iter().enumerate() {
+            let c = &mut share[owner[k] as usize];
+            c.1 += 1;
+            c.0 += usize::from(n.is_some());
+        }
+        for (k, n) in nearest.iter().enumerate() {
+            let (Some((j, d)), (hit, all)) = (*n, share[owner[k] as usize]) else {
+                continue;
+            };
+            if hit as f64 > MAX_CROWDED_SHARE * all as f64 {
                 continue;
             }
-            all.within(p, gap * gap, &mut near);
-            let nearest = near
-                .iter()
-                .filter(|&&(j, _)| {
-                    let (a, b) = (owner[k], owner[j as usize]);
-                    a != b && !share_a_corner(a, b)
-                })
-                .map(|&(j, d2)| (j, d2.sqrt()))
-                .min_by(|x, y| x.1.total_cmp(&y.1));
-            if let Some((j, d)) = nearest {
-                // A step's worth less: the curves' samples fall anywhere along them.
-                let w = ((d - step).max(0.0) / gap).max(SEPARATION_MIN_WIDTH);
-                if w < 1.0 {
-                    kept_points.extend([p, points[j as usize]]);
-                    widths.extend([w, w]);
-                }
+            // A step's worth less: the curves' samples fall anywhere along them.
+            let w = ((d - step).max(0.0) / gap).max(SEPARATION_MIN_WIDTH);
+            if w < 1.0 {
+                kept_points.extend([points[k], points[j as usize]]);
+                widths.extend([w, w]);
             }
         }
         let least = widths.iter().copied().fold(1.0f64, f64::min);
