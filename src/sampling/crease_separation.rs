@@ -156,33 +156,36 @@ mod tests {
     use super::*;
     use crate::surface::features::FeatureCurve;
 
-    /// Two straight open curves along x, `d` apart in y, from 0 to 10, on a mesh of their
-    /// vertices only (the curves need positions, not faces).
-    fn two_lines(d: f64) -> (TriMesh, Features) {
-        let positions = vec![
-            DVec3::new(0.0, 0.0, 0.0),
-            DVec3::new(10.0, 0.0, 0.0),
-            DVec3::new(0.0, d, 0.0),
-            DVec3::new(10.0, d, 0.0),
-        ];
-        let line = |a: u32, b: u32| FeatureCurve {
-            vertices: vec![a, b],
-            faces: vec![0],
+    /// Two open curves from x = 0 to 10: a straight one on the x axis and one at y = 2 that dips
+    /// to y = `d` at x = 5 (from x = 4 to 6) when `dip`, else runs at y = `d` all along.
+    fn two_curves(d: f64, dip: bool) -> (TriMesh, Features) {
+        let mut positions = vec![DVec3::new(0.0, 0.0, 0.0), DVec3::new(10.0, 0.0, 0.0)];
+        let far = if dip { 2.0 } else { d };
+        positions.extend([
+            DVec3::new(0.0, far, 0.0),
+            DVec3::new(4.0, far, 0.0),
+            DVec3::new(5.0, d, 0.0),
+            DVec3::new(6.0, far, 0.0),
+            DVec3::new(10.0, far, 0.0),
+        ]);
+        let curve = |vertices: Vec<u32>| FeatureCurve {
+            faces: vec![0; vertices.len() - 1],
+            vertices,
             closed: false,
         };
         let features = Features {
-            edges: vec![[0, 1], [2, 3]],
-            curves: vec![line(0, 1), line(2, 3)],
-            corners: vec![0, 1, 2, 3],
+            edges: vec![[0, 1], [2, 3], [3, 4], [4, 5], [5, 6]],
+            curves: vec![curve(vec![0, 1]), curve(vec![2, 3, 4, 5, 6])],
+            corners: vec![0, 1, 2, 6],
         };
         (TriMesh::new(positions, vec![]), features)
     }
 
     #[test]
-    fn creases_closer_than_the_gap_beside_a_crowded_one_get_the_width_that_keeps_it() {
+    fn a_crease_dipping_towards_another_gets_the_width_that_keeps_the_gap_there() {
         let spacing = 1.0;
         let gap = CURVE_SAMPLE_GAP * spacing;
-        let (mesh, features) = two_lines(0.7 * gap);
+        let (mesh, features) = two_curves(0.7 * gap, true);
         // Nothing crowded: no grading.
         assert!(CreaseSeparation::new(&mesh, &features, &[false, false], spacing).is_uniform());
         let s = CreaseSeparation::new(&mesh, &features, &[false, true], spacing);
@@ -190,13 +193,21 @@ mod tests {
         let w = s.width(DVec3::new(5.0, 0.0, 0.0));
         // The two curves' samples at w · spacing keep w · gap between them.
         assert!(w * gap <= 0.7 * gap && w >= SEPARATION_MIN_WIDTH, "{w}");
-        assert!(w > 0.7 - 0.3, "{w}");
-        // Graded back to 1 a few spacings away.
+        // Graded back to 1 a few spacings away, and between.
         assert_eq!(s.width(DVec3::new(5.0, 10.0, 0.0)), 1.0);
+        assert_eq!(s.width(DVec3::new(0.0, -5.0, 0.0)), 1.0);
         let between = s.width(DVec3::new(5.0, 1.0, 0.0));
         assert!(between > w && between <= 1.0, "{between}");
-        let (mesh, features) = two_lines(1.2 * gap);
+        // Curves farther apart than the gap: none.
+        let (mesh, features) = two_curves(1.2 * gap, true);
         assert!(CreaseSeparation::new(&mesh, &features, &[true, true], spacing).is_uniform());
+    }
+
+    #[test]
+    fn a_crease_crowded_along_its_whole_length_is_not_graded() {
+        // A strip narrower than the spacing (MAX_CROWDED_SHARE): left as it is.
+        let (mesh, features) = two_curves(0.7 * CURVE_SAMPLE_GAP, false);
+        assert!(CreaseSeparation::new(&mesh, &features, &[true, true], 1.0).is_uniform());
     }
 
     #[test]
