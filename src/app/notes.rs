@@ -193,9 +193,10 @@ pub(super) fn features_note(f: &crate::pipeline::FeatureStats) -> Option<String>
     ))
 }
 
-/// What the automatic decision on the creases went by ([`FeatureDetection::Auto`]
-/// (crate::internal::FeatureDetection::Auto)): the share in long curves, and where that fell
-/// short, the share in curves from junction to junction and the gentler bends beside them.
+/// What the automatic decision on the creases went by
+/// ([`FeatureDetection::Auto`](crate::internal::FeatureDetection::Auto)): the share in long
+/// curves, and where that fell short, the share in curves from junction to junction, their
+/// density and the gentler bends beside them.
 fn auto_reason(f: &crate::pipeline::FeatureStats) -> String {
     use crate::surface::features::{
         GAP_ANGLE_DEG, LONG_CURVE_SPACINGS, MAX_CREASE_DENSITY, MAX_GAP_RATIO,
