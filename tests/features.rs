@@ -496,21 +496,21 @@ fn gear(teeth: usize) -> TriMesh {
     TriMesh::new(positions, triangles)
 }
 
+/// A remesh of `input` at `points`, seed 1, with the default (automatic) crease detection.
+fn automatic(input: &TriMesh, points: usize) -> spectral_remesh::RemeshOutput {
+    let params = RemeshParams {
+        density: Density::Points(points),
+        seed: 1,
+        ..Default::default()
+    };
+    remesh(input, &params, &|_| {}).expect("remesh")
+}
+
 #[test]
 fn a_gears_short_creases_are_judged_a_parts_and_kept() {
     // The default (automatic) detection: the long curves alone fall short of the share, the
     // curves from junction to junction make it, and nothing gentler bends beside them.
-    let out = remesh(
-        &gear(20),
-        &RemeshParams {
-            density: Density::Points(2000),
-            seed: 1,
-            ..Default::default()
-        },
-        &|_| {},
-    )
-    .expect("remesh");
-    let f = &out.features;
+    let f = &automatic(&gear(20), 2000).features;
     assert_eq!(f.automatic_kept, Some(true), "{f:?}");
     assert!(f.long_curve_share < 0.9, "{f:?}");
     assert!(f.junction_curve_share.is_some_and(|s| s >= 0.9), "{f:?}");
@@ -530,17 +530,7 @@ fn a_surface_crumpled_at_the_spacing_keeps_no_creases() {
     for p in &mut m.positions {
         *p *= 1.0 + rng.random_range(-0.08..0.08);
     }
-    let out = remesh(
-        &m,
-        &RemeshParams {
-            density: Density::Points(1500),
-            seed: 1,
-            ..Default::default()
-        },
-        &|_| {},
-    )
-    .expect("remesh");
-    let f = &out.features;
+    let f = &automatic(&m, 1500).features;
     assert!(f.junction_curve_share.is_some_and(|s| s >= 0.9), "{f:?}");
     assert!(f.crease_density.is_some_and(|d| d > 1.0), "{f:?}");
     assert_eq!(f.automatic_kept, Some(false), "{f:?}");
@@ -555,13 +545,7 @@ fn the_beetles_folds_stay_a_scans_where_only_the_gap_tells() {
     let input = spectral_remesh::read_mesh(&common::model("beetle.obj"))
         .expect("beetle")
         .0;
-    let params = RemeshParams {
-        density: Density::Points(13_000),
-        seed: 1,
-        ..Default::default()
-    };
-    let out = remesh(&input, &params, &|_| {}).expect("remesh");
-    let f = &out.features;
+    let f = &automatic(&input, 13_000).features;
     assert!(f.junction_curve_share.is_some_and(|s| s >= 0.9), "{f:?}");
     assert!(f.crease_density.is_some_and(|d| d <= 1.0), "{f:?}");
     assert!(f.gap_ratio.is_some_and(|r| r > 1.3), "{f:?}");
