@@ -137,12 +137,12 @@ def measure(out_path, in_path, V, creases, corner_ids):
     }
 
 
-def run_ours(in_path, n, seed, work):
+def run_ours(in_path, n, seed, work, extra=()):
     out = Path(work) / f"ours-{seed}.obj"
     rep = Path(work) / f"ours-{seed}.json"
     compare.subprocess.run(
         [compare.REMESH, str(in_path), str(out), "--points", str(n), "--seed", str(seed), "-q",
-         "--no-distance", "--report", str(rep)],
+         "--no-distance", "--report", str(rep), *extra],
         check=True,
     )
     notes = json.loads(rep.read_text()).get("notes", [])
@@ -156,6 +156,7 @@ def main():
     ap.add_argument("--seeds", default="1-5")
     ap.add_argument("--count", type=int, default=3000)
     ap.add_argument("--no-references", action="store_true")
+    ap.add_argument("--ours-args", default="", help="more arguments for ours, e.g. '--chord-error 0.003'")
     ap.add_argument("--name", default="creases")
     ap.add_argument("--out", default=str(here / "results" / "features"))
     args = ap.parse_args()
@@ -176,7 +177,7 @@ def main():
         pw = work / name
         pw.mkdir()
         for s in seeds:
-            out, decision = run_ours(in_path, args.count, s, pw)
+            out, decision = run_ours(in_path, args.count, s, pw, args.ours_args.split())
             r = {"method": "ours", "seed": s, "decision": decision, **measure(out, in_path, V, creases, corner_ids)}
             row["runs"].append(r)
             print("  ", json.dumps(r), flush=True)
