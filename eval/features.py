@@ -42,6 +42,7 @@ here = Path(__file__).resolve().parent
 sys.path.insert(0, str(here))
 import cad_parts  # noqa: E402
 import compare  # noqa: E402
+import points_real  # noqa: E402
 
 SHARED = here.parent.parent / "shared" / "data"
 SHARED_PARTS = ["fandisk", "bracket", "flange"]
@@ -113,8 +114,7 @@ def input_corner_angle(V, creases):
 def measure(out_path, in_path, V, creases, corner_ids):
     q = compare.ruler(out_path, in_path)
     V2, F2 = compare.read_mesh(out_path)
-    E = np.concatenate([F2[:, [0, 1]], F2[:, [1, 2]], F2[:, [2, 0]]])
-    h = float(np.linalg.norm(V2[E[:, 0]] - V2[E[:, 1]], axis=1).mean())
+    h = points_real.mean_edge(V2, F2)
     P = crease_samples(V, creases, h / 8)
     d = distance_to_edges(P, V2, F2) if len(P) else np.zeros(0)
     from scipy.spatial import cKDTree

@@ -216,25 +216,23 @@ fn auto_reason(f: &crate::pipeline::FeatureStats) -> String {
     let Some(density) = f.crease_density else {
         return junction;
     };
-    let junction = format!(
-        "{junction}, their length times the spacing over the area {density:.2} ({} \
-         {MAX_CREASE_DENSITY})",
-        if density <= MAX_CREASE_DENSITY {
-            "at most"
+    // A measure against the bound that keeps the creases.
+    let against = |v: f64, bound: f64| {
+        if v <= bound {
+            format!("at most {bound}")
         } else {
-            "more than"
+            format!("more than {bound}")
         }
+    };
+    let junction = format!(
+        "{junction}, their length times the spacing over the area {density:.2} ({})",
+        against(density, MAX_CREASE_DENSITY)
     );
     match f.gap_ratio {
         None => junction,
         Some(r) => format!(
-            "{junction}, and detection at {GAP_ANGLE_DEG}° finds {r:.2} times their length \
-             ({} {MAX_GAP_RATIO})",
-            if r <= MAX_GAP_RATIO {
-                "at most"
-            } else {
-                "more than"
-            }
+            "{junction}, and detection at {GAP_ANGLE_DEG}° finds {r:.2} times their length ({})",
+            against(r, MAX_GAP_RATIO)
         ),
     }
 }

@@ -5,6 +5,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::geometry::segment::points_along;
 use crate::mesh::TriMesh;
 use crate::spatial::StaticTree;
 
@@ -48,11 +49,7 @@ pub fn crease_distance(
     let tree = StaticTree::new(&output.positions);
     let points: Vec<DVec3> = edges
         .iter()
-        .flat_map(|e| {
-            let (p, q) = (positions[e[0] as usize], positions[e[1] as usize]);
-            let n = (p.distance(q) / step).ceil().max(1.0) as usize;
-            (0..=n).map(move |i| p.lerp(q, i as f64 / n as f64))
-        })
+        .flat_map(|e| points_along(positions[e[0] as usize], positions[e[1] as usize], step))
         .collect();
     let distances: Vec<f64> = points
         .par_iter()

@@ -11,6 +11,7 @@ pub(crate) mod face_intersection;
 pub(crate) mod morton;
 pub(crate) mod plane;
 pub(crate) mod polygon_triangulation;
+pub(crate) mod segment;
 pub(crate) mod self_intersection;
 pub(crate) mod tolerance;
 pub(crate) mod triangle;

@@ -52,8 +52,7 @@ pub(super) fn ascend(
     let corner_term = scanned.corner_term();
     let field = scanned
         .widths
-        .with_corners(&corner_term)
-        .with(&scanned.scan.separation);
+        .with_creases(&corner_term, &scanned.scan.separation);
     // Surface samples keep out of a band along the sampled creases.
     let band = {
         let positions: Vec<DVec3> = samples[..boundary_count]

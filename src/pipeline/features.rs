@@ -28,6 +28,7 @@ pub(super) fn sharp_features(
         },
     );
     let positions = &input.mesh.positions;
+    let length = features.length(positions);
     let long_share = long_curve_share(&features, positions, feature_scale);
     // Automatic detection keeps a part's creases and leaves a scan's folds out: creases in long
     // curves are a part's; short ones between junctions are when they lie more than a spacing
@@ -45,7 +46,7 @@ pub(super) fn sharp_features(
         if share < AUTO_FEATURE_MIN_SHARE {
             return false;
         }
-        let density = features.length(positions) * feature_scale / input.area;
+        let density = length * feature_scale / input.area;
         crease_density = Some(density);
         if density > MAX_CREASE_DENSITY {
             return false;
@@ -57,7 +58,7 @@ pub(super) fn sharp_features(
                 scale: feature_scale,
             },
         );
-        let ratio = gentle.length(positions) / features.length(positions);
+        let ratio = gentle.length(positions) / length;
         gap_ratio = Some(ratio);
         ratio <= MAX_GAP_RATIO
     });
@@ -73,7 +74,7 @@ pub(super) fn sharp_features(
         curves: features.curves.len(),
         closed_curves: features.curves.iter().filter(|c| c.closed).count(),
         corners: features.corners.len(),
-        length: features.length(positions),
+        length,
         sampled_edges: 0,
         triangulated_edges: 0,
         recovered_edges: 0,

@@ -194,8 +194,7 @@ fn run_once<'s>(
     let corners = scanned.corner_term();
     let field = scanned
         .widths
-        .with_corners(&corners)
-        .with(&scanned.scan.separation);
+        .with_creases(&corners, &scanned.scan.separation);
     let edges = (boundary_edges.as_slice(), feature_edges.as_slice());
     let samples = &ascended.samples;
     let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, params);

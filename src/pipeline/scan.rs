@@ -142,7 +142,7 @@ impl ScanInputs<'_> {
         // samples are graded too (corner_width).
         let corners = graded_corners(normalized, &feature_curves, feature_spacing);
         let corner_term = Corners::new(&corners, feature_spacing);
-        let field = widths.with_corners(&corner_term).with(&separation);
+        let field = widths.with_creases(&corner_term, &separation);
         let b = sample_curves_and_features(
             normalized,
             &boundary_pieces,

@@ -5,6 +5,7 @@
 use super::input::NormalizedInput;
 use super::RemeshParams;
 use crate::error::Result;
+use crate::sampling::crease_separation::CreaseSeparation;
 use crate::sampling::features::Corners;
 use crate::sampling::grading::{Grading, Thickness};
 use crate::sampling::sizing::{SizingField, Smallest};
@@ -100,8 +101,13 @@ impl Widths<'_> {
         Smallest::new(thickness.into_iter().chain(curvature))
     }
 
-    /// [`Widths::field`] lowered around the corners creases are graded towards.
-    pub(super) fn with_corners<'b>(&'b self, corners: &'b Corners<'b>) -> Smallest<'b> {
-        self.field().with(corners)
+    /// [`Widths::field`] lowered around the corners creases are graded towards and beside
+    /// creases closer than their samples' gap.
+    pub(super) fn with_creases<'b>(
+        &'b self,
+        corners: &'b Corners<'b>,
+        separation: &'b CreaseSeparation,
+    ) -> Smallest<'b> {
+        self.field().with(corners).with(separation)
     }
 }

@@ -35,4 +35,11 @@ pub(crate) mod test_support {
             state as usize
         }
     }
+
+    /// Asserts that the error message `e` is one line and names each of `mentions` (the file,
+    /// the format), as every reader's errors must.
+    pub(crate) fn assert_one_line_naming(e: &str, mentions: &[&str]) {
+        assert!(mentions.iter().all(|m| e.contains(m)), "{e}");
+        assert!(!e.contains('\n'), "one line: {e}");
+    }
 }

@@ -9,6 +9,7 @@
 
 use glam::DVec3;
 
+use crate::geometry::segment::points_along;
 use crate::spatial::StaticTree;
 
 /// The half-width of the band, in units of the local spacing w · sigma_p: a sample at that
@@ -35,12 +36,10 @@ impl CreaseBand {
         if edges.is_empty() || !(step > 0.0) {
             return None;
         }
-        let mut points = Vec::new();
-        for &[a, b] in edges {
-            let (p, q) = (positions[a as usize], positions[b as usize]);
-            let n = (p.distance(q) / step).ceil().max(1.0) as usize;
-            points.extend((0..=n).map(|k| p.lerp(q, k as f64 / n as f64)));
-        }
+        let points: Vec<DVec3> = edges
+            .iter()
+            .flat_map(|&[a, b]| points_along(positions[a as usize], positions[b as usize], step))
+            .collect();
         Some(CreaseBand {
             tree: StaticTree::new(&points),
             spacing,

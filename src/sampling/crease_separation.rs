@@ -13,6 +13,7 @@
 
 use glam::DVec3;
 
+use crate::geometry::segment::points_along;
 use crate::mesh::TriMesh;
 use crate::sampling::features::CURVE_SAMPLE_GAP;
 use crate::sampling::sizing::SizingField;
@@ -53,24 +54,24 @@ impl CreaseSeparation {
     /// gear's tooth flanks, closer than the gap but sampled without crowding, keep the spacing.
     /// Uniform when nothing is crowded. Deterministic.
     pub fn new(mesh: &TriMesh, features: &Features, crowded: &[bool], spacing: f64) -> Self {
+        if !crowded.contains(&true) {
+            return CreaseSeparation::graded(&[], Vec::new(), spacing);
+        }
         let step = spacing / POINTS_PER_SPACING;
         let mut points: Vec<DVec3> = Vec::new();
         let mut owner: Vec<u32> = Vec::new();
         for (i, c) in features.curves.iter().enumerate() {
+            // Each edge's points after its first vertex (the one before it has that), and a
+            // closed curve's without its last (its first).
             let nv = c.vertices.len();
             let pos = |k: usize| mesh.positions[c.vertices[k % nv] as usize];
             for k in 0..c.faces.len() {
-                let (a, b) = (pos(k), pos(k + 1));
-                let n = (a.distance(b) / step).ceil().max(1.0) as usize;
-                for s in 0..n {
-                    points.push(a.lerp(b, s as f64 / n as f64));
-                    owner.push(i as u32);
-                }
+                points.extend(points_along(pos(k), pos(k + 1), step).skip(usize::from(k > 0)));
             }
-            if !c.closed {
-                points.push(pos(nv - 1));
-                owner.push(i as u32);
+            if c.closed {
+                points.pop();
             }
+            owner.resize(points.len(), i as u32);
         }
         let ends = |i: u32| {
             let c = &features.curves[i as usize];
@@ -126,10 +127,15 @@ impl CreaseSeparation {
                 widths.extend([w, w]);
             }
         }
+        CreaseSeparation::graded(&kept_points, widths, spacing)
+    }
+
+    /// The field of `widths` at `points`, graded around them at `spacing`.
+    fn graded(points: &[DVec3], widths: Vec<f64>, spacing: f64) -> Self {
         let least = widths.iter().copied().fold(1.0f64, f64::min);
         let reach = (1.0 - least) / CURVATURE_GRADATION * spacing;
         CreaseSeparation {
-            tree: StaticTree::new(&kept_points),
+            tree: StaticTree::new(points),
             widths,
             spacing,
             reach_2: (reach * (1.0 + 1e-9)).powi(2),

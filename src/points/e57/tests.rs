@@ -1,6 +1,7 @@
 use super::*;
 use crate::points::normals::NormalOrientation;
 use crate::points::source::PointSource;
+use crate::points::test_support::assert_one_line_naming;
 use e57::{E57Writer, Extension, Quaternion, RecordDataType, RecordValue, Transform, Translation};
 
 /// One scan to write: its pose and its points, each `[x y z]` (cartesian) or `[range azimuth
@@ -138,12 +139,18 @@ fn two_scans() -> (Vec<Scan>, Vec<DVec3>) {
     (scans, expected)
 }
 
+/// [`two_scans`] written to `path`: the points they read back as.
+fn write_two_scans(path: &Path) -> Vec<DVec3> {
+    let (scans, expected) = two_scans();
+    write(path, &scans);
+    expected
+}
+
 #[test]
 fn two_scans_read_back_posed_into_the_files_frame_without_their_invalid_points() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("site.e57");
-    let (scans, expected) = two_scans();
-    write(&path, &scans);
+    let expected = write_two_scans(&path);
     let read = read_e57(&path).unwrap();
     assert_eq!(read.positions.len(), expected.len());
     for (&a, &b) in read.positions.iter().zip(&expected) {
@@ -172,8 +179,7 @@ fn an_e57_file_reads_through_the_point_reader_and_the_point_source() {
     let dir = tempfile::tempdir().unwrap();
     // Two scans: the points of both, no viewpoint, so the spanning tree orients the normals.
     let path = dir.path().join("site.e57");
-    let (scans, expected) = two_scans();
-    write(&path, &scans);
+    let expected = write_two_scans(&path);
     let mut reader = crate::points::PointReader::open(&path).unwrap();
     assert_eq!(reader.count(), expected.len() as u64);
     assert_eq!(reader.viewpoint(), None);
@@ -267,26 +273,22 @@ fn a_file_that_is_not_e57_is_an_error_naming_the_file() {
         ] {
             assert!(matches!(e, Error::Parse { .. }), "{e:?}");
             let e = e.to_string();
-            assert!(e.contains("scan.e57") && e.contains("E57"), "{e}");
-            assert!(!e.contains('\n'), "one line: {e}");
+            assert_one_line_naming(&e, &["scan.e57", "E57"]);
         }
     }
     // A file cut short: its XML section is at the end, and gone.
-    let (scans, _) = two_scans();
-    write(&path, &scans);
+    write_two_scans(&path);
     let bytes = std::fs::read(&path).unwrap();
     std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
     let e = read_e57(&path).unwrap_err().to_string();
-    assert!(e.contains("scan.e57") && e.contains("E57"), "{e}");
-    assert!(!e.contains('\n'), "one line: {e}");
+    assert_one_line_naming(&e, &["scan.e57", "E57"]);
 }
 
 #[test]
 fn corrupted_e57_files_never_panic() {
     let dir = tempfile::tempdir().unwrap();
     let source = dir.path().join("source.e57");
-    let (scans, _) = two_scans();
-    write(&source, &scans);
+    write_two_scans(&source);
     let bytes = std::fs::read(&source).unwrap();
     let mut next = crate::points::test_support::xorshift();
     for round in 0..200 {

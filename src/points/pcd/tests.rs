@@ -1,4 +1,5 @@
 use super::*;
+use crate::points::test_support::assert_one_line_naming;
 use pcd_rs::{DataKind, DynRecord, DynWriter, Schema, ValueKind, WriterInit};
 
 /// Writes `rows` (x y z, and a fourth float field `intensity`) as a PCD of `kind`, `width` ×
@@ -91,8 +92,7 @@ fn a_file_without_x_y_z_or_not_pcd_is_an_error_naming_the_file() {
     assert!(e.contains("scan.pcd") && e.contains("x y z"), "{e}");
     std::fs::write(&path, "ply\nformat ascii 1.0\n").unwrap();
     let e = read_pcd(&path).unwrap_err().to_string();
-    assert!(e.contains("scan.pcd") && e.contains("PCD"), "{e}");
-    assert!(!e.contains('\n'), "one line: {e}");
+    assert_one_line_naming(&e, &["scan.pcd", "PCD"]);
 }
 
 /// A grid of `n` × `n` points in the plane z = `z`, spacing `h`, centred on the z axis, with
