@@ -5,7 +5,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::geometry::segment::points_along;
+use crate::geometry::segment::{distance_to_segment, points_along};
 use crate::mesh::TriMesh;
 use crate::spatial::StaticTree;
 
@@ -59,10 +59,7 @@ pub fn crease_distance(
             for &(v, _) in near.iter() {
                 let s = output.positions[v as usize];
                 for &w in &incident[v as usize] {
-                    let e = output.positions[w as usize] - s;
-                    let t = ((x - s).dot(e) / e.length_squared().max(f64::MIN_POSITIVE))
-                        .clamp(0.0, 1.0);
-                    best = best.min(x.distance(s + e * t));
+                    best = best.min(distance_to_segment(x, s, output.positions[w as usize]));
                 }
             }
             best

@@ -1,4 +1,4 @@
-//! Points along a segment at a bounded step.
+//! Points along a segment at a bounded step, and a point's distance to a segment.
 
 use glam::DVec3;
 
@@ -7,6 +7,17 @@ use glam::DVec3;
 pub fn points_along(p: DVec3, q: DVec3, step: f64) -> impl Iterator<Item = DVec3> {
     let n = (p.distance(q) / step).ceil().max(1.0) as usize;
     (0..=n).map(move |k| p.lerp(q, k as f64 / n as f64))
+}
+
+/// The distance from `p` to the segment `a`–`b` (any units); to `a` when the segment is a point.
+pub fn distance_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 {
+        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + t * ab)
 }
 
 #[cfg(test)]
@@ -24,5 +35,14 @@ mod tests {
             .iter()
             .all(|&s| s <= 0.5 && (s - steps[0]).abs() < 1e-12));
         assert_eq!(points_along(p, p, 0.5).count(), 2);
+    }
+
+    #[test]
+    fn the_distance_to_a_segment_is_to_its_nearest_point() {
+        let (a, b) = (DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0));
+        assert_eq!(distance_to_segment(DVec3::new(1.0, 3.0, 4.0), a, b), 5.0);
+        assert_eq!(distance_to_segment(DVec3::new(-3.0, 4.0, 0.0), a, b), 5.0);
+        assert_eq!(distance_to_segment(DVec3::new(5.0, 0.0, 4.0), a, b), 5.0);
+        assert_eq!(distance_to_segment(DVec3::new(0.0, 3.0, 4.0), a, a), 5.0);
     }
 }

@@ -1,8 +1,8 @@
 //! The grading beside creases that run closer together than their samples may come (issue 59).
 //! Two feature curves closer than [`CURVE_SAMPLE_GAP`] spacings would crowd each other's
 //! samples, and [`feature_pieces`](crate::sampling::features::feature_pieces) leaves the
-//! shorter out: a hex nut's chamfer arc where it dips towards the chamfer's circle, a rib's two
-//! edges. Here the spacing is lowered where that happens, to the width at which the two curves'
+//! shorter out: a hex nut's chamfer arc where it dips towards the chamfer's circle, fandisk's
+//! faceted fillet (three creases 0.7 gaps apart along their whole length). Here the spacing is lowered where that happens, to the width at which the two curves'
 //! samples keep the gap (down to [`SEPARATION_MIN_WIDTH`]), and graded back to the spacing
 //! around it ([`CURVATURE_GRADATION`], the spacing's Lipschitz constant), so both curves are
 //! sampled and the sheet between them gets samples as close as theirs.
@@ -25,10 +25,6 @@ use crate::surface::features::Features;
 /// `CORNER_MIN_WIDTH`): creases closer than half the gap stay crowded, and the shorter is left
 /// out as before.
 pub const SEPARATION_MIN_WIDTH: f64 = 0.5;
-
-/// The largest share of a crowded curve's length that may be crowded for the grading to take
-/// it: beyond, the curve runs beside another along its length (see [`CreaseSeparation::new`]).
-pub const MAX_CROWDED_SHARE: f64 = 0.5;
 
 /// Points along each curve per spacing, where the separation is measured.
 const POINTS_PER_SPACING: f64 = 4.0;
@@ -104,22 +100,10 @@ impl CreaseSeparation {
                     .min_by(|x, y| x.1.total_cmp(&y.1))
             })
             .collect();
-        // A curve crowded along most of its length runs beside another as a strip narrower
-        // than the spacing (a gear's tooth land, a rib): grading it would take the strip's
-        // whole length down, for triangles of worse shape. Only a stretch is graded.
-        let mut share = vec![(0usize, 0usize); features.curves.len()];
         for (k, n) in nearest.iter().enumerate() {
-            let c = &mut share[owner[k] as usize];
-            c.1 += 1;
-            c.0 += usize::from(n.is_some());
-        }
-        for (k, n) in nearest.iter().enumerate() {
-            let (Some((j, d)), (hit, all)) = (*n, share[owner[k] as usize]) else {
+            let Some((j, d)) = *n else {
                 continue;
             };
-            if hit as f64 > MAX_CROWDED_SHARE * all as f64 {
-                continue;
-            }
             // A step's worth less: the curves' samples fall anywhere along them.
             let w = ((d - step).max(0.0) / gap).max(SEPARATION_MIN_WIDTH);
             if w < 1.0 {
@@ -210,10 +194,19 @@ mod tests {
     }
 
     #[test]
-    fn a_crease_crowded_along_its_whole_length_is_not_graded() {
-        // A strip narrower than the spacing (MAX_CROWDED_SHARE): left as it is.
-        let (mesh, features) = two_curves(0.7 * CURVE_SAMPLE_GAP, false);
-        assert!(CreaseSeparation::new(&mesh, &features, &[true, true], 1.0).is_uniform());
+    fn a_strip_between_two_parallel_creases_is_graded_along_its_length() {
+        // fandisk's faceted fillet: creases 0.7 gaps apart along their whole length.
+        let spacing = 1.0;
+        let gap = CURVE_SAMPLE_GAP * spacing;
+        let (mesh, features) = two_curves(0.7 * gap, false);
+        let s = CreaseSeparation::new(&mesh, &features, &[false, true], spacing);
+        for x in [0.5, 3.0, 5.0, 7.0, 9.5] {
+            let w = s.width(DVec3::new(x, 0.0, 0.0));
+            assert!(
+                w * gap <= 0.7 * gap && w >= SEPARATION_MIN_WIDTH,
+                "{x}: {w}"
+            );
+        }
     }
 
     #[test]

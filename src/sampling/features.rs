@@ -183,12 +183,13 @@ fn crowded_only_at_ends(clear: &[bool], closed: bool) -> bool {
 /// cannot hold a sample between its corners, and two corners closer than the spacing would
 /// only give thin triangles (the folds a scan leaves are such bits). Curves are then taken
 /// longest first, and one whose samples come closer than [`CURVE_SAMPLE_GAP`] spacings to
-/// those of a curve taken before (apart from a shared corner) is left out, unless the crowded
-/// samples are only its first or last few and the curves they crowd leave the same corner at
-/// [`MIN_GRADED_CORNER_DEG`] or more: then both are graded towards that corner (samples at the
-/// same distances from it on both, their steps shrinking with the gap between the creases:
-/// [`FeaturePiece::graded`]), so the triangles between them keep the corner's angle, which no
-/// triangle there can exceed. Deterministic.
+/// those of a curve taken before (apart from the samples at its own corners, whichever curve
+/// placed them: how close its next samples come to those is its steps') is left out, unless
+/// the crowded samples are only its first or last few and the curves they crowd leave the same
+/// corner at [`MIN_GRADED_CORNER_DEG`] or more: then both are graded towards that corner
+/// (samples at the same distances from it on both, their steps shrinking with the gap between
+/// the creases: [`FeaturePiece::graded`]), so the triangles between them keep the corner's
+/// angle, which no triangle there can exceed. Deterministic.
 pub fn feature_pieces(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
@@ -319,6 +320,13 @@ pub fn feature_pieces(
         // graded towards that corner.
         let mut regrade: Vec<(usize, usize, Vec<f64>)> = Vec::new();
         let mut points = Vec::new();
+        // The samples at its own corners are its own (also where other curves placed them): how
+        // close its next samples come to them is its steps' business, not crowding.
+        let own_ends: &[u32] = if piece.curve.closed {
+            &[]
+        } else {
+            &ends(&piece.curve)
+        };
         for round in 0..2 {
             points = points_of(&piece);
             let last = points.len().saturating_sub(1);
@@ -339,7 +347,7 @@ pub fn feature_pieces(
                                 };
                                 for &(q, at, i, generation) in v {
                                     if kept[i].1 == generation
-                                        && !(here.is_some() && at == here)
+                                        && !at.is_some_and(|v| own_ends.contains(&v))
                                         && !here.is_some_and(|v| ends_at(&kept[i].0.curve, v))
                                         && p.distance(q) < gap * w(p).min(w(q))
                                         && !regrade.iter().any(|r| r.0 == i)
@@ -728,5 +736,38 @@ mod tests {
         };
         let (_, pieces) = feature_pieces(&mesh, &[], &alone, spacing, &Uniform);
         assert!(pieces[0].graded.iter().all(|g| g.is_empty()));
+    }
+
+    /// A crease 1.5 spacings long between the corners of two long parallel creases (fandisk's
+    /// narrow face): its two steps of 0.75 spacing bring its middle sample closer than the gap
+    /// to its own corners, which the long creases placed; that is its steps' business, and it
+    /// is kept.
+    #[test]
+    fn a_short_crease_is_not_crowded_by_the_samples_at_its_own_corners() {
+        use crate::surface::features::FeatureCurve;
+        let n = 24;
+        let mesh = crate::mesh::test_meshes::grid(n, |i, j| {
+            DVec3::new(0.5 * i as f64, 0.5 * j as f64, 0.0)
+        });
+        let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let curve = |vertices: Vec<u32>| FeatureCurve {
+            faces: vec![0; vertices.len() - 1],
+            vertices,
+            closed: false,
+        };
+        let lower: Vec<u32> = (0..=20).rev().map(|i| at(i, 10)).collect();
+        let upper: Vec<u32> = (0..=20).rev().map(|i| at(i, 13)).collect();
+        let short: Vec<u32> = (10..=13).map(|j| at(20, j)).collect();
+        let features = Features {
+            edges: Vec::new(),
+            curves: vec![curve(lower), curve(upper), curve(short)],
+            corners: vec![at(20, 10), at(20, 13), at(0, 10), at(0, 13)],
+        };
+        let spacing = 1.0;
+        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing, &Uniform);
+        assert_eq!(pieces.len(), 3, "the short crease is kept");
+        let b = sample_curves_and_features(&mesh, &[], &pieces, spacing, spacing, &Uniform);
+        let on_short = b.samples.iter().filter(|s| s.position.x == 10.0).count();
+        assert_eq!(on_short, 3, "its corners and one sample between them");
     }
 }

@@ -5,6 +5,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::geometry::morton::morton_order;
+use crate::geometry::segment::distance_to_segment;
 
 use super::*;
 
@@ -82,7 +83,7 @@ pub(super) fn cover(
             let k = *outside
                 .iter()
                 .min_by(|&&k1, &&k2| {
-                    let d = |k: usize| segment_distance(corner[k], corner[(k + 1) % 3], p);
+                    let d = |k: usize| distance_to_segment(p, corner[k], corner[(k + 1) % 3]);
                     d(k1).total_cmp(&d(k2))
                 })
                 .unwrap_or(&outside[0]);
@@ -140,14 +141,3 @@ pub(super) fn cover(
 
 /// The faces a split makes: (new face, the old face it comes from).
 type SplitPlan = Vec<([u32; 3], [u32; 3])>;
-
-/// The distance from `p` to the segment `a`–`b`.
-fn segment_distance(a: DVec3, b: DVec3, p: DVec3) -> f64 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 {
-        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + t * ab)
-}
