@@ -50,9 +50,11 @@ pub(super) fn ascend(
     let boundary_count = scan.result.initial;
     let before_ascent = index.buried_test.as_ref().map(|_| samples.clone());
     let corner_term = scanned.corner_term();
-    let field = scanned
-        .widths
-        .with_creases(&corner_term, &scanned.scan.separation);
+    let field = scanned.widths.with_creases(
+        &corner_term,
+        &scanned.scan.separation,
+        &scanned.scan.curvature,
+    );
     // Surface samples keep out of a band along the sampled creases.
     let band = {
         let positions: Vec<DVec3> = samples[..boundary_count]

@@ -192,9 +192,10 @@ fn run_once<'s>(
     let (sigma_p, curves) = (scanned.sigma_p, &scanned.scan);
     let (boundary_edges, feature_edges) = (&curves.boundary_edges, &curves.feature_edges);
     let corners = scanned.corner_term();
-    let field = scanned
-        .widths
-        .with_creases(&corners, &scanned.scan.separation);
+    let field =
+        scanned
+            .widths
+            .with_creases(&corners, &scanned.scan.separation, &scanned.scan.curvature);
     let edges = (boundary_edges.as_slice(), feature_edges.as_slice());
     let samples = &ascended.samples;
     let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, params);

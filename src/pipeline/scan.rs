@@ -13,11 +13,12 @@ use super::sizing::{Sizing, Widths};
 use super::{RemeshParams, MAX_POINTS};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
+use crate::sampling::crease_curvature::crease_curvature;
 use crate::sampling::crease_separation::CreaseSeparation;
 use crate::sampling::curves::{boundary_sample_count, sample_curves_and_features, FeaturePiece};
 use crate::sampling::features::{feature_pieces, graded_corners, Corners, GradedCorner};
 use crate::sampling::linear_scan::{linear_scan, LinearScanResult};
-use crate::sampling::sizing::{SizingField, Uniform};
+use crate::sampling::sizing::{GradedPoints, SizingField, Uniform};
 use crate::sampling::spacing::{BOUNDARY_SPACING_PER_SIGMA, FEATURE_SPACING_PER_SIGMA};
 use crate::sampling::target_count::{find_sigma_p, TargetCountParams};
 use crate::surface::curvature::CurvatureWidths;
@@ -36,6 +37,8 @@ pub(super) struct CurveScan {
     pub corners: Vec<GradedCorner>,
     /// The grading beside creases closer than their samples' gap (at the creases' spacing).
     pub separation: CreaseSeparation,
+    /// The grading along curved creases (at the creases' spacing).
+    pub curvature: GradedPoints,
 }
 
 /// The state of the count search across the pipeline's attempts: the count aimed at, where the
@@ -102,7 +105,9 @@ impl ScanInputs<'_> {
         }
         // The boundary curves, cut where creases end on them, and the creases long enough to
         // take samples at their spacing.
-        let field = widths.field();
+        // Along a curved crease, the spacing its chords' sag asks for (crease_curvature).
+        let curvature = crease_curvature(normalized, self.features, feature_spacing);
+        let field = widths.field().with(&curvature);
         let (mut boundary_pieces, mut feature_curves) = feature_pieces(
             normalized,
             &self.input.curves,
@@ -126,7 +131,7 @@ impl ScanInputs<'_> {
                 &self.input.curves,
                 self.features,
                 feature_spacing,
-                &widths.field().with(&separation),
+                &widths.field().with(&curvature).with(&separation),
             );
         }
         let boundary_count = boundary_sample_count(normalized, &boundary_pieces, spacing)
@@ -142,7 +147,7 @@ impl ScanInputs<'_> {
         // samples are graded too (corner_width).
         let corners = graded_corners(normalized, &feature_curves, feature_spacing);
         let corner_term = Corners::new(&corners, feature_spacing);
-        let field = widths.with_creases(&corner_term, &separation);
+        let field = widths.with_creases(&corner_term, &separation, &curvature);
         let b = sample_curves_and_features(
             normalized,
             &boundary_pieces,
@@ -153,22 +158,24 @@ impl ScanInputs<'_> {
         );
         let r = if !field.is_uniform() {
             // The candidates' widths: the round's, lowered around the graded corners.
-            let pool_w: Option<Cow<[f64]>> = if corners.is_empty() && separation.is_uniform() {
-                pool_widths.map(Cow::Borrowed)
-            } else {
-                Some(Cow::Owned(
-                    self.pool
-                        .par_iter()
-                        .enumerate()
-                        .map(|(i, c)| {
-                            pool_widths
-                                .map_or(1.0, |pw| pw[i])
-                                .min(corner_term.width(c.position))
-                                .min(separation.width(c.position))
-                        })
-                        .collect(),
-                ))
-            };
+            let pool_w: Option<Cow<[f64]>> =
+                if corners.is_empty() && separation.is_uniform() && curvature.is_uniform() {
+                    pool_widths.map(Cow::Borrowed)
+                } else {
+                    Some(Cow::Owned(
+                        self.pool
+                            .par_iter()
+                            .enumerate()
+                            .map(|(i, c)| {
+                                pool_widths
+                                    .map_or(1.0, |pw| pw[i])
+                                    .min(corner_term.width(c.position))
+                                    .min(separation.width(c.position))
+                                    .min(curvature.width(c.position))
+                            })
+                            .collect(),
+                    ))
+                };
             linear_scan(
                 &kernel,
                 self.pool,
@@ -194,6 +201,7 @@ impl ScanInputs<'_> {
             feature_edges: b.feature_edges,
             corners,
             separation,
+            curvature,
         };
         Ok((count, Some(scan)))
     }

@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::sampling::crease_separation::CreaseSeparation;
 use crate::sampling::features::Corners;
 use crate::sampling::grading::{Grading, Thickness};
-use crate::sampling::sizing::{SizingField, Smallest};
+use crate::sampling::sizing::{GradedPoints, SizingField, Smallest};
 use crate::surface::curvature::{Curvature, CurvatureParams, CurvatureWidths};
 use crate::surface::{MeshSurface, SurfaceSample};
 use crate::timing::StageTimer;
@@ -101,13 +101,15 @@ impl Widths<'_> {
         Smallest::new(thickness.into_iter().chain(curvature))
     }
 
-    /// [`Widths::field`] lowered around the corners creases are graded towards and beside
-    /// creases closer than their samples' gap.
+    /// [`Widths::field`] lowered around the corners creases are graded towards, beside
+    /// creases closer than their samples' gap and along creases curved tighter than their
+    /// chords allow.
     pub(super) fn with_creases<'b>(
         &'b self,
         corners: &'b Corners<'b>,
         separation: &'b CreaseSeparation,
+        curvature: &'b GradedPoints,
     ) -> Smallest<'b> {
-        self.field().with(corners).with(separation)
+        self.field().with(corners).with(separation).with(curvature)
     }
 }

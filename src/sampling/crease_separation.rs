@@ -2,9 +2,9 @@
 //! Two feature curves closer than [`CURVE_SAMPLE_GAP`] spacings would crowd each other's
 //! samples, and [`feature_pieces`](crate::sampling::features::feature_pieces) leaves the
 //! shorter out: a hex nut's chamfer arc where it dips towards the chamfer's circle, fandisk's
-//! faceted fillet (three creases 0.7 gaps apart along their whole length). Here the spacing is lowered where that happens, to the width at which the two curves'
-//! samples keep the gap (down to [`SEPARATION_MIN_WIDTH`]), and graded back to the spacing
-//! around it ([`CURVATURE_GRADATION`], the spacing's Lipschitz constant), so both curves are
+//! faceted fillet (three creases 0.7 gaps apart along their whole length). Here the spacing is
+//! lowered where that happens, to the width at which the two curves' samples keep the gap (down to [`SEPARATION_MIN_WIDTH`]), and graded back to the spacing
+//! around it (the spacing's Lipschitz constant, [`GradedPoints`]), so both curves are
 //! sampled and the sheet between them gets samples as close as theirs.
 //!
 //! Curves that share a corner are not each other's neighbours here: near the corner they come as
@@ -16,9 +16,8 @@ use glam::DVec3;
 use crate::geometry::segment::points_along;
 use crate::mesh::TriMesh;
 use crate::sampling::features::CURVE_SAMPLE_GAP;
-use crate::sampling::sizing::SizingField;
+use crate::sampling::sizing::{GradedPoints, SizingField};
 use crate::spatial::StaticTree;
-use crate::surface::curvature::CURVATURE_GRADATION;
 use crate::surface::features::Features;
 
 /// The smallest relative width the separation grading gives (as the corner grading's
@@ -30,15 +29,8 @@ pub const SEPARATION_MIN_WIDTH: f64 = 0.5;
 const POINTS_PER_SPACING: f64 = 4.0;
 
 /// The widths the creases' separation asks for, at points along the creases where it is below
-/// 1 (bbox-100 units), graded around them.
-pub struct CreaseSeparation {
-    tree: StaticTree,
-    widths: Vec<f64>,
-    /// The creases' spacing where the width is 1.
-    spacing: f64,
-    /// The farthest a point's width reaches before the grading brings it to 1, squared.
-    reach_2: f64,
-}
+/// 1 (bbox-100 units), graded around them ([`GradedPoints`]).
+pub struct CreaseSeparation(GradedPoints);
 
 impl CreaseSeparation {
     /// The grading for `features`' curves on `mesh` sampled at `spacing` (bbox-100 units), for
@@ -51,7 +43,7 @@ impl CreaseSeparation {
     /// Uniform when nothing is crowded. Deterministic.
     pub fn new(mesh: &TriMesh, features: &Features, crowded: &[bool], spacing: f64) -> Self {
         if !crowded.contains(&true) {
-            return CreaseSeparation::graded(&[], Vec::new(), spacing);
+            return CreaseSeparation(GradedPoints::new(&[], Vec::new(), spacing));
         }
         let step = spacing / POINTS_PER_SPACING;
         let mut points: Vec<DVec3> = Vec::new();
@@ -111,33 +103,17 @@ impl CreaseSeparation {
                 widths.extend([w, w]);
             }
         }
-        CreaseSeparation::graded(&kept_points, widths, spacing)
-    }
-
-    /// The field of `widths` at `points`, graded around them at `spacing`.
-    fn graded(points: &[DVec3], widths: Vec<f64>, spacing: f64) -> Self {
-        let least = widths.iter().copied().fold(1.0f64, f64::min);
-        let reach = (1.0 - least) / CURVATURE_GRADATION * spacing;
-        CreaseSeparation {
-            tree: StaticTree::new(points),
-            widths,
-            spacing,
-            reach_2: (reach * (1.0 + 1e-9)).powi(2),
-        }
+        CreaseSeparation(GradedPoints::new(&kept_points, widths, spacing))
     }
 }
 
 impl SizingField for CreaseSeparation {
     fn width(&self, p: DVec3) -> f64 {
-        let mut w = 1.0f64;
-        self.tree.visit_within(p, self.reach_2, |i, d2| {
-            w = w.min(self.widths[i as usize] + CURVATURE_GRADATION * d2.sqrt() / self.spacing);
-        });
-        w
+        self.0.width(p)
     }
 
     fn is_uniform(&self) -> bool {
-        self.widths.is_empty()
+        self.0.is_uniform()
     }
 }
 

@@ -4,6 +4,7 @@
 
 pub mod boundary;
 pub mod crease_band;
+pub mod crease_curvature;
 pub mod crease_separation;
 pub mod curves;
 pub mod features;

@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use crate::surface::curvature::CurvatureWidths;
+use crate::surface::curvature::{CurvatureWidths, CURVATURE_GRADATION};
 
 /// A field of relative kernel widths over positions (bbox-100 units).
 pub trait SizingField: Sync {
@@ -40,6 +40,47 @@ impl SizingField for Uniform {
 impl SizingField for CurvatureWidths {
     fn width(&self, p: DVec3) -> f64 {
         CurvatureWidths::width(self, p)
+    }
+}
+
+/// Relative widths given at points, graded around them: at `x`, the smallest over the points q
+/// of w(q) + [`CURVATURE_GRADATION`] · |x − q| / `spacing` (the spacing's Lipschitz bound), at
+/// most 1. The terms that lower the spacing along creases build one
+/// (`sampling::crease_separation`, `sampling::crease_curvature`).
+pub struct GradedPoints {
+    tree: crate::spatial::StaticTree,
+    widths: Vec<f64>,
+    /// The spacing where the width is 1 (bbox-100 units).
+    spacing: f64,
+    /// The farthest a point's width reaches before the grading brings it to 1, squared.
+    reach_2: f64,
+}
+
+impl GradedPoints {
+    /// The field of `widths` at `points` (each in (0, 1)), for the spacing `spacing`.
+    pub fn new(points: &[DVec3], widths: Vec<f64>, spacing: f64) -> Self {
+        let least = widths.iter().copied().fold(1.0f64, f64::min);
+        let reach = (1.0 - least) / CURVATURE_GRADATION * spacing;
+        GradedPoints {
+            tree: crate::spatial::StaticTree::new(points),
+            widths,
+            spacing,
+            reach_2: (reach * (1.0 + 1e-9)).powi(2),
+        }
+    }
+}
+
+impl SizingField for GradedPoints {
+    fn width(&self, p: DVec3) -> f64 {
+        let mut w = 1.0f64;
+        self.tree.visit_within(p, self.reach_2, |i, d2| {
+            w = w.min(self.widths[i as usize] + CURVATURE_GRADATION * d2.sqrt() / self.spacing);
+        });
+        w
+    }
+
+    fn is_uniform(&self) -> bool {
+        self.widths.is_empty()
     }
 }
 
