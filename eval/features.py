@@ -3,10 +3,12 @@ detection) and CGAL's isotropic remeshing with the creases as constraints, at th
 
     eval/features                                  # the made parts and the shared CAD parts, seeds 1-5
     eval/features --parts gear,hex_nut --seeds 1 --name try
+    eval/features --parts ../shared/corpus/trimesh-models/plate_holes.STL --name unseen   # any mesh file
 
 Parts: those eval/cad_parts.py makes by CSG (a hex nut, a chamfered block with holes, a gear, a
 part with a 1° and a 179° dihedral), written to the work folder, and the shared CAD parts
-(../shared/data: fandisk, bracket, flange). Each at `--count` vertices (3,000).
+(../shared/data: fandisk, bracket, flange), or any mesh file given by its path. Each at `--count`
+vertices (3,000).
 
 Per run: vertices; Hausdorff and RMS (bbox-100, two-sided, `remesh quality --ref`); the creases'
 distance to the output's edges: the input's crease edges (faces turning by 20° or more,
@@ -167,7 +169,8 @@ def main():
     made = cad_parts.write_parts(work / "parts")
     results = []
     for name in names:
-        in_path = made.get(name) or SHARED / f"{name}.obj"
+        in_path = made.get(name) or (Path(name) if Path(name).is_file() else SHARED / f"{name}.obj")
+        name = name if name in made else Path(in_path).stem
         V, F = compare.read_mesh(in_path)
         creases = cad_parts.crease_edges(V, F)
         corner_ids = corners(V, creases)
