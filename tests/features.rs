@@ -552,3 +552,73 @@ fn the_beetles_folds_stay_a_scans_where_only_the_gap_tells() {
     assert_eq!(f.automatic_kept, Some(false), "{f:?}");
     assert_eq!(f.sampled_edges, 0, "{f:?}");
 }
+
+/// A washer round the z axis: outer radius `r`, a hole of radius `ri`, thickness `h`; `sides`
+/// facets round and `k` rings across each of its four faces, as one closed loop of rings
+/// (top inward, hole downward, bottom outward, rim upward) banded together.
+fn washer(r: f64, ri: f64, h: f64, sides: usize, k: usize) -> TriMesh {
+    let mut rings: Vec<(f64, f64)> = Vec::new();
+    let t = |i: usize| i as f64 / k as f64;
+    rings.extend((0..k).map(|i| (h, r + (ri - r) * t(i))));
+    rings.extend((0..k).map(|i| (h * (1.0 - t(i)), ri)));
+    rings.extend((0..k).map(|i| (0.0, ri + (r - ri) * t(i))));
+    rings.extend((0..k).map(|i| (h * t(i), r)));
+    let mut positions = Vec::new();
+    for &(z, radius) in &rings {
+        for i in 0..sides {
+            let a = std::f64::consts::TAU * i as f64 / sides as f64;
+            positions.push(DVec3::new(radius * a.cos(), radius * a.sin(), z));
+        }
+    }
+    let n = rings.len();
+    let at = |ring: usize, i: usize| ((ring % n) * sides + i % sides) as u32;
+    let mut triangles = Vec::new();
+    for ring in 0..n {
+        for i in 0..sides {
+            let (a, b, c, d) = (
+                at(ring, i),
+                at(ring, i + 1),
+                at(ring + 1, i + 1),
+                at(ring + 1, i),
+            );
+            triangles.push([a, c, b]);
+            triangles.push([a, d, c]);
+        }
+    }
+    TriMesh::new(positions, triangles)
+}
+
+#[test]
+fn a_tight_rim_is_followed_within_a_tenth_of_an_edge() {
+    // The hole's rims have a radius near the output's spacing: at an even crease spacing their
+    // chords would stand a tenth of an edge or more off them; the spacing along them follows
+    // their curvature (sampling::crease_curvature).
+    let input = washer(20.0, 2.0, 4.0, 96, 4);
+    for seed in [1, 2] {
+        let params = RemeshParams {
+            density: Density::Points(1000),
+            seed,
+            ..Default::default()
+        };
+        let out = remesh(&input, &params, &|_| {}).expect("remesh");
+        let f = &out.features;
+        assert_eq!(f.automatic_kept, Some(true), "{f:?}");
+        assert_every_crease_edge_kept(f, seed);
+        // The output's mean edge in bbox-100 units (the input's bounding box is 40 across).
+        let m = &out.mesh;
+        let mut edges = 0.0;
+        let mut count = 0;
+        for t in &m.triangles {
+            for k in 0..3 {
+                edges += m.positions[t[k] as usize].distance(m.positions[t[(k + 1) % 3] as usize]);
+                count += 1;
+            }
+        }
+        let h = edges / count as f64 * 100.0 / 40.0;
+        let d = f.crease_distance.as_ref().expect("measured").max;
+        assert!(
+            d <= 0.1 * h,
+            "seed {seed}: creases within {d} of the edges, h {h}"
+        );
+    }
+}
