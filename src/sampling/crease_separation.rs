@@ -3,9 +3,10 @@
 //! samples, and [`feature_pieces`](crate::sampling::features::feature_pieces) leaves the
 //! shorter out: a hex nut's chamfer arc where it dips towards the chamfer's circle, fandisk's
 //! faceted fillet (three creases 0.7 gaps apart along their whole length). Here the spacing is
-//! lowered where that happens, to the width at which the two curves' samples keep the gap (down to [`SEPARATION_MIN_WIDTH`]), and graded back to the spacing
-//! around it (the spacing's Lipschitz constant, [`GradedPoints`]), so both curves are
-//! sampled and the sheet between them gets samples as close as theirs.
+//! lowered where that happens, to the width at which the two curves' samples keep the gap (down
+//! to [`SEPARATION_MIN_WIDTH`]), and graded back to the spacing around it (the spacing's
+//! Lipschitz constant, [`GradedPoints`]), so both curves are sampled and the sheet between them
+//! gets samples as close as theirs.
 //!
 //! Curves that share a corner are not each other's neighbours here: near the corner they come as
 //! close as the angle between them makes them, which the corner grading

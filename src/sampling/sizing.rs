@@ -2,9 +2,10 @@
 //! graded kernel's width is w(p) · sigma_p (see `Kernel`). One field is read by every stage that
 //! places samples: the curve samples (`sampling::curves`, `sampling::features`), the linear scan
 //! and the gradient ascent. Its terms are the paper's single sigma_p ([`Uniform`]), the grading
-//! by thickness (`grading::Thickness`, the local feature size), the grading by
-//! curvature (`CurvatureWidths`) and the grading towards crease corners (`features::Corners`); a run's field is the
-//! smallest of the terms it asks for ([`Smallest`]).
+//! by thickness (`grading::Thickness`, the local feature size), the grading by curvature
+//! (`CurvatureWidths`), the grading towards crease corners (`features::Corners`), beside
+//! crowded creases (`crease_separation`) and along curved ones (`crease_curvature`); a run's
+//! field is the smallest of the terms it asks for ([`Smallest`]).
 
 use glam::DVec3;
 

@@ -33,11 +33,11 @@ pub enum FeatureDetection {
     /// ([`junction_curve_share`]), the creases lie more than a spacing apart on average (length
     /// times spacing over area at most [`MAX_CREASE_DENSITY`]) and the surface shows a gap
     /// between its creases and the rest: detection at [`GAP_ANGLE_DEG`] finds at most
-    /// [`MAX_GAP_RATIO`] times the length it finds at the feature angle. The creases of a CAD part run from corner to corner, and between
-    /// them the surface is smooth; a scan's folds are sharp at its own scale in short pieces, the
-    /// sharp end of bends of every angle, and sampled as creases they leave poor triangles and
-    /// no closer surface (the shares and figures: `docs/decisions/feature-angle-auto.md`). The
-    /// default.
+    /// [`MAX_GAP_RATIO`] times the length it finds at the feature angle. The creases of a CAD
+    /// part run from corner to corner, and between them the surface is smooth; a scan's folds
+    /// are sharp at its own scale in short pieces, the sharp end of bends of every angle, and
+    /// sampled as creases they leave poor triangles and no closer surface (the shares and
+    /// figures: `docs/decisions/feature-angle-auto.md`). The default.
     #[default]
     Auto,
     /// Detection at this feature angle (degrees; 180 or more: off), every crease kept.
@@ -226,11 +226,11 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     // crease when the surface a spacing either side of it bends by the angle; and an edge joined
     // through a chain of such edges to a crease is one too when the smooth sheets beside it (not
     // crossing any other dihedral candidate) bend by the angle, or when it continues the crease
-    // (the only other candidate at their vertex, turning by less than the angle there). The second step keeps a crease
-    // whole up to a corner where it meets another at a small angle (within a spacing of the
-    // corner, a patch either side takes in the sheet beyond the other crease), and leaves alone
-    // a fold narrower than the spacing that no crease leads to (its flanks are sheets between
-    // candidates too).
+    // (the only other candidate at their vertex, turning by less than the angle there). The
+    // second step keeps a crease whole up to a corner where it meets another at a small angle
+    // (within a spacing of the corner, a patch either side takes in the sheet beyond the other
+    // crease), and leaves alone a fold narrower than the spacing that no crease leads to (its
+    // flanks are sheets between candidates too).
     let adjacency = FaceAdjacency::new(mesh, &uses, &candidates);
     let mut sharp: Vec<bool> = candidates
         .par_iter()
