@@ -104,8 +104,8 @@ impl ScanInputs<'_> {
             return Ok((least.min(usize::MAX as f64) as usize, None));
         }
         // The boundary curves, cut where creases end on them, and the creases long enough to
-        // take samples at their spacing.
-        // Along a curved crease, the spacing its chords' sag asks for (crease_curvature).
+        // take samples at their spacing; along a curved crease, at the spacing its chords' sag
+        // asks for (crease_curvature).
         let curvature = crease_curvature(normalized, self.features, feature_spacing);
         let field = widths.field().with(&curvature);
         let (mut boundary_pieces, mut feature_curves) = feature_pieces(
@@ -157,7 +157,8 @@ impl ScanInputs<'_> {
             &field,
         );
         let r = if !field.is_uniform() {
-            // The candidates' widths: the round's, lowered around the graded corners.
+            // The candidates' widths: the round's, lowered by the crease terms (around the graded
+            // corners, beside crowded creases, along curved ones).
             let pool_w: Option<Cow<[f64]>> =
                 if corners.is_empty() && separation.is_uniform() && curvature.is_uniform() {
                     pool_widths.map(Cow::Borrowed)
