@@ -7,6 +7,7 @@ use crate::geometry::morton::morton_order;
 
 use super::input::InputIndex;
 use super::scan::Scanned;
+use super::sizing::crease_terms;
 use super::RemeshParams;
 use crate::error::Result;
 use crate::kernel::Kernel;
@@ -50,11 +51,12 @@ pub(super) fn ascend(
     let boundary_count = scan.result.initial;
     let before_ascent = index.buried_test.as_ref().map(|_| samples.clone());
     let corner_term = scanned.corner_term();
-    let field = scanned.widths.with_creases(
+    let creases = crease_terms(
         &corner_term,
         &scanned.scan.separation,
         &scanned.scan.curvature,
     );
+    let field = scanned.widths.field().with(&creases);
     // Surface samples keep out of a band along the sampled creases.
     let band = {
         let positions: Vec<DVec3> = samples[..boundary_count]

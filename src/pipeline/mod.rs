@@ -30,7 +30,7 @@ use finish::{finish, Finished, Finishing, StrayRule};
 use input::{Candidates, InputIndex, NormalizedInput};
 use params::Target;
 use scan::{Scanned, Search};
-use sizing::Sizing;
+use sizing::{crease_terms, Sizing};
 use triangulation::{triangulate_samples, Triangulated};
 
 pub use crate::sampling::spacing::{
@@ -192,10 +192,8 @@ fn run_once<'s>(
     let (sigma_p, curves) = (scanned.sigma_p, &scanned.scan);
     let (boundary_edges, feature_edges) = (&curves.boundary_edges, &curves.feature_edges);
     let corners = scanned.corner_term();
-    let field =
-        scanned
-            .widths
-            .with_creases(&corners, &scanned.scan.separation, &scanned.scan.curvature);
+    let creases = crease_terms(&corners, &scanned.scan.separation, &scanned.scan.curvature);
+    let field = scanned.widths.field().with(&creases);
     let edges = (boundary_edges.as_slice(), feature_edges.as_slice());
     let samples = &ascended.samples;
     let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, params);

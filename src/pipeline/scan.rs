@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::input::{Candidates, NormalizedInput};
 use super::params::Target;
-use super::sizing::{Sizing, Widths};
+use super::sizing::{crease_terms, Sizing, Widths};
 use super::{RemeshParams, MAX_POINTS};
 use crate::error::{Error, Result};
 use crate::kernel::Kernel;
@@ -147,7 +147,8 @@ impl ScanInputs<'_> {
         // samples are graded too (corner_width).
         let corners = graded_corners(normalized, &feature_curves, feature_spacing);
         let corner_term = Corners::new(&corners, feature_spacing);
-        let field = widths.with_creases(&corner_term, &separation, &curvature);
+        let creases = crease_terms(&corner_term, &separation, &curvature);
+        let field = widths.field().with(&creases);
         let b = sample_curves_and_features(
             normalized,
             &boundary_pieces,
@@ -159,24 +160,21 @@ impl ScanInputs<'_> {
         let r = if !field.is_uniform() {
             // The candidates' widths: the round's, lowered by the crease terms (around the graded
             // corners, beside crowded creases, along curved ones).
-            let pool_w: Option<Cow<[f64]>> =
-                if corners.is_empty() && separation.is_uniform() && curvature.is_uniform() {
-                    pool_widths.map(Cow::Borrowed)
-                } else {
-                    Some(Cow::Owned(
-                        self.pool
-                            .par_iter()
-                            .enumerate()
-                            .map(|(i, c)| {
-                                pool_widths
-                                    .map_or(1.0, |pw| pw[i])
-                                    .min(corner_term.width(c.position))
-                                    .min(separation.width(c.position))
-                                    .min(curvature.width(c.position))
-                            })
-                            .collect(),
-                    ))
-                };
+            let pool_w: Option<Cow<[f64]>> = if creases.is_uniform() {
+                pool_widths.map(Cow::Borrowed)
+            } else {
+                Some(Cow::Owned(
+                    self.pool
+                        .par_iter()
+                        .enumerate()
+                        .map(|(i, c)| {
+                            pool_widths
+                                .map_or(1.0, |pw| pw[i])
+                                .min(creases.width(c.position))
+                        })
+                        .collect(),
+                ))
+            };
             linear_scan(
                 &kernel,
                 self.pool,

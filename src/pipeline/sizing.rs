@@ -100,16 +100,15 @@ impl Widths<'_> {
         let curvature = self.curvature.as_ref().map(|c| c as &dyn SizingField);
         Smallest::new(thickness.into_iter().chain(curvature))
     }
+}
 
-    /// [`Widths::field`] lowered around the corners creases are graded towards, beside
-    /// creases closer than their samples' gap and along creases curved tighter than their
-    /// chords allow.
-    pub(super) fn with_creases<'b>(
-        &'b self,
-        corners: &'b Corners<'b>,
-        separation: &'b CreaseSeparation,
-        curvature: &'b GradedPoints,
-    ) -> Smallest<'b> {
-        self.field().with(corners).with(separation).with(curvature)
-    }
+/// The crease terms of the sizing field: the grading around the corners creases are graded
+/// towards, beside creases closer than their samples' gap and along creases curved tighter than
+/// their chords allow. The field is [`Widths::field`] with these.
+pub(super) fn crease_terms<'b>(
+    corners: &'b Corners<'b>,
+    separation: &'b CreaseSeparation,
+    curvature: &'b GradedPoints,
+) -> Smallest<'b> {
+    Smallest::new([corners as &dyn SizingField, separation, curvature])
 }

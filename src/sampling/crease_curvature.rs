@@ -31,10 +31,11 @@ pub fn crease_curvature(mesh: &TriMesh, features: &Features, spacing: f64) -> Gr
     for c in &features.curves {
         let nv = c.vertices.len();
         let pos = |k: usize| mesh.positions[c.vertices[k % nv] as usize];
-        let inner: Box<dyn Iterator<Item = usize>> = if c.closed {
-            Box::new(0..nv)
+        // Every vertex of a closed curve; an open one's between its ends.
+        let inner = if c.closed {
+            0..nv
         } else {
-            Box::new(1..nv.saturating_sub(1))
+            1..nv.saturating_sub(1)
         };
         for k in inner {
             let (a, b, d) = (pos(k + nv - 1), pos(k), pos(k + 1));

@@ -135,11 +135,7 @@ mod tests {
             DVec3::new(6.0, far, 0.0),
             DVec3::new(10.0, far, 0.0),
         ]);
-        let curve = |vertices: Vec<u32>| FeatureCurve {
-            faces: vec![0; vertices.len() - 1],
-            vertices,
-            closed: false,
-        };
+        let curve = FeatureCurve::open;
         let features = Features {
             edges: vec![[0, 1], [2, 3], [3, 4], [4, 5], [5, 6]],
             curves: vec![curve(vec![0, 1]), curve(vec![2, 3, 4, 5, 6])],
@@ -198,11 +194,7 @@ mod tests {
                 0.0,
             ),
         ];
-        let line = |a: u32, b: u32| FeatureCurve {
-            vertices: vec![a, b],
-            faces: vec![0],
-            closed: false,
-        };
+        let line = |a: u32, b: u32| FeatureCurve::open(vec![a, b]);
         let features = Features {
             edges: vec![[0, 1], [0, 2]],
             curves: vec![line(0, 1), line(0, 2)],

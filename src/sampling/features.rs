@@ -657,11 +657,7 @@ mod tests {
         let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
         let row: Vec<u32> = (0..=n).map(|i| at(i, 30)).collect();
         let rising: Vec<u32> = (0..=20).map(|k| at(3 * k, 30 + k)).collect();
-        let curve = |vertices: Vec<u32>| FeatureCurve {
-            faces: vec![0; vertices.len() - 1],
-            vertices,
-            closed: false,
-        };
+        let curve = FeatureCurve::open;
         let features = Features {
             edges: Vec::new(),
             curves: vec![curve(row), curve(rising)],
@@ -750,11 +746,7 @@ mod tests {
             DVec3::new(0.5 * i as f64, 0.5 * j as f64, 0.0)
         });
         let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-        let curve = |vertices: Vec<u32>| FeatureCurve {
-            faces: vec![0; vertices.len() - 1],
-            vertices,
-            closed: false,
-        };
+        let curve = FeatureCurve::open;
         let lower: Vec<u32> = (0..=20).rev().map(|i| at(i, 10)).collect();
         let upper: Vec<u32> = (0..=20).rev().map(|i| at(i, 13)).collect();
         let short: Vec<u32> = (10..=13).map(|j| at(20, j)).collect();

@@ -9,6 +9,7 @@
 
 use glam::DVec3;
 
+use crate::spatial::StaticTree;
 use crate::surface::curvature::{CurvatureWidths, CURVATURE_GRADATION};
 
 /// A field of relative kernel widths over positions (bbox-100 units).
@@ -49,7 +50,7 @@ impl SizingField for CurvatureWidths {
 /// most 1. The terms that lower the spacing along creases build one
 /// (`sampling::crease_separation`, `sampling::crease_curvature`).
 pub struct GradedPoints {
-    tree: crate::spatial::StaticTree,
+    tree: StaticTree,
     widths: Vec<f64>,
     /// The spacing where the width is 1 (bbox-100 units).
     spacing: f64,
@@ -63,7 +64,7 @@ impl GradedPoints {
         let least = widths.iter().copied().fold(1.0f64, f64::min);
         let reach = (1.0 - least) / CURVATURE_GRADATION * spacing;
         GradedPoints {
-            tree: crate::spatial::StaticTree::new(points),
+            tree: StaticTree::new(points),
             widths,
             spacing,
             reach_2: (reach * (1.0 + 1e-9)).powi(2),

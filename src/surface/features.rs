@@ -171,6 +171,16 @@ pub struct Features {
 }
 
 impl FeatureCurve {
+    /// An open curve through `vertices`, every edge on face 0 (tests' curves).
+    #[cfg(test)]
+    pub(crate) fn open(vertices: Vec<u32>) -> Self {
+        FeatureCurve {
+            faces: vec![0; vertices.len() - 1],
+            vertices,
+            closed: false,
+        }
+    }
+
     /// The curve's length: the sum of its edges, `vertices[k] → vertices[k+1]` and, closed,
     /// the last back to the first (units of `positions`).
     pub fn length(&self, positions: &[DVec3]) -> f64 {
@@ -268,10 +278,7 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
             };
             at_vertex[&v].len() == 2
                 && !boundary_vertex[v as usize]
-                && (p - far(i))
-                    .normalize_or_zero()
-                    .dot((far(j) - p).normalize_or_zero())
-                    > cos_bound
+                && turns_less_than(far(i), p, far(j), cos_bound)
         };
         let mut scratch = PatchScratch::new(mesh.triangles.len());
         // Grown from the creases, one vertex at a time; each edge's patch tested at most once
@@ -498,6 +505,12 @@ fn sharp_at_scale(
     n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) <= cos_bound
 }
 
+/// Whether the path `a` → `v` → `b` turns at `v` by less than the angle whose cosine is
+/// `cos_bound` (a curve through `v` goes on there; a degenerate step turns by 90°).
+fn turns_less_than(a: DVec3, v: DVec3, b: DVec3, cos_bound: f64) -> bool {
+    (v - a).normalize_or_zero().dot((b - v).normalize_or_zero()) > cos_bound
+}
+
 /// Chains `edges` (sorted) into curves between corners: vertices of feature degree other than
 /// 2, on the boundary, or where the curve turns by more than the angle whose cosine is
 /// `cos_bound`. What is left after the open curves are closed loops without a corner.
@@ -539,10 +552,12 @@ fn chain(
         if inc.len() != 2 || boundary_vertex[v as usize] {
             return true;
         }
-        let p = positions[v as usize];
-        let a = (p - positions[other(inc[0], v) as usize]).normalize_or_zero();
-        let b = (positions[other(inc[1], v) as usize] - p).normalize_or_zero();
-        a.dot(b) <= cos_bound
+        !turns_less_than(
+            positions[other(inc[0], v) as usize],
+            positions[v as usize],
+            positions[other(inc[1], v) as usize],
+            cos_bound,
+        )
     };
     let mut corners: Vec<u32> = incident.keys().copied().filter(|&v| is_corner(v)).collect();
     corners.sort_unstable();
@@ -791,11 +806,7 @@ mod tests {
         // Vertices on a line 1 apart, a junction at 0 (edges to 1, 2 and 3) and at 4 (to 5, 6
         // and 7); a curve's length is the distance between its ends.
         let positions: Vec<DVec3> = (0..8).map(|k| DVec3::new(k as f64, 0.0, 0.0)).collect();
-        let curve = |vertices: Vec<u32>| FeatureCurve {
-            faces: vec![0; vertices.len() - 1],
-            vertices,
-            closed: false,
-        };
+        let curve = FeatureCurve::open;
         let mut edges = vec![[0, 1], [0, 2], [0, 3], [4, 5], [4, 6], [4, 7]];
         edges.sort_unstable();
         // 0 -> 1, 0 -> 2 and 0 -> 3 end free (at 1, 2, 3), none long at a spacing of 2 (6).
