@@ -114,9 +114,11 @@ impl ScanInputs<'_> {
             self.features,
             feature_spacing,
             &field,
+            false,
         );
         // Where creases were left out for running closer to others than their samples' gap,
-        // the spacing is lowered beside them (crease_separation) and the curves taken again.
+        // the spacing is lowered beside them (crease_separation) and the curves taken again;
+        // those still crowded then are sampled as ladders beside the others (crease_ladder).
         let crowded = left_out(
             self.features,
             &feature_curves,
@@ -125,13 +127,14 @@ impl ScanInputs<'_> {
         );
         let separation =
             CreaseSeparation::new(normalized, self.features, &crowded, feature_spacing);
-        if !separation.is_uniform() {
+        if crowded.contains(&true) {
             (boundary_pieces, feature_curves) = feature_pieces(
                 normalized,
                 &self.input.curves,
                 self.features,
                 feature_spacing,
                 &widths.field().with(&curvature).with(&separation),
+                true,
             );
         }
         let boundary_count = boundary_sample_count(normalized, &boundary_pieces, spacing)

@@ -209,7 +209,7 @@ pub(crate) fn sample_curves(
     for (curve, feature) in all {
         let nv = curve.vertices.len();
         let points = match feature {
-            Some(f) if f.graded.iter().any(|g| !g.is_empty()) => {
+            Some(f) if f.ladder.is_some() || f.graded.iter().any(|g| !g.is_empty()) => {
                 graded_points(mesh, f, spacing * feature_scale, field)
             }
             Some(_) => curve_points(mesh, curve, unit * feature_scale, measure),
@@ -271,6 +271,10 @@ pub struct FeaturePiece {
     /// Per end (start, end): the graded samples' distances along the curve from that end, the
     /// first the farthest (where the even spacing starts).
     pub graded: [Vec<f64>; 2],
+    /// The arc lengths from the start (units of the mesh, increasing, from 0 to the length) of
+    /// the samples of a crease sampled as a ladder beside others
+    /// ([`crease_ladder`](crate::sampling::crease_ladder)); `None` otherwise.
+    pub ladder: Option<Vec<f64>>,
 }
 
 impl FeaturePiece {
@@ -329,7 +333,8 @@ impl FeaturePiece {
 /// The points of a feature piece with graded ends ([`FeaturePiece::arcs`]), corners exact. With
 /// a `width` field the even steps between the graded ends follow it (equal steps of ∫ ds / w,
 /// the width taken at the curve's vertices, linear in between, as on the other curves); the
-/// graded distances stay as they are (they were set at the corner's width).
+/// graded distances stay as they are (they were set at the corner's width). A ladder's points are
+/// at its own arcs ([`FeaturePiece::ladder`]).
 pub(crate) fn graded_points(
     mesh: &TriMesh,
     piece: &FeaturePiece,
@@ -339,9 +344,10 @@ pub(crate) fn graded_points(
     let width = (!field.is_uniform()).then_some(field);
     let lengths = edge_lengths(mesh, &piece.curve);
     let total: f64 = lengths.iter().sum();
-    let arcs = match width {
-        None => piece.arcs(total, spacing),
-        Some(w) => {
+    let arcs = match (&piece.ladder, width) {
+        (Some(arcs), _) => arcs.clone(),
+        (None, None) => piece.arcs(total, spacing),
+        (None, Some(w)) => {
             let nv = piece.curve.vertices.len();
             let pos = |k: usize| mesh.positions[piece.curve.vertices[k % nv] as usize];
             let measures: Vec<f64> = (0..lengths.len())

@@ -10,6 +10,7 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::mesh::TriMesh;
+use crate::sampling::crease_ladder::ladder_arcs;
 use crate::sampling::curves::{
     curve_length, curve_points, edge_lengths, graded_points, points_along, width_steps,
     BoundaryCurve, FeaturePiece,
@@ -189,13 +190,16 @@ fn crowded_only_at_ends(clear: &[bool], closed: bool) -> bool {
 /// corner at [`MIN_GRADED_CORNER_DEG`] or more: then both are graded towards that corner
 /// (samples at the same distances from it on both, their steps shrinking with the gap between
 /// the creases: [`FeaturePiece::graded`]), so the triangles between them keep the corner's
-/// angle, which no triangle there can exceed. Deterministic.
+/// angle, which no triangle there can exceed. With `ladders`, a curve that would be left out
+/// for crowding is sampled as a ladder beside the curves it crowds instead ([`ladder_arcs`]:
+/// its samples across from theirs; [`FeaturePiece::ladder`]). Deterministic.
 pub fn feature_pieces(
     mesh: &TriMesh,
     curves: &[BoundaryCurve],
     features: &Features,
     spacing: f64,
     field: &dyn SizingField,
+    ladders: bool,
 ) -> (Vec<BoundaryCurve>, Vec<FeaturePiece>) {
     let width = (!field.is_uniform()).then_some(field);
     let w = |p: DVec3| width.map_or(1.0, |f| f.width(p).max(1e-6));
@@ -272,7 +276,7 @@ pub fn feature_pieces(
             .then(|| c.vertices[if k == 0 { 0 } else { c.vertices.len() - 1 }])
     };
     let points_of = |piece: &FeaturePiece| -> Vec<(DVec3, usize)> {
-        if piece.graded.iter().all(|g| g.is_empty()) {
+        if piece.ladder.is_none() && piece.graded.iter().all(|g| g.is_empty()) {
             match width {
                 None => curve_points(mesh, &piece.curve, spacing, |a, b| a.distance(b)),
                 Some(f) => curve_points(mesh, &piece.curve, 1.0, |a, b| {
@@ -314,6 +318,7 @@ pub fn feature_pieces(
         let mut piece = FeaturePiece {
             curve,
             graded: [Vec::new(), Vec::new()],
+            ladder: None,
         };
         // Up to two rounds: the even samples; then, where the first or last few crowd a curve
         // kept before that leaves the same corner (a small angle between them), both curves
@@ -327,12 +332,14 @@ pub fn feature_pieces(
         } else {
             &ends(&piece.curve)
         };
-        for round in 0..2 {
-            points = points_of(&piece);
+        // For each of `points` (the piece's samples), the kept curves whose samples it crowds
+        // (apart from a shared corner and from curves being graded for it).
+        let crowding = |piece: &FeaturePiece,
+                        points: &[(DVec3, usize)],
+                        regrade: &[(usize, usize, Vec<f64>)]|
+         -> Vec<Vec<usize>> {
             let last = points.len().saturating_sub(1);
-            // For each sample, the kept curves whose samples it crowds (apart from a shared
-            // corner).
-            let crowded: Vec<Vec<usize>> = points
+            points
                 .iter()
                 .enumerate()
                 .map(|(k, &(p, _))| {
@@ -362,67 +369,151 @@ pub fn feature_pieces(
                     owners.dedup();
                     owners
                 })
-                .collect();
-            let clear: Vec<bool> = crowded.iter().map(|o| o.is_empty()).collect();
-            if clear.iter().all(|&c| c) {
-                break;
+                .collect()
+        };
+        let taken = 'take: {
+            for round in 0..2 {
+                points = points_of(&piece);
+                let last = points.len().saturating_sub(1);
+                let crowded = crowding(&piece, &points, &regrade);
+                let clear: Vec<bool> = crowded.iter().map(|o| o.is_empty()).collect();
+                if clear.iter().all(|&c| c) {
+                    break;
+                }
+                // A crowded sample anywhere but in a run at an end (a crease beside another
+                // along its length), or still crowded after grading: the curve is left out
+                // (or, with `ladders`, sampled as a ladder beside the others).
+                if round == 1 || !crowded_only_at_ends(&clear, piece.curve.closed) {
+                    break 'take false;
+                }
+                for end in [0usize, 1] {
+                    let run: Vec<usize> = if end == 0 {
+                        (1..last).take_while(|&k| !clear[k]).collect()
+                    } else {
+                        (1..last).rev().take_while(|&k| !clear[k]).collect()
+                    };
+                    if run.is_empty() {
+                        continue;
+                    }
+                    let at = end_vertex(&piece.curve, if end == 0 { 0 } else { last }, last);
+                    let mut owners: Vec<usize> = run
+                        .iter()
+                        .flat_map(|&k| crowded[k].iter().copied())
+                        .collect();
+                    owners.sort_unstable();
+                    owners.dedup();
+                    // Each crowded curve must leave the same corner.
+                    let mut grading: Option<Vec<f64>> = None;
+                    for &i in &owners {
+                        let other = &kept[i].0;
+                        let nv = other.curve.vertices.len();
+                        let other_end = match at {
+                            Some(v) if !other.curve.closed && other.curve.vertices[0] == v => 0,
+                            Some(v) if !other.curve.closed && other.curve.vertices[nv - 1] == v => {
+                                1
+                            }
+                            _ => break 'take false,
+                        };
+                        let angle = leaving(&piece.curve, end)
+                            .angle_between(leaving(&other.curve, other_end));
+                        if !(angle >= MIN_GRADED_CORNER_DEG.to_radians()) {
+                            break 'take false;
+                        }
+                        // The other curve's grading at that corner, if it has one, is the one
+                        // to pair with; else both get one for this angle.
+                        let distances = if other.graded[other_end].is_empty() {
+                            let cap = 0.45 * length.min(curve_length(mesh, &other.curve));
+                            let corner = mesh.positions[at.unwrap_or(0) as usize];
+                            graded_distances(angle, spacing * w(corner), cap)
+                        } else {
+                            other.graded[other_end].clone()
+                        };
+                        if grading.as_ref().is_none_or(|g| distances[0] > g[0]) {
+                            grading = Some(distances.clone());
+                        }
+                        if other.graded[other_end].is_empty() {
+                            regrade.push((i, other_end, distances));
+                        }
+                    }
+                    if let Some(g) = grading {
+                        piece.graded[end] = g;
+                    }
+                }
             }
-            // A crowded sample anywhere but in a run at an end (a crease beside another
-            // along its length), or still crowded after grading: the curve is left out.
-            if round == 1 || !crowded_only_at_ends(&clear, piece.curve.closed) {
+            true
+        };
+        if !taken {
+            if !ladders || piece.curve.closed {
                 continue 'curves;
             }
-            for end in [0usize, 1] {
-                let run: Vec<usize> = if end == 0 {
-                    (1..last).take_while(|&k| !clear[k]).collect()
-                } else {
-                    (1..last).rev().take_while(|&k| !clear[k]).collect()
-                };
-                if run.is_empty() {
-                    continue;
-                }
-                let at = end_vertex(&piece.curve, if end == 0 { 0 } else { last }, last);
-                let mut owners: Vec<usize> = run
-                    .iter()
-                    .flat_map(|&k| crowded[k].iter().copied())
-                    .collect();
-                owners.sort_unstable();
-                owners.dedup();
-                // Each crowded curve must leave the same corner.
-                let mut grading: Option<Vec<f64>> = None;
-                for &i in &owners {
-                    let other = &kept[i].0;
-                    let nv = other.curve.vertices.len();
-                    let other_end = match at {
-                        Some(v) if !other.curve.closed && other.curve.vertices[0] == v => 0,
-                        Some(v) if !other.curve.closed && other.curve.vertices[nv - 1] == v => 1,
-                        _ => continue 'curves,
-                    };
-                    let angle =
-                        leaving(&piece.curve, end).angle_between(leaving(&other.curve, other_end));
-                    if !(angle >= MIN_GRADED_CORNER_DEG.to_radians()) {
-                        continue 'curves;
+            // A ladder: its samples where the samples beside it project onto it, its own even
+            // ones where nothing is beside it.
+            regrade.clear();
+            piece.graded = [Vec::new(), Vec::new()];
+            let even = points_of(&piece);
+            let clear: Vec<bool> = crowding(&piece, &even, &[])
+                .iter()
+                .map(|o| o.is_empty())
+                .collect();
+            let lengths = edge_lengths(mesh, &piece.curve);
+            let starts: Vec<f64> = lengths
+                .iter()
+                .scan(0.0, |s, &l| {
+                    let start = *s;
+                    *s += l;
+                    Some(start)
+                })
+                .collect();
+            let nv = piece.curve.vertices.len();
+            let own: Vec<(f64, bool)> = even
+                .iter()
+                .zip(&clear)
+                .map(|(&(p, e), &c)| {
+                    let a = mesh.positions[piece.curve.vertices[e % nv] as usize];
+                    (starts[e] + a.distance(p), c)
+                })
+                .collect();
+            // The samples of kept curves near it (apart from those at its own corners).
+            let mut cells: FxHashSet<[i64; 3]> = FxHashSet::default();
+            for k in 0..piece.curve.faces.len() {
+                let (a, b) = (
+                    mesh.positions[piece.curve.vertices[k] as usize],
+                    mesh.positions[piece.curve.vertices[(k + 1) % nv] as usize],
+                );
+                for p in crate::geometry::segment::points_along(a, b, 0.5 * gap) {
+                    let c = cell(p);
+                    for dx in -1..=1 {
+                        for dy in -1..=1 {
+                            for dz in -1..=1 {
+                                cells.insert([c[0] + dx, c[1] + dy, c[2] + dz]);
+                            }
+                        }
                     }
-                    // The other curve's grading at that corner, if it has one, is the one to
-                    // pair with; else both get one for this angle.
-                    let distances = if other.graded[other_end].is_empty() {
-                        let cap = 0.45 * length.min(curve_length(mesh, &other.curve));
-                        let corner = mesh.positions[at.unwrap_or(0) as usize];
-                        graded_distances(angle, spacing * w(corner), cap)
-                    } else {
-                        other.graded[other_end].clone()
-                    };
-                    if grading.as_ref().is_none_or(|g| distances[0] > g[0]) {
-                        grading = Some(distances.clone());
-                    }
-                    if other.graded[other_end].is_empty() {
-                        regrade.push((i, other_end, distances));
-                    }
-                }
-                if let Some(g) = grading {
-                    piece.graded[end] = g;
                 }
             }
+            let mut cells: Vec<[i64; 3]> = cells.into_iter().collect();
+            cells.sort_unstable();
+            let beside: Vec<DVec3> = cells
+                .iter()
+                .filter_map(|c| placed.get(c))
+                .flatten()
+                .filter(|&&(_, at, i, generation)| {
+                    kept[i].1 == generation && !at.is_some_and(|v| own_ends.contains(&v))
+                })
+                .map(|&(q, ..)| q)
+                .collect();
+            let Some(arcs) = ladder_arcs(
+                mesh,
+                &piece.curve,
+                &beside,
+                |q| gap * w(q),
+                &own,
+                |x| spacing * w(x),
+            ) else {
+                continue 'curves;
+            };
+            piece.ladder = Some(arcs);
+            points = points_of(&piece);
         }
         // The curves graded for this one are placed again.
         for (i, end, distances) in regrade {
@@ -605,7 +696,7 @@ mod tests {
         assert_eq!(features.curves[0].vertices, crease);
         let curves = boundary_curves(&mesh);
         assert_eq!(curves.len(), 1);
-        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 0.1, &Uniform);
+        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 0.1, &Uniform, false);
         assert_eq!(
             boundary.len(),
             2,
@@ -641,7 +732,7 @@ mod tests {
         assert_eq!(on_crease_only, 9);
         assert!(degree.iter().all(|&d| d == 0 || d == 2));
         // A crease shorter than the spacing is left out, and the loop stays whole.
-        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 1.5, &Uniform);
+        let (boundary, feature) = feature_pieces(&mesh, &curves, &features, 1.5, &Uniform, false);
         assert!(feature.is_empty());
         assert_eq!(boundary, curves);
     }
@@ -664,7 +755,7 @@ mod tests {
             corners: vec![at(0, 30), at(60, 30), at(60, 50)],
         };
         let spacing = 2.0;
-        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing, &Uniform);
+        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing, &Uniform, false);
         assert_eq!(pieces.len(), 2, "both creases are kept");
         let angle = (1.0f64 / 3.0).atan();
         let expected = graded_distances(angle, spacing, f64::INFINITY);
@@ -730,7 +821,7 @@ mod tests {
             curves: vec![features.curves[0].clone()],
             ..features.clone()
         };
-        let (_, pieces) = feature_pieces(&mesh, &[], &alone, spacing, &Uniform);
+        let (_, pieces) = feature_pieces(&mesh, &[], &alone, spacing, &Uniform, false);
         assert!(pieces[0].graded.iter().all(|g| g.is_empty()));
     }
 
@@ -756,7 +847,7 @@ mod tests {
             corners: vec![at(20, 10), at(20, 13), at(0, 10), at(0, 13)],
         };
         let spacing = 1.0;
-        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing, &Uniform);
+        let (_, pieces) = feature_pieces(&mesh, &[], &features, spacing, &Uniform, false);
         assert_eq!(pieces.len(), 3, "the short crease is kept");
         let b = sample_curves_and_features(&mesh, &[], &pieces, spacing, spacing, &Uniform);
         let on_short = b.samples.iter().filter(|s| s.position.x == 10.0).count();

@@ -5,6 +5,7 @@
 pub mod boundary;
 pub mod crease_band;
 pub mod crease_curvature;
+pub mod crease_ladder;
 pub mod crease_separation;
 pub mod curves;
 pub mod features;
