@@ -498,9 +498,14 @@ fn gear(teeth: usize) -> TriMesh {
 
 /// A remesh of `input` at `points`, seed 1, with the default (automatic) crease detection.
 fn automatic(input: &TriMesh, points: usize) -> spectral_remesh::RemeshOutput {
+    automatic_at(input, points, 1)
+}
+
+/// [`automatic`] at `seed`.
+fn automatic_at(input: &TriMesh, points: usize, seed: u64) -> spectral_remesh::RemeshOutput {
     let params = RemeshParams {
         density: Density::Points(points),
-        seed: 1,
+        seed,
         ..Default::default()
     };
     remesh(input, &params, &|_| {}).expect("remesh")
@@ -619,6 +624,70 @@ fn a_tight_rim_is_followed_within_a_tenth_of_an_edge() {
         assert!(
             d <= 0.1 * h,
             "seed {seed}: creases within {d} of the edges, h {h}"
+        );
+    }
+}
+
+/// A wedge of length `l` along x, width `w` along y, `t` thick at its base (x = 0) and sharp at
+/// its tip (x = l): its top and bottom faces meet at the tip at atan(t / l), its two ends are
+/// triangles of that angle. 8 triangles, outward.
+fn thin_wedge(l: f64, w: f64, t: f64) -> TriMesh {
+    let positions = vec![
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(0.0, 0.0, t),
+        DVec3::new(l, 0.0, 0.0),
+        DVec3::new(0.0, w, 0.0),
+        DVec3::new(0.0, w, t),
+        DVec3::new(l, w, 0.0),
+    ];
+    let triangles = vec![
+        [0, 2, 1], // end y = 0
+        [3, 4, 5], // end y = w
+        [0, 3, 5], // bottom
+        [0, 5, 2],
+        [1, 2, 5], // top
+        [1, 5, 4],
+        [0, 1, 4], // base x = 0
+        [0, 4, 3],
+    ];
+    common::orient_outward(TriMesh::new(positions, triangles))
+}
+
+#[test]
+fn a_thin_wedges_rims_are_both_followed_up_to_its_tip() {
+    // A 1° wedge under half a spacing thick at its base: its ends' two long rims run closer than
+    // their samples' gap all along and meet at the 1° tip, the base's two rims as close. Left
+    // out for crowding, one rim of each pair was the wedge's thickness off the output's edges
+    // (1.4 in bbox-100 units); sampled as a ladder beside the other (sampling::crease_ladder),
+    // every crease is an output edge.
+    let l = 20.0;
+    let input = thin_wedge(l, 16.0, l * 1f64.to_radians().tan());
+    for seed in [1, 2] {
+        let out = automatic_at(&input, 1000, seed);
+        let f = &out.features;
+        assert_eq!(f.automatic_kept, Some(true), "{f:?}");
+        assert_every_crease_edge_kept(f, seed);
+        // The output's mean edge in bbox-100 units (the input's bounding box is 20 long).
+        let m = &out.mesh;
+        let mut edges = 0.0;
+        let mut count = 0;
+        for t in &m.triangles {
+            for k in 0..3 {
+                edges += m.positions[t[k] as usize].distance(m.positions[t[(k + 1) % 3] as usize]);
+                count += 1;
+            }
+        }
+        let h = edges / count as f64 * 100.0 / l;
+        let d = f.crease_distance.as_ref().expect("measured").max;
+        assert!(
+            d <= 0.1 * h,
+            "seed {seed}: creases within {d} of the edges, h {h}"
+        );
+        let topology = spectral_remesh::topology(m);
+        assert_eq!(
+            (topology.components, topology.euler_characteristic),
+            (1, 2),
+            "seed {seed}"
         );
     }
 }

@@ -22,15 +22,17 @@ use crate::sampling::curves::{edge_lengths, BoundaryCurve};
 /// The least step between two of a ladder's samples, in units of the local spacing: stations
 /// closer than this (two creases beside it sampled at steps that do not match) are merged into
 /// the first.
-pub const MIN_LADDER_STEP: f64 = 0.25;
+pub const MIN_LADDER_STEP: f64 = 0.5;
 
 /// The arc lengths (from the curve's start, units of the mesh) of the samples of `curve` as a
 /// ladder: its ends; the nearest point on it of each point of `beside` (the samples of the kept
 /// creases near it) within `reach(q)` of it; and of its own even samples `own` (arc lengths, each
 /// with whether it is clear of those creases' samples) the clear ones farther than half the local
-/// step `step(x)` (at the point x of the arc) from every station. Sorted, then thinned so that consecutive arcs are at least
-/// [`MIN_LADDER_STEP`] local steps apart (the ends kept). `None` when no point of `beside` is
-/// within reach (nothing to pair with). Only for open curves. Deterministic.
+/// step `step(x)` (at the point x of the arc) from every station. Sorted, then thinned so that
+/// consecutive arcs are at least [`MIN_LADDER_STEP`] local steps apart (the ends kept). A closed
+/// curve's arcs start at 0 (its first vertex) and stop short of its length (that vertex again),
+/// thinned across that point too. `None` when no point of `beside` is within reach (nothing to
+/// pair with). Deterministic.
 pub fn ladder_arcs(
     mesh: &TriMesh,
     curve: &BoundaryCurve,
@@ -41,7 +43,7 @@ pub fn ladder_arcs(
 ) -> Option<Vec<f64>> {
     let lengths = edge_lengths(mesh, curve);
     let total: f64 = lengths.iter().sum();
-    if curve.closed || !(total > 0.0) {
+    if !(total > 0.0) {
         return None;
     }
     let nv = curve.vertices.len();
@@ -98,11 +100,23 @@ pub fn ladder_arcs(
     let mut out = vec![0.0];
     for &a in &arcs[1..arcs.len() - 1] {
         let prev = *out.last().unwrap_or(&0.0);
-        if a - prev >= MIN_LADDER_STEP * step(a) && total - a >= MIN_LADDER_STEP * step(a) {
+        let next = if curve.closed {
+            f64::INFINITY
+        } else {
+            total - a
+        };
+        if a - prev >= MIN_LADDER_STEP * step(a) && next >= MIN_LADDER_STEP * step(a) {
             out.push(a);
         }
     }
-    out.push(total);
+    if curve.closed {
+        // The first sample is the last one's next: the step across it is kept too.
+        while out.len() > 1 && total - out[out.len() - 1] < MIN_LADDER_STEP * step(0.0) {
+            out.pop();
+        }
+    } else {
+        out.push(total);
+    }
     Some(out)
 }
 
@@ -140,6 +154,34 @@ mod tests {
         assert_eq!(arcs, vec![0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
         // Nothing within reach: no ladder.
         assert!(ladder_arcs(&mesh, &curve, &beside, |_| 0.2, &[], |_| 2.0).is_none());
+    }
+
+    #[test]
+    fn a_closed_ladder_stops_short_of_its_first_vertex_and_keeps_the_step_across_it() {
+        // A square loop of side 4 (length 16), a crease beside it 0.3 outside every 1.
+        let corners = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(4.0, 0.0, 0.0),
+            DVec3::new(4.0, 4.0, 0.0),
+            DVec3::new(0.0, 4.0, 0.0),
+        ];
+        let mesh = TriMesh {
+            positions: corners.to_vec(),
+            triangles: vec![[0, 1, 2]],
+        };
+        let curve = BoundaryCurve {
+            vertices: vec![0, 1, 2, 3],
+            faces: vec![0; 4],
+            closed: true,
+        };
+        let beside: Vec<DVec3> = (0..4)
+            .map(|k| DVec3::new(k as f64 + 0.05, -0.3, 0.0))
+            .chain([DVec3::new(-0.3, 0.1, 0.0)])
+            .collect();
+        let arcs = ladder_arcs(&mesh, &curve, &beside, |_| 1.0, &[], |_| 1.0).unwrap();
+        // 0.05 is merged into 0; the point beside the last side projects to 15.9, within a
+        // quarter step of 16 (the first vertex again), and is merged too.
+        assert_eq!(arcs, vec![0.0, 1.05, 2.05, 3.05]);
     }
 
     #[test]

@@ -359,7 +359,9 @@ pub(crate) fn graded_points(
     let mut points = points_along(mesh, &piece.curve, &lengths, arcs);
     let (last, nv) = (points.len() - 1, piece.curve.vertices.len());
     points[0].0 = mesh.positions[piece.curve.vertices[0] as usize];
-    points[last].0 = mesh.positions[piece.curve.vertices[nv - 1] as usize];
+    if !piece.curve.closed {
+        points[last].0 = mesh.positions[piece.curve.vertices[nv - 1] as usize];
+    }
     points
 }
 

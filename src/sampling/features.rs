@@ -443,7 +443,7 @@ pub fn feature_pieces(
             true
         };
         if !taken {
-            if !ladders || piece.curve.closed {
+            if !ladders {
                 continue 'curves;
             }
             // A ladder: its samples where the samples beside it project onto it, its own even
