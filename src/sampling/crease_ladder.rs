@@ -24,9 +24,17 @@ use crate::sampling::curves::{edge_lengths, BoundaryCurve};
 /// the first.
 pub const MIN_LADDER_STEP: f64 = 0.5;
 
+/// The least distance between a sample beside the curve and the curve, in units of the local
+/// spacing, for the sample to take a partner on the curve: closer, the partner would be the
+/// sample's twin (a fuzzed input's sliver faces, whose long edges are far closer, gave two
+/// faces on the same corners); the edges along the crease beside it follow the curve within
+/// that anyway. A 1° fin's samples a step from its tip are 0.012 spacings from their partners.
+pub const MIN_LADDER_WIDTH: f64 = 0.005;
+
 /// The arc lengths (from the curve's start, units of the mesh) of the samples of `curve` as a
 /// ladder: its ends; the nearest point on it of each point of `beside` (the samples of the kept
-/// creases near it) within `reach(q)` of it; and of its own even samples `own` (arc lengths, each
+/// creases near it) within `reach(q)` of it and at least [`MIN_LADDER_WIDTH`] local steps
+/// away; and of its own even samples `own` (arc lengths, each
 /// with whether it is clear of those creases' samples) the clear ones farther than half the local
 /// step `step(x)` (at the point x of the arc) from every station. Sorted, then thinned so that
 /// consecutive arcs are at least [`MIN_LADDER_STEP`] local steps apart (the ends kept). A closed
@@ -71,7 +79,7 @@ pub fn ladder_arcs(
         .iter()
         .filter_map(|&q| {
             let (d, arc) = nearest(q);
-            (d < reach(q)).then_some(arc)
+            (d < reach(q) && d >= MIN_LADDER_WIDTH * step(q)).then_some(arc)
         })
         .collect();
     if stations.is_empty() {

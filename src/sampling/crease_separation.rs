@@ -22,8 +22,8 @@ use crate::spatial::StaticTree;
 use crate::surface::features::Features;
 
 /// The smallest relative width the separation grading gives (as the corner grading's
-/// `CORNER_MIN_WIDTH`): creases closer than half the gap stay crowded, and the shorter is left
-/// out as before.
+/// `CORNER_MIN_WIDTH`): creases closer than half the gap stay crowded, and the shorter is
+/// sampled as a ladder beside the other ([`crease_ladder`](crate::sampling::crease_ladder)).
 pub const SEPARATION_MIN_WIDTH: f64 = 0.5;
 
 /// Points along each curve per spacing, where the separation is measured.

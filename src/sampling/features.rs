@@ -23,7 +23,8 @@ use crate::surface::features::Features;
 /// (apart from a corner they share): where two kept curves would come closer, the shorter is
 /// left out, so curves meeting at a corner at less than about 50° are not both kept (closer
 /// curves' samples make thin triangles among themselves: `docs/decisions/
-/// feature-curve-separation.md`).
+/// feature-curve-separation.md`), unless grading towards their corner or beside them parts
+/// them; with `ladders` ([`feature_pieces`]) the shorter is then sampled beside the other.
 pub const CURVE_SAMPLE_GAP: f64 = 0.85;
 
 /// The smallest angle (degrees) between two creases leaving a corner that the sampling grades
