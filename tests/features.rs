@@ -30,6 +30,18 @@ fn assert_every_crease_edge_kept(f: &FeatureStats, seed: u64) {
     );
 }
 
+/// The mean length of `mesh`'s face edges (each interior edge counted from both faces), in its
+/// units.
+fn mean_edge(mesh: &TriMesh) -> f64 {
+    let p = |v: u32| mesh.positions[v as usize];
+    let total: f64 = mesh
+        .triangles
+        .iter()
+        .map(|t| p(t[0]).distance(p(t[1])) + p(t[1]).distance(p(t[2])) + p(t[2]).distance(p(t[0])))
+        .sum();
+    total / (3 * mesh.triangles.len()) as f64
+}
+
 /// The largest distance from points along the box's 12 edges (20 per edge) to the nearest
 /// edge of `mesh`.
 fn box_edges_to_mesh_edges(lo: DVec3, hi: DVec3, mesh: &TriMesh) -> f64 {
@@ -600,26 +612,13 @@ fn a_tight_rim_is_followed_within_a_tenth_of_an_edge() {
     // their curvature (sampling::crease_curvature).
     let input = washer(20.0, 2.0, 4.0, 96, 4);
     for seed in [1, 2] {
-        let params = RemeshParams {
-            density: Density::Points(1000),
-            seed,
-            ..Default::default()
-        };
-        let out = remesh(&input, &params, &|_| {}).expect("remesh");
+        let out = automatic_at(&input, 1000, seed);
         let f = &out.features;
         assert_eq!(f.automatic_kept, Some(true), "{f:?}");
         assert_every_crease_edge_kept(f, seed);
         // The output's mean edge in bbox-100 units (the input's bounding box is 40 across).
         let m = &out.mesh;
-        let mut edges = 0.0;
-        let mut count = 0;
-        for t in &m.triangles {
-            for k in 0..3 {
-                edges += m.positions[t[k] as usize].distance(m.positions[t[(k + 1) % 3] as usize]);
-                count += 1;
-            }
-        }
-        let h = edges / count as f64 * 100.0 / 40.0;
+        let h = mean_edge(m) * 100.0 / 40.0;
         let d = f.crease_distance.as_ref().expect("measured").max;
         assert!(
             d <= 0.1 * h,
@@ -669,15 +668,7 @@ fn a_thin_wedges_rims_are_both_followed_up_to_its_tip() {
         assert_every_crease_edge_kept(f, seed);
         // The output's mean edge in bbox-100 units (the input's bounding box is 20 long).
         let m = &out.mesh;
-        let mut edges = 0.0;
-        let mut count = 0;
-        for t in &m.triangles {
-            for k in 0..3 {
-                edges += m.positions[t[k] as usize].distance(m.positions[t[(k + 1) % 3] as usize]);
-                count += 1;
-            }
-        }
-        let h = edges / count as f64 * 100.0 / l;
+        let h = mean_edge(m) * 100.0 / l;
         let d = f.crease_distance.as_ref().expect("measured").max;
         assert!(
             d <= 0.1 * h,
