@@ -14,6 +14,7 @@ exactly the edges where the construction puts two surfaces together.
   crease) with a fin whose tip is a 1° dihedral (a turn of 179°, a crease of a 1° corner).
 
 Units are model units (the parts are 20-60 long). Each part is written as OBJ by `write_parts`.
+`noisy` makes a part as a CAD export with noise in its positions (`NAME~A` in eval/features).
 """
 
 import math
@@ -147,6 +148,28 @@ def crease_edges(V, F, turn_deg=CREASE_TURN_DEG):
             out.append(tuple(key[i]))
         i = j
     return np.array(out, dtype=np.int64).reshape(-1, 2)
+
+
+NOISE_SEED = 1
+
+
+def noisy(name, amplitude):
+    """Part `name` as a CAD export with noise in its positions: every vertex moved by a Gaussian
+    offset of standard deviation `amplitude` times the bounding box's diagonal (seed
+    `NOISE_SEED`). Returns (noisy V, F, clean V): the expected creases are the clean part's
+    (`crease_edges` on the clean positions), the connectivity being the same."""
+    V, F = PARTS[name]()
+    diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    rng = np.random.default_rng(NOISE_SEED)
+    return V + rng.normal(0.0, amplitude * diag, V.shape), F, V
+
+
+def parse_noisy(spec):
+    """`NAME~A` (e.g. `hex_nut~1e-4`) as (NAME, A), else None."""
+    name, sep, amplitude = spec.partition("~")
+    if not sep or name not in PARTS:
+        return None
+    return name, float(amplitude)
 
 
 def write_parts(folder):

@@ -4,9 +4,12 @@ detection) and CGAL's isotropic remeshing with the creases as constraints, at th
     eval/features                                  # the made parts and the shared CAD parts, seeds 1-5
     eval/features --parts gear,hex_nut --seeds 1 --name try
     eval/features --parts ../shared/corpus/trimesh-models/plate_holes.STL --name unseen   # any mesh file
+    eval/features --parts hex_nut~1e-4,gear~1e-4 --name noisy   # made parts with noise in their positions
 
 Parts: those eval/cad_parts.py makes by CSG (a hex nut, a chamfered block with holes, a gear, a
-part with a 1° and a 179° dihedral), written to the work folder, and the shared CAD parts
+part with a 1° and a 179° dihedral), written to the work folder (`NAME~A`: that part as a CAD
+export with noise in its positions, Gaussian of A times the bounding box's diagonal, its creases
+the clean part's: eval/cad_parts.noisy), and the shared CAD parts
 (../shared/data: fandisk, bracket, flange), or any mesh file given by its path. Each at `--count`
 vertices (3,000).
 
@@ -169,10 +172,18 @@ def main():
     made = cad_parts.write_parts(work / "parts")
     results = []
     for name in names:
-        in_path = made.get(name) or (Path(name) if Path(name).is_file() else SHARED / f"{name}.obj")
-        name = name if name in made else Path(in_path).stem
-        V, F = compare.read_mesh(in_path)
-        creases = cad_parts.crease_edges(V, F)
+        spec = cad_parts.parse_noisy(name)
+        if spec:
+            # A made part with noise in its positions: its creases are the clean part's.
+            V, F, V_clean = cad_parts.noisy(*spec)
+            in_path = work / "parts" / f"{name}.obj"
+            compare.write_obj(in_path, V, F)
+            creases = cad_parts.crease_edges(V_clean, F)
+        else:
+            in_path = made.get(name) or (Path(name) if Path(name).is_file() else SHARED / f"{name}.obj")
+            name = name if name in made else Path(in_path).stem
+            V, F = compare.read_mesh(in_path)
+            creases = cad_parts.crease_edges(V, F)
         corner_ids = corners(V, creases)
         row = {"part": name, "input_vertices": len(V), "crease_edges": len(creases), "corners": len(corner_ids),
                "input_corner_angle": input_corner_angle(V, creases), "runs": []}
