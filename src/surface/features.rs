@@ -860,6 +860,133 @@ mod tests {
 
     /// A flat square with a narrow sharp ridge across it: a fold at the scale of its own
     /// triangles is a crease between two faces but not at a sample spacing.
+    /// A box [-50, 50]² × [0, 20] as a CAD export can come: its top face holds a strip of
+    /// slivers `eps` wide at y = 48 (two rows of vertices every 4 along x, 2 from the box's edge
+    /// y = 50), the rest of each face fanned from a corner; every vertex moved by up to `noise` in
+    /// each coordinate (a fixed pseudo-random sequence). Outward orientation.
+    fn box_with_slivers(eps: f64, noise: f64) -> TriMesh {
+        let mut positions: Vec<DVec3> = Vec::new();
+        let mut add = |p: DVec3, positions: &mut Vec<DVec3>| {
+            positions.push(p);
+            (positions.len() - 1) as u32
+        };
+        let (lo, hi, top) = (-50.0, 50.0, 20.0);
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        // Corners: bottom 0..4, top 4..8 (counterclockwise from (lo, lo)).
+        let corners = [(lo, lo), (hi, lo), (hi, hi), (lo, hi)];
+        let b: Vec<u32> = corners
+            .iter()
+            .map(|&(x, y)| add(c(x, y, 0.0), &mut positions))
+            .collect();
+        let t: Vec<u32> = corners
+            .iter()
+            .map(|&(x, y)| add(c(x, y, top), &mut positions))
+            .collect();
+        let xs: Vec<f64> = (0..=25).map(|k| lo + 4.0 * k as f64).collect();
+        let row_a: Vec<u32> = xs
+            .iter()
+            .map(|&x| add(c(x, 48.0, top), &mut positions))
+            .collect();
+        let row_b: Vec<u32> = xs
+            .iter()
+            .map(|&x| add(c(x, 48.0 + eps, top), &mut positions))
+            .collect();
+        let mut triangles: Vec<[u32; 3]> = Vec::new();
+        // A convex polygon (counterclockwise seen from outside) fanned from its first vertex.
+        let mut fan = |poly: &[u32]| {
+            for k in 1..poly.len() - 1 {
+                triangles.push([poly[0], poly[k], poly[k + 1]]);
+            }
+        };
+        let n = xs.len();
+        // Bottom (seen from below), the sides y = lo and y = hi.
+        fan(&[b[0], b[3], b[2], b[1]]);
+        fan(&[b[0], b[1], t[1], t[0]]);
+        fan(&[b[2], b[3], t[3], t[2]]);
+        // The side x = hi: its top edge passes through the rows' last vertices.
+        fan(&[b[1], b[2], t[2], row_b[n - 1], row_a[n - 1], t[1]]);
+        // The side x = lo: through their first ones.
+        fan(&[b[3], b[0], t[0], row_a[0], row_b[0], t[3]]);
+        // The top: below the strip, the strip, above it.
+        let mut below = vec![t[0], t[1]];
+        below.extend(row_a.iter().rev());
+        fan(&below);
+        let mut above = vec![t[3]];
+        above.extend(row_b.iter());
+        above.push(t[2]);
+        fan(&above);
+        for k in 0..n - 1 {
+            triangles.push([row_a[k], row_a[k + 1], row_b[k + 1]]);
+            triangles.push([row_a[k], row_b[k + 1], row_b[k]]);
+        }
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut jitter = || {
+            // xorshift64: deterministic, no seed to carry.
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            noise * (2.0 * (state >> 11) as f64 / (1u64 << 53) as f64 - 1.0)
+        };
+        for p in &mut positions {
+            *p += DVec3::new(jitter(), jitter(), jitter());
+        }
+        TriMesh::new(positions, triangles)
+    }
+
+    #[test]
+    fn a_cad_exports_slivers_tilted_by_noise_beside_a_crease_are_not_creases() {
+        // Clean, the box's edges are its creases; with noise of half the slivers' width in the
+        // positions the slivers tilt and flip (their edges turn by up to 180° on the flat top, a
+        // tenth of the spacing from its edge), and the creases are still the box's edges only.
+        for noise in [0.0, 0.005] {
+            let m = box_with_slivers(0.01, noise);
+            let on_box_edge = |p: DVec3| {
+                let near = |x: f64, a: f64| (x - a).abs() < 0.1;
+                let n = [
+                    near(p.x, -50.0) || near(p.x, 50.0),
+                    near(p.y, -50.0) || near(p.y, 50.0),
+                    near(p.z, 0.0) || near(p.z, 20.0),
+                ];
+                n.iter().filter(|&&b| b).count() >= 2
+            };
+            let turns = m
+                .edge_uses()
+                .iter()
+                .filter(|(e, (f, k))| {
+                    *k == 2
+                        && !(on_box_edge(m.positions[e.0 as usize])
+                            && on_box_edge(m.positions[e.1 as usize]))
+                        && m.face_normal(f[0] as usize)
+                            .dot(m.face_normal(f[1] as usize))
+                            < 0.9
+                })
+                .count();
+            let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 5.0);
+            let stray: Vec<_> = f
+                .edges
+                .iter()
+                .filter(|e| {
+                    !(on_box_edge(m.positions[e[0] as usize])
+                        && on_box_edge(m.positions[e[1] as usize]))
+                })
+                .collect();
+            assert!(
+                stray.is_empty(),
+                "noise {noise}: {} edges off the box's edges: {stray:?}",
+                stray.len()
+            );
+            assert_eq!(f.corners.len(), 8, "noise {noise}");
+            assert_eq!(f.curves.len(), 12, "noise {noise}");
+            if noise > 0.0 {
+                // There are slivers turning on the flat for the test to judge.
+                assert!(
+                    turns >= 10,
+                    "only {turns} edges off the box's edges turn by 25° or more"
+                );
+            }
+        }
+    }
+
     #[test]
     fn a_fold_narrower_than_the_scale_is_not_a_crease() {
         // Grid 40 × 40 over [0, 100]²; the row of vertices at y = 50 raised by 2 (the ridge's
