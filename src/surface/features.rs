@@ -866,7 +866,7 @@ mod tests {
     /// each coordinate (a fixed pseudo-random sequence). Outward orientation.
     fn box_with_slivers(eps: f64, noise: f64) -> TriMesh {
         let mut positions: Vec<DVec3> = Vec::new();
-        let mut add = |p: DVec3, positions: &mut Vec<DVec3>| {
+        let add = |p: DVec3, positions: &mut Vec<DVec3>| {
             positions.push(p);
             (positions.len() - 1) as u32
         };
