@@ -460,22 +460,10 @@ fn sharp_at_scale(
         return true;
     }
     let mesh = adjacency.mesh;
-    let (pa, pb) = (mesh.positions[e[0] as usize], mesh.positions[e[1] as usize]);
-    let mid = 0.5 * (pa + pb);
-    let along = (pb - pa).normalize_or_zero();
-    let centroid = |f: u32| {
-        let c = mesh.corners(f as usize);
-        (c[0] + c[1] + c[2]) / 3.0
-    };
-    // The direction into a face, across the edge, in the face's plane.
-    let across = |f: u32| -> DVec3 {
-        let d = centroid(f) - mid;
-        (d - along * d.dot(along)).normalize_or_zero()
-    };
-    let split = across(faces[0]) - across(faces[1]);
-    if split == DVec3::ZERO {
+    let Some(frame) = EdgeFrame::new(mesh, e, faces) else {
         return false;
-    }
+    };
+    let (mid, centroid) = (frame.mid, |f: u32| centroid(mesh, f));
     let scale_2 = scale * scale;
     // Each side's patch: grown from its face, across edges other than the dihedral candidates
     // (the edge itself included), to faces whose centroids are within `scale`. A bit per side.
@@ -509,16 +497,51 @@ fn sharp_at_scale(
     for (f, bits) in scratch.take_sorted() {
         let t = mesh.corners(f as usize);
         // Area-weighted normal: the cross product's half.
-        let weighted = (t[1] - t[0]).cross(t[2] - t[0]);
-        let side = match bits {
-            1 => 0,
-            2 => 1,
-            _ => usize::from((centroid(f) - mid).dot(split) < 0.0),
-        };
-        sides[side] += weighted;
+        sides[frame.side(mesh, f, bits)] += (t[1] - t[0]).cross(t[2] - t[0]);
     }
     let (n0, n1) = (sides[0].normalize_or_zero(), sides[1].normalize_or_zero());
     n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) <= cos_bound
+}
+
+/// The centroid of face `f` of `mesh`.
+fn centroid(mesh: &TriMesh, f: u32) -> DVec3 {
+    let c = mesh.corners(f as usize);
+    (c[0] + c[1] + c[2]) / 3.0
+}
+
+/// An edge seen from its two faces, for the patch tests ([`sharp_at_scale`],
+/// [`sharp_near_edge`]): its midpoint, and the normal of the plane through the edge that parts
+/// the two faces (the difference of the directions into each, across the edge, in its plane).
+struct EdgeFrame {
+    mid: DVec3,
+    split: DVec3,
+}
+
+impl EdgeFrame {
+    /// None when the two faces lie on the same side of the edge (no plane parts them).
+    fn new(mesh: &TriMesh, e: [u32; 2], faces: [u32; 2]) -> Option<Self> {
+        let (pa, pb) = (mesh.positions[e[0] as usize], mesh.positions[e[1] as usize]);
+        let mid = 0.5 * (pa + pb);
+        let along = (pb - pa).normalize_or_zero();
+        let across = |f: u32| -> DVec3 {
+            let d = centroid(mesh, f) - mid;
+            (d - along * d.dot(along)).normalize_or_zero()
+        };
+        let split = across(faces[0]) - across(faces[1]);
+        (split != DVec3::ZERO).then_some(EdgeFrame { mid, split })
+    }
+
+    /// The side (0: the first face's, 1: the second's) that face `f` counts on, given the sides
+    /// it was reached from (`bits`: 1, 2 or both): one reached from one side only counts on that
+    /// side; one reached from both (round the end of a crease, or across a fold that is not
+    /// one) on the side of the edge it lies on.
+    fn side(&self, mesh: &TriMesh, f: u32, bits: u8) -> usize {
+        match bits {
+            1 => 0,
+            2 => 1,
+            _ => usize::from((centroid(mesh, f) - self.mid).dot(self.split) < 0.0),
+        }
+    }
 }
 
 /// The radius of the near test of [`detect_features`] ([`sharp_near_edge`]) as a share of the
@@ -553,28 +576,17 @@ fn sharp_near_edge(
     r: f64,
     cos_bound: f64,
 ) -> bool {
-    let (pa, pb) = (mesh.positions[e[0] as usize], mesh.positions[e[1] as usize]);
-    let mid = 0.5 * (pa + pb);
-    let along = (pb - pa).normalize_or_zero();
-    let centroid = |f: u32| {
-        let c = mesh.corners(f as usize);
-        (c[0] + c[1] + c[2]) / 3.0
+    // Two faces on the same side of their edge (a fold of 180°): nothing to tell near it.
+    let Some(frame) = EdgeFrame::new(mesh, e, faces) else {
+        return true;
     };
+    let mid = frame.mid;
     // Whether face f comes within r of the midpoint (an edge of it, or its centroid).
     let near = |f: u32| -> bool {
         let c = mesh.corners(f as usize);
         (0..3).any(|k| distance_to_segment(mid, c[k], c[(k + 1) % 3]) <= r)
-            || centroid(f).distance(mid) <= r
+            || centroid(mesh, f).distance(mid) <= r
     };
-    // The direction into a face, across the edge, in the face's plane.
-    let across = |f: u32| -> DVec3 {
-        let d = centroid(f) - mid;
-        (d - along * d.dot(along)).normalize_or_zero()
-    };
-    let split = across(faces[0]) - across(faces[1]);
-    if split == DVec3::ZERO {
-        return true;
-    }
     // The faces near the edge, a bit per side they were reached from; faces looked at but not
     // near stay in the map with no bit.
     let mut marks: FxHashMap<u32, u8> = FxHashMap::default();
@@ -607,11 +619,7 @@ fn sharp_near_edge(
     marked.sort_unstable();
     let mut sides = [DVec3::ZERO; 2];
     for (f, bits) in marked {
-        let side = match bits {
-            1 => 0,
-            2 => 1,
-            _ => usize::from((centroid(f) - mid).dot(split) < 0.0),
-        };
+        let side = frame.side(mesh, f, bits);
         let t = mesh.corners(f as usize);
         let longest = (0..3)
             .map(|k| t[k].distance(t[(k + 1) % 3]))
