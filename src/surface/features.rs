@@ -211,7 +211,8 @@ impl Features {
 ///
 /// # Runtime
 /// One pass over the edges; for each edge that passes the dihedral test, a walk over the faces
-/// within `scale` of it.
+/// within a quarter of `scale` of it and, for those that pass that, over the faces within
+/// `scale` (both in parallel).
 pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Features {
     let mesh = surface.mesh();
     if !(params.angle_deg < 180.0) {
@@ -229,25 +230,29 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
         } else if n == 2 {
             let (n0, n1) = (surface.face_normal(faces[0]), surface.face_normal(faces[1]));
             if n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) <= cos_bound {
-                // Near the edge too, not only between its two faces: a sliver's normal, tilted
-                // or flipped by noise in a CAD export's positions, turns by the angle on a flat.
-                if params.scale > 0.0
-                    && !sharp_near_edge(
-                        mesh,
-                        &uses,
-                        [a, b],
-                        faces,
-                        NEAR_SCALE_SHARE * params.scale,
-                        (NEAR_TURN_SHARE * params.angle_deg).to_radians().cos(),
-                    )
-                {
-                    continue;
-                }
                 candidates.push(([a, b], faces));
             }
         }
     }
     candidates.sort_unstable();
+    let mut adjacency = FaceAdjacency::new(mesh, &uses);
+    // Near the edge too, not only between its two faces: a sliver's normal, tilted or flipped
+    // by noise in a CAD export's positions, turns by the angle on a flat.
+    if params.scale > 0.0 {
+        let r = NEAR_SCALE_SHARE * params.scale;
+        let cos_near = (NEAR_TURN_SHARE * params.angle_deg).to_radians().cos();
+        candidates = candidates
+            .into_par_iter()
+            .map_init(
+                || PatchScratch::new(mesh.triangles.len()),
+                |scratch, (e, faces)| {
+                    sharp_near_edge(&adjacency, scratch, e, faces, r, cos_near)
+                        .then_some((e, faces))
+                },
+            )
+            .flatten()
+            .collect();
+    }
     // The scale test, in two steps (hysteresis, as in Canny's edge detection): an edge is a
     // crease when the surface a spacing either side of it bends by the angle; and an edge joined
     // through a chain of such edges to a crease is one too when the smooth sheets beside it (not
@@ -257,7 +262,7 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     // (within a spacing of the corner, a patch either side takes in the sheet beyond the other
     // crease), and leaves alone a fold narrower than the spacing that no crease leads to (its
     // flanks are sheets between candidates too).
-    let adjacency = FaceAdjacency::new(mesh, &uses, &candidates);
+    adjacency.mark_candidates(&candidates);
     let mut sharp: Vec<bool> = candidates
         .par_iter()
         .map_init(
@@ -358,25 +363,17 @@ struct FaceAdjacency<'a> {
 impl<'a> FaceAdjacency<'a> {
     const NONE: u32 = u32::MAX;
 
-    fn new(
-        mesh: &'a TriMesh,
-        uses: &FxHashMap<(u32, u32), ([u32; 2], u32)>,
-        candidates: &[([u32; 2], [u32; 2])],
-    ) -> Self {
-        let candidate_edges: FxHashSet<(u32, u32)> =
-            candidates.iter().map(|(e, _)| (e[0], e[1])).collect();
-        let (across, candidate) = mesh
+    /// The faces across each face's edges, no edge a candidate yet.
+    fn new(mesh: &'a TriMesh, uses: &FxHashMap<(u32, u32), ([u32; 2], u32)>) -> Self {
+        let across = mesh
             .triangles
             .iter()
             .enumerate()
             .map(|(f, tri)| {
                 let mut across = [Self::NONE; 3];
-                let mut candidate = [false; 3];
                 for k in 0..3 {
                     let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                    let key = (a.min(b), a.max(b));
-                    candidate[k] = candidate_edges.contains(&key);
-                    if let Some(&(pair, 2)) = uses.get(&key) {
+                    if let Some(&(pair, 2)) = uses.get(&(a.min(b), a.max(b))) {
                         across[k] = if pair[0] == f as u32 {
                             pair[1]
                         } else {
@@ -384,18 +381,30 @@ impl<'a> FaceAdjacency<'a> {
                         };
                     }
                 }
-                (across, candidate)
+                across
             })
-            .unzip();
+            .collect();
         FaceAdjacency {
             mesh,
             across,
-            candidate,
+            candidate: vec![[false; 3]; mesh.triangles.len()],
+        }
+    }
+
+    /// Marks the edges of `candidates` (the dihedral candidates) as such.
+    fn mark_candidates(&mut self, candidates: &[([u32; 2], [u32; 2])]) {
+        let candidate_edges: FxHashSet<(u32, u32)> =
+            candidates.iter().map(|(e, _)| (e[0], e[1])).collect();
+        for (tri, flags) in self.mesh.triangles.iter().zip(&mut self.candidate) {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                flags[k] = candidate_edges.contains(&(a.min(b), a.max(b)));
+            }
         }
     }
 }
 
-/// The faces a patch of [`sharp_at_scale`] reached, with a bit per side: a byte per face of
+/// The faces a patch of [`sharp_at_scale`] or [`sharp_near_edge`] reached, with a bit per side: a byte per face of
 /// the mesh and the list of those set, so each patch costs what it reaches (one per thread).
 struct PatchScratch {
     bits: Vec<u8>,
@@ -408,6 +417,11 @@ impl PatchScratch {
             bits: vec![0; faces],
             reached: Vec::new(),
         }
+    }
+
+    /// Whether face `f` has `bit` set.
+    fn has(&self, f: u32, bit: u8) -> bool {
+        self.bits[f as usize] & bit != 0
     }
 
     /// Sets `bit` on face `f`; whether it was not set before.
@@ -436,7 +450,7 @@ impl PatchScratch {
     }
 }
 
-/// The most faces [`sharp_at_scale`] takes on each side of an edge.
+/// The most faces [`sharp_at_scale`] and [`sharp_near_edge`] take on each side of an edge.
 const PATCH_FACES: usize = 1024;
 
 /// Whether the surface within `scale` of edge `e`'s midpoint still bends by the feature angle
@@ -463,7 +477,7 @@ fn sharp_at_scale(
     let Some(frame) = EdgeFrame::new(mesh, e, faces) else {
         return false;
     };
-    let (mid, centroid) = (frame.mid, |f: u32| centroid(mesh, f));
+    let mid = frame.mid;
     let scale_2 = scale * scale;
     // Each side's patch: grown from its face, across edges other than the dihedral candidates
     // (the edge itself included), to faces whose centroids are within `scale`. A bit per side.
@@ -484,7 +498,7 @@ fn sharp_at_scale(
                 if g == FaceAdjacency::NONE || (barriers && adjacency.candidate[f as usize][k]) {
                     continue;
                 }
-                if centroid(g).distance_squared(mid) <= scale_2 && scratch.mark(g, bit) {
+                if centroid(mesh, g).distance_squared(mid) <= scale_2 && scratch.mark(g, bit) {
                     queue.push_back(g);
                     taken += 1;
                 }
@@ -569,13 +583,14 @@ pub const NEAR_TURN_SHARE: f64 = 0.85;
 /// area: tilted or flipped by noise on a flat, it turns nothing, where a crease turns about as
 /// much near it as between its two faces. Deterministic (faces summed in index order).
 fn sharp_near_edge(
-    mesh: &TriMesh,
-    uses: &FxHashMap<(u32, u32), ([u32; 2], u32)>,
+    adjacency: &FaceAdjacency,
+    scratch: &mut PatchScratch,
     e: [u32; 2],
     faces: [u32; 2],
     r: f64,
     cos_bound: f64,
 ) -> bool {
+    let mesh = adjacency.mesh;
     // Two faces on the same side of their edge (a fold of 180°): nothing to tell near it.
     let Some(frame) = EdgeFrame::new(mesh, e, faces) else {
         return true;
@@ -587,36 +602,33 @@ fn sharp_near_edge(
         (0..3).any(|k| distance_to_segment(mid, c[k], c[(k + 1) % 3]) <= r)
             || centroid(mesh, f).distance(mid) <= r
     };
-    // The faces near the edge, a bit per side they were reached from; faces looked at but not
-    // near stay in the map with no bit.
-    let mut marks: FxHashMap<u32, u8> = FxHashMap::default();
+    // The faces near the edge, a bit per side they were reached from (depth first over any
+    // edge but `e`).
     for (side, &seed) in faces.iter().enumerate() {
         let bit = 1u8 << side;
-        *marks.entry(seed).or_default() |= bit;
+        scratch.mark(seed, bit);
         let mut stack = vec![seed];
         let mut taken = 1;
         while let Some(f) = stack.pop() {
             let t = mesh.triangles[f as usize];
             for k in 0..3 {
                 let (u, v) = (t[k], t[(k + 1) % 3]);
-                let key = (u.min(v), u.max(v));
-                if key == (e[0], e[1]) || taken >= PATCH_FACES {
+                let g = adjacency.across[f as usize][k];
+                if (u.min(v), u.max(v)) == (e[0], e[1])
+                    || taken >= PATCH_FACES
+                    || g == FaceAdjacency::NONE
+                {
                     continue;
                 }
-                if let Some(&(pair, 2)) = uses.get(&key) {
-                    let g = if pair[0] == f { pair[1] } else { pair[0] };
-                    let m = marks.entry(g).or_default();
-                    if *m & bit == 0 && near(g) {
-                        *m |= bit;
-                        stack.push(g);
-                        taken += 1;
-                    }
+                if !scratch.has(g, bit) && near(g) {
+                    scratch.mark(g, bit);
+                    stack.push(g);
+                    taken += 1;
                 }
             }
         }
     }
-    let mut marked: Vec<(u32, u8)> = marks.into_iter().filter(|&(_, b)| b != 0).collect();
-    marked.sort_unstable();
+    let marked = scratch.take_sorted();
     let mut sides = [DVec3::ZERO; 2];
     for (f, bits) in marked {
         let side = frame.side(mesh, f, bits);
