@@ -605,6 +605,21 @@ fn washer(r: f64, ri: f64, h: f64, sides: usize, k: usize) -> TriMesh {
     TriMesh::new(positions, triangles)
 }
 
+/// Asserts that the creases `out` measured lie within a tenth of its mean edge (in bbox-100
+/// units, the input's bounding box `size` long) of its edges.
+fn assert_creases_within_a_tenth_of_an_edge(
+    out: &spectral_remesh::RemeshOutput,
+    size: f64,
+    seed: u64,
+) {
+    let h = mean_edge(&out.mesh) * 100.0 / size;
+    let d = out.features.crease_distance.as_ref().expect("measured").max;
+    assert!(
+        d <= 0.1 * h,
+        "seed {seed}: creases within {d} of the edges, h {h}"
+    );
+}
+
 #[test]
 fn a_tight_rim_is_followed_within_a_tenth_of_an_edge() {
     // The hole's rims have a radius near the output's spacing: at an even crease spacing their
@@ -616,14 +631,8 @@ fn a_tight_rim_is_followed_within_a_tenth_of_an_edge() {
         let f = &out.features;
         assert_eq!(f.automatic_kept, Some(true), "{f:?}");
         assert_every_crease_edge_kept(f, seed);
-        // The output's mean edge in bbox-100 units (the input's bounding box is 40 across).
-        let m = &out.mesh;
-        let h = mean_edge(m) * 100.0 / 40.0;
-        let d = f.crease_distance.as_ref().expect("measured").max;
-        assert!(
-            d <= 0.1 * h,
-            "seed {seed}: creases within {d} of the edges, h {h}"
-        );
+        // The input's bounding box is 40 across.
+        assert_creases_within_a_tenth_of_an_edge(&out, 40.0, seed);
     }
 }
 
@@ -666,15 +675,9 @@ fn a_thin_wedges_rims_are_both_followed_up_to_its_tip() {
         let f = &out.features;
         assert_eq!(f.automatic_kept, Some(true), "{f:?}");
         assert_every_crease_edge_kept(f, seed);
-        // The output's mean edge in bbox-100 units (the input's bounding box is 20 long).
-        let m = &out.mesh;
-        let h = mean_edge(m) * 100.0 / l;
-        let d = f.crease_distance.as_ref().expect("measured").max;
-        assert!(
-            d <= 0.1 * h,
-            "seed {seed}: creases within {d} of the edges, h {h}"
-        );
-        let topology = spectral_remesh::topology(m);
+        // The input's bounding box is 20 long.
+        assert_creases_within_a_tenth_of_an_edge(&out, l, seed);
+        let topology = spectral_remesh::topology(&out.mesh);
         assert_eq!(
             (topology.components, topology.euler_characteristic),
             (1, 2),

@@ -17,7 +17,7 @@
 use glam::DVec3;
 
 use crate::mesh::TriMesh;
-use crate::sampling::curves::{edge_lengths, BoundaryCurve};
+use crate::sampling::curves::{edge_lengths, points_along, BoundaryCurve};
 
 /// The least step between two of a ladder's samples, in units of the local spacing: stations
 /// closer than this (two creases beside it sampled at steps that do not match) are merged into
@@ -85,19 +85,8 @@ pub fn ladder_arcs(
     if stations.is_empty() {
         return None;
     }
-    // The point at an arc, for the local step there.
-    let at = |arc: f64| -> DVec3 {
-        let mut start = 0.0;
-        for (k, &l) in lengths.iter().enumerate() {
-            if start + l >= arc {
-                let t = if l > 0.0 { (arc - start) / l } else { 0.0 };
-                return pos(k).lerp(pos(k + 1), t.clamp(0.0, 1.0));
-            }
-            start += l;
-        }
-        pos(nv - 1)
-    };
-    let step = |arc: f64| step(at(arc));
+    // The local step at an arc (at the curve's point there).
+    let step = |arc: f64| step(points_along(mesh, curve, &lengths, [arc])[0].0);
     let mut arcs = vec![0.0, total];
     arcs.extend(stations.iter().copied().filter(|&a| a > 0.0 && a < total));
     arcs.extend(own.iter().filter_map(|&(a, clear)| {
