@@ -2,8 +2,9 @@
 //!
 //! A feature edge is an interior edge of two faces whose normals differ by at least the feature
 //! angle, and nearly as much near it (the faces within a quarter of the scale, by area: a sliver
-//! whose normal noise in the positions has tilted is no crease) and at the sampling's scale: the surface within `scale` of the edge, on either
-//! side of it, has mean normals that differ by the feature angle too. The second test is what tells
+//! whose normal noise in the positions has tilted is no crease), and still do at the sampling's
+//! scale: the surface within `scale` of the edge, on either side of it, has mean normals that
+//! differ by the feature angle too. The test at the scale is what tells
 //! a crease of a part (fandisk, a CSG flange) from the folds and spikes a scan leaves at the scale
 //! of its own triangles (horse, bunny), which are sharp between two faces but smooth a sample
 //! spacing away; an edge that continues a crease (a crease fading out) is one too. Feature edges
