@@ -10,7 +10,8 @@
 //! spacing away; an edge that continues a crease (a crease fading out) is one too. Feature edges
 //! are chained into curves that end at corners: vertices where one, three or more feature edges
 //! meet, where a feature curve meets the boundary, or where a curve turns by the feature angle
-//! or more.
+//! or more, between its two edges and still between its chords a quarter of the scale long (a
+//! crease's short edges, turned by noise in a CAD export's positions, make no corner).
 //!
 //! # References
 //! The dihedral-angle test is the one of MeshLab's and CGAL's feature detection
@@ -140,7 +141,8 @@ pub const CAD_FEATURE_ANGLE_DEG: f64 = 20.0;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FeatureParams {
     /// The least angle (degrees) between the normals either side of an edge for it to be a
-    /// crease, and the least turn of a feature curve at a vertex for the vertex to be a corner.
+    /// crease, and the least turn of a feature curve at a vertex for the vertex to be a corner
+    /// (between its two edges and between its chords a quarter of `scale` long).
     /// 180 or more turns detection off (see [`FeatureDetection`]).
     pub angle_deg: f64,
     /// How far across an edge (bbox-100 units when the mesh is normalized) the surface must
@@ -343,7 +345,14 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
         .filter(|(_, &s)| s)
         .map(|(c, _)| *c)
         .unzip();
-    let (curves, corners) = chain(mesh, &edges, &edge_faces, &boundary_vertex, cos_bound);
+    let (curves, corners) = chain(
+        mesh,
+        &edges,
+        &edge_faces,
+        &boundary_vertex,
+        cos_bound,
+        NEAR_SCALE_SHARE * params.scale,
+    );
     Features {
         edges,
         curves,
@@ -656,13 +665,16 @@ fn turns_less_than(a: DVec3, v: DVec3, b: DVec3, cos_bound: f64) -> bool {
 
 /// Chains `edges` (sorted) into curves between corners: vertices of feature degree other than
 /// 2, on the boundary, or where the curve turns by more than the angle whose cosine is
-/// `cos_bound`. What is left after the open curves are closed loops without a corner.
+/// `cos_bound`, both between its two edges and (`reach` > 0) between the chords to its points
+/// `reach` along it either side, with no other corner within `reach` along it that turns more.
+/// What is left after the open curves are closed loops without a corner. Deterministic.
 fn chain(
     mesh: &TriMesh,
     edges: &[[u32; 2]],
     edge_faces: &[[u32; 2]],
     boundary_vertex: &[bool],
     cos_bound: f64,
+    reach: f64,
 ) -> (Vec<FeatureCurve>, Vec<u32>) {
     let positions = &mesh.positions;
     // The face of edge `e` that has it as `a → b` (the later one if both do), else the later
@@ -690,19 +702,72 @@ fn chain(
             edges[i][0]
         }
     };
-    let is_corner = |v: u32| -> bool {
-        let inc = &incident[&v];
-        if inc.len() != 2 || boundary_vertex[v as usize] {
-            return true;
+    // Where curves end whatever their turn: not two feature edges, or on the boundary.
+    let ends = |v: u32| incident[&v].len() != 2 || boundary_vertex[v as usize];
+    let mut corners: Vec<u32> = incident.keys().copied().filter(|&v| ends(v)).collect();
+    // Where a curve turns by the angle: between its two edges, and (at `reach` > 0) between the
+    // chords to the points `reach` along it either side, no end within `reach`; of two such
+    // vertices within `reach` along the curve, the one that turns more. Noise in a CAD export's
+    // positions turns a crease's short edges by the angle on a straight line, and two corners
+    // a hundredth of a spacing apart, both sampled, make a sliver.
+    let mut turning: Vec<(f64, u32, Vec<u32>)> = Vec::new();
+    for (&v, inc) in &incident {
+        if ends(v) {
+            continue;
         }
-        !turns_less_than(
-            positions[other(inc[0], v) as usize],
-            positions[v as usize],
-            positions[other(inc[1], v) as usize],
+        let p = positions[v as usize];
+        let ab = [other(inc[0], v), other(inc[1], v)];
+        if turns_less_than(
+            positions[ab[0] as usize],
+            p,
+            positions[ab[1] as usize],
             cos_bound,
-        )
-    };
-    let mut corners: Vec<u32> = incident.keys().copied().filter(|&v| is_corner(v)).collect();
+        ) {
+            continue;
+        }
+        if !(reach > 0.0) {
+            turning.push((0.0, v, Vec::new()));
+            continue;
+        }
+        // Each way: the point `reach` along the curve, and the vertices passed; `None` when an
+        // end (or `v` again, round a short loop) comes first.
+        let mut passed = Vec::new();
+        let mut arm = |first: usize| -> Option<DVec3> {
+            let (mut u, mut e) = (v, inc[first]);
+            let mut left = reach;
+            loop {
+                let w = other(e, u);
+                let (a, b) = (positions[u as usize], positions[w as usize]);
+                let l = a.distance(b);
+                if l >= left {
+                    return Some(a.lerp(b, left / l));
+                }
+                if w == v || ends(w) {
+                    return None;
+                }
+                left -= l;
+                passed.push(w);
+                e = *incident[&w].iter().find(|&&i| i != e)?;
+                u = w;
+            }
+        };
+        let (Some(a), Some(b)) = (arm(0), arm(1)) else {
+            continue;
+        };
+        let cos = (p - a).normalize_or_zero().dot((b - p).normalize_or_zero());
+        if cos <= cos_bound {
+            turning.push((cos, v, passed));
+        }
+    }
+    // The most turning first (the least cosine), then by vertex: the same corners in any order.
+    turning.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let mut within_reach_of_corner: rustc_hash::FxHashSet<u32> = Default::default();
+    for (_, v, passed) in turning {
+        if within_reach_of_corner.insert(v) {
+            corners.push(v);
+            within_reach_of_corner.extend(passed);
+        }
+    }
     corners.sort_unstable();
     let corner_set: rustc_hash::FxHashSet<u32> = corners.iter().copied().collect();
     let mut used = vec![false; edges.len()];
@@ -842,6 +907,68 @@ mod tests {
         }
         // Off at 180°.
         assert!(detect(&m, 180.0, 5.0).edges.is_empty());
+    }
+
+    #[test]
+    fn a_creases_short_edges_turned_by_noise_make_no_corner() {
+        // A cube [0, 100]³, each face fanned from a corner, its top edge y = 100 in
+        // steps of 0.5 whose inner vertices are moved by up to 0.1 in z (a fixed pseudo-random
+        // sequence; in the plane of the side y = 100, so its slivers stay in that plane): that
+        // crease zigzags, its edges turning by up to 77°, but it is straight at the spacing.
+        let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let mut positions = vec![
+            c(0.0, 0.0, 0.0),
+            c(100.0, 0.0, 0.0),
+            c(100.0, 100.0, 0.0),
+            c(0.0, 100.0, 0.0),
+            c(0.0, 0.0, 100.0),
+            c(100.0, 0.0, 100.0),
+        ];
+        let (b, t) = ([0u32, 1, 2, 3], [4u32, 5]);
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut jitter = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            0.1 * (2.0 * (state >> 11) as f64 / (1u64 << 53) as f64 - 1.0)
+        };
+        // The top edge from (0, 100, 100) to (100, 100, 100).
+        let edge: Vec<u32> = (0..=200)
+            .map(|k| {
+                let inner = k > 0 && k < 200;
+                let dz = if inner { jitter() } else { 0.0 };
+                positions.push(c(0.5 * k as f64, 100.0, 100.0 + dz));
+                (positions.len() - 1) as u32
+            })
+            .collect();
+        let (t3, t2) = (edge[0], edge[200]);
+        let mut triangles: Vec<[u32; 3]> = Vec::new();
+        // A convex polygon (counterclockwise seen from outside) fanned from its first vertex.
+        let mut fan = |poly: &[u32]| {
+            for k in 1..poly.len() - 1 {
+                triangles.push([poly[0], poly[k], poly[k + 1]]);
+            }
+        };
+        fan(&[b[0], b[3], b[2], b[1]]);
+        fan(&[b[0], b[1], t[1], t[0]]);
+        fan(&[b[1], b[2], t2, t[1]]);
+        fan(&[b[3], b[0], t[0], t3]);
+        let mut side = vec![b[2], b[3]];
+        side.extend(&edge);
+        fan(&side);
+        let mut top = vec![t[0], t[1]];
+        top.extend(edge.iter().rev());
+        fan(&top);
+        let m = TriMesh::new(positions, triangles);
+        // Between its edges the crease turns by the angle at many vertices (and the slivers of
+        // the top, tilted by the steps, turn between their faces).
+        let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 0.0);
+        assert!(f.edges.len() > 11 + 200);
+        assert!(f.corners.len() > 8 + 20, "{} corners", f.corners.len());
+        // A quarter of a spacing of 20 either side, it turns only at the cube's corners.
+        let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 20.0);
+        assert_eq!(f.edges.len(), 11 + 200);
+        assert_eq!((f.curves.len(), f.corners.len()), (12, 8));
     }
 
     #[test]
