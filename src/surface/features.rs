@@ -215,7 +215,9 @@ impl Features {
 /// # Runtime
 /// One pass over the edges; for each edge that passes the dihedral test, a walk over the faces
 /// within a quarter of `scale` of it and, for those that pass that, over the faces within
-/// `scale` (both in parallel).
+/// `scale` (both in parallel); for each crease edge longer than half of `scale`, a walk per
+/// piece of it; for each crease edge, a search of at most [`CHORD_PATH_STEPS`] steps over the
+/// creases beside it.
 pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Features {
     let mesh = surface.mesh();
     if !(params.angle_deg < 180.0) {
@@ -249,7 +251,7 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
             .map_init(
                 || PatchScratch::new(mesh.triangles.len()),
                 |scratch, (e, faces)| {
-                    sharp_near_edge(&adjacency, scratch, e, faces, r, cos_near)
+                    sharp_near_edge(&adjacency, scratch, e, faces, r, cos_near, false)
                         .then_some((e, faces))
                 },
             )
@@ -335,6 +337,94 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
                         stack.push(j);
                     }
                 }
+            }
+        }
+    }
+    // Along a crease edge longer than the near test's ball too (after the scale test, whose
+    // patches stop at the candidates as they were).
+    if params.scale > 0.0 {
+        let r = NEAR_SCALE_SHARE * params.scale;
+        let cos_near = (NEAR_TURN_SHARE * params.angle_deg).to_radians().cos();
+        let long: Vec<usize> = (0..candidates.len())
+            .filter(|&i| {
+                let e = candidates[i].0;
+                sharp[i]
+                    && mesh.positions[e[0] as usize].distance(mesh.positions[e[1] as usize])
+                        > 2.0 * r
+            })
+            .collect();
+        let fails: Vec<usize> = long
+            .into_par_iter()
+            .map_init(
+                || PatchScratch::new(mesh.triangles.len()),
+                |scratch, i| {
+                    let (e, faces) = candidates[i];
+                    (!sharp_near_edge(&adjacency, scratch, e, faces, r, cos_near, true))
+                        .then_some(i)
+                },
+            )
+            .flatten()
+            .collect();
+        for i in fails {
+            sharp[i] = false;
+        }
+    }
+    // A crease edge with a path of shorter crease edges between its ends and beside it (within
+    // the near test's radius, where that test cannot tell the two apart; a few steps, each going
+    // the edge's way) is a chord across that path, which carries the crease: a CAD export's fan
+    // of slivers from a vertex of a hole's rim to the next ones, tilted by noise. Sampled too,
+    // it would be a second crease beside the path. Longest first, each path through the edges
+    // left.
+    if params.scale > 0.0 {
+        let tube = NEAR_SCALE_SHARE * params.scale;
+        let length = |i: usize| {
+            let e = candidates[i].0;
+            mesh.positions[e[0] as usize].distance(mesh.positions[e[1] as usize])
+        };
+        let mut at_vertex: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
+        let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| sharp[i]).collect();
+        for &i in &order {
+            let e = candidates[i].0;
+            at_vertex.entry(e[0]).or_default().push(i);
+            at_vertex.entry(e[1]).or_default().push(i);
+        }
+        order.sort_by(|&i, &j| length(j).total_cmp(&length(i)).then(i.cmp(&j)));
+        for i in order {
+            let [a, b] = candidates[i].0;
+            let (pa, pb, li) = (
+                mesh.positions[a as usize],
+                mesh.positions[b as usize],
+                length(i),
+            );
+            let mut stack = vec![(a, 0usize)];
+            let mut seen = vec![a];
+            let mut chord = false;
+            'search: while let Some((v, steps)) = stack.pop() {
+                for &j in &at_vertex[&v] {
+                    if j == i || !sharp[j] || length(j) >= li {
+                        continue;
+                    }
+                    let e = candidates[j].0;
+                    let w = if e[0] == v { e[1] } else { e[0] };
+                    let (pv, pw) = (mesh.positions[v as usize], mesh.positions[w as usize]);
+                    if (pw - pv).normalize_or_zero().dot((pb - pa) / li) < CHORD_PATH_COS {
+                        continue;
+                    }
+                    if w == b {
+                        chord = true;
+                        break 'search;
+                    }
+                    if steps + 1 < CHORD_PATH_STEPS
+                        && !seen.contains(&w)
+                        && distance_to_segment(pw, pa, pb) <= tube
+                    {
+                        seen.push(w);
+                        stack.push((w, steps + 1));
+                    }
+                }
+            }
+            if chord {
+                sharp[i] = false;
             }
         }
     }
@@ -568,6 +658,17 @@ impl EdgeFrame {
     }
 }
 
+/// The most edges of a path of creases beside a longer crease edge that make it a chord
+/// ([`detect_features`]).
+pub const CHORD_PATH_STEPS: usize = 16;
+
+/// The least cosine between each step of a path of creases and the longer crease edge it runs
+/// beside for that edge to be a chord across it ([`detect_features`]): the path goes the edge's
+/// way at every step (45°), as a rim's arc does under its chord (a chord 2 spacings long of a
+/// rim 3 spacings round: 20° at most), where two creases a chamfer apart, joined at their ends,
+/// step across.
+pub const CHORD_PATH_COS: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
 /// The radius of the near test of [`detect_features`] ([`sharp_near_edge`]) as a share of the
 /// scale (the sample spacing). eval/features at 3,000 vertices, seed 1, the made parts of
 /// eval/cad_parts.py as CSG exports (slivers down to 1e-4 of the diagonal high) with noise in
@@ -585,7 +686,8 @@ pub const NEAR_TURN_SHARE: f64 = 0.85;
 
 /// Whether the surface near edge `e` (faces `faces`) turns by the angle whose cosine is
 /// `cos_bound`: the area-weighted normals of the faces that come within `r` of the edge's
-/// midpoint, grown from each of its two faces over any edge but `e`, differ by the angle. A face
+/// midpoint, grown from each of its two faces over any edge but `e`, differ by the angle; with
+/// `along`, at the middles of pieces at most 2 `r` long instead, at half of them or more. A face
 /// reached from one side counts on that side, one reached from both on the side of the edge it
 /// lies on; a face longer than the ball (2 `r`) counts with the share of it that can lie in the
 /// ball (2 `r` over its longest edge: a CAD export's long sliver beside a hole's rim reaches
@@ -599,18 +701,50 @@ fn sharp_near_edge(
     faces: [u32; 2],
     r: f64,
     cos_bound: f64,
+    along: bool,
 ) -> bool {
     let mesh = adjacency.mesh;
     // Two faces on the same side of their edge (a fold of 180°): nothing to tell near it.
     let Some(frame) = EdgeFrame::new(mesh, e, faces) else {
         return true;
     };
-    let mid = frame.mid;
-    // Whether face f comes within r of the midpoint (an edge of it, or its centroid).
+    let (pa, pb) = (mesh.positions[e[0] as usize], mesh.positions[e[1] as usize]);
+    // Along it, an edge longer than the ball is tested at the middles of pieces at most 2 r
+    // long: it is a crease where at least half of them turn (a CAD export's long sliver edge
+    // tangent to a hole's rim is within r of the rim at its middle only).
+    let pieces = if along {
+        (pa.distance(pb) / (2.0 * r)).ceil().max(1.0) as usize
+    } else {
+        1
+    };
+    let turning = (0..pieces)
+        .filter(|&k| {
+            let at = pa.lerp(pb, (k as f64 + 0.5) / pieces as f64);
+            turns_near(adjacency, scratch, &frame, e, faces, at, r, cos_bound)
+        })
+        .count();
+    2 * turning >= pieces
+}
+
+/// Whether the faces that come within `r` of the point `at` of edge `e` (faces `faces`, seen
+/// from `frame`) turn by the angle whose cosine is `cos_bound` ([`sharp_near_edge`]).
+#[allow(clippy::too_many_arguments)]
+fn turns_near(
+    adjacency: &FaceAdjacency,
+    scratch: &mut PatchScratch,
+    frame: &EdgeFrame,
+    e: [u32; 2],
+    faces: [u32; 2],
+    at: DVec3,
+    r: f64,
+    cos_bound: f64,
+) -> bool {
+    let mesh = adjacency.mesh;
+    // Whether face f comes within r of the point (an edge of it, or its centroid).
     let near = |f: u32| -> bool {
         let c = mesh.corners(f as usize);
-        (0..3).any(|k| distance_to_segment(mid, c[k], c[(k + 1) % 3]) <= r)
-            || centroid(mesh, f).distance(mid) <= r
+        (0..3).any(|k| distance_to_segment(at, c[k], c[(k + 1) % 3]) <= r)
+            || centroid(mesh, f).distance(at) <= r
     };
     // The faces near the edge, a bit per side they were reached from (depth first over any
     // edge but `e`).
