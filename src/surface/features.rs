@@ -1269,6 +1269,130 @@ mod tests {
         }
     }
 
+    /// A block [-50, 50] × [-50, rim(x)] × [0, 20] whose side y = rim(x) = 50 + x²/100 is curved
+    /// (a vertex every 1 along x), as a CAD export can come: its top holds a strip of slivers
+    /// `eps` wide whose two rows have vertices at x = -50, -25, 25 and 50 only, the upper one
+    /// `gap` below the rim's lowest point: its edge from x = -25 to 25 is tangent to the rim's
+    /// curve in its middle. The rest of each face is zipped between chains of vertices. The lower
+    /// row's middle vertices are raised by `lift`, tilting the strip's slivers as noise in the
+    /// positions does. Outward orientation. Returns the mesh and that edge.
+    fn block_with_a_tangent_strip(gap: f64, eps: f64, lift: f64) -> (TriMesh, [u32; 2]) {
+        let rim = |x: f64| 50.0 + x * x / 100.0;
+        let mut positions: Vec<DVec3> = Vec::new();
+        let mut chain = |points: &[(f64, f64, f64)]| -> Vec<u32> {
+            points
+                .iter()
+                .map(|&(x, y, z)| {
+                    positions.push(DVec3::new(x, y, z));
+                    (positions.len() - 1) as u32
+                })
+                .collect()
+        };
+        let xs: Vec<f64> = (0..=100).map(|k| -50.0 + k as f64).collect();
+        let along = |y: &dyn Fn(f64) -> f64, z: f64| -> Vec<(f64, f64, f64)> {
+            xs.iter().map(|&x| (x, y(x), z)).collect()
+        };
+        let front_bottom = chain(&along(&|_| -50.0, 0.0));
+        let front_top = chain(&along(&|_| -50.0, 20.0));
+        let back_bottom = chain(&along(&rim, 0.0));
+        let back_top = chain(&along(&rim, 20.0));
+        let row_x: [f64; 4] = [-50.0, -25.0, 25.0, 50.0];
+        let y0 = 50.0 - gap - eps;
+        let row_a = chain(&row_x.map(|x| (x, y0, if x.abs() < 50.0 { 20.0 + lift } else { 20.0 })));
+        let row_b = chain(&row_x.map(|x| (x, y0 + eps, 20.0)));
+        let x = |v: u32| positions[v as usize].x;
+        let mut triangles: Vec<[u32; 3]> = Vec::new();
+        // Between two chains along x, the upper one at larger y: counterclockwise seen from +z.
+        // Each lower edge takes the upper vertices up to its middle (the rim above the tangent
+        // edge is seen from its ends only).
+        let zip = |lower: &[u32], upper: &[u32], triangles: &mut Vec<[u32; 3]>| {
+            let (mut i, mut j) = (0, 0);
+            while i + 1 < lower.len() || j + 1 < upper.len() {
+                if j + 1 == upper.len()
+                    || (i + 1 < lower.len()
+                        && x(upper[j + 1]) > 0.5 * (x(lower[i]) + x(lower[i + 1])))
+                {
+                    triangles.push([lower[i], lower[i + 1], upper[j]]);
+                    i += 1;
+                } else {
+                    triangles.push([lower[i], upper[j + 1], upper[j]]);
+                    j += 1;
+                }
+            }
+        };
+        zip(&front_top, &row_a, &mut triangles);
+        zip(&row_a, &row_b, &mut triangles);
+        zip(&row_b, &back_top, &mut triangles);
+        let mut bottom = Vec::new();
+        zip(&front_bottom, &back_bottom, &mut bottom);
+        triangles.extend(bottom.iter().map(|t| [t[0], t[2], t[1]]));
+        // The walls y = -50 (seen from -y) and y = rim(x) (seen from +y).
+        for k in 0..100 {
+            let (b, t) = (&front_bottom, &front_top);
+            triangles.push([b[k], b[k + 1], t[k + 1]]);
+            triangles.push([b[k], t[k + 1], t[k]]);
+            let (b, t) = (&back_bottom, &back_top);
+            triangles.push([b[k + 1], b[k], t[k]]);
+            triangles.push([b[k + 1], t[k], t[k + 1]]);
+        }
+        // The ends x = -50 and x = 50, fanned from a bottom corner.
+        let mut fan = |poly: &[u32]| {
+            for k in 1..poly.len() - 1 {
+                triangles.push([poly[0], poly[k], poly[k + 1]]);
+            }
+        };
+        fan(&[
+            back_bottom[0],
+            front_bottom[0],
+            front_top[0],
+            row_a[0],
+            row_b[0],
+            back_top[0],
+        ]);
+        fan(&[
+            front_bottom[100],
+            back_bottom[100],
+            back_top[100],
+            row_b[3],
+            row_a[3],
+            front_top[100],
+        ]);
+        (TriMesh::new(positions, triangles), [row_b[1], row_b[2]])
+    }
+
+    #[test]
+    fn a_sliver_edge_tangent_to_a_curved_crease_is_no_crease() {
+        // The strip's edges 0.3 from the rim at their middle (0.06 of the spacing of 5), 6.55
+        // away from it at x = ±25; the strip's slivers, 0.01 wide, tilted by 63°.
+        let (m, tangent) = block_with_a_tangent_strip(0.3, 0.01, 0.02);
+        let e = [tangent[0].min(tangent[1]), tangent[0].max(tangent[1])];
+        // Between its two faces, the tangent edge turns by the angle.
+        assert!(detect(&m, CAD_FEATURE_ANGLE_DEG, 0.0).edges.contains(&e));
+        let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 5.0);
+        // Each crease lies on the block's rims: top or bottom, at the front, the back or an end.
+        let rim = |x: f64| 50.0 + x * x / 100.0;
+        let stray: Vec<_> = f
+            .edges
+            .iter()
+            .filter(|e| {
+                let p = 0.5 * (m.positions[e[0] as usize] + m.positions[e[1] as usize]);
+                let near = |a: f64, b: f64| (a - b).abs() < 0.1;
+                let sides = [
+                    near(p.z, 0.0) || near(p.z, 20.0),
+                    near(p.y, -50.0) || near(p.y, rim(p.x)),
+                    near(p.x, -50.0) || near(p.x, 50.0),
+                ];
+                sides.iter().filter(|&&s| s).count() < 2
+            })
+            .collect();
+        assert!(
+            stray.is_empty(),
+            "{} edges off the rims: {stray:?}",
+            stray.len()
+        );
+        assert!(!f.edges.contains(&e));
+    }
+
     #[test]
     fn a_fold_narrower_than_the_scale_is_not_a_crease() {
         // Grid 40 × 40 over [0, 100]²; the row of vertices at y = 50 raised by 2 (the ridge's
