@@ -1394,6 +1394,36 @@ mod tests {
     }
 
     #[test]
+    fn chords_of_a_rim_across_a_fan_of_slivers_are_not_creases() {
+        // A cylinder of radius 30 and height 100, 48 sides: its top cap fanned from the centre
+        // but for the first five rim edges, which are fanned from rim vertex 0 instead (chords
+        // 0-2, 0-3, 0-4 within 1 of the rim: slivers, as a CAD export fans a hole's rim). Rim
+        // vertices 2 and 4 raised by 0.5 tilt the slivers, so the chords turn between their faces.
+        let mut m = cylinder(30.0, 100.0, 48, 10);
+        let rim = |i: usize| (10 * 48 + i % 48) as u32;
+        let top = (m.positions.len() - 1) as u32;
+        m.triangles
+            .retain(|t| !(t[0] == top && t[1] < rim(5) && t[1] >= rim(0)));
+        for k in 1..5 {
+            m.triangles.push([rim(0), rim(k), rim(k + 1)]);
+        }
+        m.triangles.push([top, rim(0), rim(5)]);
+        for i in [2, 4] {
+            m.positions[rim(i) as usize].z += 0.5;
+        }
+        let m = TriMesh::new(m.positions, m.triangles);
+        let chords: Vec<[u32; 2]> = (2..5).map(|k| [rim(0), rim(k)]).collect();
+        // Between their two faces the chords turn by the angle.
+        let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 0.0);
+        assert!(chords.iter().all(|c| f.edges.contains(c)), "{:?}", f.edges);
+        // At a spacing of 20 the creases are the two rims, closed, and no chord.
+        let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 20.0);
+        assert!(chords.iter().all(|c| !f.edges.contains(c)));
+        assert_eq!(f.edges.len(), 2 * 48);
+        assert!(f.curves.len() == 2 && f.curves.iter().all(|c| c.closed));
+    }
+
+    #[test]
     fn a_fold_narrower_than_the_scale_is_not_a_crease() {
         // Grid 40 × 40 over [0, 100]²; the row of vertices at y = 50 raised by 2 (the ridge's
         // flanks 2.5 wide: 39° from the plane, 77° between them).
