@@ -12,7 +12,10 @@
 //! the best-shaped ear first) with the segment as an edge. Where that projection is not
 //! one-to-one on the faces it touches, the walk meets a vertex on the segment, or a new
 //! triangle would be a sliver (an angle below `RECOVERY_MIN_ANGLE_DEG`: a vertex a hair off the
-//! segment), the edge stays missing (the report counts it).
+//! segment), the edge stays missing (the report counts it), unless flips put it in: the one
+//! edge between its ends when they are the opposite corners of its two faces, or that after
+//! a flip of an edge of one end's link (a crease sample whose faces all lie on one side of the
+//! crease, under a face that spans it).
 
 use glam::{DVec2, DVec3};
 use robust::{orient2d, Coord};
@@ -54,7 +57,10 @@ pub fn recover_edges<L: Copy>(m: &mut EditMesh<L>, edges: &[[u32; 2]], label: L)
         }
         if !m.has_edge(a, b) {
             stats.missing += 1;
-            if insert_edge(m, a, b, label) {
+            if insert_edge(m, a, b, label)
+                || flip_into(m, a, b, label)
+                || insert_edge_after_link_flip(m, a, b, label)
+            {
                 stats.recovered += 1;
             }
         }
@@ -63,6 +69,116 @@ pub fn recover_edges<L: Copy>(m: &mut EditMesh<L>, edges: &[[u32; 2]], label: L)
         }
     }
     stats
+}
+
+/// Puts `a`–`b` in ([`insert_edge`]) after flipping one edge of the link of `a` or `b`: a crease
+/// sample whose faces all lie on one side of the crease (three faces tucked under a face that
+/// spans the crease, as the triangulation can leave where two creases run a third of a spacing
+/// apart) has no fan the walk can start from; the flip of the link edge it shares with that face
+/// gives it a face on the other side. Each unprotected link edge is tried in turn (`a`'s first,
+/// in face order); the flip is kept only when its two faces are [`well_flipped`] and the
+/// insertion (or [`flip_into`]) then succeeds; otherwise the two faces are put back as they
+/// were. Deterministic.
+fn insert_edge_after_link_flip<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
+    for end in [a, b] {
+        let link: Vec<(u32, u32)> = m
+            .faces_around(end)
+            .iter()
+            .filter_map(|&f| m.face(f))
+            .map(|t| {
+                let t = starting_at(t, end);
+                (t[1], t[2])
+            })
+            .collect();
+        for (p, q) in link {
+            if m.is_protected(p, q) {
+                continue;
+            }
+            let Ok((f1, f2, _, _)) = m.edge_faces(p, q) else {
+                continue;
+            };
+            let (Some(old1), Some(old2)) = (m.face(f1), m.face(f2)) else {
+                continue;
+            };
+            let (l1, l2) = (m.label(f1), m.label(f2));
+            let Ok(new) = m.flip_edge(p, q, label) else {
+                continue;
+            };
+            let flipped = new.map(|g| m.face(g));
+            if well_flipped(m, new, true)
+                && (insert_edge(m, a, b, label) || flip_into(m, a, b, label))
+            {
+                return true;
+            }
+            // Back as they were (the flip's two faces are there again when the insertion fails,
+            // maybe in other slots).
+            unflip(m, flipped, [(old1, l1), (old2, l2)]);
+        }
+    }
+    false
+}
+
+/// Whether the two faces in slots `new` (an edge flip's) have no angle below
+/// [`RECOVERY_MIN_ANGLE_DEG`] and, with `unfolded`, do not fold onto each other (their normals
+/// less than 90° apart; a flip onto a crease edge makes the crease's own angle there).
+fn well_flipped<L: Copy>(m: &EditMesh<L>, new: [u32; 2], unfolded: bool) -> bool {
+    let faces = new.map(|g| m.face(g).map(|t| m.corners(t)));
+    let normal = |c: [DVec3; 3]| (c[1] - c[0]).cross(c[2] - c[0]);
+    match faces {
+        [Some(x), Some(y)] => {
+            triangle_min_angle_deg(x) >= RECOVERY_MIN_ANGLE_DEG
+                && triangle_min_angle_deg(y) >= RECOVERY_MIN_ANGLE_DEG
+                && (!unfolded || normal(x).dot(normal(y)) > 0.0)
+        }
+        _ => false,
+    }
+}
+
+/// Puts `a`–`b` in by flipping the one edge between them, when `a` and `b` are the opposite
+/// corners of its two faces and that edge is not protected: the one crossing that
+/// [`insert_edge`]'s walk needs no projection for (its fans need not project one-to-one). The
+/// flip is kept when its faces have no angle below [`RECOVERY_MIN_ANGLE_DEG`], else undone.
+/// Deterministic.
+fn flip_into<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
+    let across = m.faces_around(a).iter().find_map(|&f| {
+        let t = starting_at(m.face(f)?, a);
+        let g = m.face_on(t[2], t[1])?;
+        (starting_at(m.face(g)?, t[2])[2] == b).then_some((t[1], t[2], f, g))
+    });
+    let Some((x, y, f, g)) = across else {
+        return false;
+    };
+    if m.is_protected(x, y) {
+        return false;
+    }
+    let (Some(old1), Some(old2)) = (m.face(f), m.face(g)) else {
+        return false;
+    };
+    let (l1, l2) = (m.label(f), m.label(g));
+    let Ok(new) = m.flip_edge(x, y, label) else {
+        return false;
+    };
+    if well_flipped(m, new, false) {
+        return true;
+    }
+    let flipped = new.map(|g| m.face(g));
+    unflip(m, flipped, [(old1, l1), (old2, l2)]);
+    false
+}
+
+/// Undoes an edge flip: removes its two faces `flipped` (found by their corners, in whatever
+/// slots they are) and puts the faces `old` back with their labels.
+fn unflip<L: Copy>(m: &mut EditMesh<L>, flipped: [Option<[u32; 3]>; 2], old: [([u32; 3], L); 2]) {
+    for t in flipped.into_iter().flatten() {
+        if let Some(f) = m.face_on(t[0], t[1]) {
+            if m.face(f).is_some_and(|u| starting_at(u, t[0]) == t) {
+                let _ = m.remove_face(f);
+            }
+        }
+    }
+    for (t, l) in old {
+        let _ = m.add_face(t, l);
+    }
 }
 
 /// Closes the slits a triangulation can leave along a crease with graded samples: a hole of
