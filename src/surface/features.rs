@@ -216,7 +216,7 @@ impl Features {
 /// One pass over the edges; for each edge that passes the dihedral test, a walk over the faces
 /// within a quarter of `scale` of it and, for those that pass that, over the faces within
 /// `scale` (both in parallel); for each crease edge longer than half of `scale`, a walk per
-/// piece of it; for each crease edge, a search of at most [`CHORD_PATH_STEPS`] steps over the
+/// piece of it; for each crease edge, a search of at most `CHORD_PATH_STEPS` steps over the
 /// creases beside it.
 pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Features {
     let mesh = surface.mesh();
