@@ -340,6 +340,89 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
             }
         }
     }
+    // Gaps in a crease chain: from a chain's end, the edges that go on most straight (turning by
+    // less than the angle at each vertex) and pass the near test, a few at most, when they reach
+    // another crease. Noise in a CAD export's positions tilts the slivers beside a rim until
+    // their edges no longer pass the dihedral test, and the rim falls into pieces.
+    if params.scale > 0.0 {
+        let r = NEAR_SCALE_SHARE * params.scale;
+        let cos_near = (NEAR_TURN_SHARE * params.angle_deg).to_radians().cos();
+        let mut neighbours: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+        for (&(a, b), &(_, n)) in &uses {
+            if n == 2 {
+                neighbours.entry(a).or_default().push(b);
+                neighbours.entry(b).or_default().push(a);
+            }
+        }
+        for list in neighbours.values_mut() {
+            list.sort_unstable();
+        }
+        let mut degree: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+        for (i, (e, _)) in candidates.iter().enumerate() {
+            if sharp[i] {
+                degree.entry(e[0]).or_default().push(e[1]);
+                degree.entry(e[1]).or_default().push(e[0]);
+            }
+        }
+        let mut ends: Vec<(u32, u32)> = degree
+            .iter()
+            .filter(|(&v, list)| list.len() == 1 && !boundary_vertex[v as usize])
+            .map(|(&v, list)| (v, list[0]))
+            .collect();
+        ends.sort_unstable();
+        let mut scratch = PatchScratch::new(mesh.triangles.len());
+        let mut added: Vec<([u32; 2], [u32; 2])> = Vec::new();
+        let mut taken: FxHashSet<(u32, u32)> = FxHashSet::default();
+        for (end, before) in ends {
+            let (mut x, mut from) = (end, mesh.positions[before as usize]);
+            let mut path: Vec<([u32; 2], [u32; 2])> = Vec::new();
+            let mut joined = false;
+            for _ in 0..GAP_STEPS {
+                let px = mesh.positions[x as usize];
+                let d = (px - from).normalize_or_zero();
+                let next = neighbours.get(&x).and_then(|list| {
+                    list.iter()
+                        .copied()
+                        .map(|y| {
+                            (
+                                d.dot((mesh.positions[y as usize] - px).normalize_or_zero()),
+                                y,
+                            )
+                        })
+                        .filter(|&(c, _)| c > cos_bound)
+                        .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)))
+                });
+                let Some((_, y)) = next else { break };
+                let e = [x.min(y), x.max(y)];
+                if taken.contains(&(e[0], e[1])) || degree.get(&x).is_some_and(|l| l.contains(&y)) {
+                    break;
+                }
+                let Some(&(faces, 2)) = uses.get(&(e[0], e[1])) else {
+                    break;
+                };
+                if !sharp_near_edge(&adjacency, &mut scratch, e, faces, r, cos_near, false) {
+                    break;
+                }
+                path.push((e, faces));
+                if degree.contains_key(&y) {
+                    joined = true;
+                    break;
+                }
+                (from, x) = (px, y);
+            }
+            if joined {
+                for (e, faces) in path {
+                    if taken.insert((e[0], e[1])) {
+                        added.push((e, faces));
+                    }
+                }
+            }
+        }
+        for c in added {
+            candidates.push(c);
+            sharp.push(true);
+        }
+    }
     // Along a crease edge longer than the near test's ball too (after the scale test, whose
     // patches stop at the candidates as they were).
     if params.scale > 0.0 {
@@ -428,13 +511,15 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
             }
         }
     }
-    // Sorted by edge already (the candidates are).
-    let (edges, edge_faces): (Vec<[u32; 2]>, Vec<[u32; 2]>) = candidates
+    // Sorted by edge (the gaps closed came last).
+    let mut kept: Vec<([u32; 2], [u32; 2])> = candidates
         .iter()
         .zip(&sharp)
         .filter(|(_, &s)| s)
         .map(|(c, _)| *c)
-        .unzip();
+        .collect();
+    kept.sort_unstable();
+    let (edges, edge_faces): (Vec<[u32; 2]>, Vec<[u32; 2]>) = kept.into_iter().unzip();
     let (curves, corners) = chain(
         mesh,
         &edges,
@@ -661,6 +746,10 @@ impl EdgeFrame {
 /// The most edges of a path of creases beside a longer crease edge that make it a chord
 /// ([`detect_features`]).
 pub const CHORD_PATH_STEPS: usize = 16;
+
+/// The most edges that close a gap between the end of a crease chain and another crease
+/// ([`detect_features`]).
+pub const GAP_STEPS: usize = 8;
 
 /// The least cosine between each step of a path of creases and the longer crease edge it runs
 /// beside for that edge to be a chord across it ([`detect_features`]): the path goes the edge's
@@ -1043,12 +1132,11 @@ mod tests {
         assert!(detect(&m, 180.0, 5.0).edges.is_empty());
     }
 
-    #[test]
-    fn a_creases_short_edges_turned_by_noise_make_no_corner() {
-        // A cube [0, 100]³, each face fanned from a corner, its top edge y = 100 in
-        // steps of 0.5 whose inner vertices are moved by up to 0.1 in z (a fixed pseudo-random
-        // sequence; in the plane of the side y = 100, so its slivers stay in that plane): that
-        // crease zigzags, its edges turning by up to 77°, but it is straight at the spacing.
+    /// A cube [0, 100]³, each face fanned from a corner, its top edge y = 100 in steps of 0.5
+    /// (vertices `edge`, from x = 0 to 100), whose inner vertices are moved by up to `noise` in
+    /// z (a fixed pseudo-random sequence; in the plane of the side y = 100, so its slivers stay in
+    /// that plane). The top is fanned from (0, 0, 100): face `[4, edge[k + 1], edge[k]]`.
+    fn cube_with_a_fine_top_edge(noise: f64) -> (Vec<DVec3>, Vec<[u32; 3]>, Vec<u32>) {
         let c = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
         let mut positions = vec![
             c(0.0, 0.0, 0.0),
@@ -1064,7 +1152,7 @@ mod tests {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
-            0.1 * (2.0 * (state >> 11) as f64 / (1u64 << 53) as f64 - 1.0)
+            noise * (2.0 * (state >> 11) as f64 / (1u64 << 53) as f64 - 1.0)
         };
         // The top edge from (0, 100, 100) to (100, 100, 100).
         let edge: Vec<u32> = (0..=200)
@@ -1093,6 +1181,14 @@ mod tests {
         let mut top = vec![t[0], t[1]];
         top.extend(edge.iter().rev());
         fan(&top);
+        (positions, triangles, edge)
+    }
+
+    #[test]
+    fn a_creases_short_edges_turned_by_noise_make_no_corner() {
+        // The cube's top edge zigzags by up to 0.1 in steps of 0.5, its edges turning by up to
+        // 77°, but it is straight at the spacing.
+        let (positions, triangles, _) = cube_with_a_fine_top_edge(0.1);
         let m = TriMesh::new(positions, triangles);
         // Between its edges the crease turns by the angle at many vertices (and the slivers of
         // the top, tilted by the steps, turn between their faces).
@@ -1103,6 +1199,32 @@ mod tests {
         let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 20.0);
         assert_eq!(f.edges.len(), 11 + 200);
         assert_eq!((f.curves.len(), f.corners.len()), (12, 8));
+    }
+
+    #[test]
+    fn a_crease_edge_whose_face_beside_it_is_tilted_closes_the_gap() {
+        // A roof over [0, 100]² in a 40 × 40 grid, its two sides sloping by 12.5° from the ridge
+        // y = 50 (a crease of 25°); one vertex beside the ridge raised to halve its side's slope
+        // there, as noise tilts a sliver beside a rim: the ridge edges of its faces turn by less
+        // than 20° between their two faces, but the ridge goes on either side of them.
+        let n = 40usize;
+        let slope = 12.5f64.to_radians().tan();
+        let raised = (20, n / 2 + 1);
+        let m = crate::mesh::test_meshes::grid(n, |i, j| {
+            let (x, y) = (100.0 * i as f64 / n as f64, 100.0 * j as f64 / n as f64);
+            let z = -slope * (y - 50.0).abs();
+            DVec3::new(x, y, if (i, j) == raised { 0.45 * z } else { z })
+        });
+        let on_ridge = |e: &[u32; 2]| e.iter().all(|&v| m.positions[v as usize].y == 50.0);
+        // Between their two faces some ridge edges do not turn by the angle.
+        let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 0.0);
+        let found = f.edges.iter().filter(|e| on_ridge(e)).count();
+        assert!(found < n, "{found}");
+        // At a spacing of 20 the ridge is whole, one curve.
+        let f = detect(&m, CAD_FEATURE_ANGLE_DEG, 20.0);
+        assert_eq!(f.edges.iter().filter(|e| on_ridge(e)).count(), n);
+        assert!(f.edges.iter().all(on_ridge), "{:?}", f.edges);
+        assert_eq!(f.curves.len(), 1);
     }
 
     #[test]
