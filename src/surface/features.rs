@@ -224,6 +224,9 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
         return Features::default();
     }
     let cos_bound = params.angle_deg.to_radians().cos();
+    // The near test's radius and the cosine of the turn it asks for.
+    let r = NEAR_SCALE_SHARE * params.scale;
+    let cos_near = (NEAR_TURN_SHARE * params.angle_deg).to_radians().cos();
     // Undirected edge -> the faces that use it (the first two) and how many do.
     let uses = mesh.edge_uses();
     let mut boundary_vertex = vec![false; mesh.positions.len()];
@@ -244,8 +247,6 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
     // Near the edge too, not only between its two faces: a sliver's normal, tilted or flipped
     // by noise in a CAD export's positions, turns by the angle on a flat.
     if params.scale > 0.0 {
-        let r = NEAR_SCALE_SHARE * params.scale;
-        let cos_near = (NEAR_TURN_SHARE * params.angle_deg).to_radians().cos();
         candidates = candidates
             .into_par_iter()
             .map_init(
@@ -340,176 +341,21 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
             }
         }
     }
-    // Gaps in a crease chain: from a chain's end, the edges that go on most straight (turning by
-    // less than the angle at each vertex) and pass the near test, a few at most, when they reach
-    // another crease. Noise in a CAD export's positions tilts the slivers beside a rim until
-    // their edges no longer pass the dihedral test, and the rim falls into pieces.
+    // After the scale test: gaps in crease chains closed, long crease edges tested along their
+    // length, chords across a path of creases dropped (noise in a CAD export's positions).
     if params.scale > 0.0 {
-        let r = NEAR_SCALE_SHARE * params.scale;
-        let cos_near = (NEAR_TURN_SHARE * params.angle_deg).to_radians().cos();
-        let mut neighbours: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
-        for (&(a, b), &(_, n)) in &uses {
-            if n == 2 {
-                neighbours.entry(a).or_default().push(b);
-                neighbours.entry(b).or_default().push(a);
-            }
-        }
-        for list in neighbours.values_mut() {
-            list.sort_unstable();
-        }
-        let mut degree: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
-        for (i, (e, _)) in candidates.iter().enumerate() {
-            if sharp[i] {
-                degree.entry(e[0]).or_default().push(e[1]);
-                degree.entry(e[1]).or_default().push(e[0]);
-            }
-        }
-        let mut ends: Vec<(u32, u32)> = degree
-            .iter()
-            .filter(|(&v, list)| list.len() == 1 && !boundary_vertex[v as usize])
-            .map(|(&v, list)| (v, list[0]))
-            .collect();
-        ends.sort_unstable();
-        let mut scratch = PatchScratch::new(mesh.triangles.len());
-        let mut added: Vec<([u32; 2], [u32; 2])> = Vec::new();
-        let mut taken: FxHashSet<(u32, u32)> = FxHashSet::default();
-        for (end, before) in ends {
-            let (mut x, mut from) = (end, mesh.positions[before as usize]);
-            let mut path: Vec<([u32; 2], [u32; 2])> = Vec::new();
-            let mut joined = false;
-            for _ in 0..GAP_STEPS {
-                let px = mesh.positions[x as usize];
-                let d = (px - from).normalize_or_zero();
-                let next = neighbours.get(&x).and_then(|list| {
-                    list.iter()
-                        .copied()
-                        .map(|y| {
-                            (
-                                d.dot((mesh.positions[y as usize] - px).normalize_or_zero()),
-                                y,
-                            )
-                        })
-                        .filter(|&(c, _)| c > cos_bound)
-                        .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)))
-                });
-                let Some((_, y)) = next else { break };
-                let e = [x.min(y), x.max(y)];
-                if taken.contains(&(e[0], e[1])) || degree.get(&x).is_some_and(|l| l.contains(&y)) {
-                    break;
-                }
-                let Some(&(faces, 2)) = uses.get(&(e[0], e[1])) else {
-                    break;
-                };
-                if !sharp_near_edge(&adjacency, &mut scratch, e, faces, r, cos_near, false) {
-                    break;
-                }
-                path.push((e, faces));
-                if degree.contains_key(&y) {
-                    joined = true;
-                    break;
-                }
-                (from, x) = (px, y);
-            }
-            if joined {
-                for (e, faces) in path {
-                    if taken.insert((e[0], e[1])) {
-                        added.push((e, faces));
-                    }
-                }
-            }
-        }
-        for c in added {
-            candidates.push(c);
-            sharp.push(true);
-        }
-    }
-    // Along a crease edge longer than the near test's ball too (after the scale test, whose
-    // patches stop at the candidates as they were).
-    if params.scale > 0.0 {
-        let r = NEAR_SCALE_SHARE * params.scale;
-        let cos_near = (NEAR_TURN_SHARE * params.angle_deg).to_radians().cos();
-        let long: Vec<usize> = (0..candidates.len())
-            .filter(|&i| {
-                let e = candidates[i].0;
-                sharp[i]
-                    && mesh.positions[e[0] as usize].distance(mesh.positions[e[1] as usize])
-                        > 2.0 * r
-            })
-            .collect();
-        let fails: Vec<usize> = long
-            .into_par_iter()
-            .map_init(
-                || PatchScratch::new(mesh.triangles.len()),
-                |scratch, i| {
-                    let (e, faces) = candidates[i];
-                    (!sharp_near_edge(&adjacency, scratch, e, faces, r, cos_near, true))
-                        .then_some(i)
-                },
-            )
-            .flatten()
-            .collect();
-        for i in fails {
-            sharp[i] = false;
-        }
-    }
-    // A crease edge with a path of shorter crease edges between its ends and beside it (within
-    // the near test's radius, where that test cannot tell the two apart; a few steps, each going
-    // the edge's way) is a chord across that path, which carries the crease: a CAD export's fan
-    // of slivers from a vertex of a hole's rim to the next ones, tilted by noise. Sampled too,
-    // it would be a second crease beside the path. Longest first, each path through the edges
-    // left.
-    if params.scale > 0.0 {
-        let tube = NEAR_SCALE_SHARE * params.scale;
-        let length = |i: usize| {
-            let e = candidates[i].0;
-            mesh.positions[e[0] as usize].distance(mesh.positions[e[1] as usize])
-        };
-        let mut at_vertex: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
-        let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| sharp[i]).collect();
-        for &i in &order {
-            let e = candidates[i].0;
-            at_vertex.entry(e[0]).or_default().push(i);
-            at_vertex.entry(e[1]).or_default().push(i);
-        }
-        order.sort_by(|&i, &j| length(j).total_cmp(&length(i)).then(i.cmp(&j)));
-        for i in order {
-            let [a, b] = candidates[i].0;
-            let (pa, pb, li) = (
-                mesh.positions[a as usize],
-                mesh.positions[b as usize],
-                length(i),
-            );
-            let mut stack = vec![(a, 0usize)];
-            let mut seen = vec![a];
-            let mut chord = false;
-            'search: while let Some((v, steps)) = stack.pop() {
-                for &j in &at_vertex[&v] {
-                    if j == i || !sharp[j] || length(j) >= li {
-                        continue;
-                    }
-                    let e = candidates[j].0;
-                    let w = if e[0] == v { e[1] } else { e[0] };
-                    let (pv, pw) = (mesh.positions[v as usize], mesh.positions[w as usize]);
-                    if (pw - pv).normalize_or_zero().dot((pb - pa) / li) < CHORD_PATH_COS {
-                        continue;
-                    }
-                    if w == b {
-                        chord = true;
-                        break 'search;
-                    }
-                    if steps + 1 < CHORD_PATH_STEPS
-                        && !seen.contains(&w)
-                        && distance_to_segment(pw, pa, pb) <= tube
-                    {
-                        seen.push(w);
-                        stack.push((w, steps + 1));
-                    }
-                }
-            }
-            if chord {
-                sharp[i] = false;
-            }
-        }
+        close_gaps(
+            &adjacency,
+            &uses,
+            &boundary_vertex,
+            &mut candidates,
+            &mut sharp,
+            r,
+            cos_near,
+            cos_bound,
+        );
+        drop_long_edges_turning_short(&adjacency, &candidates, &mut sharp, r, cos_near);
+        drop_chords(mesh, &candidates, &mut sharp, r);
     }
     // Sorted by edge (the gaps closed came last).
     let mut kept: Vec<([u32; 2], [u32; 2])> = candidates
@@ -520,18 +366,203 @@ pub fn detect_features(surface: &MeshSurface, params: &FeatureParams) -> Feature
         .collect();
     kept.sort_unstable();
     let (edges, edge_faces): (Vec<[u32; 2]>, Vec<[u32; 2]>) = kept.into_iter().unzip();
-    let (curves, corners) = chain(
-        mesh,
-        &edges,
-        &edge_faces,
-        &boundary_vertex,
-        cos_bound,
-        NEAR_SCALE_SHARE * params.scale,
-    );
+    let (curves, corners) = chain(mesh, &edges, &edge_faces, &boundary_vertex, cos_bound, r);
     Features {
         edges,
         curves,
         corners,
+    }
+}
+
+/// Closes gaps in the crease chains of `candidates` (those marked in `sharp`): from a chain's
+/// end off the boundary, the mesh edges (of two faces in `uses`) that go on most straight,
+/// turning by less than the angle whose cosine is `cos_bound` at each vertex and passing the
+/// near test ([`sharp_near_edge`] at `r`, `cos_near`), at most [`GAP_STEPS`], are added as
+/// creases when they reach another crease. Noise in a CAD export's positions tilts the slivers
+/// beside a rim until their edges no longer pass the dihedral test, and the rim falls into
+/// pieces. Deterministic (chain ends in vertex order).
+#[allow(clippy::too_many_arguments)]
+fn close_gaps(
+    adjacency: &FaceAdjacency,
+    uses: &FxHashMap<(u32, u32), ([u32; 2], u32)>,
+    boundary_vertex: &[bool],
+    candidates: &mut Vec<([u32; 2], [u32; 2])>,
+    sharp: &mut Vec<bool>,
+    r: f64,
+    cos_near: f64,
+    cos_bound: f64,
+) {
+    let mesh = adjacency.mesh;
+    let mut neighbours: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    for (&(a, b), &(_, n)) in uses {
+        if n == 2 {
+            neighbours.entry(a).or_default().push(b);
+            neighbours.entry(b).or_default().push(a);
+        }
+    }
+    for list in neighbours.values_mut() {
+        list.sort_unstable();
+    }
+    let mut degree: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    for (i, (e, _)) in candidates.iter().enumerate() {
+        if sharp[i] {
+            degree.entry(e[0]).or_default().push(e[1]);
+            degree.entry(e[1]).or_default().push(e[0]);
+        }
+    }
+    let mut ends: Vec<(u32, u32)> = degree
+        .iter()
+        .filter(|(&v, list)| list.len() == 1 && !boundary_vertex[v as usize])
+        .map(|(&v, list)| (v, list[0]))
+        .collect();
+    ends.sort_unstable();
+    let mut scratch = PatchScratch::new(mesh.triangles.len());
+    let mut added: Vec<([u32; 2], [u32; 2])> = Vec::new();
+    let mut taken: FxHashSet<(u32, u32)> = FxHashSet::default();
+    for (end, before) in ends {
+        let (mut x, mut from) = (end, mesh.positions[before as usize]);
+        let mut path: Vec<([u32; 2], [u32; 2])> = Vec::new();
+        let mut joined = false;
+        for _ in 0..GAP_STEPS {
+            let px = mesh.positions[x as usize];
+            let d = (px - from).normalize_or_zero();
+            let next = neighbours.get(&x).and_then(|list| {
+                list.iter()
+                    .copied()
+                    .map(|y| {
+                        (
+                            d.dot((mesh.positions[y as usize] - px).normalize_or_zero()),
+                            y,
+                        )
+                    })
+                    .filter(|&(c, _)| c > cos_bound)
+                    .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)))
+            });
+            let Some((_, y)) = next else { break };
+            let e = [x.min(y), x.max(y)];
+            if taken.contains(&(e[0], e[1])) || degree.get(&x).is_some_and(|l| l.contains(&y)) {
+                break;
+            }
+            let Some(&(faces, 2)) = uses.get(&(e[0], e[1])) else {
+                break;
+            };
+            if !sharp_near_edge(adjacency, &mut scratch, e, faces, r, cos_near, false) {
+                break;
+            }
+            path.push((e, faces));
+            if degree.contains_key(&y) {
+                joined = true;
+                break;
+            }
+            (from, x) = (px, y);
+        }
+        if joined {
+            for (e, faces) in path {
+                if taken.insert((e[0], e[1])) {
+                    added.push((e, faces));
+                }
+            }
+        }
+    }
+    for c in added {
+        candidates.push(c);
+        sharp.push(true);
+    }
+}
+
+/// Unmarks in `sharp` each crease edge of `candidates` longer than the near test's ball (2 `r`)
+/// that does not turn along at least half of its length ([`sharp_near_edge`] with `along`): a
+/// CAD export's long sliver edge tangent to a hole's rim is within `r` of the rim at its middle
+/// only. Run after the scale test, whose patches stop at the candidates as they were. In
+/// parallel; deterministic.
+fn drop_long_edges_turning_short(
+    adjacency: &FaceAdjacency,
+    candidates: &[([u32; 2], [u32; 2])],
+    sharp: &mut [bool],
+    r: f64,
+    cos_near: f64,
+) {
+    let mesh = adjacency.mesh;
+    let long: Vec<usize> = (0..candidates.len())
+        .filter(|&i| {
+            let e = candidates[i].0;
+            sharp[i]
+                && mesh.positions[e[0] as usize].distance(mesh.positions[e[1] as usize]) > 2.0 * r
+        })
+        .collect();
+    let fails: Vec<usize> = long
+        .into_par_iter()
+        .map_init(
+            || PatchScratch::new(mesh.triangles.len()),
+            |scratch, i| {
+                let (e, faces) = candidates[i];
+                (!sharp_near_edge(adjacency, scratch, e, faces, r, cos_near, true)).then_some(i)
+            },
+        )
+        .flatten()
+        .collect();
+    for i in fails {
+        sharp[i] = false;
+    }
+}
+
+/// Unmarks in `sharp` each crease edge of `candidates` that is a chord across a path of shorter
+/// crease edges between its ends and beside it: within `r` of it (the near test's radius, where
+/// that test cannot tell the two apart), at most [`CHORD_PATH_STEPS`] steps, each within 45° of
+/// its direction ([`CHORD_PATH_COS`]). The path carries the crease: a CAD export's fan of
+/// slivers from a vertex of a hole's rim to the next ones, tilted by noise; sampled too, the
+/// chord would be a second crease beside it. Longest first, each path through the edges left.
+/// Deterministic.
+fn drop_chords(mesh: &TriMesh, candidates: &[([u32; 2], [u32; 2])], sharp: &mut [bool], r: f64) {
+    let length = |i: usize| {
+        let e = candidates[i].0;
+        mesh.positions[e[0] as usize].distance(mesh.positions[e[1] as usize])
+    };
+    let mut at_vertex: FxHashMap<u32, Vec<usize>> = FxHashMap::default();
+    let mut order: Vec<usize> = (0..candidates.len()).filter(|&i| sharp[i]).collect();
+    for &i in &order {
+        let e = candidates[i].0;
+        at_vertex.entry(e[0]).or_default().push(i);
+        at_vertex.entry(e[1]).or_default().push(i);
+    }
+    order.sort_by(|&i, &j| length(j).total_cmp(&length(i)).then(i.cmp(&j)));
+    for i in order {
+        let [a, b] = candidates[i].0;
+        let (pa, pb, li) = (
+            mesh.positions[a as usize],
+            mesh.positions[b as usize],
+            length(i),
+        );
+        let mut stack = vec![(a, 0usize)];
+        let mut seen = vec![a];
+        let mut chord = false;
+        'search: while let Some((v, steps)) = stack.pop() {
+            for &j in &at_vertex[&v] {
+                if j == i || !sharp[j] || length(j) >= li {
+                    continue;
+                }
+                let e = candidates[j].0;
+                let w = if e[0] == v { e[1] } else { e[0] };
+                let (pv, pw) = (mesh.positions[v as usize], mesh.positions[w as usize]);
+                if (pw - pv).normalize_or_zero().dot((pb - pa) / li) < CHORD_PATH_COS {
+                    continue;
+                }
+                if w == b {
+                    chord = true;
+                    break 'search;
+                }
+                if steps + 1 < CHORD_PATH_STEPS
+                    && !seen.contains(&w)
+                    && distance_to_segment(pw, pa, pb) <= r
+                {
+                    seen.push(w);
+                    stack.push((w, steps + 1));
+                }
+            }
+        }
+        if chord {
+            sharp[i] = false;
+        }
     }
 }
 
@@ -1105,6 +1136,17 @@ mod tests {
         TriMesh::new(positions, triangles)
     }
 
+    /// A fixed pseudo-random sequence (xorshift64 from `state`) of offsets in [-`amplitude`,
+    /// `amplitude`].
+    fn jitter(mut state: u64, amplitude: f64) -> impl FnMut() -> f64 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            amplitude * (2.0 * (state >> 11) as f64 / (1u64 << 53) as f64 - 1.0)
+        }
+    }
+
     fn detect(mesh: &TriMesh, angle_deg: f64, scale: f64) -> Features {
         let surface = MeshSurface::new(mesh).unwrap();
         detect_features(&surface, &FeatureParams { angle_deg, scale })
@@ -1147,13 +1189,7 @@ mod tests {
             c(100.0, 0.0, 100.0),
         ];
         let (b, t) = ([0u32, 1, 2, 3], [4u32, 5]);
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut jitter = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            noise * (2.0 * (state >> 11) as f64 / (1u64 << 53) as f64 - 1.0)
-        };
+        let mut jitter = jitter(0x9e37_79b9_7f4a_7c15, noise);
         // The top edge from (0, 100, 100) to (100, 100, 100).
         let edge: Vec<u32> = (0..=200)
             .map(|k| {
@@ -1323,14 +1359,7 @@ mod tests {
             triangles.push([row_a[k], row_a[k + 1], row_b[k + 1]]);
             triangles.push([row_a[k], row_b[k + 1], row_b[k]]);
         }
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut jitter = || {
-            // xorshift64: deterministic, no seed to carry.
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            noise * (2.0 * (state >> 11) as f64 / (1u64 << 53) as f64 - 1.0)
-        };
+        let mut jitter = jitter(0x2545_f491_4f6c_dd1d, noise);
         for p in &mut positions {
             *p += DVec3::new(jitter(), jitter(), jitter());
         }

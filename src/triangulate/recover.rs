@@ -91,28 +91,13 @@ fn insert_edge_after_link_flip<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, lab
             })
             .collect();
         for (p, q) in link {
-            if m.is_protected(p, q) {
-                continue;
-            }
-            let Ok((f1, f2, _, _)) = m.edge_faces(p, q) else {
-                continue;
-            };
-            let (Some(old1), Some(old2)) = (m.face(f1), m.face(f2)) else {
-                continue;
-            };
-            let (l1, l2) = (m.label(f1), m.label(f2));
-            let Ok(new) = m.flip_edge(p, q, label) else {
-                continue;
-            };
-            let flipped = new.map(|g| m.face(g));
-            if well_flipped(m, new, true)
-                && (insert_edge(m, a, b, label) || flip_into(m, a, b, label))
-            {
+            let kept = flip_or_undo(m, p, q, label, |m, new| {
+                well_flipped(m, new, true)
+                    && (insert_edge(m, a, b, label) || flip_into(m, a, b, label))
+            });
+            if kept {
                 return true;
             }
-            // Back as they were (the flip's two faces are there again when the insertion fails,
-            // maybe in other slots).
-            unflip(m, flipped, [(old1, l1), (old2, l2)]);
         }
     }
     false
@@ -143,25 +128,42 @@ fn flip_into<L: Copy>(m: &mut EditMesh<L>, a: u32, b: u32, label: L) -> bool {
     let across = m.faces_around(a).iter().find_map(|&f| {
         let t = starting_at(m.face(f)?, a);
         let g = m.face_on(t[2], t[1])?;
-        (starting_at(m.face(g)?, t[2])[2] == b).then_some((t[1], t[2], f, g))
+        (starting_at(m.face(g)?, t[2])[2] == b).then_some((t[1], t[2]))
     });
-    let Some((x, y, f, g)) = across else {
+    let Some((x, y)) = across else {
         return false;
     };
-    if m.is_protected(x, y) {
+    flip_or_undo(m, x, y, label, |m, new| well_flipped(m, new, false))
+}
+
+/// Flips the unprotected edge `p`–`q` and keeps the flip when `keep` (given the mesh after it
+/// and the new faces' slots) says so, having made any further changes it keeps; otherwise the
+/// two faces are put back as they were ([`unflip`]: the flip's faces are there again when
+/// `keep`'s own changes failed, maybe in other slots). Whether the flip was kept.
+fn flip_or_undo<L: Copy>(
+    m: &mut EditMesh<L>,
+    p: u32,
+    q: u32,
+    label: L,
+    keep: impl FnOnce(&mut EditMesh<L>, [u32; 2]) -> bool,
+) -> bool {
+    if m.is_protected(p, q) {
         return false;
     }
-    let (Some(old1), Some(old2)) = (m.face(f), m.face(g)) else {
+    let Ok((f1, f2, _, _)) = m.edge_faces(p, q) else {
         return false;
     };
-    let (l1, l2) = (m.label(f), m.label(g));
-    let Ok(new) = m.flip_edge(x, y, label) else {
+    let (Some(old1), Some(old2)) = (m.face(f1), m.face(f2)) else {
         return false;
     };
-    if well_flipped(m, new, false) {
+    let (l1, l2) = (m.label(f1), m.label(f2));
+    let Ok(new) = m.flip_edge(p, q, label) else {
+        return false;
+    };
+    let flipped = new.map(|g| m.face(g));
+    if keep(m, new) {
         return true;
     }
-    let flipped = new.map(|g| m.face(g));
     unflip(m, flipped, [(old1, l1), (old2, l2)]);
     false
 }
