@@ -393,16 +393,6 @@ fn close_gaps(
     cos_bound: f64,
 ) {
     let mesh = adjacency.mesh;
-    let mut neighbours: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
-    for (&(a, b), &(_, n)) in uses {
-        if n == 2 {
-            neighbours.entry(a).or_default().push(b);
-            neighbours.entry(b).or_default().push(a);
-        }
-    }
-    for list in neighbours.values_mut() {
-        list.sort_unstable();
-    }
     let mut degree: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
     for (i, (e, _)) in candidates.iter().enumerate() {
         if sharp[i] {
@@ -416,6 +406,20 @@ fn close_gaps(
         .map(|(&v, list)| (v, list[0]))
         .collect();
     ends.sort_unstable();
+    if ends.is_empty() {
+        return;
+    }
+    // Each vertex's neighbours across edges of two faces, in index order.
+    let mut neighbours: FxHashMap<u32, Vec<u32>> = FxHashMap::default();
+    for (&(a, b), &(_, n)) in uses {
+        if n == 2 {
+            neighbours.entry(a).or_default().push(b);
+            neighbours.entry(b).or_default().push(a);
+        }
+    }
+    for list in neighbours.values_mut() {
+        list.sort_unstable();
+    }
     let mut scratch = PatchScratch::new(mesh.triangles.len());
     let mut added: Vec<([u32; 2], [u32; 2])> = Vec::new();
     let mut taken: FxHashSet<(u32, u32)> = FxHashSet::default();
@@ -1015,7 +1019,7 @@ fn chain(
     }
     // The most turning first (the least cosine), then by vertex: the same corners in any order.
     turning.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    let mut within_reach_of_corner: rustc_hash::FxHashSet<u32> = Default::default();
+    let mut within_reach_of_corner: FxHashSet<u32> = Default::default();
     for (_, v, passed) in turning {
         if within_reach_of_corner.insert(v) {
             corners.push(v);
@@ -1023,7 +1027,7 @@ fn chain(
         }
     }
     corners.sort_unstable();
-    let corner_set: rustc_hash::FxHashSet<u32> = corners.iter().copied().collect();
+    let corner_set: FxHashSet<u32> = corners.iter().copied().collect();
     let mut used = vec![false; edges.len()];
     let mut curves = Vec::new();
     // Walks from `start` along edge `first` until a corner (or back to `start`).
