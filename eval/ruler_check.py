@@ -41,11 +41,34 @@ def read_obj(path):
     return np.array(v, dtype=np.float64), np.array(f, dtype=np.int64)
 
 
+WELD_RELATIVE = 1e-10  # remesh's geometry::tolerance::WELD_RELATIVE
+
+
 def weld(V, F):
-    """Merges bit-identical positions and drops faces that then repeat a vertex (as the readers
-    of remesh do), then drops unreferenced vertices."""
+    """Merges positions that are bit-identical or within WELD_RELATIVE of the bounding box's
+    diagonal (each into the first vertex kept before it within that distance, as the readers of
+    remesh do; CAD exports repeat a seam's corners a rounding apart) and drops faces that then
+    repeat a vertex, then drops unreferenced vertices."""
     _, first, inverse = np.unique(V, axis=0, return_index=True, return_inverse=True)
     F = first[inverse.ravel()[F]]
+    used = np.unique(F)
+    if len(used):
+        from scipy.spatial import cKDTree
+
+        P = V[used]
+        tol = WELD_RELATIVE * np.linalg.norm(P.max(axis=0) - P.min(axis=0))
+        pairs = cKDTree(P).query_pairs(tol, output_type="ndarray") if tol > 0 else np.zeros((0, 2), int)
+        if len(pairs):
+            into = np.arange(len(V))
+            near = {}
+            for a, b in pairs.tolist():
+                a, b = sorted((int(used[a]), int(used[b])))
+                near.setdefault(b, []).append(a)
+            for b in sorted(near):
+                kept = [a for a in near[b] if into[a] == a]
+                if kept:
+                    into[b] = min(kept)
+            F = into[F]
     F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
     used, F = np.unique(F, return_inverse=True)
     return V[used], F.reshape(-1, 3)

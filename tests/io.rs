@@ -322,6 +322,57 @@ fn stl_and_off_round_trips_keep_the_mesh() {
     }
 }
 
+/// Issue 59: a CAD export repeats a seam's corners with positions a rounding apart (2.7e-16 of
+/// the model on a real part); read bit for bit those seams are cracks, and a closed part reads
+/// as one with boundary loops. A unit cube as an ascii STL whose top face's corners are written
+/// 1e-16 off reads as the closed cube: 8 vertices, no boundary edge.
+#[test]
+fn an_stl_whose_seam_corners_are_a_rounding_apart_reads_closed() {
+    let cube = TriMesh::new(
+        (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
+            .collect(),
+        vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ],
+    );
+    let mut text = String::from("solid cube\n");
+    for (f, t) in cube.triangles.iter().enumerate() {
+        text.push_str(" facet normal 0 0 0\n  outer loop\n");
+        for &i in t {
+            let mut p = cube.positions[i as usize];
+            // The top face's two triangles write their corners a rounding off.
+            if f == 2 || f == 3 {
+                p += DVec3::new(1e-16, -1e-16, 2e-16);
+            }
+            text.push_str(&format!("   vertex {:e} {:e} {:e}\n", p.x, p.y, p.z));
+        }
+        text.push_str("  endloop\n endfacet\n");
+    }
+    text.push_str("endsolid cube\n");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("seams.stl");
+    fs::write(&path, text).unwrap();
+    let (m, s) = read_mesh(&path).unwrap();
+    assert_eq!(s.vertices_read, 36);
+    assert_eq!(m.vertex_count(), 8, "welded into the cube's corners");
+    assert_eq!(s.welded_vertices, 28);
+    assert_eq!(m.face_count(), 12);
+    let t = spectral_remesh::topology(&m);
+    assert_eq!((t.boundary_edges, t.euler_characteristic), (0, 2), "{t:?}");
+}
+
 #[test]
 fn obj_round_trip_is_exact_for_arbitrary_f64() {
     let m = TriMesh::new(

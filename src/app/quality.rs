@@ -31,7 +31,7 @@ pub fn run_quality(path: &Path, reference: Option<&Path>, seed: u64) -> Result<Q
 
 /// Reports on a mesh held in memory as [`run_quality`] reports on a file holding it: `mesh`
 /// and `reference` get the checks and clean-up reading gives a file's mesh (faces present,
-/// indices in range, finite coordinates; identical positions welded, unreferenced vertices
+/// indices in range, finite coordinates; positions within a rounding welded, unreferenced vertices
 /// removed), then the same measures; with `reference`, the distance to it too (both in the
 /// reference's bbox-100 frame, or the mesh's own without one; the distance's random points
 /// from `seed`). The report equals `run_quality`'s for files holding the same meshes, but for
@@ -114,7 +114,7 @@ pub(super) fn quality_read(
 }
 
 /// `mesh` (model units, as a file stores it) as [`run_quality`] sees the file: cleaned as a
-/// reader cleans it ([`check_and_clean`]: identical positions welded, unreferenced vertices
+/// reader cleans it ([`check_and_clean`]: positions within a rounding welded, unreferenced vertices
 /// dropped), subnormal coordinates scaled up, in its own bbox-100 frame ([`own_frame`]).
 /// `None` when the file would be refused.
 /// With it, the map from model units (before the subnormal scaling) into that frame.

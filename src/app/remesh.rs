@@ -392,7 +392,7 @@ pub(super) fn remesh_read(
     insert_json(extra, "input_cleanup", cleanup);
     if welded_vertices > 0 {
         report.notes.push(format!(
-            "{welded_vertices} input vertices at identical positions were merged"
+            "{welded_vertices} input vertices at the position of another (identical, or within 1e-10 of the bounding box's diagonal) were merged"
         ));
     }
     count_note(&mut report.notes, out.target, out.mesh.vertex_count());
@@ -462,7 +462,7 @@ pub(super) fn remesh_read(
 
 /// Remeshes a mesh held in memory exactly as [`run_remesh`](crate::run_remesh) remeshes a file
 /// holding it (written as PLY, OBJ or OFF): the checks and clean-up reading gives a file's mesh
-/// (faces present, indices in range, finite coordinates; identical positions welded, unreferenced
+/// (faces present, indices in range, finite coordinates; positions within a rounding welded, unreferenced
 /// vertices removed), the same pipeline, check and report. The same `params` give the same output
 /// mesh, bit for bit, as `remesh` on a file holding `mesh`.
 ///

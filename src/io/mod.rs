@@ -27,6 +27,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
+use crate::geometry::tolerance::WELD_RELATIVE;
 use crate::mesh::TriMesh;
 
 pub use atomic::{write_atomically, AtomicFile, FinishedFile};
@@ -108,8 +109,8 @@ pub struct ReadStats {
     /// repeated corner, zero area, a boundary crossing itself) is fanned from its first corner
     /// (OBJ and PLY; always 0 for glTF).
     pub polygons_triangulated: usize,
-    /// Vertices merged into another one with a bit-identical position
-    /// ([`TriMesh::weld_identical_positions`]).
+    /// Vertices merged into another one at the same position, bit-identical or within
+    /// [`WELD_RELATIVE`] of the bounding box's diagonal ([`TriMesh::weld_close_positions`]).
     pub welded_vertices: usize,
     /// Vertices dropped because no triangle uses them
     /// ([`TriMesh::remove_unreferenced_vertices`]).
@@ -138,9 +139,10 @@ impl ReadStats {
 ///
 /// Polygons are triangulated in their best-fit plane (concave ones included, see
 /// [`ReadStats::polygons_triangulated`]); points and lines are ignored. After parsing, the mesh is
-/// checked (every index in range, every coordinate finite), vertices with bit-identical
-/// positions are welded (triangles that collapse are dropped) and vertices no triangle uses are
-/// removed; [`ReadStats`] reports what was found and changed.
+/// checked (every index in range, every coordinate finite), vertices at the same position
+/// (bit-identical, or within [`WELD_RELATIVE`] = 1e-10 of the bounding box's diagonal, as CAD
+/// exports repeat a seam's corners a rounding apart) are welded (triangles that collapse are
+/// dropped) and vertices no triangle uses are removed; [`ReadStats`] reports what was found and changed.
 ///
 /// - OBJ: `v` and `f` statements (`f` corners as `v`, `v/vt`, `v//vn`, `v/vt/vn`, negative
 ///   indices relative to the vertices read so far). Vertices are shared by position index even
@@ -387,7 +389,7 @@ fn finish(path: &Path, mut mesh: TriMesh, stats: &mut ReadStats) -> Result<TriMe
             ),
         ));
     }
-    stats.welded_vertices = mesh.weld_identical_positions();
+    stats.welded_vertices = mesh.weld_close_positions(weld_tolerance(&mesh));
     stats.unreferenced_vertices_removed = mesh.remove_unreferenced_vertices();
     if mesh.triangles.is_empty() {
         return Err(Error::invalid_mesh(
@@ -399,13 +401,28 @@ fn finish(path: &Path, mut mesh: TriMesh, stats: &mut ReadStats) -> Result<TriMe
 }
 
 /// The checks and clean-up [`read_mesh`] gives a file's mesh after parsing it (faces present,
-/// indices in range, finite coordinates; identical positions welded, unreferenced vertices
+/// indices in range, finite coordinates; positions within a rounding welded, unreferenced vertices
 /// removed), for a mesh made in memory; `label` names it in errors where a file's path would.
 /// Returns the mesh and how many vertices were welded.
 pub(crate) fn check_and_clean(label: &Path, mesh: TriMesh) -> Result<(TriMesh, usize)> {
     let mut stats = ReadStats::new(MeshFormat::Ply);
     let mesh = finish(label, mesh, &mut stats)?;
     Ok((mesh, stats.welded_vertices))
+}
+
+/// The distance within which [`read_mesh`] welds two vertices: [`WELD_RELATIVE`] of the
+/// diagonal of the bounding box of the vertices the triangles use (model units).
+fn weld_tolerance(mesh: &TriMesh) -> f64 {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for &i in mesh.triangles.iter().flatten() {
+        let p = mesh.positions[i as usize];
+        (lo, hi) = (lo.min(p), hi.max(p));
+    }
+    if lo.x <= hi.x {
+        WELD_RELATIVE * lo.distance(hi)
+    } else {
+        0.0
+    }
 }
 
 /// Reads a whole file, mapping failure to [`Error::Io`] naming `path`.

@@ -1,6 +1,6 @@
 //! STL (stereolithography), binary and ascii, through the `stl_io` crate: the format CAD parts
 //! are exported in. A triangle soup: every triangle stores its three corners, so shared corners
-//! are welded by their bit-identical positions (the readers' common clean-up).
+//! are welded by position, bit-identical or a rounding apart (the readers' common clean-up).
 
 use std::io::Cursor;
 use std::path::Path;

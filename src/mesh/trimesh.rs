@@ -419,6 +419,70 @@ impl TriMesh {
             .retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
         merged
     }
+
+    /// Merges vertices whose positions lie within `tolerance` (model units) of each other:
+    /// first those at bit-identical positions ([`weld_identical_positions`](Self::weld_identical_positions)),
+    /// then each remaining vertex, in index order, into the first vertex kept before it that
+    /// lies within `tolerance` (no chains: a vertex is compared with kept vertices only).
+    /// Triangles are renumbered and those that then repeat a vertex are dropped. This is how a
+    /// CAD export whose seams repeat a corner with positions a rounding apart (1e-16 of the
+    /// model's size) is read as the closed solid it is, not as one with cracks along its seams.
+    /// Returns how many vertices were merged away. O(n) expected, deterministic; a `tolerance`
+    /// of zero (or not finite) merges identical positions only.
+    pub fn weld_close_positions(&mut self, tolerance: f64) -> usize {
+        let identical = self.weld_identical_positions();
+        if !(tolerance > 0.0 && tolerance.is_finite()) || self.positions.is_empty() {
+            return identical;
+        }
+        let lo = self
+            .positions
+            .iter()
+            .fold(DVec3::splat(f64::INFINITY), |a, &p| a.min(p));
+        // Cells of side `tolerance`: two points within it are in the same or adjacent cells.
+        // `as i64` saturates, so a far point cannot wrap around.
+        let cell = |p: DVec3| ((p - lo) / tolerance).floor().to_array().map(|c| c as i64);
+        let mut grid: FxHashMap<[i64; 3], Vec<u32>> = FxHashMap::default();
+        let mut kept: Vec<DVec3> = Vec::with_capacity(self.positions.len());
+        let mut remap = Vec::with_capacity(self.positions.len());
+        for &p in &self.positions {
+            let c = cell(p);
+            let mut into: Option<u32> = None;
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        let key = [c[0] + dx, c[1] + dy, c[2] + dz];
+                        for &j in grid.get(&key).into_iter().flatten() {
+                            if kept[j as usize].distance(p) <= tolerance
+                                && into.map_or(true, |k| j < k)
+                            {
+                                into = Some(j);
+                            }
+                        }
+                    }
+                }
+            }
+            let idx = into.unwrap_or_else(|| {
+                kept.push(p);
+                let j = (kept.len() - 1) as u32;
+                grid.entry(c).or_default().push(j);
+                j
+            });
+            remap.push(idx);
+        }
+        let near = self.positions.len() - kept.len();
+        if near == 0 {
+            return identical;
+        }
+        self.positions = kept;
+        for t in &mut self.triangles {
+            for i in t.iter_mut() {
+                *i = remap[*i as usize];
+            }
+        }
+        self.triangles
+            .retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+        identical + near
+    }
 }
 
 /// The faces of `both_windings` (faces given in both windings, vertices sorted, each once)

@@ -165,6 +165,44 @@ fn weld_merges_identical_positions_and_drops_collapsed_faces() {
 }
 
 #[test]
+fn weld_close_merges_a_seams_corners_a_rounding_apart_and_keeps_points_farther_apart() {
+    // Two triangles of a square whose shared edge's ends are repeated a rounding apart (as a
+    // CAD export writes a seam), and a third triangle with a vertex 1e-6 from a corner.
+    let e = 2.7e-16;
+    let mut m = TriMesh::new(
+        vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::new(1.0 + e, 0.0, 0.0),
+            DVec3::new(0.0, 1.0 - e, e),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(1.0 + 1e-6, 1.0, 0.0),
+            DVec3::new(2.0, 1.0, 0.0),
+        ],
+        vec![[0, 1, 2], [3, 5, 4], [5, 6, 7]],
+    );
+    assert_eq!(m.weld_close_positions(1e-10), 2);
+    assert_eq!(m.positions.len(), 6);
+    // The square's diagonal is one edge of both its triangles.
+    assert_eq!(m.triangles[..2], [[0, 1, 2], [1, 3, 2]]);
+    // 1e-6 apart is two vertices, and no triangle collapsed.
+    assert_eq!(m.triangles.len(), 3);
+    // Zero merges identical positions only.
+    let mut n = TriMesh::new(
+        vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::new(1.0 + e, 0.0, 0.0),
+        ],
+        vec![[0, 1, 2], [3, 2, 1]],
+    );
+    assert_eq!(n.weld_close_positions(0.0), 0);
+    assert_eq!(n.positions.len(), 4);
+}
+
+#[test]
 fn corner_normals_split_at_creases_sharper_than_the_angle() {
     // A roof: two planes meeting at a ridge along x with a 90° dihedral angle, each a 2 x 2
     // grid of squares; the ridge vertices are shared.
