@@ -373,6 +373,40 @@ fn an_stl_whose_seam_corners_are_a_rounding_apart_reads_closed() {
     assert_eq!((t.boundary_edges, t.euler_characteristic), (0, 2), "{t:?}");
 }
 
+/// The weld's distance scales with the model, but a stray triangle 10^12 away (which makes the
+/// bounding box's diagonal 10^12) does not weld a unit cube's corners together: the cube reads
+/// with its 8 corners and 12 faces, the stray triangle with its own 3.
+#[test]
+fn a_stray_far_triangle_does_not_weld_a_part_into_a_point() {
+    let mut positions: Vec<DVec3> = (0..8)
+        .map(|i| DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
+        .collect();
+    positions.extend([1e12, 1e12 + 1.0, 1e12 + 2.0].map(|x| DVec3::new(x, 0.0, (x - 1e12) * 0.5)));
+    let mut triangles = vec![
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
+    ];
+    triangles.push([8, 9, 10]);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stray.obj");
+    write_mesh(&path, &TriMesh::new(positions, triangles)).unwrap();
+    let (m, s) = read_mesh(&path).unwrap();
+    assert_eq!(
+        (m.vertex_count(), m.face_count(), s.welded_vertices),
+        (11, 13, 0)
+    );
+}
+
 #[test]
 fn obj_round_trip_is_exact_for_arbitrary_f64() {
     let m = TriMesh::new(

@@ -14,6 +14,12 @@
 /// sheets of a glTF scene into non-manifold edges. Dimensionless.
 pub const WELD_RELATIVE: f64 = 1e-10;
 
+/// The weld's distance is also at most this fraction of the input's median edge length
+/// (`io::read_mesh`): a bounding box stretched by one stray vertex far out would otherwise make
+/// [`WELD_RELATIVE`] of its diagonal larger than the part. On sane inputs the diagonal's bound
+/// is the smaller one by orders of magnitude. Dimensionless.
+pub const WELD_EDGE_RELATIVE: f64 = 1e-7;
+
 /// Relative tolerance of the zero-area test: a triangle is degenerate when
 /// `|(b-a)×(c-a)| <= DEGENERATE_AREA_TOLERANCE · h²`, with `h` its longest edge. The test is
 /// scale-free (both sides scale with length²); `|(b-a)×(c-a)| / h²` is about the sine of the

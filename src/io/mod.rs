@@ -27,7 +27,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::geometry::tolerance::WELD_RELATIVE;
+use crate::geometry::tolerance::{WELD_EDGE_RELATIVE, WELD_RELATIVE};
 use crate::mesh::TriMesh;
 
 pub use atomic::{write_atomically, AtomicFile, FinishedFile};
@@ -410,19 +410,34 @@ pub(crate) fn check_and_clean(label: &Path, mesh: TriMesh) -> Result<(TriMesh, u
     Ok((mesh, stats.welded_vertices))
 }
 
-/// The distance within which [`read_mesh`] welds two vertices: [`WELD_RELATIVE`] of the
-/// diagonal of the bounding box of the vertices the triangles use (model units).
+/// The distance within which [`read_mesh`] welds two vertices (model units): [`WELD_RELATIVE`]
+/// of the diagonal of the bounding box of the vertices the triangles use, but at most
+/// [`WELD_EDGE_RELATIVE`] of the median edge length, so that one stray vertex far out (which
+/// makes the box huge) cannot weld a whole part into a point. Zero for a mesh without triangles.
 fn weld_tolerance(mesh: &TriMesh) -> f64 {
     let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for &i in mesh.triangles.iter().flatten() {
         let p = mesh.positions[i as usize];
         (lo, hi) = (lo.min(p), hi.max(p));
     }
-    if lo.x <= hi.x {
-        WELD_RELATIVE * lo.distance(hi)
-    } else {
-        0.0
+    if lo.x > hi.x {
+        return 0.0;
     }
+    let mut edges: Vec<f64> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| {
+            let p = t.map(|i| mesh.positions[i as usize]);
+            [
+                p[0].distance(p[1]),
+                p[1].distance(p[2]),
+                p[2].distance(p[0]),
+            ]
+        })
+        .collect();
+    let mid = edges.len() / 2;
+    let median = *edges.select_nth_unstable_by(mid, f64::total_cmp).1;
+    (WELD_RELATIVE * lo.distance(hi)).min(WELD_EDGE_RELATIVE * median)
 }
 
 /// Reads a whole file, mapping failure to [`Error::Io`] naming `path`.
