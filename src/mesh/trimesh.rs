@@ -453,7 +453,7 @@ impl TriMesh {
                         let key = [c[0] + dx, c[1] + dy, c[2] + dz];
                         for &j in grid.get(&key).into_iter().flatten() {
                             if kept[j as usize].distance(p) <= tolerance
-                                && into.map_or(true, |k| j < k)
+                                && into.is_none_or(|k| j < k)
                             {
                                 into = Some(j);
                             }
