@@ -392,7 +392,7 @@ pub(super) fn remesh_read(
     insert_json(extra, "input_cleanup", cleanup);
     if welded_vertices > 0 {
         report.notes.push(format!(
-            "{welded_vertices} input vertices at the position of another (identical, or within 1e-10 of the bounding box's diagonal) were merged"
+            "{welded_vertices} input vertices at the position of another (identical, or a rounding apart) were merged"
         ));
     }
     count_note(&mut report.notes, out.target, out.mesh.vertex_count());

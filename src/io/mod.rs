@@ -109,8 +109,9 @@ pub struct ReadStats {
     /// repeated corner, zero area, a boundary crossing itself) is fanned from its first corner
     /// (OBJ and PLY; always 0 for glTF).
     pub polygons_triangulated: usize,
-    /// Vertices merged into another one at the same position, bit-identical or within
-    /// [`WELD_RELATIVE`] of the bounding box's diagonal ([`TriMesh::weld_close_positions`]).
+    /// Vertices merged into another one at the same position: bit-identical, or within 1e-10 of
+    /// the bounding box's diagonal and 1e-7 of the median edge
+    /// ([`TriMesh::weld_close_positions`]).
     pub welded_vertices: usize,
     /// Vertices dropped because no triangle uses them
     /// ([`TriMesh::remove_unreferenced_vertices`]).
@@ -140,9 +141,10 @@ impl ReadStats {
 /// Polygons are triangulated in their best-fit plane (concave ones included, see
 /// [`ReadStats::polygons_triangulated`]); points and lines are ignored. After parsing, the mesh is
 /// checked (every index in range, every coordinate finite), vertices at the same position
-/// (bit-identical, or within [`WELD_RELATIVE`] = 1e-10 of the bounding box's diagonal, as CAD
-/// exports repeat a seam's corners a rounding apart) are welded (triangles that collapse are
-/// dropped) and vertices no triangle uses are removed; [`ReadStats`] reports what was found and changed.
+/// (bit-identical, or within 1e-10 of the bounding box's diagonal and 1e-7 of the median edge,
+/// as CAD exports repeat a seam's corners a rounding apart) are welded (triangles that collapse
+/// are dropped) and vertices no triangle uses are removed; [`ReadStats`] reports what was found
+/// and changed.
 ///
 /// - OBJ: `v` and `f` statements (`f` corners as `v`, `v/vt`, `v//vn`, `v/vt/vn`, negative
 ///   indices relative to the vertices read so far). Vertices are shared by position index even
