@@ -14,10 +14,11 @@
 /// sheets of a glTF scene into non-manifold edges. Dimensionless.
 pub const WELD_RELATIVE: f64 = 1e-10;
 
-/// The weld's distance is also at most this fraction of the input's median edge length
-/// (`io::read_mesh`): a bounding box stretched by one stray vertex far out would otherwise make
-/// [`WELD_RELATIVE`] of its diagonal larger than the part. On sane inputs the diagonal's bound
-/// is the smaller one by orders of magnitude. Dimensionless.
+/// Two input vertices are welded only when also within this fraction of the shortest edge at
+/// either (`TriMesh::weld_close_positions`): in a mesh spanning many scales (a unit part and a
+/// stray triangle 1e12 away, or a tetrahedron 2.5e10 long with a 0.4 edge) a fraction of the
+/// bounding box's diagonal is larger than whole faces. A seam's corners a rounding apart are
+/// 1e-15 of their edges and closer. Dimensionless.
 pub const WELD_EDGE_RELATIVE: f64 = 1e-7;
 
 /// Relative tolerance of the zero-area test: a triangle is degenerate when

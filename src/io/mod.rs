@@ -110,7 +110,7 @@ pub struct ReadStats {
     /// (OBJ and PLY; always 0 for glTF).
     pub polygons_triangulated: usize,
     /// Vertices merged into another one at the same position: bit-identical, or within 1e-10 of
-    /// the bounding box's diagonal and 1e-7 of the median edge
+    /// the bounding box's diagonal and 1e-7 of the shortest edge at either
     /// ([`TriMesh::weld_close_positions`]).
     pub welded_vertices: usize,
     /// Vertices dropped because no triangle uses them
@@ -141,7 +141,7 @@ impl ReadStats {
 /// Polygons are triangulated in their best-fit plane (concave ones included, see
 /// [`ReadStats::polygons_triangulated`]); points and lines are ignored. After parsing, the mesh is
 /// checked (every index in range, every coordinate finite), vertices at the same position
-/// (bit-identical, or within 1e-10 of the bounding box's diagonal and 1e-7 of the median edge,
+/// (bit-identical, or within 1e-10 of the bounding box's diagonal and 1e-7 of the shortest edge at either,
 /// as CAD exports repeat a seam's corners a rounding apart) are welded (triangles that collapse
 /// are dropped) and vertices no triangle uses are removed; [`ReadStats`] reports what was found
 /// and changed.
@@ -391,7 +391,7 @@ fn finish(path: &Path, mut mesh: TriMesh, stats: &mut ReadStats) -> Result<TriMe
             ),
         ));
     }
-    stats.welded_vertices = mesh.weld_close_positions(weld_tolerance(&mesh));
+    stats.welded_vertices = mesh.weld_close_positions(weld_tolerance(&mesh), WELD_EDGE_RELATIVE);
     stats.unreferenced_vertices_removed = mesh.remove_unreferenced_vertices();
     if mesh.triangles.is_empty() {
         return Err(Error::invalid_mesh(
@@ -413,9 +413,8 @@ pub(crate) fn check_and_clean(label: &Path, mesh: TriMesh) -> Result<(TriMesh, u
 }
 
 /// The distance within which [`read_mesh`] welds two vertices (model units): [`WELD_RELATIVE`]
-/// of the diagonal of the bounding box of the vertices the triangles use, but at most
-/// [`WELD_EDGE_RELATIVE`] of the median edge length, so that one stray vertex far out (which
-/// makes the box huge) cannot weld a whole part into a point. Zero for a mesh without triangles.
+/// of the diagonal of the bounding box of the vertices the triangles use; zero for a mesh
+/// without triangles. The weld also keeps within [`WELD_EDGE_RELATIVE`] of the edges at them.
 fn weld_tolerance(mesh: &TriMesh) -> f64 {
     let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for &i in mesh.triangles.iter().flatten() {
@@ -425,21 +424,7 @@ fn weld_tolerance(mesh: &TriMesh) -> f64 {
     if lo.x > hi.x {
         return 0.0;
     }
-    let mut edges: Vec<f64> = mesh
-        .triangles
-        .iter()
-        .flat_map(|t| {
-            let p = t.map(|i| mesh.positions[i as usize]);
-            [
-                p[0].distance(p[1]),
-                p[1].distance(p[2]),
-                p[2].distance(p[0]),
-            ]
-        })
-        .collect();
-    let mid = edges.len() / 2;
-    let median = *edges.select_nth_unstable_by(mid, f64::total_cmp).1;
-    (WELD_RELATIVE * lo.distance(hi)).min(WELD_EDGE_RELATIVE * median)
+    WELD_RELATIVE * lo.distance(hi)
 }
 
 /// Reads a whole file, mapping failure to [`Error::Io`] naming `path`.

@@ -420,19 +420,32 @@ impl TriMesh {
         merged
     }
 
-    /// Merges vertices whose positions lie within `tolerance` (model units) of each other:
-    /// first those at bit-identical positions ([`weld_identical_positions`](Self::weld_identical_positions)),
-    /// then each remaining vertex, in index order, into the first vertex kept before it that
-    /// lies within `tolerance` (no chains: a vertex is compared with kept vertices only).
-    /// Triangles are renumbered and those that then repeat a vertex are dropped. This is how a
-    /// CAD export whose seams repeat a corner with positions a rounding apart (1e-16 of the
-    /// model's size) is read as the closed solid it is, not as one with cracks along its seams.
-    /// Returns how many vertices were merged away. O(n) expected, deterministic; a `tolerance`
-    /// of zero (or not finite) merges identical positions only.
-    pub fn weld_close_positions(&mut self, tolerance: f64) -> usize {
+    /// Merges vertices whose positions lie within `tolerance` (model units) of each other and
+    /// within `edge_fraction` of the shortest edge at either: first those at bit-identical
+    /// positions ([`weld_identical_positions`](Self::weld_identical_positions)), then each
+    /// remaining vertex, in index order, into the first vertex kept before it within reach (no
+    /// chains: a vertex is compared with kept vertices only). Triangles are renumbered and those
+    /// that then repeat a vertex are dropped. This is how a CAD export whose seams repeat a
+    /// corner with positions a rounding apart (1e-16 of the model's size) is read as the closed
+    /// solid it is, not as one with cracks along its seams; the bound by the edges keeps apart
+    /// two vertices a mesh spanning many scales holds close on purpose (a stray triangle 1e12
+    /// away makes any fraction of the box too coarse for a unit part). Returns how many vertices
+    /// were merged away. O(n) expected, deterministic; a `tolerance` of zero (or not finite)
+    /// merges identical positions only.
+    pub fn weld_close_positions(&mut self, tolerance: f64, edge_fraction: f64) -> usize {
         let identical = self.weld_identical_positions();
         if !(tolerance > 0.0 && tolerance.is_finite()) || self.positions.is_empty() {
             return identical;
+        }
+        // The shortest edge at each vertex (infinite at a vertex no triangle uses).
+        let mut shortest = vec![f64::INFINITY; self.positions.len()];
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                let l = self.positions[a].distance(self.positions[b]);
+                shortest[a] = shortest[a].min(l);
+                shortest[b] = shortest[b].min(l);
+            }
         }
         let lo = self
             .positions
@@ -442,9 +455,9 @@ impl TriMesh {
         // `as i64` saturates, so a far point cannot wrap around.
         let cell = |p: DVec3| ((p - lo) / tolerance).floor().to_array().map(|c| c as i64);
         let mut grid: FxHashMap<[i64; 3], Vec<u32>> = FxHashMap::default();
-        let mut kept: Vec<DVec3> = Vec::with_capacity(self.positions.len());
+        let mut kept: Vec<(DVec3, f64)> = Vec::with_capacity(self.positions.len());
         let mut remap = Vec::with_capacity(self.positions.len());
-        for &p in &self.positions {
+        for (&p, &short) in self.positions.iter().zip(&shortest) {
             let c = cell(p);
             let mut into: Option<u32> = None;
             for dx in -1..=1 {
@@ -452,7 +465,10 @@ impl TriMesh {
                     for dz in -1..=1 {
                         let key = [c[0] + dx, c[1] + dy, c[2] + dz];
                         for &j in grid.get(&key).into_iter().flatten() {
-                            if kept[j as usize].distance(p) <= tolerance
+                            let (q, q_short) = kept[j as usize];
+                            let d = q.distance(p);
+                            if d <= tolerance
+                                && d <= edge_fraction * short.min(q_short)
                                 && into.is_none_or(|k| j < k)
                             {
                                 into = Some(j);
@@ -462,7 +478,7 @@ impl TriMesh {
                 }
             }
             let idx = into.unwrap_or_else(|| {
-                kept.push(p);
+                kept.push((p, short));
                 let j = (kept.len() - 1) as u32;
                 grid.entry(c).or_default().push(j);
                 j
@@ -473,7 +489,7 @@ impl TriMesh {
         if near == 0 {
             return identical;
         }
-        self.positions = kept;
+        self.positions = kept.into_iter().map(|(p, _)| p).collect();
         for t in &mut self.triangles {
             for i in t.iter_mut() {
                 *i = remap[*i as usize];

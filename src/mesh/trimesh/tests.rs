@@ -182,7 +182,7 @@ fn weld_close_merges_a_seams_corners_a_rounding_apart_and_keeps_points_farther_a
         ],
         vec![[0, 1, 2], [3, 5, 4], [5, 6, 7]],
     );
-    assert_eq!(m.weld_close_positions(1e-10), 2);
+    assert_eq!(m.weld_close_positions(1e-10, 1e-7), 2);
     assert_eq!(m.positions.len(), 6);
     // The square's diagonal is one edge of both its triangles.
     assert_eq!(m.triangles[..2], [[0, 1, 2], [1, 3, 2]]);
@@ -198,7 +198,7 @@ fn weld_close_merges_a_seams_corners_a_rounding_apart_and_keeps_points_farther_a
         ],
         vec![[0, 1, 2], [3, 2, 1]],
     );
-    assert_eq!(n.weld_close_positions(0.0), 0);
+    assert_eq!(n.weld_close_positions(0.0, 1e-7), 0);
     assert_eq!(n.positions.len(), 4);
 }
 
