@@ -42,13 +42,15 @@ def read_obj(path):
 
 
 WELD_RELATIVE = 1e-10  # remesh's geometry::tolerance::WELD_RELATIVE
+WELD_EDGE_RELATIVE = 1e-7  # and WELD_EDGE_RELATIVE
 
 
 def weld(V, F):
     """Merges positions that are bit-identical or within WELD_RELATIVE of the bounding box's
-    diagonal (each into the first vertex kept before it within that distance, as the readers of
-    remesh do; CAD exports repeat a seam's corners a rounding apart) and drops faces that then
-    repeat a vertex, then drops unreferenced vertices."""
+    diagonal and WELD_EDGE_RELATIVE of the shortest edge at either (each into the first vertex
+    kept before it within that distance, as the readers of remesh do; CAD exports repeat a
+    seam's corners a rounding apart) and drops faces that then repeat a vertex, then drops
+    unreferenced vertices."""
     _, first, inverse = np.unique(V, axis=0, return_index=True, return_inverse=True)
     F = first[inverse.ravel()[F]]
     used = np.unique(F)
@@ -59,11 +61,17 @@ def weld(V, F):
         tol = WELD_RELATIVE * np.linalg.norm(P.max(axis=0) - P.min(axis=0))
         pairs = cKDTree(P).query_pairs(tol, output_type="ndarray") if tol > 0 else np.zeros((0, 2), int)
         if len(pairs):
+            E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+            L = np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)
+            shortest = np.full(len(V), np.inf)
+            np.minimum.at(shortest, E[:, 0], L)
+            np.minimum.at(shortest, E[:, 1], L)
             into = np.arange(len(V))
             near = {}
             for a, b in pairs.tolist():
                 a, b = sorted((int(used[a]), int(used[b])))
-                near.setdefault(b, []).append(a)
+                if np.linalg.norm(V[a] - V[b]) <= WELD_EDGE_RELATIVE * min(shortest[a], shortest[b]):
+                    near.setdefault(b, []).append(a)
             for b in sorted(near):
                 kept = [a for a in near[b] if into[a] == a]
                 if kept:
