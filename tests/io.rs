@@ -322,13 +322,9 @@ fn stl_and_off_round_trips_keep_the_mesh() {
     }
 }
 
-/// Issue 59: a CAD export repeats a seam's corners with positions a rounding apart (2.7e-16 of
-/// the model on a real part); read bit for bit those seams are cracks, and a closed part reads
-/// as one with boundary loops. A unit cube as an ascii STL whose top face's corners are written
-/// 1e-16 off reads as the closed cube: 8 vertices, no boundary edge.
-#[test]
-fn an_stl_whose_seam_corners_are_a_rounding_apart_reads_closed() {
-    let cube = TriMesh::new(
+/// The unit cube [0, 1]³: corner i at (i & 1, i >> 1 & 1, i >> 2), 12 faces facing out.
+fn unit_cube() -> TriMesh {
+    TriMesh::new(
         (0..8)
             .map(|i| DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
             .collect(),
@@ -346,7 +342,16 @@ fn an_stl_whose_seam_corners_are_a_rounding_apart_reads_closed() {
             [1, 3, 5],
             [3, 7, 5],
         ],
-    );
+    )
+}
+
+/// Issue 59: a CAD export repeats a seam's corners with positions a rounding apart (2.7e-16 of
+/// the model on a real part); read bit for bit those seams are cracks, and a closed part reads
+/// as one with boundary loops. A unit cube as an ascii STL whose top face's corners are written
+/// 1e-16 off reads as the closed cube: 8 vertices, no boundary edge.
+#[test]
+fn an_stl_whose_seam_corners_are_a_rounding_apart_reads_closed() {
+    let cube = unit_cube();
     let mut text = String::from("solid cube\n");
     for (f, t) in cube.triangles.iter().enumerate() {
         text.push_str(" facet normal 0 0 0\n  outer loop\n");
@@ -378,24 +383,11 @@ fn an_stl_whose_seam_corners_are_a_rounding_apart_reads_closed() {
 /// with its 8 corners and 12 faces, the stray triangle with its own 3.
 #[test]
 fn a_stray_far_triangle_does_not_weld_a_part_into_a_point() {
-    let mut positions: Vec<DVec3> = (0..8)
-        .map(|i| DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
-        .collect();
+    let TriMesh {
+        mut positions,
+        mut triangles,
+    } = unit_cube();
     positions.extend([1e12, 1e12 + 1.0, 1e12 + 2.0].map(|x| DVec3::new(x, 0.0, (x - 1e12) * 0.5)));
-    let mut triangles = vec![
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5],
-    ];
     triangles.push([8, 9, 10]);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("stray.obj");

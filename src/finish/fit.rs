@@ -105,15 +105,7 @@ pub fn fit_to_surface<S: SurfaceQuery + ?Sized>(
     };
     let normals = mesh.vertex_normals();
     // Each vertex's shortest edge, for the bound on its offset.
-    let mut shortest = vec![f64::INFINITY; n];
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            let l = mesh.positions[a].distance(mesh.positions[b]);
-            shortest[a] = shortest[a].min(l);
-            shortest[b] = shortest[b].min(l);
-        }
-    }
+    let shortest = mesh.shortest_edges();
     let mut offset = vec![0.0f64; n];
     // Each face's points' closest points of the last iteration: points of the surface, whose
     // distance to a point bounds its distance to the surface (the search prunes by it).

@@ -420,6 +420,21 @@ impl TriMesh {
         merged
     }
 
+    /// The length of the shortest edge at each vertex (model units; infinite at a vertex no
+    /// triangle uses). Shape: one per position.
+    pub fn shortest_edges(&self) -> Vec<f64> {
+        let mut shortest = vec![f64::INFINITY; self.positions.len()];
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                let l = self.positions[a].distance(self.positions[b]);
+                shortest[a] = shortest[a].min(l);
+                shortest[b] = shortest[b].min(l);
+            }
+        }
+        shortest
+    }
+
     /// Merges vertices whose positions lie within `tolerance` (model units) of each other and
     /// within `edge_fraction` of the shortest edge at either: first those at bit-identical
     /// positions ([`weld_identical_positions`](Self::weld_identical_positions)), then each
@@ -437,16 +452,7 @@ impl TriMesh {
         if !(tolerance > 0.0 && tolerance.is_finite()) || self.positions.is_empty() {
             return identical;
         }
-        // The shortest edge at each vertex (infinite at a vertex no triangle uses).
-        let mut shortest = vec![f64::INFINITY; self.positions.len()];
-        for t in &self.triangles {
-            for k in 0..3 {
-                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-                let l = self.positions[a].distance(self.positions[b]);
-                shortest[a] = shortest[a].min(l);
-                shortest[b] = shortest[b].min(l);
-            }
-        }
+        let shortest = self.shortest_edges();
         let lo = self
             .positions
             .iter()
