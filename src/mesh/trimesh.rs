@@ -60,6 +60,10 @@ impl Aabb {
     }
 }
 
+/// The most vertices one cell of [`TriMesh::weld_close_positions`]'s grid keeps as merge
+/// targets: a seam repeats a corner a few times, never dozens.
+pub const WELD_CELL_CAP: usize = 32;
+
 impl TriMesh {
     /// A mesh from positions and triangles, taken as they are (see [`TriMesh::check_indices`]).
     pub fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Self {
@@ -445,7 +449,9 @@ impl TriMesh {
     /// solid it is, not as one with cracks along its seams; the bound by the edges keeps apart
     /// two vertices a mesh spanning many scales holds close on purpose (a stray triangle 1e12
     /// away makes any fraction of the box too coarse for a unit part). Returns how many vertices
-    /// were merged away. O(n) expected, deterministic; a `tolerance` of zero (or not finite)
+    /// were merged away. O(n), deterministic (a vertex is compared with at most 27 ·
+    /// [`WELD_CELL_CAP`] kept ones: in a cluster of more distinct vertices within `tolerance`
+    /// than that, the later ones are not merge targets); a `tolerance` of zero (or not finite)
     /// merges identical positions only.
     pub fn weld_close_positions(&mut self, tolerance: f64, edge_fraction: f64) -> usize {
         let identical = self.weld_identical_positions();
@@ -486,7 +492,13 @@ impl TriMesh {
             let idx = into.unwrap_or_else(|| {
                 kept.push((p, short));
                 let j = (kept.len() - 1) as u32;
-                grid.entry(c).or_default().push(j);
+                // A cell holds at most WELD_CELL_CAP merge targets: a cluster of distinct
+                // vertices within one cell (tiny faces, kept apart by the edge bound) would
+                // otherwise be compared pairwise.
+                let cell = grid.entry(c).or_default();
+                if cell.len() < WELD_CELL_CAP {
+                    cell.push(j);
+                }
                 j
             });
             remap.push(idx);

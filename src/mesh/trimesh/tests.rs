@@ -202,6 +202,35 @@ fn weld_close_merges_a_seams_corners_a_rounding_apart_and_keeps_points_farther_a
     assert_eq!(n.positions.len(), 4);
 }
 
+/// The weld's grid keeps at most WELD_CELL_CAP merge targets per cell, so a cluster of
+/// distinct vertices (tiny faces kept apart by the edge bound) costs linear time: a vertex a
+/// rounding from the 40th of such a cluster stays apart, one a rounding from the 6th is welded.
+#[test]
+fn the_welds_cells_keep_a_bounded_number_of_merge_targets() {
+    use super::WELD_CELL_CAP;
+    assert!(WELD_CELL_CAP < 39);
+    // 13 tiny triangles (39 vertices) 1e-3 across, all in one cell of the tolerance 1.0.
+    let mut positions: Vec<DVec3> = (0..39)
+        .map(|i| DVec3::new(i as f64 * 1e-3, (i % 3) as f64 * 1e-3, 0.0))
+        .collect();
+    let mut triangles: Vec<[u32; 3]> = (0..13).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+    // Two triangles from far away, each with a corner a rounding from vertex 38 or vertex 5.
+    for (near, x) in [(38usize, 10.0), (5, 20.0)] {
+        let base = positions.len() as u32;
+        positions.extend([
+            positions[near] + DVec3::splat(1e-15),
+            DVec3::new(x, 0.0, 0.0),
+            DVec3::new(x, 1.0, 0.0),
+        ]);
+        triangles.push([base, base + 1, base + 2]);
+    }
+    let mut m = TriMesh::new(positions, triangles);
+    assert_eq!(m.weld_close_positions(1.0, 1e-7), 1);
+    // The far triangles' first corners: the one by vertex 38 stays apart, the other is 5.
+    assert_eq!(m.triangles[13][0], 39);
+    assert_eq!(m.triangles[14][0], 5);
+}
+
 #[test]
 fn corner_normals_split_at_creases_sharper_than_the_angle() {
     // A roof: two planes meeting at a ridge along x with a 90° dihedral angle, each a 2 x 2
