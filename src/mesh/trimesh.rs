@@ -62,7 +62,7 @@ impl Aabb {
 
 /// The most vertices one cell of [`TriMesh::weld_close_positions`]'s grid keeps as merge
 /// targets: a seam repeats a corner a few times, never dozens.
-pub const WELD_CELL_CAP: usize = 32;
+pub(crate) const WELD_CELL_CAP: usize = 32;
 
 impl TriMesh {
     /// A mesh from positions and triangles, taken as they are (see [`TriMesh::check_indices`]).
@@ -449,10 +449,10 @@ impl TriMesh {
     /// solid it is, not as one with cracks along its seams; the bound by the edges keeps apart
     /// two vertices a mesh spanning many scales holds close on purpose (a stray triangle 1e12
     /// away makes any fraction of the box too coarse for a unit part). Returns how many vertices
-    /// were merged away. O(n), deterministic (a vertex is compared with at most 27 ·
-    /// [`WELD_CELL_CAP`] kept ones: in a cluster of more distinct vertices within `tolerance`
-    /// than that, the later ones are not merge targets); a `tolerance` of zero (or not finite)
-    /// merges identical positions only.
+    /// were merged away. O(n), deterministic (a vertex is compared with at most 27 · 32 kept
+    /// ones: in a cluster of more distinct vertices within `tolerance` than 32 to a grid cell,
+    /// the later ones are not merge targets); a `tolerance` of zero (or not finite) merges
+    /// identical positions only.
     pub fn weld_close_positions(&mut self, tolerance: f64, edge_fraction: f64) -> usize {
         let identical = self.weld_identical_positions();
         if !(tolerance > 0.0 && tolerance.is_finite()) || self.positions.is_empty() {

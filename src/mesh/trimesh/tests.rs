@@ -208,7 +208,7 @@ fn weld_close_merges_a_seams_corners_a_rounding_apart_and_keeps_points_farther_a
 #[test]
 fn the_welds_cells_keep_a_bounded_number_of_merge_targets() {
     use super::WELD_CELL_CAP;
-    assert!(WELD_CELL_CAP < 39);
+    const { assert!(WELD_CELL_CAP < 39) };
     // 13 tiny triangles (39 vertices) 1e-3 across, all in one cell of the tolerance 1.0.
     let mut positions: Vec<DVec3> = (0..39)
         .map(|i| DVec3::new(i as f64 * 1e-3, (i % 3) as f64 * 1e-3, 0.0))
