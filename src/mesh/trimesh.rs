@@ -413,6 +413,13 @@ impl TriMesh {
             remap.push(idx);
         }
         let merged = self.positions.len() - kept.len();
+        self.merge_vertices(kept, &remap);
+        merged
+    }
+
+    /// Replaces the positions by `kept`, renumbers the triangles by `remap` (old index → index
+    /// into `kept`) and drops the triangles that then repeat a vertex: the welds' last step.
+    fn merge_vertices(&mut self, kept: Vec<DVec3>, remap: &[u32]) {
         self.positions = kept;
         for t in &mut self.triangles {
             for i in t.iter_mut() {
@@ -421,7 +428,6 @@ impl TriMesh {
         }
         self.triangles
             .retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
-        merged
     }
 
     /// The length of the shortest edge at each vertex (model units; infinite at a vertex no
@@ -507,14 +513,7 @@ impl TriMesh {
         if near == 0 {
             return identical;
         }
-        self.positions = kept.into_iter().map(|(p, _)| p).collect();
-        for t in &mut self.triangles {
-            for i in t.iter_mut() {
-                *i = remap[*i as usize];
-            }
-        }
-        self.triangles
-            .retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+        self.merge_vertices(kept.into_iter().map(|(p, _)| p).collect(), &remap);
         identical + near
     }
 }
