@@ -64,6 +64,11 @@ impl Aabb {
 /// targets: a seam repeats a corner a few times, never dozens.
 pub(crate) const WELD_CELL_CAP: usize = 32;
 
+/// How near the middle of its cell (along an axis, in cells) a vertex has
+/// [`TriMesh::weld_close_positions`] look in both neighbouring cells: rounding puts a point's
+/// cell coordinate off by about 1e-6 of a cell at the readers' tolerance (1e-10 of the diagonal).
+const WELD_CELL_MIDDLE: f64 = 1e-3;
+
 impl TriMesh {
     /// A mesh from positions and triangles, taken as they are (see [`TriMesh::check_indices`]).
     pub fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Self {
@@ -455,8 +460,8 @@ impl TriMesh {
     /// solid it is, not as one with cracks along its seams; the bound by the edges keeps apart
     /// two vertices a mesh spanning many scales holds close on purpose (a stray triangle 1e12
     /// away makes any fraction of the box too coarse for a unit part). Returns how many vertices
-    /// were merged away. O(n), deterministic (a vertex is compared with at most 27 · 32 kept
-    /// ones: in a cluster of more distinct vertices within `tolerance` than 32 to a grid cell,
+    /// were merged away. O(n), deterministic (a vertex is compared with at most 8 · 32 kept
+    /// ones, 27 · 32 near a cell's middle: in a cluster of more distinct vertices within `tolerance` than 32 to a grid cell,
     /// the later ones are not merge targets); a `tolerance` of zero (or not finite) merges
     /// identical positions only.
     pub fn weld_close_positions(&mut self, tolerance: f64, edge_fraction: f64) -> usize {
@@ -469,18 +474,30 @@ impl TriMesh {
             .positions
             .iter()
             .fold(DVec3::splat(f64::INFINITY), |a, &p| a.min(p));
-        // Cells of side `tolerance`: two points within it are in the same or adjacent cells.
-        // `as i64` saturates, so a far point cannot wrap around.
-        let cell = |p: DVec3| ((p - lo) / tolerance).floor().to_array().map(|c| c as i64);
+        // Cells of side 2 · `tolerance`: along each axis, a point within `tolerance` of p lies in
+        // p's cell or in the neighbour on the side of the half p lies in, so 8 cells are looked
+        // in, not 27 (both neighbours within WELD_CELL_MIDDLE of the middle, where rounding
+        // could put it either way). `as i64` saturates, so a far point cannot wrap around.
+        let side = 2.0 * tolerance;
         let mut grid: FxHashMap<[i64; 3], Vec<u32>> = FxHashMap::default();
         let mut kept: Vec<(DVec3, f64)> = Vec::with_capacity(self.positions.len());
         let mut remap = Vec::with_capacity(self.positions.len());
         for (&p, &short) in self.positions.iter().zip(&shortest) {
-            let c = cell(p);
+            let at = (p - lo) / side;
+            let c = at.floor().to_array().map(|c| c as i64);
+            let reach = (at - at.floor()).to_array().map(|f| {
+                if f < 0.5 - WELD_CELL_MIDDLE {
+                    -1..=0
+                } else if f > 0.5 + WELD_CELL_MIDDLE {
+                    0..=1
+                } else {
+                    -1..=1
+                }
+            });
             let mut into: Option<u32> = None;
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
+            for dx in reach[0].clone() {
+                for dy in reach[1].clone() {
+                    for dz in reach[2].clone() {
                         let key = [c[0] + dx, c[1] + dy, c[2] + dz];
                         for &j in grid.get(&key).into_iter().flatten() {
                             let (q, q_short) = kept[j as usize];
