@@ -45,7 +45,7 @@ pub(super) fn triangulate_samples(
     params: &RemeshParams,
 ) -> Triangulated {
     let surface = &index.surface;
-    let positions: Vec<DVec3> = samples.iter().map(|s| s.position).collect();
+    let mut positions: Vec<DVec3> = samples.iter().map(|s| s.position).collect();
     let normals: Vec<DVec3> = samples
         .par_iter()
         .map(
@@ -86,7 +86,10 @@ pub(super) fn triangulate_samples(
         }
     };
     let (faces, mut face_sources, mut assembly, restricted_delaunay) = match restricted {
-        Some((f, s, a, rd)) => (f, s, a, Some(rd)),
+        Some((f, s, a, rd, inserted)) => {
+            positions.extend(inserted);
+            (f, s, a, Some(rd))
+        }
         None => {
             let (f, s, a) = triangulate(&set, &params.triangulate);
             (f, s, a, None)

@@ -10,6 +10,7 @@ pub mod refine;
 pub mod restricted_delaunay;
 pub mod restricted_voronoi;
 pub mod tangent_delaunay;
+pub mod topological_ball;
 pub mod unsupported;
 
 pub use cleanup::{assemble, AssemblyParams, AssemblyStats, FaceSource};
@@ -79,6 +80,7 @@ pub fn triangulate_restricted(
     rd: &RestrictedDelaunayParams,
 ) -> Option<Restricted> {
     let mut rd_stats = None;
+    let mut added: Vec<DVec3> = Vec::new();
     let (faces, sources, stats) = on_distinct(set, |s| {
         let found = if rd.clipped {
             let tolerance = crate::geometry::tolerance::ON_SURFACE_RELATIVE * spacing;
@@ -89,6 +91,7 @@ pub fn triangulate_restricted(
                 s.normals,
                 tolerance,
             )
+            .map(|(v, st)| (v, st, Vec::new()))
         } else {
             restricted_delaunay::restricted_delaunay(
                 surface,
@@ -99,25 +102,48 @@ pub fn triangulate_restricted(
                 rd,
             )
         };
-        let Some((voted, st)) = found else {
+        let Some((voted, st, inserted)) = found else {
             return (Vec::new(), Vec::new(), AssemblyStats::default());
         };
         rd_stats = Some(st);
-        assemble_candidates(s, voted, params)
+        if inserted.is_empty() {
+            return assemble_candidates(s, voted, params);
+        }
+        // The samples inserted for the topological ball property, after the others, with the
+        // input's normals.
+        let mut positions = s.positions.to_vec();
+        let mut normals = s.normals.to_vec();
+        for &p in &inserted {
+            positions.push(p);
+            normals.push(
+                surface
+                    .closest_point(p)
+                    .map_or(DVec3::ZERO, |sp| surface.smooth_normal(&sp)),
+            );
+        }
+        added = inserted;
+        let extended = SampleSet {
+            positions: &positions,
+            normals: &normals,
+            boundary_edges: s.boundary_edges,
+        };
+        assemble_candidates(&extended, voted, params)
     });
     // No triangle at all (samples scattered over parts far below the refinement's resolution,
     // such as a small sphere beside a far triangle) is no triangulation either.
     rd_stats
         .filter(|_| !faces.is_empty())
-        .map(|st| (faces, sources, stats, st))
+        .map(|st| (faces, sources, stats, st, added))
 }
 
-/// [`Triangulated`] and what the restricted Delaunay step did.
+/// [`Triangulated`], what the restricted Delaunay step did, and the samples it inserted (the
+/// faces number them after the given samples, in order).
 pub type Restricted = (
     Vec<[u32; 3]>,
     Vec<FaceSource>,
     AssemblyStats,
     RestrictedDelaunayStats,
+    Vec<DVec3>,
 );
 
 /// Faces, how each came in, and what the assembly did.
@@ -158,9 +184,12 @@ fn on_distinct(set: &SampleSet, mut run: impl FnMut(&SampleSet) -> Triangulated)
         boundary_edges: &boundary_edges,
     };
     let (faces, sources, stats) = run(&reduced);
+    // Samples the run inserted are numbered after the distinct ones, and after all of them in
+    // the answer.
+    let (given, kept) = (set.positions.len() as u32, distinct.len() as u32);
     let faces = faces
         .into_iter()
-        .map(|f| f.map(|v| distinct[v as usize]))
+        .map(|f| f.map(|v| distinct.get(v as usize).copied().unwrap_or(given + v - kept)))
         .collect();
     (faces, sources, stats)
 }

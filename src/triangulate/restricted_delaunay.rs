@@ -22,6 +22,7 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use super::tangent_delaunay::VotedTriangle;
+use super::topological_ball::{self, TopologicalBallParams, TopologicalBallStats};
 use crate::mesh::bisect::bisect_to_length;
 use crate::mesh::sheets::Sheets;
 use crate::sampling::sizing::SizingField;
@@ -47,6 +48,9 @@ pub struct RestrictedDelaunayParams {
     /// clipped cells are tested against). `resolution` and `max_added_per_sample` apply to
     /// the refined cells only.
     pub clipped: bool,
+    /// The check of the topological ball property on the refined cells and the samples it
+    /// inserts where a cell is not a disc or two cells meet twice (refined cells only).
+    pub topological_ball: TopologicalBallParams,
 }
 
 impl Default for RestrictedDelaunayParams {
@@ -55,6 +59,7 @@ impl Default for RestrictedDelaunayParams {
             resolution: 0.5,
             max_added_per_sample: 200,
             clipped: false,
+            topological_ball: TopologicalBallParams::default(),
         }
     }
 }
@@ -73,15 +78,20 @@ pub struct RestrictedDelaunayStats {
     /// Samples in no dual triangle (refined cells: whose cell holds no vertex of the refined
     /// input).
     pub empty_cells: usize,
+    /// The check of the topological ball property and the samples it inserted (refined cells
+    /// only).
+    pub topological_ball: TopologicalBallStats,
 }
 
 /// The dual triangles of the samples' restricted Voronoi cells on `surface`'s mesh, as
 /// candidates for [`assemble`](super::assemble): each with 3 votes, oriented like the input,
 /// the ones met at more refined faces first. `sheets`: those of `surface`'s mesh (closed parts
 /// that meet at a non-manifold edge are refined apart). `positions`: the samples (units of the
-/// mesh, on or near the surface); `spacing`: the sample spacing (same units). `None` when the
-/// refinement
-/// would add more than `params.max_added_per_sample` vertices per sample.
+/// mesh, on or near the surface); `spacing`: the sample spacing (same units). Also returns the
+/// samples inserted where the cells failed the topological ball property
+/// ([`topological_ball`](super::topological_ball)): on the input, numbered after `positions`
+/// in the triangles. `None` when the refinement would add more than
+/// `params.max_added_per_sample` vertices per sample.
 pub fn restricted_delaunay(
     surface: &MeshSurface,
     sheets: &Sheets,
@@ -89,7 +99,7 @@ pub fn restricted_delaunay(
     spacing: f64,
     field: &dyn SizingField,
     params: &RestrictedDelaunayParams,
-) -> Option<(Vec<VotedTriangle>, RestrictedDelaunayStats)> {
+) -> Option<(Vec<VotedTriangle>, RestrictedDelaunayStats, Vec<DVec3>)> {
     let budget = params
         .max_added_per_sample
         .saturating_mul(positions.len().max(1));
@@ -136,7 +146,14 @@ pub fn restricted_delaunay(
         tolerance,
         on_sheet: &on_sheet,
     };
-    let label = labels.grow();
+    let mut label = labels.grow();
+    let cells = topological_ball::Refined {
+        positions: &refined.positions,
+        triangles: &refined.triangles,
+        neighbours: &neighbours,
+    };
+    let (added, ball) =
+        topological_ball::enforce(&cells, positions, &mut label, &params.topological_ball);
     // Dual triangles: refined faces with three labels, counted per triple and orientation.
     let tally = tally_triples(
         refined
@@ -145,7 +162,7 @@ pub fn restricted_delaunay(
             .map(|t| t.map(|v| label[v as usize]))
             .filter(|l| l[0] != l[1] && l[1] != l[2] && l[0] != l[2] && !l.contains(&u32::MAX)),
     );
-    let mut owned = vec![false; positions.len()];
+    let mut owned = vec![false; positions.len() + added.len()];
     for &l in &label {
         if l != u32::MAX {
             owned[l as usize] = true;
@@ -157,8 +174,9 @@ pub fn restricted_delaunay(
         reclipped_facets: 0,
         triangles: tally.len(),
         empty_cells: owned.iter().filter(|o| !**o).count(),
+        topological_ball: ball,
     };
-    Some((voted(tally, false), stats))
+    Some((voted(tally, false), stats, added))
 }
 
 /// The tallied dual triangles ([`tally_triples`]) as candidates of 3 votes each, in order;
@@ -476,7 +494,7 @@ fn lies_in(surface: &MeshSurface, f: u32, p: DVec3, tolerance: f64) -> bool {
 /// each neighbour once (an interior edge is on two faces: offering a vertex twice the same
 /// sample at the same distance changes nothing in the search, so the second entry only cost a
 /// look).
-struct Rows {
+pub(super) struct Rows {
     start: Vec<u32>,
     values: Vec<u32>,
 }
@@ -488,7 +506,7 @@ impl Rows {
     /// each row is then sorted and its repeats dropped, and the entries whose reverse is missing
     /// (boundary edges, faces oriented against their neighbours) are added: the same rows as
     /// listing both other corners of every face at each corner, in half the memory.
-    fn new(n: usize, triangles: &[[u32; 3]]) -> Self {
+    pub(super) fn new(n: usize, triangles: &[[u32; 3]]) -> Self {
         let directed = |t: &[u32; 3]| {
             let t = *t;
             (0..3).map(move |k| (t[k], t[(k + 1) % 3]))
@@ -582,7 +600,7 @@ impl Rows {
         (compact, values)
     }
 
-    fn row(&self, r: u32) -> &[u32] {
+    pub(super) fn row(&self, r: u32) -> &[u32] {
         &self.values[self.start[r as usize] as usize..self.start[r as usize + 1] as usize]
     }
 }
@@ -791,7 +809,7 @@ mod tests {
             normals: &normals,
             boundary_edges: &[],
         };
-        let (voted, stats) = restricted_delaunay(
+        let (voted, stats, _) = restricted_delaunay(
             &surface,
             &sheets,
             &positions,

@@ -174,6 +174,7 @@ pub fn restricted_voronoi(
         reclipped_facets,
         triangles: tally.len(),
         empty_cells,
+        topological_ball: Default::default(),
     };
     Some((voted(tally, true), stats))
 }
@@ -577,10 +578,15 @@ mod tests {
         let params = RestrictedDelaunayParams {
             resolution: 0.1,
             max_added_per_sample: 10_000,
+            // The oracle's cells as grown, no sample inserted.
+            topological_ball: crate::triangulate::topological_ball::TopologicalBallParams {
+                enabled: false,
+                ..Default::default()
+            },
             ..Default::default()
         };
         let spacing = (4.0 * std::f64::consts::PI * 100.0 / 400.0).sqrt();
-        let (oracle, _) = restricted_delaunay(
+        let (oracle, _, _) = restricted_delaunay(
             &surface,
             &Sheets::new(&mesh),
             &positions,

@@ -1,0 +1,494 @@
+//! The topological ball property of the restricted Voronoi cells, checked on the discrete cells
+//! of `restricted_delaunay` (each refined vertex of the input labelled with its sample) and
+//! enforced by inserting samples where it fails.
+//!
+//! When every restricted Voronoi cell is a closed disc and every two cells meet in at most one
+//! arc, the restricted Delaunay triangulation is homeomorphic to the surface (H. Edelsbrunner,
+//! N. Shah, "Triangulating topological spaces", IJCGA 7(4), 1997). Where a cell is not a disc (it
+//! wraps around a tube or a hole thinner than the spacing, or covers a small part whole) or two
+//! cells meet in two arcs (across a wall or a gap), a sample is inserted at the point of the
+//! offending cell farthest from its sample, the discrete counterpart of the centre of its
+//! largest surface Delaunay ball, and only the cells it takes over change: the refinement of
+//! J.-D. Boissonnat, S. Oudot, "Provably good sampling and meshing of surfaces", Graphical
+//! Models 67(5), 2005, and of CGAL's surface mesher with `Manifold_tag` (a vertex is bad when its
+//! restricted facets do not form one disc); S.-W. Cheng, T. K. Dey, E. A. Ramos, "Manifold
+//! reconstruction from point samples", SODA 2005 / "Delaunay refinement for piecewise smooth
+//! complexes", DCG 2007.
+//!
+//! On the discrete cells: a cell (the refined vertices of one label, the edges and faces among
+//! them) is a disc when it is connected and its Euler characteristic V − E + F is 1 (a
+//! connected part of an orientable surface with χ = 1 is a disc); two cells meet in one arc when
+//! the refined edges between them (mixed edges of that pair) form one chain of faces.
+
+use glam::DVec3;
+use rustc_hash::FxHashMap;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use super::restricted_delaunay::Rows;
+use crate::disjoint_sets::Dsu;
+
+/// Parameters of [`enforce`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TopologicalBallParams {
+    /// Whether the property is checked and enforced at all (default true).
+    pub enabled: bool,
+    /// The most rounds of check and insertion (default 24): each round inserts one sample per
+    /// offending cell or pair.
+    pub max_rounds: usize,
+    /// The most samples inserted, as a fraction of the samples (default 0.5), plus
+    /// [`MIN_INSERTIONS`].
+    pub max_added_fraction: f64,
+}
+
+impl Default for TopologicalBallParams {
+    fn default() -> Self {
+        TopologicalBallParams {
+            enabled: true,
+            max_rounds: 24,
+            max_added_fraction: 0.5,
+        }
+    }
+}
+
+/// Insertions allowed whatever the sample count (a small closed part needs four samples to be a
+/// tetrahedron).
+pub const MIN_INSERTIONS: usize = 64;
+
+/// What [`enforce`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct TopologicalBallStats {
+    /// Samples inserted.
+    pub inserted: usize,
+    /// Rounds of check and insertion run.
+    pub rounds: usize,
+    /// Cells that were not discs at the first check.
+    pub bad_cells_first: usize,
+    /// Pairs of cells meeting in more than one arc at the first check.
+    pub bad_pairs_first: usize,
+    /// Cells still not discs after the last round (0 when the property holds).
+    pub bad_cells_left: usize,
+    /// Pairs of cells still meeting in more than one arc after the last round.
+    pub bad_pairs_left: usize,
+}
+
+/// The refined input the cells live on.
+pub(super) struct Refined<'a> {
+    pub positions: &'a [DVec3],
+    pub triangles: &'a [[u32; 3]],
+    pub neighbours: &'a Rows,
+}
+
+/// Checks the cells `label` (one sample index per refined vertex, `u32::MAX` for none) of the
+/// samples `samples` and inserts samples until every cell is a disc and every two cells meet in
+/// at most one arc, or the rounds or the insertions run out. Returns the inserted samples (at
+/// refined vertices, so on the input; their labels are `samples.len()` onwards, in order) and
+/// what was done; `label` is updated.
+pub(super) fn enforce(
+    refined: &Refined,
+    samples: &[DVec3],
+    label: &mut [u32],
+    params: &TopologicalBallParams,
+) -> (Vec<DVec3>, TopologicalBallStats) {
+    let mut stats = TopologicalBallStats::default();
+    let mut added: Vec<DVec3> = Vec::new();
+    if !params.enabled {
+        return (added, stats);
+    }
+    let budget = (params.max_added_fraction * samples.len() as f64) as usize + MIN_INSERTIONS;
+    let site = |l: u32, added: &[DVec3]| {
+        let l = l as usize;
+        if l < samples.len() {
+            samples[l]
+        } else {
+            added[l - samples.len()]
+        }
+    };
+    let mut dist: Vec<f64> = label
+        .iter()
+        .zip(refined.positions)
+        .map(|(&l, &p)| {
+            if l == u32::MAX {
+                f64::INFINITY
+            } else {
+                p.distance(site(l, &added))
+            }
+        })
+        .collect();
+    loop {
+        let count = samples.len() + added.len();
+        let (cells, pairs) = offending(refined, label, count);
+        if stats.rounds == 0 {
+            stats.bad_cells_first = cells.len();
+            stats.bad_pairs_first = pairs.len();
+        }
+        stats.bad_cells_left = cells.len();
+        stats.bad_pairs_left = pairs.len();
+        if (cells.is_empty() && pairs.is_empty())
+            || stats.rounds >= params.max_rounds
+            || added.len() >= budget
+        {
+            break;
+        }
+        stats.rounds += 1;
+        let candidates = insertion_points(refined, label, &dist, &cells, &pairs);
+        // One insertion per offending cell or pair, farthest first; a candidate whose vertex an
+        // earlier insertion of this round took over is left (its cell changed).
+        let start_label: Vec<(u32, u32)> = candidates.iter().map(|&(_, v)| (v, label[v as usize])).collect();
+        for (&(_, v), &(_, l0)) in candidates.iter().zip(&start_label) {
+            if added.len() >= budget {
+                break;
+            }
+            if label[v as usize] != l0 || dist[v as usize] == 0.0 {
+                continue;
+            }
+            let x = refined.positions[v as usize];
+            let s = (samples.len() + added.len()) as u32;
+            added.push(x);
+            take_over(refined, label, &mut dist, s, v, x);
+        }
+        let count = samples.len() + added.len();
+        connect_cells(refined, label, &mut dist, count, |l| site(l, &added));
+        stats.inserted = added.len();
+    }
+    (added, stats)
+}
+
+/// The refined vertices nearer to the new sample `s` at `x` (refined vertex `v`) than to their
+/// own, reached from `v` through such vertices, relabelled `s`.
+fn take_over(refined: &Refined, label: &mut [u32], dist: &mut [f64], s: u32, v: u32, x: DVec3) {
+    label[v as usize] = s;
+    dist[v as usize] = 0.0;
+    let mut stack = vec![v];
+    while let Some(a) = stack.pop() {
+        for &b in refined.neighbours.row(a) {
+            let d = refined.positions[b as usize].distance(x);
+            if d < dist[b as usize] {
+                dist[b as usize] = d;
+                label[b as usize] = s;
+                stack.push(b);
+            }
+        }
+    }
+}
+
+/// Each cell made connected again after insertions took parts of it over: the vertices of a
+/// cell not joined to its vertex nearest its sample through the cell are labelled anew, by a
+/// search from the cells around them (the nearest sample that reaches them, as
+/// `restricted_delaunay` grows the cells).
+fn connect_cells(
+    refined: &Refined,
+    label: &mut [u32],
+    dist: &mut [f64],
+    count: usize,
+    site: impl Fn(u32) -> DVec3,
+) {
+    let n = refined.positions.len();
+    let mut anchor = vec![(f64::INFINITY, u32::MAX); count];
+    for v in 0..n {
+        let l = label[v];
+        if l != u32::MAX && (dist[v], v as u32) < anchor[l as usize] {
+            anchor[l as usize] = (dist[v], v as u32);
+        }
+    }
+    let mut joined = vec![false; n];
+    let mut stack: Vec<u32> = anchor
+        .iter()
+        .filter(|a| a.1 != u32::MAX)
+        .map(|a| a.1)
+        .collect();
+    for &v in &stack {
+        joined[v as usize] = true;
+    }
+    while let Some(v) = stack.pop() {
+        let l = label[v as usize];
+        for &u in refined.neighbours.row(v) {
+            if !joined[u as usize] && label[u as usize] == l {
+                joined[u as usize] = true;
+                stack.push(u);
+            }
+        }
+    }
+    let mut heap: BinaryHeap<Reverse<(u64, u32, u32)>> = BinaryHeap::new();
+    let mut orphans = false;
+    for v in 0..n {
+        if label[v] != u32::MAX && !joined[v] {
+            label[v] = u32::MAX;
+            dist[v] = f64::INFINITY;
+            orphans = true;
+        }
+    }
+    if !orphans {
+        return;
+    }
+    for v in 0..n as u32 {
+        let l = label[v as usize];
+        if l != u32::MAX
+            && refined
+                .neighbours
+                .row(v)
+                .iter()
+                .any(|&u| label[u as usize] == u32::MAX && dist[u as usize].is_infinite())
+        {
+            heap.push(Reverse((dist[v as usize].to_bits(), l, v)));
+        }
+    }
+    let mut done = joined;
+    while let Some(Reverse((_, s, v))) = heap.pop() {
+        if label[v as usize] != s {
+            continue;
+        }
+        let x = site(s);
+        for &u in refined.neighbours.row(v) {
+            let i = u as usize;
+            if done[i] {
+                continue;
+            }
+            let d = refined.positions[i].distance(x);
+            if d < dist[i] || (d == dist[i] && s < label[i]) {
+                dist[i] = d;
+                label[i] = s;
+                heap.push(Reverse((d.to_bits(), s, u)));
+            }
+        }
+        done[v as usize] = true;
+    }
+}
+
+/// The cells that are not discs (labels, ascending) and the pairs of cells that meet in more
+/// than one arc (ascending), of `count` labels.
+fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[u32; 2]>) {
+    let n = refined.positions.len();
+    // Per label: vertices, edges and faces inside the cell, and its components.
+    let mut chi = vec![0i64; count];
+    let mut present = vec![false; count];
+    let mut dsu = Dsu::new(n);
+    for v in 0..n as u32 {
+        let l = label[v as usize];
+        if l == u32::MAX {
+            continue;
+        }
+        chi[l as usize] += 1;
+        present[l as usize] = true;
+        for &u in refined.neighbours.row(v) {
+            if u > v && label[u as usize] == l {
+                chi[l as usize] -= 1;
+                dsu.union(v as usize, u as usize, false);
+            }
+        }
+    }
+    for t in refined.triangles {
+        let l = label[t[0] as usize];
+        if l != u32::MAX && label[t[1] as usize] == l && label[t[2] as usize] == l {
+            chi[l as usize] += 1;
+        }
+    }
+    let mut components = vec![0u32; count];
+    for v in 0..n {
+        let l = label[v];
+        if l != u32::MAX && dsu.find(v).0 == v {
+            components[l as usize] += 1;
+        }
+    }
+    let cells: Vec<u32> = (0..count)
+        .filter(|&l| present[l] && (components[l] != 1 || chi[l] != 1))
+        .map(|l| l as u32)
+        .collect();
+
+    // Mixed edges (between two cells), joined when they are edges of one face of the same pair.
+    let mut ids: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+    let mut pair_of: Vec<[u32; 2]> = Vec::new();
+    let pair = |a: u32, b: u32| [a.min(b), a.max(b)];
+    for v in 0..n as u32 {
+        let l = label[v as usize];
+        if l == u32::MAX {
+            continue;
+        }
+        for &u in refined.neighbours.row(v) {
+            let k = label[u as usize];
+            if u > v && k != l && k != u32::MAX {
+                ids.insert((v, u), pair_of.len() as u32);
+                pair_of.push(pair(l, k));
+            }
+        }
+    }
+    let mut arcs = Dsu::new(pair_of.len());
+    let id = |a: u32, b: u32| ids.get(&(a.min(b), a.max(b))).copied();
+    for t in refined.triangles {
+        let [a, b, c] = t.map(|v| label[v as usize]);
+        if a == u32::MAX || b == u32::MAX || c == u32::MAX || (a == b && b == c) {
+            continue;
+        }
+        if a != b && b != c && a != c {
+            continue;
+        }
+        // Two of the three edges are mixed, of the same pair.
+        let edges: Vec<u32> = (0..3)
+            .filter_map(|k| id(t[k], t[(k + 1) % 3]))
+            .collect();
+        if let [e, f] = edges[..] {
+            arcs.union(e as usize, f as usize, false);
+        }
+    }
+    let mut roots: Vec<([u32; 2], usize)> = (0..pair_of.len())
+        .map(|e| (pair_of[e], arcs.find(e).0))
+        .collect();
+    roots.sort_unstable();
+    roots.dedup();
+    let mut pairs: Vec<[u32; 2]> = roots
+        .chunk_by(|a, b| a.0 == b.0)
+        .filter(|group| group.len() > 1)
+        .map(|group| group[0].0)
+        .collect();
+    pairs.sort_unstable();
+    (cells, pairs)
+}
+
+/// Where to insert for the offending `cells` and `pairs`: for a cell, its refined vertex
+/// farthest from its sample; for a pair, the vertex of either cell on their common boundary
+/// farthest from its own sample. (distance, vertex), farthest first, ties to the lower vertex;
+/// each vertex once.
+fn insertion_points(
+    refined: &Refined,
+    label: &[u32],
+    dist: &[f64],
+    cells: &[u32],
+    pairs: &[[u32; 2]],
+) -> Vec<(f64, u32)> {
+    let n = refined.positions.len();
+    let mut cell_best: FxHashMap<u32, (f64, u32)> = cells.iter().map(|&c| (c, (-1.0, 0))).collect();
+    let mut pair_best: FxHashMap<[u32; 2], (f64, u32)> =
+        pairs.iter().map(|&p| (p, (-1.0, 0))).collect();
+    let better = |best: &mut (f64, u32), d: f64, v: u32| {
+        if d > best.0 || (d == best.0 && v < best.1) {
+            *best = (d, v);
+        }
+    };
+    for v in 0..n as u32 {
+        let l = label[v as usize];
+        if l == u32::MAX {
+            continue;
+        }
+        let d = dist[v as usize];
+        if let Some(best) = cell_best.get_mut(&l) {
+            better(best, d, v);
+        }
+        if !pair_best.is_empty() {
+            for &u in refined.neighbours.row(v) {
+                let k = label[u as usize];
+                if k != l && k != u32::MAX {
+                    if let Some(best) = pair_best.get_mut(&[l.min(k), l.max(k)]) {
+                        better(best, d, v);
+                    }
+                }
+            }
+        }
+    }
+    let mut out: Vec<(f64, u32)> = cell_best
+        .into_values()
+        .chain(pair_best.into_values())
+        .filter(|&(d, _)| d > 0.0)
+        .collect();
+    out.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    out.dedup_by_key(|x| x.1);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes;
+
+    fn rows(positions: &[DVec3], triangles: &[[u32; 3]]) -> Rows {
+        Rows::new(positions.len(), triangles)
+    }
+
+    /// Nearest-sample labels (no growth: enough on convex test shapes).
+    fn nearest(positions: &[DVec3], samples: &[DVec3]) -> Vec<u32> {
+        positions
+            .iter()
+            .map(|p| {
+                (0..samples.len() as u32)
+                    .min_by(|&a, &b| {
+                        p.distance(samples[a as usize])
+                            .total_cmp(&p.distance(samples[b as usize]))
+                    })
+                    .unwrap()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn one_sample_on_a_sphere_is_not_a_disc_and_four_are_enough() {
+        let mesh = test_meshes::uv_sphere(1.0, 24, 48);
+        let neighbours = rows(&mesh.positions, &mesh.triangles);
+        let refined = Refined {
+            positions: &mesh.positions,
+            triangles: &mesh.triangles,
+            neighbours: &neighbours,
+        };
+        let samples = [DVec3::new(0.0, 0.0, 1.0)];
+        let mut label = nearest(&mesh.positions, &samples);
+        let (cells, _) = offending(&refined, &label, 1);
+        assert_eq!(cells, vec![0]);
+        let (added, stats) = enforce(&refined, &samples, &mut label, &Default::default());
+        assert_eq!(stats.bad_cells_left + stats.bad_pairs_left, 0, "{stats:?}");
+        assert!(added.len() >= 3 && added.len() <= 6, "{stats:?}");
+        let (cells, pairs) = offending(&refined, &label, 1 + added.len());
+        assert!(cells.is_empty() && pairs.is_empty());
+    }
+
+    #[test]
+    fn well_spread_samples_on_a_sphere_need_nothing() {
+        let mesh = test_meshes::uv_sphere(10.0, 64, 128);
+        let neighbours = rows(&mesh.positions, &mesh.triangles);
+        let refined = Refined {
+            positions: &mesh.positions,
+            triangles: &mesh.triangles,
+            neighbours: &neighbours,
+        };
+        let samples: Vec<DVec3> = test_meshes::fibonacci_sphere(60)
+            .into_iter()
+            .map(|u| 10.0 * u)
+            .collect();
+        let mut label = nearest(&mesh.positions, &samples);
+        let (added, stats) = enforce(&refined, &samples, &mut label, &Default::default());
+        assert_eq!((added.len(), stats.bad_cells_first, stats.bad_pairs_first), (0, 0, 0));
+    }
+
+    /// Two samples on a thin tube, one at each end: each cell wraps around the tube (an
+    /// annulus is no disc: a sample is inserted until none does).
+    #[test]
+    fn cells_around_a_thin_tube_are_split() {
+        // A tube of radius 0.2 and length 4 (open ends), 16 around, 40 along.
+        let (around, along) = (16usize, 40usize);
+        let mut positions = Vec::new();
+        for j in 0..=along {
+            for i in 0..around {
+                let a = std::f64::consts::TAU * i as f64 / around as f64;
+                positions.push(DVec3::new(0.2 * a.cos(), 0.2 * a.sin(), 4.0 * j as f64 / along as f64));
+            }
+        }
+        let id = |i: usize, j: usize| (j * around + i % around) as u32;
+        let mut triangles = Vec::new();
+        for j in 0..along {
+            for i in 0..around {
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let neighbours = rows(&positions, &triangles);
+        let refined = Refined {
+            positions: &positions,
+            triangles: &triangles,
+            neighbours: &neighbours,
+        };
+        let samples = [DVec3::new(0.2, 0.0, 1.0), DVec3::new(-0.2, 0.0, 3.0)];
+        let mut label = nearest(&positions, &samples);
+        let (cells, _) = offending(&refined, &label, 2);
+        assert_eq!(cells, vec![0, 1], "annuli");
+        let (added, stats) = enforce(&refined, &samples, &mut label, &Default::default());
+        assert!(!added.is_empty());
+        assert_eq!(stats.bad_cells_left + stats.bad_pairs_left, 0, "{stats:?}");
+    }
+}
