@@ -13,7 +13,9 @@ use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{boundary_curves, BoundaryCurve};
 use crate::sampling::curves::curve_length;
 use crate::sampling::spacing::{expected_samples, BOUNDARY_SPACING_PER_SIGMA, SAMPLES_PER_SIGMA2};
-use crate::surface::candidates::surface_candidates;
+use crate::sampling::sizing::SizingField;
+use crate::surface::candidates::{graded_candidates, shuffle_candidates, surface_candidates};
+use rayon::prelude::*;
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::winding::BuriedTest;
 use crate::surface::{MeshSurface, SurfaceSample};
@@ -184,6 +186,9 @@ pub(super) struct Candidates {
     pub cover_points: Vec<DVec3>,
     /// Candidates left out as buried inside the input's own solid.
     pub buried: usize,
+    /// The pool as drawn, area-uniform (kept once a graded supplement is added, for the next
+    /// grading), and its density per unit area.
+    uniform: Option<(Vec<SurfaceSample>, f64)>,
 }
 
 impl Candidates {
@@ -230,6 +235,55 @@ impl Candidates {
             pool,
             cover_points,
             buried,
+            uniform: None,
         }
+    }
+
+    /// The pool made to follow the sizing `field` (relative widths in (0, 1]): the area-uniform
+    /// pool as drawn, and where the field is below 1, as many more candidates as the finer
+    /// spacing takes ([`graded_candidates`]; a face's width: the field's at its centroid, and
+    /// the smallest at its corners too where the face is larger than that spacing), those
+    /// the index finds buried left out, visited in a seeded random order. `round`: a new seed
+    /// for each grading of one run. A uniform field leaves the pool as drawn.
+    pub(super) fn grade(
+        &mut self,
+        input: &NormalizedInput,
+        index: &InputIndex,
+        field: &dyn SizingField,
+        sigma_p: f64,
+        seed: u64,
+        round: u64,
+    ) {
+        let (uniform, density) = self.uniform.get_or_insert_with(|| {
+            let density = self.pool.len() as f64 / input.area.max(f64::MIN_POSITIVE);
+            (self.pool.clone(), density)
+        });
+        if field.is_uniform() {
+            self.pool.clone_from(uniform);
+            return;
+        }
+        let mesh = &input.mesh;
+        let widths: Vec<f64> = (0..mesh.face_count())
+            .into_par_iter()
+            .map(|f| {
+                let c = mesh.corners(f);
+                let w = field.width((c[0] + c[1] + c[2]) / 3.0);
+                let size = c[0].distance(c[1]).max(c[1].distance(c[2])).max(c[2].distance(c[0]));
+                if size > w * sigma_p {
+                    c.iter().map(|&p| field.width(p)).fold(w, f64::min)
+                } else {
+                    w
+                }
+            })
+            .collect();
+        let salt = seed ^ (0x9e37_79b9_7f4a_7c15u64.wrapping_mul(round + 1));
+        let mut extra = graded_candidates(mesh, *density, |f| widths[f], salt);
+        if let Some(test) = &index.buried_test {
+            self.buried += test.remove_buried(&mut extra, |c| (c.position, c.normal, Some(c.face)));
+        }
+        let mut pool = uniform.clone();
+        pool.extend(extra);
+        shuffle_candidates(&mut pool, salt);
+        self.pool = pool;
     }
 }

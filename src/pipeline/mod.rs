@@ -24,6 +24,7 @@ use crate::geometry::self_intersection::CrossingRegions;
 use crate::mesh::{Normalization, TriMesh};
 use crate::sampling::spacing::sigma_p_for_count;
 use crate::surface::features::Features;
+use crate::sampling::sizing::SizingField;
 use crate::timing::StageTimer;
 use ascent::{ascend, Ascended};
 use finish::{finish, Finished, Finishing, StrayRule};
@@ -45,6 +46,10 @@ pub use params::{Density, RemeshParams, FIT_ITERATIONS, MAX_POINTS};
 /// shortfall: the retry's miss is how closely the count can be aimed on this input, and a
 /// second retry aims no closer, at the cost of a third run.
 const MAX_ATTEMPTS: usize = 2;
+
+/// The width around the samples a triangulation inserted for the topological ball property,
+/// relative to the width there, for the next attempt (see `RemeshParams::topology_refinements`).
+const REFINEMENT_FACTOR: f64 = 0.5;
 
 /// Checks `mesh` and returns its normalization to bbox 100.
 ///
@@ -87,7 +92,7 @@ pub fn remesh(
     timer.lap("normalize");
 
     on_stage("candidates");
-    let candidates = Candidates::draw(as_read, &input, &index, pool_size, params.seed);
+    let mut candidates = Candidates::draw(as_read, &input, &index, pool_size, params.seed);
     timer.lap("candidates");
 
     // The search's first sigma_p (the given one for a sigma_p).
@@ -103,6 +108,7 @@ pub fn remesh(
         &input,
         &index.surface,
         first_sigma_p,
+        &features.edges,
         params,
         on_stage,
         &mut timer,
@@ -115,10 +121,42 @@ pub fn remesh(
         history: Vec::new(),
     };
     let mut attempt = 1;
+    let mut refinements = 0;
+    let mut sizing = sizing;
+    let mut graded_for = None;
     let (run, reached) = loop {
+        // The pool follows the sizing field (for the sigma_p the search starts from), drawn
+        // again when the field changed.
+        if graded_for != Some(refinements) {
+            graded_for = Some(refinements);
+            let widths = sizing.widths_at(&candidates.pool, search.sigma_ref);
+            let field = widths.field();
+            let round = refinements as u64;
+            let seed = params.seed;
+            candidates.grade(&input, &index, &field, search.sigma_ref, seed, round);
+        }
         let stages = (&input, &index, &candidates, &features, &sizing);
         let run = run_once(target, &mut search, stages, params, on_stage, &mut timer)?;
         search.history.extend(run.scanned.history.iter().copied());
+        // Where the triangulation had to insert samples for the topological ball property, the
+        // sampling was too coarse for the surface there: the width is lowered around them and
+        // the sampling run again, so that the samples there are placed by the sampler itself.
+        // Only where the inserted samples take the count out of its tolerance: a few inserted
+        // samples are kept as they are.
+        let inserted = run.triangulated.inserted.len() as f64;
+        let aimed = run.ascended.samples.len().max(1) as f64;
+        if inserted > params.count_tolerance * aimed && refinements < params.topology_refinements {
+            let inserted = run.triangulated.inserted.clone();
+            let sigma_ref = run.scanned.widths.sigma_ref;
+            let corners = run.scanned.corner_term();
+            let creases = crease_terms(&corners, &run.scanned.scan.separation, &run.scanned.scan.curvature);
+            let field = run.scanned.widths.field().with(&creases);
+            let widths: Vec<f64> = inserted.iter().map(|&p| field.width(p)).collect();
+            drop(run);
+            sizing.refine_at(&inserted, &widths, REFINEMENT_FACTOR, sigma_ref);
+            refinements += 1;
+            continue;
+        }
         match next_goal(target, attempt, &run, search.goal, params.count_tolerance) {
             Next::Done { reached } => break (run, reached),
             Next::Again { goal } => {

@@ -73,6 +73,10 @@ pub struct RemeshParams {
     /// [`CAD_FEATURE_ANGLE_DEG`](crate::internal::CAD_FEATURE_ANGLE_DEG), kept when the creases are
     /// a part's (long curves), left out on a scan.
     pub features: FeatureDetection,
+    /// Times at most the sampling runs again with a finer spacing around the samples the
+    /// triangulation inserted for the topological ball property (default 2; 0: the inserted
+    /// samples are kept as they are).
+    pub topology_refinements: usize,
     /// Relative tolerance of the count search (default 0.005).
     pub count_tolerance: f64,
     /// Seed of every random choice.
@@ -95,6 +99,7 @@ impl Default for RemeshParams {
             curvature: None,
             fit_iterations: FIT_ITERATIONS,
             features: FeatureDetection::Auto,
+            topology_refinements: 2,
             count_tolerance: 0.005,
             seed: 1,
         }

@@ -13,6 +13,10 @@ use crate::surface::curvature::{Curvature, CurvatureParams, CurvatureWidths};
 use crate::surface::{MeshSurface, SurfaceSample};
 use crate::timing::StageTimer;
 
+/// The smallest width the refinement for the topological ball property asks for (relative to
+/// sigma_p).
+pub(super) const MIN_REFINED_WIDTH: f64 = 1.0 / 16.0;
+
 /// The most points the local feature size is estimated at for the grading (their spacing is
 /// about the expected samples' otherwise).
 const MAX_GRADING_POINTS: f64 = 200_000.0;
@@ -26,6 +30,11 @@ pub(super) struct Sizing {
     /// The input's component count, which the stray-shell pass (grading only) brings the output
     /// back to (0 without grading).
     pub input_components: usize,
+    /// Where an earlier attempt's triangulation failed the topological ball property: the
+    /// width lowered around the samples it inserted (`None` before any did).
+    pub refinement: Option<GradedPoints>,
+    /// The points and widths of `refinement`.
+    refined_at: (Vec<glam::DVec3>, Vec<f64>),
 }
 
 impl Sizing {
@@ -37,6 +46,7 @@ impl Sizing {
         input: &NormalizedInput,
         surface: &MeshSurface,
         first_sigma_p: f64,
+        creases: &[[u32; 2]],
         params: &RemeshParams,
         on_stage: &(dyn Fn(&str) + Sync),
         timer: &mut StageTimer,
@@ -52,7 +62,7 @@ impl Sizing {
                 // Estimate points every first_sigma_p (about one per expected sample), at most
                 // MAX_GRADING_POINTS of them.
                 let spacing = first_sigma_p.max((input.area / MAX_GRADING_POINTS).sqrt());
-                let grading = Grading::new(&input.mesh, &input.curves, g, cap, spacing)?;
+                let grading = Grading::new(&input.mesh, &input.curves, creases, g, cap, spacing)?;
                 timer.lap("local feature size");
                 Some(grading)
             }
@@ -65,7 +75,28 @@ impl Sizing {
             grading,
             curvature,
             input_components,
+            refinement: None,
+            refined_at: (Vec::new(), Vec::new()),
         })
+    }
+
+    /// Lowers the width to `factor` times `width_at` at `points` (where the
+    /// triangulation inserted samples for the topological ball property), at least
+    /// [`MIN_REFINED_WIDTH`], graded around them, for the global `sigma_ref`: the next attempt
+    /// samples finely enough there by itself. Points already refined at are refined again.
+    pub(super) fn refine_at(
+        &mut self,
+        points: &[glam::DVec3],
+        width_at: &[f64],
+        factor: f64,
+        sigma_ref: f64,
+    ) {
+        let (at, widths) = &mut self.refined_at;
+        for (&p, &w) in points.iter().zip(width_at) {
+            at.push(p);
+            widths.push((factor * w).max(MIN_REFINED_WIDTH));
+        }
+        self.refinement = Some(GradedPoints::new(at, widths.clone(), sigma_ref));
     }
 
     /// The width field for the global `sigma_ref`, the curvature's taken at the candidates
@@ -80,6 +111,7 @@ impl Sizing {
                 .curvature
                 .as_ref()
                 .map(|(c, p)| CurvatureWidths::new(c, pool, sigma_ref, p.chord_error, p.min_width)),
+            refinement: self.refinement.as_ref(),
             sigma_ref,
         }
     }
@@ -90,6 +122,8 @@ impl Sizing {
 pub(super) struct Widths<'a> {
     pub thickness: Option<Thickness<'a>>,
     pub curvature: Option<CurvatureWidths>,
+    /// Where an earlier attempt failed the topological ball property.
+    pub refinement: Option<&'a GradedPoints>,
     pub sigma_ref: f64,
 }
 
@@ -98,7 +132,8 @@ impl Widths<'_> {
     pub(super) fn field(&self) -> Smallest<'_> {
         let thickness = self.thickness.as_ref().map(|t| t as &dyn SizingField);
         let curvature = self.curvature.as_ref().map(|c| c as &dyn SizingField);
-        Smallest::new(thickness.into_iter().chain(curvature))
+        let refinement = self.refinement.map(|r| r as &dyn SizingField);
+        Smallest::new(thickness.into_iter().chain(curvature).chain(refinement))
     }
 }
 

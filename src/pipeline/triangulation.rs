@@ -32,6 +32,9 @@ pub(super) struct Triangulated {
     pub feature_edges_triangulated: usize,
     /// What putting in the others did.
     pub recovery: RecoverStats,
+    /// The samples the restricted Delaunay triangulation inserted where the samples' cells
+    /// failed the topological ball property (after the given samples among the vertices).
+    pub inserted: Vec<DVec3>,
 }
 
 /// Triangulates `samples` (on the input, spaced about `sigma_p` times the sizing `field`) with
@@ -85,9 +88,11 @@ pub(super) fn triangulate_samples(
             )
         }
     };
+    let mut inserted = Vec::new();
     let (faces, mut face_sources, mut assembly, restricted_delaunay) = match restricted {
-        Some((f, s, a, rd, inserted)) => {
-            positions.extend(inserted);
+        Some((f, s, a, rd, added)) => {
+            positions.extend_from_slice(&added);
+            inserted = added;
             (f, s, a, Some(rd))
         }
         None => {
@@ -120,5 +125,6 @@ pub(super) fn triangulate_samples(
         restricted_delaunay,
         feature_edges_triangulated,
         recovery,
+        inserted,
     }
 }

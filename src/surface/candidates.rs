@@ -51,6 +51,57 @@ pub fn surface_candidates(mesh: &TriMesh, count: usize, seed: u64) -> Vec<Surfac
     out
 }
 
+/// The candidates a graded sizing field needs besides an area-uniform pool of `density` points
+/// per unit area (bbox-100 units): on each face `f` of `mesh`, area-uniform points at
+/// `density · (1 / w_f² − 1)` per unit area, `w_f = width(f)` in (0, 1] the face's smallest
+/// relative width (a spacing w times finer takes 1 / w² times the samples, so the pool and the
+/// supplement keep as many candidates per expected sample everywhere). Faces of width 1 get
+/// none; in face order (the caller shuffles); deterministic for a given `seed`.
+pub fn graded_candidates(
+    mesh: &TriMesh,
+    density: f64,
+    width: impl Fn(usize) -> f64,
+    seed: u64,
+) -> Vec<SurfaceSample> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::new();
+    if !(density > 0.0) {
+        return out;
+    }
+    for f in 0..mesh.face_count() {
+        let w = width(f);
+        if !(w < 1.0 && w > 0.0) {
+            continue;
+        }
+        let cross = mesh.face_cross(f);
+        let a = 0.5 * cross.length();
+        if !(a > 0.0) {
+            continue;
+        }
+        let normal = cross / (2.0 * a);
+        let expected = a * density * (1.0 / (w * w) - 1.0);
+        let mut m = expected.floor() as usize;
+        if rng.random::<f64>() < expected - m as f64 {
+            m += 1;
+        }
+        let corners = mesh.corners(f);
+        for _ in 0..m {
+            let (u, v) = random_barycentric(&mut rng);
+            out.push(SurfaceSample {
+                position: point_in_triangle(corners, u, v),
+                normal,
+                face: f as u32,
+            });
+        }
+    }
+    out
+}
+
+/// Shuffles `pool` with `seed` (the linear scan visits candidates in this order).
+pub fn shuffle_candidates(pool: &mut [SurfaceSample], seed: u64) {
+    pool.shuffle(&mut ChaCha8Rng::seed_from_u64(seed));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
