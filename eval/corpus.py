@@ -246,8 +246,12 @@ def main():
             if clean and not args.no_cgal:
                 # CGAL on the input welded as remesh reads it: a crossing our check missed, or
                 # a surface CGAL cannot build, makes it not clean.
-                c = cgal_ruler.check(welded_copy(path, tmp), args.timeout)
-                clean = c.get("pairs") == 0
+                try:
+                    c = cgal_ruler.check(welded_copy(path, tmp), args.timeout)
+                    clean = c.get("pairs") == 0
+                except (ValueError, IndexError, OSError):
+                    clean = False  # a file CGAL's reader cannot take is not known clean
+
             runs = []
             for s in seeds:
                 r = one_run(binary, path, s, args, tmp, input_pairs)

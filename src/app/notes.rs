@@ -13,6 +13,31 @@ pub(super) fn count_note(notes: &mut Vec<String>, target: Option<usize>, vertice
     }
 }
 
+/// The report's notes on the samples the triangulation inserted for the topological ball
+/// property ([`TopologicalBallStats`]): how many, with the count asked and written, and where
+/// the property still failed after the last insertion.
+pub(super) fn topological_ball_notes(
+    notes: &mut Vec<String>,
+    stats: &crate::triangulate::topological_ball::TopologicalBallStats,
+    target: Option<usize>,
+    vertices: usize,
+) {
+    if stats.inserted > 0 {
+        let asked = target.map_or(String::new(), |n| format!("{n} asked, {vertices} written: "));
+        notes.push(format!(
+            "{asked}{} samples were inserted where the sampling was too coarse for the surface              (a sample's restricted Voronoi cell not a disc, or two cells meeting twice: a hole,              a gap, a wall or a tube narrower than the spacing), so that the output keeps the              input's topology",
+            stats.inserted
+        ));
+    }
+    let left = stats.bad_cells_left + stats.bad_pairs_left;
+    if left > 0 {
+        notes.push(format!(
+            "after {} inserted samples the topological ball property still fails at {} cells and              {} pairs of cells: the output's topology may differ from the input's there",
+            stats.inserted, stats.bad_cells_left, stats.bad_pairs_left
+        ));
+    }
+}
+
 /// The report's note on samples that ended in no triangle.
 pub(super) fn dropped_note(dropped: usize) -> String {
     format!("{dropped} samples ended in no triangle and were left out")

@@ -9,6 +9,7 @@ use super::job::{RemeshJob, RemeshedMesh};
 use super::memory;
 use super::notes::{
     count_note, dropped_note, features_note, grading_notes, holes_note, orientation_notes,
+    topological_ball_notes,
 };
 use super::output::{check_and_write, insert_json, insert_kernel_extras, write_output, Outputs};
 use super::quality::{
@@ -396,6 +397,10 @@ pub(super) fn remesh_read(
         ));
     }
     count_note(&mut report.notes, out.target, out.mesh.vertex_count());
+    if let Some(rd) = &out.restricted_delaunay {
+        let (target, vertices) = (out.target, out.mesh.vertex_count());
+        topological_ball_notes(&mut report.notes, &rd.topological_ball, target, vertices);
+    }
     if out.buried_candidates + out.buried_samples > 0 {
         report.notes.push(format!(
             "the input passes through itself: {} candidate points inside its own solid were left \

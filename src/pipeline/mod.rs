@@ -145,7 +145,11 @@ pub fn remesh(
         // samples are kept as they are.
         let inserted = run.triangulated.inserted.len() as f64;
         let aimed = run.ascended.samples.len().max(1) as f64;
-        if inserted > params.count_tolerance * aimed && refinements < params.topology_refinements {
+        let clean = index.crossing_pairs.is_empty() && index.junction_faces.is_empty();
+        if clean
+            && inserted > params.count_tolerance * aimed
+            && refinements < params.topology_refinements
+        {
             let inserted = run.triangulated.inserted.clone();
             let sigma_ref = run.scanned.widths.sigma_ref;
             let corners = run.scanned.corner_term();

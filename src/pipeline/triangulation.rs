@@ -72,7 +72,11 @@ pub(super) fn triangulate_samples(
     // refinement of the input would be too large.
     let restricted = match params.triangulation {
         TriangulationMethod::Umbrellas => None,
-        TriangulationMethod::RestrictedDelaunay(rd) => {
+        TriangulationMethod::RestrictedDelaunay(mut rd) => {
+            // The topology to keep is the input's only where its faces neither cross nor meet
+            // at non-manifold edges: elsewhere no sample is inserted for it.
+            let clean = index.crossing_pairs.is_empty() && index.junction_faces.is_empty();
+            rd.topological_ball.enabled &= clean;
             // The sample spacing is about sigma_p (SAMPLES_PER_SIGMA2 samples per sigma_p^2 of
             // area; on boundary curves one per sigma_p or closer).
             let spacing = sigma_p / SAMPLES_PER_SIGMA2.sqrt();

@@ -600,6 +600,17 @@ impl Rows {
         (compact, values)
     }
 
+    /// The index in `values` of `u` in the row of `v` (an edge's slot), if it is there.
+    pub(super) fn slot(&self, v: u32, u: u32) -> Option<usize> {
+        let from = self.start[v as usize] as usize;
+        self.row(v).binary_search(&u).ok().map(|k| from + k)
+    }
+
+    /// The number of slots (entries of all rows).
+    pub(super) fn slots(&self) -> usize {
+        self.values.len()
+    }
+
     pub(super) fn row(&self, r: u32) -> &[u32] {
         &self.values[self.start[r as usize] as usize..self.start[r as usize + 1] as usize]
     }
@@ -821,7 +832,7 @@ mod tests {
         assert_eq!(stats.empty_cells, 0);
         // On a sphere the dual alone is the whole triangulation: 2V - 4 faces.
         assert_eq!(voted.len(), 2 * 300 - 4);
-        let (faces, _, _, _) = triangulate_restricted(
+        let (faces, _, _, _, _) = triangulate_restricted(
             &set,
             &surface,
             &sheets,

@@ -18,7 +18,9 @@
 //! On the discrete cells: a cell (the refined vertices of one label, the edges and faces among
 //! them) is a disc when it is connected and its Euler characteristic V − E + F is 1 (a
 //! connected part of an orientable surface with χ = 1 is a disc); two cells meet in one arc when
-//! the refined edges between them (mixed edges of that pair) form one chain of faces.
+//! the refined edges between them (mixed edges of that pair) form one chain of faces, and that
+//! chain ends (at a face of three cells or on the input's boundary) rather than closing on
+//! itself.
 
 use glam::DVec3;
 use rustc_hash::FxHashMap;
@@ -115,6 +117,9 @@ pub(super) fn enforce(
             }
         })
         .collect();
+    // A cell grown in pieces (a piece reached through vertices later taken by a nearer sample)
+    // is made one before it is judged: its other pieces go to the cells around them.
+    connect_cells(refined, label, &mut dist, samples.len(), |l| site(l, &added));
     loop {
         let count = samples.len() + added.len();
         let (cells, pairs) = offending(refined, label, count);
@@ -255,8 +260,9 @@ fn connect_cells(
     }
 }
 
-/// The cells that are not discs (labels, ascending) and the pairs of cells that meet in more
-/// than one arc (ascending), of `count` labels.
+/// The cells that are not discs, or that meet two others in more than one point (labels,
+/// ascending), and the pairs of cells that meet in more than one arc or in a closed curve
+/// (ascending), of `count` labels.
 fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[u32; 2]>) {
     let n = refined.positions.len();
     // Per label: vertices, edges and faces inside the cell, and its components.
@@ -294,53 +300,117 @@ fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[
         .filter(|&l| present[l] && (components[l] != 1 || chi[l] != 1))
         .map(|l| l as u32)
         .collect();
-
-    // Mixed edges (between two cells), joined when they are edges of one face of the same pair.
-    let mut ids: FxHashMap<(u32, u32), u32> = FxHashMap::default();
-    let mut pair_of: Vec<[u32; 2]> = Vec::new();
-    let pair = |a: u32, b: u32| [a.min(b), a.max(b)];
-    for v in 0..n as u32 {
-        let l = label[v as usize];
-        if l == u32::MAX {
-            continue;
-        }
-        for &u in refined.neighbours.row(v) {
-            let k = label[u as usize];
-            if u > v && k != l && k != u32::MAX {
-                ids.insert((v, u), pair_of.len() as u32);
-                pair_of.push(pair(l, k));
+    // Mixed edges (between two cells), each by its slot in the row of its lower vertex, joined
+    // when they are edges of one face of the same pair.
+    let neighbours = refined.neighbours;
+    let slot = |a: u32, b: u32| neighbours.slot(a.min(b), a.max(b));
+    let mut arcs = Dsu::new(neighbours.slots());
+    // Per slot: the faces on the edge (an edge of one face is on the input's boundary), and
+    // whether it ends an arc (an edge of a face of three cells).
+    let mut faces_on = vec![0u8; neighbours.slots()];
+    let mut ends = vec![false; neighbours.slots()];
+    for t in refined.triangles {
+        for k in 0..3 {
+            if let Some(e) = slot(t[k], t[(k + 1) % 3]) {
+                faces_on[e] = faces_on[e].saturating_add(1);
             }
         }
-    }
-    let mut arcs = Dsu::new(pair_of.len());
-    let id = |a: u32, b: u32| ids.get(&(a.min(b), a.max(b))).copied();
-    for t in refined.triangles {
         let [a, b, c] = t.map(|v| label[v as usize]);
         if a == u32::MAX || b == u32::MAX || c == u32::MAX || (a == b && b == c) {
             continue;
         }
         if a != b && b != c && a != c {
+            for k in 0..3 {
+                if let Some(e) = slot(t[k], t[(k + 1) % 3]) {
+                    ends[e] = true;
+                }
+            }
             continue;
         }
         // Two of the three edges are mixed, of the same pair.
-        let edges: Vec<u32> = (0..3)
-            .filter_map(|k| id(t[k], t[(k + 1) % 3]))
-            .collect();
-        if let [e, f] = edges[..] {
-            arcs.union(e as usize, f as usize, false);
+        let mut mixed = (0..3)
+            .filter(|&k| label[t[k] as usize] != label[t[(k + 1) % 3] as usize])
+            .filter_map(|k| slot(t[k], t[(k + 1) % 3]));
+        if let (Some(e), Some(f)) = (mixed.next(), mixed.next()) {
+            arcs.union(e, f, false);
         }
     }
-    let mut roots: Vec<([u32; 2], usize)> = (0..pair_of.len())
-        .map(|e| (pair_of[e], arcs.find(e).0))
+    let pair = |a: u32, b: u32| [a.min(b), a.max(b)];
+    let mut edges: Vec<([u32; 2], usize)> = Vec::new();
+    for v in 0..n as u32 {
+        let l = label[v as usize];
+        if l == u32::MAX {
+            continue;
+        }
+        for &u in neighbours.row(v) {
+            let k = label[u as usize];
+            if u > v && k != l && k != u32::MAX {
+                if let Some(e) = neighbours.slot(v, u) {
+                    edges.push((pair(l, k), e));
+                }
+            }
+        }
+    }
+    // An arc with no end (no face of three cells on it, no edge on the input's boundary) is a
+    // closed curve: two cells that meet all around, as two on a sphere.
+    let mut ended = vec![false; neighbours.slots()];
+    for &(_, e) in &edges {
+        if ends[e] || faces_on[e] == 1 {
+            ended[arcs.find(e).0] = true;
+        }
+    }
+    let mut roots: Vec<([u32; 2], usize)> = edges
+        .into_iter()
+        .map(|(p, e)| (p, arcs.find(e).0))
         .collect();
     roots.sort_unstable();
     roots.dedup();
     let mut pairs: Vec<[u32; 2]> = roots
         .chunk_by(|a, b| a.0 == b.0)
-        .filter(|group| group.len() > 1)
+        .filter(|group| group.len() > 1 || !ended[group[0].1])
         .map(|group| group[0].0)
         .collect();
     pairs.sort_unstable();
+    // Three cells meet in at most one point: the faces of three cells of one triple, joined
+    // where they share an edge, are one group. Where they are not, the three cells are judged
+    // as cells that are not discs.
+    let mut triples: Vec<([u32; 3], usize)> = refined
+        .triangles
+        .iter()
+        .enumerate()
+        .filter_map(|(f, t)| {
+            let mut l = t.map(|v| label[v as usize]);
+            if l.contains(&u32::MAX) || l[0] == l[1] || l[1] == l[2] || l[0] == l[2] {
+                return None;
+            }
+            l.sort_unstable();
+            Some((l, f))
+        })
+        .collect();
+    triples.sort_unstable();
+    let mut cells = cells;
+    for group in triples.chunk_by(|a, b| a.0 == b.0) {
+        if group.len() < 2 {
+            continue;
+        }
+        let shares_edge = |f: usize, g: usize| {
+            let (a, b) = (refined.triangles[f], refined.triangles[g]);
+            a.iter().filter(|v| b.contains(v)).count() >= 2
+        };
+        let mut sets = Dsu::new(group.len());
+        for i in 0..group.len() {
+            for j in i + 1..group.len() {
+                if shares_edge(group[i].1, group[j].1) {
+                    sets.union(i, j, false);
+                }
+            }
+        }
+        if (0..group.len()).any(|i| sets.find(i).0 != sets.find(0).0) {
+            cells.extend(group[0].0);
+        }
+    }
+    cells.sort_unstable();
+    cells.dedup();
     (cells, pairs)
 }
 
