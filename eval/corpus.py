@@ -270,13 +270,13 @@ def main():
                 note = worst["message"].splitlines()[0][:90] if worst["message"] else f"exit {worst['exit']}"
             if worst["outcome"] in ("violation", "crossings", "disagree"):
                 note = f"pairs {worst.get('pairs')} ({worst.get('pairs_where_input_crosses', 0)} at the input's; input {input_pairs}) {','.join(sorted(set(worst.get('violations', []))))} " + note
+            if clean:
+                note = "[clean] " + note
             cgal = [r["cgal"]["pairs"] for r in done if r.get("cgal")]
             cgal_text = "" if args.no_cgal else (
                 "-" if not cgal or any(c is None for c in cgal) else str(max(cgal)))
             print(f"{path.name[:34]:34} {worst['outcome']:10} {statistics.median(walls):7.2f}/{max(walls):6.2f}"
                   f" {tmin:6.1f} {tmax:6.1f} {outside:7d} {cgal_text:>5}  {note}", flush=True)
-            if clean:
-                note = "[clean] " + note
             rows.append({"file": str(path.relative_to(corpus)), "input_faces": input_faces,
                          "input_pairs": input_pairs, "clean": clean, "runs": runs})
     all_runs = [r for row in rows for r in row["runs"]]

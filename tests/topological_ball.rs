@@ -77,7 +77,9 @@ fn plate_with_hole(w: f64) -> TriMesh {
     ticks.extend([50.0 - w / 2.0, 50.0 + w / 2.0]);
     ticks.sort_by(f64::total_cmp);
     let hole = ticks.iter().position(|&t| t == 50.0 - w / 2.0).unwrap();
-    boxes([&ticks, &ticks, &[0.0, 2.0]], |i, j, _| !(i == hole && j == hole))
+    boxes([&ticks, &ticks, &[0.0, 2.0]], |i, j, _| {
+        !(i == hole && j == hole)
+    })
 }
 
 fn run(mesh: &TriMesh, points: usize, seed: u64, features: FeatureDetection) -> TriMesh {
@@ -94,7 +96,12 @@ fn run(mesh: &TriMesh, points: usize, seed: u64, features: FeatureDetection) -> 
 fn the_plate_is_a_closed_torus() {
     let t = topology(&plate_with_hole(2.0));
     assert_eq!(
-        (t.components, t.euler_characteristic, t.boundary_edges, t.non_manifold_edges),
+        (
+            t.components,
+            t.euler_characteristic,
+            t.boundary_edges,
+            t.non_manifold_edges
+        ),
         (1, 0, 0, 0)
     );
 }

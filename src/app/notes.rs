@@ -23,7 +23,9 @@ pub(super) fn topological_ball_notes(
     vertices: usize,
 ) {
     if stats.inserted > 0 {
-        let asked = target.map_or(String::new(), |n| format!("{n} asked, {vertices} written: "));
+        let asked = target.map_or(String::new(), |n| {
+            format!("{n} asked, {vertices} written: ")
+        });
         notes.push(format!(
             "{asked}{} samples were inserted where the sampling was too coarse for the surface              (a sample's restricted Voronoi cell not a disc, or two cells meeting twice: a hole,              a gap, a wall or a tube narrower than the spacing), so that the output keeps the              input's topology",
             stats.inserted

@@ -12,13 +12,13 @@ use crate::mesh::sheets::Sheets;
 use crate::mesh::{orient_consistently, Normalization, OrientStats, TriMesh};
 use crate::sampling::boundary::{boundary_curves, BoundaryCurve};
 use crate::sampling::curves::curve_length;
-use crate::sampling::spacing::{expected_samples, BOUNDARY_SPACING_PER_SIGMA, SAMPLES_PER_SIGMA2};
 use crate::sampling::sizing::SizingField;
+use crate::sampling::spacing::{expected_samples, BOUNDARY_SPACING_PER_SIGMA, SAMPLES_PER_SIGMA2};
 use crate::surface::candidates::{graded_candidates, shuffle_candidates, surface_candidates};
-use rayon::prelude::*;
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::winding::BuriedTest;
 use crate::surface::{MeshSurface, SurfaceSample};
+use rayon::prelude::*;
 
 use super::MAX_POINTS;
 
@@ -268,7 +268,10 @@ impl Candidates {
             .map(|f| {
                 let c = mesh.corners(f);
                 let w = field.width((c[0] + c[1] + c[2]) / 3.0);
-                let size = c[0].distance(c[1]).max(c[1].distance(c[2])).max(c[2].distance(c[0]));
+                let size = c[0]
+                    .distance(c[1])
+                    .max(c[1].distance(c[2]))
+                    .max(c[2].distance(c[0]));
                 if size > w * sigma_p {
                     c.iter().map(|&p| field.width(p)).fold(w, f64::min)
                 } else {

@@ -22,9 +22,9 @@ use crate::error::{Error, Result};
 use crate::finish::untangle::UntangleParams;
 use crate::geometry::self_intersection::CrossingRegions;
 use crate::mesh::{Normalization, TriMesh};
+use crate::sampling::sizing::SizingField;
 use crate::sampling::spacing::sigma_p_for_count;
 use crate::surface::features::Features;
-use crate::sampling::sizing::SizingField;
 use crate::timing::StageTimer;
 use ascent::{ascend, Ascended};
 use finish::{finish, Finished, Finishing, StrayRule};
@@ -145,15 +145,18 @@ pub fn remesh(
         // samples are kept as they are.
         let inserted = run.triangulated.inserted.len() as f64;
         let aimed = run.ascended.samples.len().max(1) as f64;
-        let clean = index.crossing_pairs.is_empty() && index.junction_faces.is_empty();
-        if clean
+        if index.junction_faces.is_empty()
             && inserted > params.count_tolerance * aimed
             && refinements < params.topology_refinements
         {
             let inserted = run.triangulated.inserted.clone();
             let sigma_ref = run.scanned.widths.sigma_ref;
             let corners = run.scanned.corner_term();
-            let creases = crease_terms(&corners, &run.scanned.scan.separation, &run.scanned.scan.curvature);
+            let creases = crease_terms(
+                &corners,
+                &run.scanned.scan.separation,
+                &run.scanned.scan.curvature,
+            );
             let field = run.scanned.widths.field().with(&creases);
             let widths: Vec<f64> = inserted.iter().map(|&p| field.width(p)).collect();
             drop(run);

@@ -18,7 +18,9 @@ use crate::sampling::boundary::BoundaryCurve;
 use crate::sampling::sizing::SizingField;
 use crate::sampling::spacing::SAMPLES_PER_SIGMA2;
 use crate::spatial::StaticTree;
-use crate::surface::local_feature_size::{local_feature_size_in_patches, LfsParams, LocalFeatureSize};
+use crate::surface::local_feature_size::{
+    local_feature_size_in_patches, LfsParams, LocalFeatureSize,
+};
 
 /// Parameters of the grading.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -152,7 +152,8 @@ impl LocalFeatureSize {
                     return m.max(0.0);
                 }
                 let reach = m / slope;
-                self.tree.within_unsorted(self.positions[i], reach * reach, near);
+                self.tree
+                    .within_unsorted(self.positions[i], reach * reach, near);
                 near.iter()
                     .map(|&(j, d2)| values[j as usize] + slope * d2.sqrt())
                     .fold(m, f64::min)
@@ -272,7 +273,13 @@ pub fn local_feature_size_in_patches(
     }
     let point_patch: Vec<u32> = first_face
         .iter()
-        .map(|&f| if f == u32::MAX { u32::MAX } else { patch[f as usize] })
+        .map(|&f| {
+            if f == u32::MAX {
+                u32::MAX
+            } else {
+                patch[f as usize]
+            }
+        })
         .chain(samples.iter().map(|s| patch[s.face as usize]))
         .collect();
     let tree = StaticTree::new(&positions);
@@ -298,8 +305,13 @@ pub fn local_feature_size_in_patches(
             let outer = ball.shrink(p, n, 1.0, &tree);
             let thin = |b: &Shrunk| if b.thin { b.radius } else { max_radius };
             // A contact on the point's own patch (or of a point on no face) measures the patch.
-            let on_patch =
-                |b: &Shrunk| if own == u32::MAX || b.contact_patch == own { b.radius } else { max_radius };
+            let on_patch = |b: &Shrunk| {
+                if own == u32::MAX || b.contact_patch == own {
+                    b.radius
+                } else {
+                    max_radius
+                }
+            };
             (
                 inner.radius.min(outer.radius),
                 usize::from(!inner.converged) + usize::from(!outer.converged),

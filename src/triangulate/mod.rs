@@ -9,6 +9,7 @@ pub mod recover;
 pub mod refine;
 pub mod restricted_delaunay;
 pub mod restricted_voronoi;
+mod rows;
 pub mod tangent_delaunay;
 pub mod topological_ball;
 pub mod unsupported;
@@ -189,7 +190,14 @@ fn on_distinct(set: &SampleSet, mut run: impl FnMut(&SampleSet) -> Triangulated)
     let (given, kept) = (set.positions.len() as u32, distinct.len() as u32);
     let faces = faces
         .into_iter()
-        .map(|f| f.map(|v| distinct.get(v as usize).copied().unwrap_or(given + v - kept)))
+        .map(|f| {
+            f.map(|v| {
+                distinct
+                    .get(v as usize)
+                    .copied()
+                    .unwrap_or(given + v - kept)
+            })
+        })
         .collect();
     (faces, sources, stats)
 }

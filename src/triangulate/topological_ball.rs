@@ -27,7 +27,7 @@ use rustc_hash::FxHashMap;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use super::restricted_delaunay::Rows;
+use super::rows::Rows;
 use crate::disjoint_sets::Dsu;
 
 /// Parameters of [`enforce`].
@@ -119,7 +119,9 @@ pub(super) fn enforce(
         .collect();
     // A cell grown in pieces (a piece reached through vertices later taken by a nearer sample)
     // is made one before it is judged: its other pieces go to the cells around them.
-    connect_cells(refined, label, &mut dist, samples.len(), |l| site(l, &added));
+    connect_cells(refined, label, &mut dist, samples.len(), |l| {
+        site(l, &added)
+    });
     loop {
         let count = samples.len() + added.len();
         let (cells, pairs) = offending(refined, label, count);
@@ -139,7 +141,10 @@ pub(super) fn enforce(
         let candidates = insertion_points(refined, label, &dist, &cells, &pairs);
         // One insertion per offending cell or pair, farthest first; a candidate whose vertex an
         // earlier insertion of this round took over is left (its cell changed).
-        let start_label: Vec<(u32, u32)> = candidates.iter().map(|&(_, v)| (v, label[v as usize])).collect();
+        let start_label: Vec<(u32, u32)> = candidates
+            .iter()
+            .map(|&(_, v)| (v, label[v as usize]))
+            .collect();
         for (&(_, v), &(_, l0)) in candidates.iter().zip(&start_label) {
             if added.len() >= budget {
                 break;
@@ -290,8 +295,7 @@ fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[
         }
     }
     let mut components = vec![0u32; count];
-    for v in 0..n {
-        let l = label[v];
+    for (v, &l) in label.iter().enumerate() {
         if l != u32::MAX && dsu.find(v).0 == v {
             components[l as usize] += 1;
         }
@@ -523,7 +527,10 @@ mod tests {
             .collect();
         let mut label = nearest(&mesh.positions, &samples);
         let (added, stats) = enforce(&refined, &samples, &mut label, &Default::default());
-        assert_eq!((added.len(), stats.bad_cells_first, stats.bad_pairs_first), (0, 0, 0));
+        assert_eq!(
+            (added.len(), stats.bad_cells_first, stats.bad_pairs_first),
+            (0, 0, 0)
+        );
     }
 
     /// Two samples on a thin tube, one at each end: each cell wraps around the tube (an
@@ -536,7 +543,11 @@ mod tests {
         for j in 0..=along {
             for i in 0..around {
                 let a = std::f64::consts::TAU * i as f64 / around as f64;
-                positions.push(DVec3::new(0.2 * a.cos(), 0.2 * a.sin(), 4.0 * j as f64 / along as f64));
+                positions.push(DVec3::new(
+                    0.2 * a.cos(),
+                    0.2 * a.sin(),
+                    4.0 * j as f64 / along as f64,
+                ));
             }
         }
         let id = |i: usize, j: usize| (j * around + i % around) as u32;
