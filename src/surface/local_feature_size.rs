@@ -84,7 +84,7 @@ pub struct LocalFeatureSize {
     /// The local feature size of each smooth patch at each of `positions`: the smaller radius
     /// of the two medial balls whose contact lies on the point's own patch (the patches are the
     /// faces joined across every edge but the creases passed to
-    /// [`local_feature_size_in_patches`]), the cap where neither does. The medial axis of the
+    /// `local_feature_size_in_patches`), the cap where neither does. The medial axis of the
     /// surface without the branches that end at the creases: a ball stopped by the face across
     /// a crease measures the crease, which its own samples keep; a ball stopped by the same
     /// patch measures its curvature, a groove or a tip. Equal to `lfs` without creases.
