@@ -763,20 +763,49 @@ fn sigma_p_too_small_for_memory_is_a_usage_error_at_once() {
 }
 
 /// Issue 14, item 11: `--points 5` and `--sigma-p 1000` said "error: : no triangle ..." with an
-/// empty file name (exit 3), and with `--no-distance` wrote an empty mesh (exit 0).
+/// empty file name (exit 3), and with `--no-distance` wrote an empty mesh (exit 0). Where no
+/// triangle forms (the umbrellas, which insert no sample) it is a usage error naming the flag,
+/// nothing written. Issue 75: the restricted Delaunay triangulation (the default) inserts the
+/// samples the surface's topology needs, so spot at 5 points comes out a closed sphere with a
+/// note saying how many were inserted; with `--strict` that count is refused, nothing written.
 #[test]
-fn a_density_that_gives_no_triangle_is_a_usage_error_and_writes_nothing() {
+fn a_density_too_small_for_the_surface_keeps_its_topology_or_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out.obj");
     let input = shared("spot.obj");
     for (flag, value) in [("--points", "5"), ("--sigma-p", "1000")] {
         for extra in [&[][..], &["--no-distance"][..]] {
             let mut args = vec![input.to_str().unwrap(), out.to_str().unwrap(), flag, value];
+            args.extend_from_slice(&["--triangulation", "umbrellas"]);
             args.extend_from_slice(extra);
             let o = remesh(&args);
             assert_error(&o, 2, &[flag, "no triangle"], &out);
         }
     }
+    for (flag, value) in [("--points", "5"), ("--sigma-p", "1000")] {
+        let r = assert_remeshed(&input, &out, &[flag, value]);
+        assert_eq!(r["topology_changes"].as_array().unwrap().len(), 0, "{r}");
+        assert_eq!(
+            (topo(&r, "components"), topo(&r, "euler_characteristic")),
+            (1, 2)
+        );
+        let notes = r["notes"].to_string();
+        assert!(notes.contains("samples were inserted"), "{notes}");
+        std::fs::remove_file(&out).unwrap();
+    }
+    let o = remesh(&[
+        input.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--points",
+        "5",
+        "--strict",
+    ]);
+    assert_error(
+        &o,
+        1,
+        &["5 points are too few to keep the input's topology"],
+        &out,
+    );
 }
 
 /// Issue 14, item 11: an unsupported output extension was an input error (3), found after the

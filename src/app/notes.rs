@@ -27,14 +27,18 @@ pub(super) fn topological_ball_notes(
             format!("{n} asked, {vertices} written: ")
         });
         notes.push(format!(
-            "{asked}{} samples were inserted where the sampling was too coarse for the surface              (a sample's restricted Voronoi cell not a disc, or two cells meeting twice: a hole,              a gap, a wall or a tube narrower than the spacing), so that the output keeps the              input's topology",
+            "{asked}{} samples were inserted where the sampling was too coarse for the surface \
+             (a sample's restricted Voronoi cell not a disc, or two cells meeting twice: a hole, \
+             a gap, a wall or a tube narrower than the spacing), so that the output keeps the \
+             input's topology",
             stats.inserted
         ));
     }
     let left = stats.bad_cells_left + stats.bad_pairs_left;
     if left > 0 {
         notes.push(format!(
-            "after {} inserted samples the topological ball property still fails at {} cells and              {} pairs of cells: the output's topology may differ from the input's there",
+            "after {} inserted samples the topological ball property still fails at {} cells and \
+             {} pairs of cells: the output's topology may differ from the input's there",
             stats.inserted, stats.bad_cells_left, stats.bad_pairs_left
         ));
     }

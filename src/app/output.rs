@@ -104,8 +104,7 @@ pub(super) fn check_and_write(
 }
 
 /// Notes the output's invariant violations in `report`; with `job.strict`, an error when it
-/// breaks an invariant, its topology differs from the input's, or the samples inserted to keep
-/// the topology took the count more than 1% past `--points`.
+/// breaks an invariant or its topology differs from the input's.
 pub(super) fn refuse_if_strict(job: &RemeshJob, report: &mut QualityReport) -> Result<()> {
     let mut refusals = Vec::new();
     if !report.invariant_violations.is_empty() {
@@ -125,23 +124,6 @@ pub(super) fn refuse_if_strict(job: &RemeshJob, report: &mut QualityReport) -> R
             "the output's topology differs from the input's ({})",
             report.topology_changes_text()
         ));
-    }
-    // Samples inserted to keep the topology that took the count more than 1% past the target.
-    let inserted = report
-        .extra
-        .get("restricted_delaunay")
-        .and_then(|r| r.get("topological_ball"))
-        .and_then(|t| t.get("inserted"))
-        .and_then(|v| v.as_u64())
-        .unwrap_or(0);
-    let target = report.extra.get("target_points").and_then(|v| v.as_u64());
-    if let (true, Some(n)) = (inserted > 0, target) {
-        let written = report.topology.vertices as u64;
-        if written as f64 > 1.01 * n as f64 {
-            refusals.push(format!(
-                "{n} points are too few to keep the input's topology ({written} written,                  {inserted} of them inserted for it)"
-            ));
-        }
     }
     if job.strict && !refusals.is_empty() {
         return Err(Error::Internal {

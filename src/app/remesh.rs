@@ -247,6 +247,21 @@ pub(super) fn remesh_read(
             ));
         }
     }
+    // With `strict`, a count too small to keep the topology is refused: the samples inserted
+    // for it took the count more than 1% past the target.
+    if let (true, Some(rd), Some(n)) = (job.strict, &out.restricted_delaunay, out.target) {
+        let (inserted, written) = (rd.topological_ball.inserted, mesh_out.vertex_count());
+        if inserted > 0 && written as f64 > 1.01 * n as f64 {
+            return Err(Error::Internal {
+                stage: "invariant check",
+                message: format!(
+                    "{n} points are too few to keep the input's topology ({written} written, \
+                     {inserted} of them inserted for it); {} was not written (`strict`)",
+                    job.output.display()
+                ),
+            });
+        }
+    }
     let check_seconds = t.elapsed();
     report.push_stage("read", read_seconds.0, read_seconds.1);
     check_and_write(

@@ -147,6 +147,9 @@ pub(super) struct InputIndex<'a> {
     pub sheets: Sheets,
     /// The faces where closed parts meet at a non-manifold edge.
     pub junction_faces: Vec<u32>,
+    /// Whether every edge of the input has at most two faces: only then is the input's topology
+    /// one the output can keep, and the triangulation inserts samples for it.
+    pub manifold_edges: bool,
 }
 
 impl<'a> InputIndex<'a> {
@@ -167,12 +170,14 @@ impl<'a> InputIndex<'a> {
         // apart).
         let sheets = Sheets::new(mesh);
         let junction_faces = sheets.junction_faces(mesh);
+        let manifold_edges = mesh.edge_uses().values().all(|&(_, uses)| uses <= 2);
         Ok(InputIndex {
             surface,
             buried_test,
             crossing_pairs,
             sheets,
             junction_faces,
+            manifold_edges,
         })
     }
 }

@@ -145,7 +145,7 @@ pub fn remesh(
         // samples are kept as they are.
         let inserted = run.triangulated.inserted.len() as f64;
         let aimed = run.ascended.samples.len().max(1) as f64;
-        if index.junction_faces.is_empty()
+        if index.manifold_edges
             && inserted > params.count_tolerance * aimed
             && refinements < params.topology_refinements
         {
