@@ -26,6 +26,7 @@ use crate::sampling::sizing::SizingField;
 use crate::sampling::spacing::sigma_p_for_count;
 use crate::surface::features::Features;
 use crate::timing::StageTimer;
+use crate::triangulate::TriangulationMethod;
 use ascent::{ascend, Ascended};
 use finish::{finish, Finished, Finishing, StrayRule};
 use input::{Candidates, InputIndex, NormalizedInput};
@@ -46,6 +47,11 @@ pub use params::{Density, RemeshParams, FIT_ITERATIONS, MAX_POINTS};
 /// shortfall: the retry's miss is how closely the count can be aimed on this input, and a
 /// second retry aims no closer, at the cost of a third run.
 const MAX_ATTEMPTS: usize = 2;
+
+/// The refinement budget of the restricted Delaunay triangulation (vertices added per sample)
+/// when the sampling runs again finer around inserted samples: with the default 200,
+/// ADIS16480's second run fell back to the umbrellas (4 components, 2 boundary loops).
+const REFINED_MAX_ADDED_PER_SAMPLE: usize = 1000;
 
 /// The width around the samples a triangulation inserted for the topological ball property,
 /// relative to the width there, for the next attempt (see `RemeshParams::topology_refinements`).
@@ -241,7 +247,15 @@ fn run_once<'s>(
     let field = scanned.widths.field().with(&creases);
     let edges = (boundary_edges.as_slice(), feature_edges.as_slice());
     let samples = &ascended.samples;
-    let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, params);
+    // A sampling run again finer around the samples an earlier triangulation inserted asks
+    // for a finer refinement of the input there than the budget against slivers allows.
+    let mut tri_params = *params;
+    if let (true, TriangulationMethod::RestrictedDelaunay(rd)) =
+        (sizing.refinement.is_some(), &mut tri_params.triangulation)
+    {
+        rd.max_added_per_sample = rd.max_added_per_sample.max(REFINED_MAX_ADDED_PER_SAMPLE);
+    }
+    let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, &tri_params);
     timer.lap("triangulate");
 
     // Where the input's faces cross or its parts meet: an output face within a spacing of there

@@ -58,7 +58,7 @@ impl Default for RestrictedDelaunayParams {
     fn default() -> Self {
         RestrictedDelaunayParams {
             resolution: 0.5,
-            max_added_per_sample: 1000,
+            max_added_per_sample: 200,
             clipped: false,
             topological_ball: TopologicalBallParams::default(),
         }
