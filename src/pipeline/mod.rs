@@ -114,7 +114,6 @@ pub fn remesh(
         &input,
         &index.surface,
         first_sigma_p,
-        &features.edges,
         params,
         on_stage,
         &mut timer,

@@ -46,7 +46,6 @@ impl Sizing {
         input: &NormalizedInput,
         surface: &MeshSurface,
         first_sigma_p: f64,
-        creases: &[[u32; 2]],
         params: &RemeshParams,
         on_stage: &(dyn Fn(&str) + Sync),
         timer: &mut StageTimer,
@@ -62,7 +61,7 @@ impl Sizing {
                 // Estimate points every first_sigma_p (about one per expected sample), at most
                 // MAX_GRADING_POINTS of them.
                 let spacing = first_sigma_p.max((input.area / MAX_GRADING_POINTS).sqrt());
-                let grading = Grading::new(&input.mesh, &input.curves, creases, g, cap, spacing)?;
+                let grading = Grading::new(&input.mesh, &input.curves, g, cap, spacing)?;
                 timer.lap("local feature size");
                 Some(grading)
             }

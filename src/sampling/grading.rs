@@ -18,9 +18,7 @@ use crate::sampling::boundary::BoundaryCurve;
 use crate::sampling::sizing::SizingField;
 use crate::sampling::spacing::SAMPLES_PER_SIGMA2;
 use crate::spatial::StaticTree;
-use crate::surface::local_feature_size::{
-    local_feature_size_in_patches, LfsParams, LocalFeatureSize,
-};
+use crate::surface::local_feature_size::{local_feature_size, LfsParams, LocalFeatureSize};
 
 /// Parameters of the grading.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -111,12 +109,11 @@ impl Grading {
     pub fn new(
         mesh: &TriMesh,
         curves: &[BoundaryCurve],
-        creases: &[[u32; 2]],
         params: GradingParams,
         cap: f64,
         spacing: f64,
     ) -> Result<Self> {
-        let lfs = local_feature_size_in_patches(
+        let lfs = local_feature_size(
             mesh,
             &LfsParams {
                 spacing,
@@ -124,17 +121,8 @@ impl Grading {
                 at_vertices: false,
                 ..LfsParams::default()
             },
-            creases,
         )?;
-        // The local feature size the spacing follows: the thickness (walls, tubes, gaps and holes)
-        // and each smooth patch's own (curvature, grooves, tips), not the branches of the medial
-        // axis that end at the creases kept.
-        let values: Vec<f64> = lfs
-            .thickness
-            .iter()
-            .zip(&lfs.patch_lfs)
-            .map(|(&t, &p)| t.min(p))
-            .collect();
+        let values = lfs.thickness.clone();
         // The spacing c · lfs grows by at most `gradation` per unit of distance.
         let slope = (params.gradation / params.lfs_factor).min(1.0);
         let filtered = median_filtered(&lfs, &values, MEDIAN_NEIGHBORS);

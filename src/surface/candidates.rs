@@ -25,21 +25,39 @@ pub fn surface_candidates(mesh: &TriMesh, count: usize, seed: u64) -> Vec<Surfac
         return out;
     }
     let density = count as f64 / area;
+    draw_per_face(mesh, &mut rng, |_| density, &mut out);
+    out.shuffle(&mut rng);
+    out
+}
+
+/// Stratified area-uniform points on each face `f` of `mesh` at `per_area(f)` points per unit
+/// area (none where it is not positive): ⌊A_f ρ⌋ points plus one more with probability equal to
+/// the fraction, each with its face's unit normal, appended to `out` in face order.
+fn draw_per_face(
+    mesh: &TriMesh,
+    rng: &mut ChaCha8Rng,
+    per_area: impl Fn(usize) -> f64,
+    out: &mut Vec<SurfaceSample>,
+) {
     for f in 0..mesh.face_count() {
+        let rho = per_area(f);
+        if !(rho > 0.0) {
+            continue;
+        }
         let cross = mesh.face_cross(f);
         let a = 0.5 * cross.length();
         if !(a > 0.0) {
             continue;
         }
         let normal = cross / (2.0 * a);
-        let expected = a * density;
+        let expected = a * rho;
         let mut m = expected.floor() as usize;
         if rng.random::<f64>() < expected - m as f64 {
             m += 1;
         }
         let corners = mesh.corners(f);
         for _ in 0..m {
-            let (u, v) = random_barycentric(&mut rng);
+            let (u, v) = random_barycentric(rng);
             out.push(SurfaceSample {
                 position: point_in_triangle(corners, u, v),
                 normal,
@@ -47,8 +65,6 @@ pub fn surface_candidates(mesh: &TriMesh, count: usize, seed: u64) -> Vec<Surfac
             });
         }
     }
-    out.shuffle(&mut rng);
-    out
 }
 
 /// The candidates a graded sizing field needs besides an area-uniform pool of `density` points
@@ -68,32 +84,15 @@ pub fn graded_candidates(
     if !(density > 0.0) {
         return out;
     }
-    for f in 0..mesh.face_count() {
+    let per_area = |f: usize| {
         let w = width(f);
-        if !(w < 1.0 && w > 0.0) {
-            continue;
+        if w < 1.0 && w > 0.0 {
+            density * (1.0 / (w * w) - 1.0)
+        } else {
+            0.0
         }
-        let cross = mesh.face_cross(f);
-        let a = 0.5 * cross.length();
-        if !(a > 0.0) {
-            continue;
-        }
-        let normal = cross / (2.0 * a);
-        let expected = a * density * (1.0 / (w * w) - 1.0);
-        let mut m = expected.floor() as usize;
-        if rng.random::<f64>() < expected - m as f64 {
-            m += 1;
-        }
-        let corners = mesh.corners(f);
-        for _ in 0..m {
-            let (u, v) = random_barycentric(&mut rng);
-            out.push(SurfaceSample {
-                position: point_in_triangle(corners, u, v),
-                normal,
-                face: f as u32,
-            });
-        }
-    }
+    };
+    draw_per_face(mesh, &mut rng, per_area, &mut out);
     out
 }
 

@@ -81,14 +81,6 @@ pub struct LocalFeatureSize {
     /// nearby sheet, a tube's radius, a tip), the cap otherwise (a ball set by a concave crease,
     /// a bump, a polyhedron's corner or the curvature of one sheet). Bounds `lfs` from above.
     pub thickness: Vec<f64>,
-    /// The local feature size of each smooth patch at each of `positions`: the smaller radius
-    /// of the two medial balls whose contact lies on the point's own patch (the patches are the
-    /// faces joined across every edge but the creases passed to
-    /// `local_feature_size_in_patches`), the cap where neither does. The medial axis of the
-    /// surface without the branches that end at the creases: a ball stopped by the face across
-    /// a crease measures the crease, which its own samples keep; a ball stopped by the same
-    /// patch measures its curvature, a groove or a tip. Equal to `lfs` without creases.
-    pub patch_lfs: Vec<f64>,
     /// Number of mesh vertices (the first entries of `positions` and `lfs`; 0 without
     /// [`LfsParams::at_vertices`]).
     pub vertex_count: usize,
@@ -194,19 +186,6 @@ impl LocalFeatureSize {
 ///   22, 1999, 481–504. doi:10.1007/PL00009475 (the local feature size: the distance from a
 ///   surface point to the medial axis; it is 1-Lipschitz).
 pub fn local_feature_size(mesh: &TriMesh, params: &LfsParams) -> Result<LocalFeatureSize> {
-    local_feature_size_in_patches(mesh, params, &[])
-}
-
-/// [`local_feature_size`], with [`LocalFeatureSize::patch_lfs`] for the patches between the
-/// edges `creases` (`[a, b]` vertex pairs of `mesh`, in either order).
-///
-/// # Errors
-/// Those of [`local_feature_size`].
-pub fn local_feature_size_in_patches(
-    mesh: &TriMesh,
-    params: &LfsParams,
-    creases: &[[u32; 2]],
-) -> Result<LocalFeatureSize> {
     let bad = |name: &'static str, message: String| Error::InvalidParameter { name, message };
     if !(params.spacing.is_finite() && params.spacing > 0.0) {
         return Err(bad(
@@ -259,33 +238,8 @@ pub fn local_feature_size_in_patches(
         }
     }));
 
-    let patch = patches(mesh, creases);
-    // The patch of each estimate point: a vertex's first face's, a point's face's.
-    let mut first_face = vec![u32::MAX; if params.at_vertices { vertex_count } else { 0 }];
-    if params.at_vertices {
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            for &v in t {
-                if first_face[v as usize] == u32::MAX {
-                    first_face[v as usize] = f as u32;
-                }
-            }
-        }
-    }
-    let point_patch: Vec<u32> = first_face
-        .iter()
-        .map(|&f| {
-            if f == u32::MAX {
-                u32::MAX
-            } else {
-                patch[f as usize]
-            }
-        })
-        .chain(samples.iter().map(|s| patch[s.face as usize]))
-        .collect();
     let tree = StaticTree::new(&positions);
     let ball = Ball {
-        patch: &patch,
-        point_patch: &point_patch,
         surface: &surface,
         positions: &positions,
         max_radius,
@@ -293,30 +247,20 @@ pub fn local_feature_size_in_patches(
         max_iterations: params.max_iterations,
         cos_thin: params.thin_separation_deg.to_radians().cos(),
     };
-    let per_point: Vec<(f64, usize, f64, f64)> = positions
+    let per_point: Vec<(f64, usize, f64)> = positions
         .par_iter()
         .zip(normals.par_iter())
-        .zip(point_patch.par_iter())
-        .map(|((&p, &n), &own)| {
+        .map(|(&p, &n)| {
             if !(n.length_squared() > 0.5) || !p.is_finite() {
-                return (max_radius, 0, max_radius, max_radius);
+                return (max_radius, 0, max_radius);
             }
-            let inner = ball.shrink(p, n, -1.0, &tree);
-            let outer = ball.shrink(p, n, 1.0, &tree);
-            let thin = |b: &Shrunk| if b.thin { b.radius } else { max_radius };
-            // A contact on the point's own patch (or of a point on no face) measures the patch.
-            let on_patch = |b: &Shrunk| {
-                if own == u32::MAX || b.contact_patch == own {
-                    b.radius
-                } else {
-                    max_radius
-                }
-            };
+            let (inner, a, inner_thin) = ball.shrink(p, n, -1.0, &tree);
+            let (outer, b, outer_thin) = ball.shrink(p, n, 1.0, &tree);
+            let thin = |r: f64, thin: bool| if thin { r } else { max_radius };
             (
-                inner.radius.min(outer.radius),
-                usize::from(!inner.converged) + usize::from(!outer.converged),
-                thin(&inner).min(thin(&outer)),
-                on_patch(&inner).min(on_patch(&outer)),
+                inner.min(outer),
+                usize::from(!a) + usize::from(!b),
+                thin(inner, inner_thin).min(thin(outer, outer_thin)),
             )
         })
         .collect();
@@ -327,56 +271,18 @@ pub fn local_feature_size_in_patches(
         .count();
     let not_converged = per_point.iter().map(|x| x.1).sum();
     let thickness = per_point.iter().map(|x| x.2).collect();
-    let patch_lfs = per_point.iter().map(|x| x.3).collect();
     let lfs = per_point.into_iter().map(|x| x.0).collect();
     Ok(LocalFeatureSize {
         tree,
         positions,
         lfs,
         thickness,
-        patch_lfs,
         vertex_count,
         spacing,
         max_radius,
         without_normal,
         not_converged,
     })
-}
-
-/// The patch of each face of `mesh`: faces joined across every edge but `creases` (an edge of
-/// other than two faces joins the faces it has). Patch ids are the smallest face of each.
-fn patches(mesh: &TriMesh, creases: &[[u32; 2]]) -> Vec<u32> {
-    let nf = mesh.triangles.len();
-    if creases.is_empty() {
-        return vec![0; nf];
-    }
-    let cut: rustc_hash::FxHashSet<[u32; 2]> =
-        creases.iter().map(|&[a, b]| [a.min(b), a.max(b)]).collect();
-    let mut first: rustc_hash::FxHashMap<[u32; 2], u32> = Default::default();
-    let mut sets = crate::disjoint_sets::Dsu::new(nf);
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            let key = [a.min(b), a.max(b)];
-            if cut.contains(&key) {
-                continue;
-            }
-            match first.entry(key) {
-                std::collections::hash_map::Entry::Occupied(e) => {
-                    sets.union(*e.get() as usize, f, false);
-                }
-                std::collections::hash_map::Entry::Vacant(e) => {
-                    e.insert(f as u32);
-                }
-            }
-        }
-    }
-    let mut root_min = vec![u32::MAX; nf];
-    let roots: Vec<usize> = (0..nf).map(|f| sets.find(f).0).collect();
-    for f in 0..nf {
-        root_min[roots[f]] = root_min[roots[f]].min(f as u32);
-    }
-    roots.iter().map(|&r| root_min[r]).collect()
 }
 
 /// Barycentric coordinates of `p` (in the triangle's plane) in triangle `[a, b, c]`; the
@@ -394,16 +300,6 @@ fn barycentric([a, b, c]: [DVec3; 3], p: DVec3) -> [f64; 3] {
     [1.0 - v - w, v, w]
 }
 
-/// One side's medial ball ([`Ball::shrink`]).
-struct Shrunk {
-    radius: f64,
-    converged: bool,
-    /// Whether it reaches across to another sheet.
-    thin: bool,
-    /// The patch of the surface point that last shrank it (`u32::MAX - 1`: none did).
-    contact_patch: u32,
-}
-
 /// How far from a medial ball's centre, in ball radii, the other sheet may be for the ball to
 /// count toward the thickness (see `Ball::shrink`): a faceted tube stops the ball short of its
 /// inscribed radius (the adjacent facet of a 16-gon, seen along an interpolated normal, stops
@@ -413,10 +309,6 @@ const ACROSS_REACH: f64 = 3.0;
 
 /// The shrinking ball's fixed inputs.
 struct Ball<'a> {
-    /// The patch of each face ([`patches`]).
-    patch: &'a [u32],
-    /// The patch of each estimate point (`u32::MAX`: none).
-    point_patch: &'a [u32],
     surface: &'a MeshSurface,
     positions: &'a [DVec3],
     max_radius: f64,
@@ -448,20 +340,18 @@ impl Ball<'_> {
     /// tube, a sharp cone or two facing sheets are nearly parallel across, while near the
     /// corner of a polyhedron (a tetrahedron's faces are 109.5° apart) the ball's antipode can
     /// land on a third face at a wide angle: a corner is a feature, not a thin part.
-    fn shrink(&self, p: DVec3, n: DVec3, side: f64, points: &StaticTree) -> Shrunk {
+    fn shrink(&self, p: DVec3, n: DVec3, side: f64, points: &StaticTree) -> (f64, bool, bool) {
         let mut near = Vec::with_capacity(2);
         let (upper, _, q1) = self.shrink_with(p, n, side, self.max_radius, |c, r| {
             points.nearest_n(c, 1, &mut near);
             let &(j, d2) = near.first()?;
-            (d2 < r * r * (1.0 - 1e-9) * (1.0 - 1e-9))
-                .then(|| (self.positions[j as usize], self.point_patch[j as usize]))
+            (d2 < r * r * (1.0 - 1e-9) * (1.0 - 1e-9)).then(|| self.positions[j as usize])
         });
         let (r, converged, q2) = self.shrink_with(p, n, side, upper, |c, r| {
             self.surface
                 .closest_point_within(c, r * (1.0 - 1e-9))
-                .map(|q| (q.position, self.patch[q.face as usize]))
+                .map(|q| q.position)
         });
-        let contact_patch = q2.or(q1).map_or(u32::MAX - 1, |q| q.1);
         let c = p + side * r * n;
         let thin = (q1.is_some() || q2.is_some())
             && self
@@ -473,12 +363,7 @@ impl Ball<'_> {
                         && u.dot(v) <= self.cos_thin * u.length() * v.length()
                         && self.surface.face_normal(q.face).dot(n) <= self.cos_thin
                 });
-        Shrunk {
-            radius: r,
-            converged,
-            thin,
-            contact_patch,
-        }
+        (r, converged, thin)
     }
 
     /// The shrinking loop from radius `start`; `inside(c, r)` gives a point of the surface
@@ -489,13 +374,13 @@ impl Ball<'_> {
         n: DVec3,
         side: f64,
         start: f64,
-        mut inside: impl FnMut(DVec3, f64) -> Option<(DVec3, u32)>,
-    ) -> (f64, bool, Option<(DVec3, u32)>) {
+        mut inside: impl FnMut(DVec3, f64) -> Option<DVec3>,
+    ) -> (f64, bool, Option<DVec3>) {
         let mut r = start;
         let mut last = None;
         for _ in 0..self.max_iterations {
             let c = p + side * r * n;
-            let Some((q, q_patch)) = inside(c, r) else {
+            let Some(q) = inside(c, r) else {
                 return (r, true, last);
             };
             let d = q - p;
@@ -511,7 +396,7 @@ impl Ball<'_> {
                 return (r, true, last);
             }
             r = r_new;
-            last = Some((q, q_patch));
+            last = Some(q);
         }
         (r, false, last)
     }
