@@ -289,9 +289,12 @@ impl Candidates {
         if let Some(test) = &index.buried_test {
             self.buried += test.remove_buried(&mut extra, |c| (c.position, c.normal, Some(c.face)));
         }
+        // A field of 1 wherever a face is (no candidate added) leaves the pool as drawn.
         let mut pool = uniform.clone();
-        pool.extend(extra);
-        shuffle_candidates(&mut pool, salt);
+        if !extra.is_empty() {
+            pool.extend(extra);
+            shuffle_candidates(&mut pool, salt);
+        }
         self.pool = pool;
     }
 }
