@@ -151,6 +151,7 @@ pub fn remesh(
         let inserted = run.triangulated.inserted.len() as f64;
         let aimed = run.ascended.samples.len().max(1) as f64;
         if index.manifold_edges
+            && index.crossing_pairs.is_empty()
             && inserted > params.count_tolerance * aimed
             && refinements < params.topology_refinements
         {

@@ -75,7 +75,7 @@ pub struct RemeshParams {
     pub features: FeatureDetection,
     /// Times at most the sampling runs again with a finer spacing around the samples the
     /// triangulation inserted for the topological ball property, when they take the count out
-    /// of its tolerance on an input without non-manifold edges
+    /// of its tolerance on an input without non-manifold edges or crossing faces
     /// (default 1: on ADIS16480 at 3000 points 0 left the property failing at 6 pairs of
     /// cells after 24 rounds, 1 kept the genus, 2 took 40 s instead of 30; 0: the inserted
     /// samples are kept as they are).
