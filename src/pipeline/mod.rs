@@ -150,11 +150,9 @@ pub fn remesh(
         // samples are kept as they are.
         let inserted = run.triangulated.inserted.len() as f64;
         let aimed = run.ascended.samples.len().max(1) as f64;
-        if index.manifold_edges
-            && index.crossing_pairs.is_empty()
-            && inserted > params.count_tolerance * aimed
-            && refinements < params.topology_refinements
-        {
+        // (Nothing is inserted where the triangulation does not check: see
+        // `triangulation::triangulate_samples`.)
+        if inserted > params.count_tolerance * aimed && refinements < params.topology_refinements {
             let inserted = run.triangulated.inserted.clone();
             let sigma_ref = run.scanned.widths.sigma_ref;
             let corners = run.scanned.corner_term();

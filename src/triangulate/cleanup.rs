@@ -282,7 +282,12 @@ fn fill_holes(
                         }
                         loose.retain(|&v| !referenced[v as usize]);
                     }
-                    Err(_) => left += 1,
+                    // A fill the mesh refuses (a triangle of zero area: three samples on a
+                    // line at a thin tip) is grown like one that was not found.
+                    Err(_) => {
+                        failed.push(lp);
+                        left += 1
+                    }
                 },
                 None => {
                     failed.push(lp);
@@ -643,6 +648,34 @@ mod tests {
         assert_eq!(stats.holes_left, 0);
         assert!(faces.iter().any(|t| t.contains(&200)));
         assert_eq!(faces.len(), 2 * n - 4);
+        let t = topology(&TriMesh::new(positions, faces));
+        assert!(
+            t.is_closed_manifold() && t.euler_characteristic == 2,
+            "{t:?}"
+        );
+    }
+
+    /// A hole whose only fill is a triangle of zero area (three samples on a line, as inserted
+    /// samples along a thin tip can be) is grown and closed with the faces around it.
+    #[test]
+    fn a_hole_whose_fill_has_zero_area_is_grown_and_closed() {
+        let n = 400;
+        let mut positions = fibonacci_sphere(n);
+        let normals = positions.clone();
+        let voted = votes(&positions, &normals, &[]);
+        // One of the triangles, its third corner moved onto the middle of the other two: the
+        // triangle has zero area, and so has the only fill of the hole it leaves.
+        let [a, b, c] = voted[0].corners;
+        positions[c as usize] = 0.5 * (positions[a as usize] + positions[b as usize]);
+        let (faces, _, stats) = assemble(
+            &positions,
+            &normals,
+            &voted,
+            &[],
+            &AssemblyParams::default(),
+        );
+        assert_sane(&positions, &faces);
+        assert_eq!(stats.holes_left, 0, "{stats:?}");
         let t = topology(&TriMesh::new(positions, faces));
         assert!(
             t.is_closed_manifold() && t.euler_characteristic == 2,
