@@ -92,6 +92,18 @@ pub(super) fn enforce(
     label: &mut [u32],
     params: &TopologicalBallParams,
 ) -> (Vec<DVec3>, TopologicalBallStats) {
+    checked_in_scope(refined, samples, label, params, true)
+}
+
+/// [`enforce`], the checks after the first one over the cells a round changed (`incremental`)
+/// or over every cell (the same answer, at more cost: the tests compare them).
+fn checked_in_scope(
+    refined: &Refined,
+    samples: &[DVec3],
+    label: &mut [u32],
+    params: &TopologicalBallParams,
+    incremental: bool,
+) -> (Vec<DVec3>, TopologicalBallStats) {
     let mut stats = TopologicalBallStats::default();
     let mut added: Vec<DVec3> = Vec::new();
     if !params.enabled {
@@ -122,9 +134,13 @@ pub(super) fn enforce(
     connect_cells(refined, label, &mut dist, samples.len(), |l| {
         site(l, &added)
     });
+    // The first check looks at every cell; the next ones only at the cells a round changed
+    // (that lost or gained refined vertices, or border one that did) and at those that failed
+    // before: the others are as they were, and passed.
+    let mut scope: Option<Scope> = None;
     loop {
         let count = samples.len() + added.len();
-        let (cells, pairs) = offending(refined, label, count);
+        let (cells, pairs) = offending(refined, label, count, scope.as_ref());
         if stats.rounds == 0 {
             stats.bad_cells_first = cells.len();
             stats.bad_pairs_first = pairs.len();
@@ -138,7 +154,8 @@ pub(super) fn enforce(
             break;
         }
         stats.rounds += 1;
-        let candidates = insertion_points(refined, label, &dist, &cells, &pairs);
+        let candidates = insertion_points(refined, label, &dist, &cells, &pairs, scope.as_ref());
+        let before = label.to_vec();
         // One insertion per offending cell or pair, farthest first; a candidate whose vertex an
         // earlier insertion of this round took over is left (its cell changed).
         let start_label: Vec<(u32, u32)> = candidates
@@ -160,6 +177,7 @@ pub(super) fn enforce(
         let count = samples.len() + added.len();
         connect_cells(refined, label, &mut dist, count, |l| site(l, &added));
         stats.inserted = added.len();
+        scope = incremental.then(|| Scope::changed(refined, &before, label, count, &cells, &pairs));
     }
     (added, stats)
 }
@@ -265,16 +283,95 @@ fn connect_cells(
     }
 }
 
+/// The part of the refined input a check looks at: the cells of some labels (`dirty`), all of
+/// their refined vertices and the faces at them. Cells, pairs and triples of cells none of
+/// which is dirty are not judged.
+struct Scope {
+    /// Per label: whether it is checked.
+    dirty: Vec<bool>,
+    /// The refined vertices with a dirty label, ascending.
+    vertices: Vec<u32>,
+    /// The refined faces with a corner of a dirty label, ascending.
+    faces: Vec<u32>,
+}
+
+impl Scope {
+    /// The cells a round changed, from the labels `before` it to `label` after it (`count`
+    /// labels): those that lost or gained a refined vertex and those next to such a vertex,
+    /// and the cells of the offending `cells` and `pairs` the round was for.
+    fn changed(
+        refined: &Refined,
+        before: &[u32],
+        label: &[u32],
+        count: usize,
+        cells: &[u32],
+        pairs: &[[u32; 2]],
+    ) -> Scope {
+        let mut dirty = vec![false; count];
+        let mut mark = |l: u32| {
+            if l != u32::MAX {
+                dirty[l as usize] = true;
+            }
+        };
+        for (v, (&b, &a)) in before.iter().zip(label).enumerate() {
+            if a != b {
+                mark(b);
+                mark(a);
+                for &u in refined.neighbours.row(v as u32) {
+                    mark(label[u as usize]);
+                }
+            }
+        }
+        for &c in cells {
+            mark(c);
+        }
+        for &[a, b] in pairs {
+            mark(a);
+            mark(b);
+        }
+        let is_dirty = |v: u32| {
+            let l = label[v as usize];
+            l != u32::MAX && dirty[l as usize]
+        };
+        let vertices = (0..label.len() as u32).filter(|&v| is_dirty(v)).collect();
+        let faces = (0..refined.triangles.len() as u32)
+            .filter(|&f| refined.triangles[f as usize].iter().any(|&v| is_dirty(v)))
+            .collect();
+        Scope {
+            dirty,
+            vertices,
+            faces,
+        }
+    }
+}
+
 /// The cells that are not discs, or that meet two others in more than one point (labels,
 /// ascending), and the pairs of cells that meet in more than one arc or in a closed curve
 /// (ascending), of `count` labels.
-fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[u32; 2]>) {
+fn offending(
+    refined: &Refined,
+    label: &[u32],
+    count: usize,
+    scope: Option<&Scope>,
+) -> (Vec<u32>, Vec<[u32; 2]>) {
     let n = refined.positions.len();
+    let every: (Vec<u32>, Vec<u32>);
+    let (vertices, faces) = match scope {
+        Some(s) => (&s.vertices, &s.faces),
+        None => {
+            every = (
+                (0..n as u32).collect(),
+                (0..refined.triangles.len() as u32).collect(),
+            );
+            (&every.0, &every.1)
+        }
+    };
+    let judged = |l: u32| l != u32::MAX && scope.is_none_or(|s| s.dirty[l as usize]);
     // Per label: vertices, edges and faces inside the cell, and its components.
     let mut chi = vec![0i64; count];
     let mut present = vec![false; count];
     let mut dsu = Dsu::new(n);
-    for v in 0..n as u32 {
+    for &v in vertices {
         let l = label[v as usize];
         if l == u32::MAX {
             continue;
@@ -288,20 +385,22 @@ fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[
             }
         }
     }
-    for t in refined.triangles {
+    for &f in faces {
+        let t = refined.triangles[f as usize];
         let l = label[t[0] as usize];
         if l != u32::MAX && label[t[1] as usize] == l && label[t[2] as usize] == l {
             chi[l as usize] += 1;
         }
     }
     let mut components = vec![0u32; count];
-    for (v, &l) in label.iter().enumerate() {
+    for &v in vertices {
+        let (v, l) = (v as usize, label[v as usize]);
         if l != u32::MAX && dsu.find(v).0 == v {
             components[l as usize] += 1;
         }
     }
     let cells: Vec<u32> = (0..count)
-        .filter(|&l| present[l] && (components[l] != 1 || chi[l] != 1))
+        .filter(|&l| judged(l as u32) && present[l] && (components[l] != 1 || chi[l] != 1))
         .map(|l| l as u32)
         .collect();
     // Mixed edges (between two cells), each by its slot in the row of its lower vertex, joined
@@ -313,7 +412,8 @@ fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[
     // whether it ends an arc (an edge of a face of three cells).
     let mut faces_on = vec![0u8; neighbours.slots()];
     let mut ends = vec![false; neighbours.slots()];
-    for t in refined.triangles {
+    for &f in faces {
+        let t = &refined.triangles[f as usize];
         for k in 0..3 {
             if let Some(e) = slot(t[k], t[(k + 1) % 3]) {
                 faces_on[e] = faces_on[e].saturating_add(1);
@@ -341,15 +441,16 @@ fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[
     }
     let pair = |a: u32, b: u32| [a.min(b), a.max(b)];
     let mut edges: Vec<([u32; 2], usize)> = Vec::new();
-    for v in 0..n as u32 {
+    for &v in vertices {
         let l = label[v as usize];
         if l == u32::MAX {
             continue;
         }
         for &u in neighbours.row(v) {
             let k = label[u as usize];
-            if u > v && k != l && k != u32::MAX {
-                if let Some(e) = neighbours.slot(v, u) {
+            // Each mixed edge once: from its lower end, or from its end in the scope.
+            if k != l && k != u32::MAX && (u > v || !judged(k)) {
+                if let Some(e) = slot(v, u) {
                     edges.push((pair(l, k), e));
                 }
             }
@@ -378,12 +479,11 @@ fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[
     // Three cells meet in at most one point: the faces of three cells of one triple, joined
     // where they share an edge, are one group. Where they are not, the three cells are judged
     // as cells that are not discs.
-    let mut triples: Vec<([u32; 3], usize)> = refined
-        .triangles
+    let mut triples: Vec<([u32; 3], usize)> = faces
         .iter()
-        .enumerate()
-        .filter_map(|(f, t)| {
-            let mut l = t.map(|v| label[v as usize]);
+        .filter_map(|&f| {
+            let f = f as usize;
+            let mut l = refined.triangles[f].map(|v| label[v as usize]);
             if l.contains(&u32::MAX) || l[0] == l[1] || l[1] == l[2] || l[0] == l[2] {
                 return None;
             }
@@ -394,7 +494,7 @@ fn offending(refined: &Refined, label: &[u32], count: usize) -> (Vec<u32>, Vec<[
     triples.sort_unstable();
     let mut cells = cells;
     for group in triples.chunk_by(|a, b| a.0 == b.0) {
-        if group.len() < 2 {
+        if group.len() < 2 || !group[0].0.iter().any(|&l| judged(l)) {
             continue;
         }
         let shares_edge = |f: usize, g: usize| {
@@ -428,8 +528,18 @@ fn insertion_points(
     dist: &[f64],
     cells: &[u32],
     pairs: &[[u32; 2]],
+    scope: Option<&Scope>,
 ) -> Vec<(f64, u32)> {
     let n = refined.positions.len();
+    let every: Vec<u32>;
+    let vertices = match scope {
+        Some(s) => &s.vertices,
+        None => {
+            every = (0..n as u32).collect();
+            &every
+        }
+    };
+    let outside = |l: u32| scope.is_some_and(|s| !s.dirty[l as usize]);
     let mut cell_best: FxHashMap<u32, (f64, u32)> = cells.iter().map(|&c| (c, (-1.0, 0))).collect();
     let mut pair_best: FxHashMap<[u32; 2], (f64, u32)> =
         pairs.iter().map(|&p| (p, (-1.0, 0))).collect();
@@ -438,7 +548,7 @@ fn insertion_points(
             *best = (d, v);
         }
     };
-    for v in 0..n as u32 {
+    for &v in vertices {
         let l = label[v as usize];
         if l == u32::MAX {
             continue;
@@ -453,6 +563,10 @@ fn insertion_points(
                 if k != l && k != u32::MAX {
                     if let Some(best) = pair_best.get_mut(&[l.min(k), l.max(k)]) {
                         better(best, d, v);
+                        // A vertex outside the scope is not visited itself.
+                        if outside(k) {
+                            better(best, dist[u as usize], u);
+                        }
                     }
                 }
             }
@@ -503,12 +617,12 @@ mod tests {
         };
         let samples = [DVec3::new(0.0, 0.0, 1.0)];
         let mut label = nearest(&mesh.positions, &samples);
-        let (cells, _) = offending(&refined, &label, 1);
+        let (cells, _) = offending(&refined, &label, 1, None);
         assert_eq!(cells, vec![0]);
         let (added, stats) = enforce(&refined, &samples, &mut label, &Default::default());
         assert_eq!(stats.bad_cells_left + stats.bad_pairs_left, 0, "{stats:?}");
         assert!(added.len() >= 3 && added.len() <= 6, "{stats:?}");
-        let (cells, pairs) = offending(&refined, &label, 1 + added.len());
+        let (cells, pairs) = offending(&refined, &label, 1 + added.len(), None);
         assert!(cells.is_empty() && pairs.is_empty());
     }
 
@@ -566,10 +680,60 @@ mod tests {
         };
         let samples = [DVec3::new(0.2, 0.0, 1.0), DVec3::new(-0.2, 0.0, 3.0)];
         let mut label = nearest(&positions, &samples);
-        let (cells, _) = offending(&refined, &label, 2);
+        let (cells, _) = offending(&refined, &label, 2, None);
         assert_eq!(cells, vec![0, 1], "annuli");
         let (added, stats) = enforce(&refined, &samples, &mut label, &Default::default());
         assert!(!added.is_empty());
         assert_eq!(stats.bad_cells_left + stats.bad_pairs_left, 0, "{stats:?}");
+    }
+    /// The checks after the first look only at the cells a round changed: the same samples
+    /// are inserted, the same cells come out, in the same rounds, as when every check looks at
+    /// every cell. A torus (R 3, r 0.5) with a few samples: cells wrap around the tube and
+    /// meet across it, over several rounds.
+    #[test]
+    fn the_checks_over_the_changed_cells_agree_with_checks_over_all() {
+        let (around, along) = (16usize, 96usize);
+        let mut positions = Vec::new();
+        for j in 0..along {
+            let b = std::f64::consts::TAU * j as f64 / along as f64;
+            for i in 0..around {
+                let a = std::f64::consts::TAU * i as f64 / around as f64;
+                let rho = 3.0 + 0.5 * a.cos();
+                positions.push(DVec3::new(rho * b.cos(), rho * b.sin(), 0.5 * a.sin()));
+            }
+        }
+        let id = |i: usize, j: usize| ((j % along) * around + i % around) as u32;
+        let mut triangles = Vec::new();
+        for j in 0..along {
+            for i in 0..around {
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let neighbours = rows(&positions, &triangles);
+        let refined = Refined {
+            positions: &positions,
+            triangles: &triangles,
+            neighbours: &neighbours,
+        };
+        for k in [1usize, 2, 3, 5, 8] {
+            let samples: Vec<DVec3> = (0..k)
+                .map(|i| positions[(i * 7 * around + (i * 5) % around) % positions.len()])
+                .collect();
+            let start = nearest(&positions, &samples);
+            let (mut a, mut b) = (start.clone(), start);
+            let params = TopologicalBallParams::default();
+            let scoped = checked_in_scope(&refined, &samples, &mut a, &params, true);
+            let full = checked_in_scope(&refined, &samples, &mut b, &params, false);
+            assert!(scoped.1.rounds >= 2, "{k} samples: {:?}", scoped.1);
+            assert_eq!(scoped, full, "{k} samples");
+            assert_eq!(a, b, "{k} samples");
+            assert_eq!(
+                scoped.1.bad_cells_left + scoped.1.bad_pairs_left,
+                0,
+                "{:?}",
+                scoped.1
+            );
+        }
     }
 }
