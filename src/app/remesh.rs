@@ -242,7 +242,8 @@ pub(super) fn remesh_read(
                 if t.non_manifold_edges > 0 {
                     " (parts that meet at a non-manifold edge are triangulated apart)"
                 } else {
-                    ""
+                    " (parts or sheets that touch at a vertex come out apart, and the topology \
+                     is compared with the input's split there)"
                 }
             ));
         }

@@ -92,9 +92,12 @@ pub fn topology_changes(input: &Topology, output: &Topology) -> Vec<TopologyChan
 
 /// The topology of `mesh`'s surface: [`topology`] of its faces without the ones that are not
 /// surface: faces with a repeated index or zero area
-/// ([`is_degenerate_face`]), and repeats of an earlier face's vertex set. This is what a remesh
-/// is compared with: it keeps no such face, so they would otherwise show as differences (a lone
-/// zero-area face as a component of its own).
+/// ([`is_degenerate_face`]), and repeats of an earlier face's vertex set; and, where the faces
+/// meet at non-manifold vertices but at no non-manifold edge, with each such vertex split into
+/// one vertex per fan of faces around it ([`split_pinched_vertices`]). This is what a remesh
+/// is compared with: it keeps no such face and no such vertex (its output is a manifold), so
+/// they would otherwise show as differences (a lone zero-area face as a component of its own;
+/// two parts that touch at a point as one component).
 pub fn surface_topology(mesh: &TriMesh) -> Topology {
     let mut seen = std::collections::HashSet::new();
     let faces: Vec<[u32; 3]> = mesh
@@ -107,10 +110,63 @@ pub fn surface_topology(mesh: &TriMesh) -> Topology {
             !is_degenerate_face(&mesh.positions, t) && seen.insert(key)
         })
         .collect();
-    if faces.len() == mesh.triangles.len() {
-        return topology(mesh);
+    let surface = if faces.len() == mesh.triangles.len() {
+        topology(mesh)
+    } else {
+        topology(&TriMesh::new(mesh.positions.clone(), faces.clone()))
+    };
+    if surface.non_manifold_vertices == 0 || surface.non_manifold_edges > 0 {
+        return surface;
     }
-    topology(&TriMesh::new(mesh.positions.clone(), faces))
+    topology(&split_pinched_vertices(&TriMesh::new(
+        mesh.positions.clone(),
+        faces,
+    )))
+}
+
+/// `mesh` with every vertex split into one vertex per fan of its faces (faces around it joined
+/// through the edges at it that have exactly two faces): a vertex where parts or sheets touch
+/// at a point (a pinched vertex) becomes one per part; every other vertex stays one (at the
+/// end of the positions, in order of first use). The manifold surface a pinched mesh stands
+/// for, as CGAL's `duplicate_non_manifold_vertices` makes it. Faces keep their order.
+pub fn split_pinched_vertices(mesh: &TriMesh) -> TriMesh {
+    use crate::disjoint_sets::Dsu;
+    let t = &mesh.triangles;
+    let corner = |f: usize, v: u32| 3 * f + t[f].iter().position(|&w| w == v).unwrap_or(0);
+    // Edges with their faces: (low, high, face).
+    let mut sides: Vec<(u32, u32, usize)> = Vec::with_capacity(3 * t.len());
+    for (f, tri) in t.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            if a != b {
+                sides.push((a.min(b), a.max(b), f));
+            }
+        }
+    }
+    sides.sort_unstable();
+    let mut corners = Dsu::new(3 * t.len());
+    for run in sides.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        if let [(lo, hi, f), (_, _, g)] = *run {
+            corners.union(corner(f, lo), corner(g, lo), false);
+            corners.union(corner(f, hi), corner(g, hi), false);
+        }
+    }
+    let mut index: std::collections::HashMap<usize, u32> = std::collections::HashMap::new();
+    let mut positions = Vec::new();
+    let triangles = t
+        .iter()
+        .enumerate()
+        .map(|(f, tri)| {
+            tri.map(|v| {
+                let root = corners.find(corner(f, v)).0;
+                *index.entry(root).or_insert_with(|| {
+                    positions.push(mesh.positions[v as usize]);
+                    (positions.len() - 1) as u32
+                })
+            })
+        })
+        .collect();
+    TriMesh::new(positions, triangles)
 }
 
 #[cfg(test)]
@@ -222,5 +278,42 @@ mod tests {
         let surface = surface_topology(&messy);
         assert!(topology_changes(&surface, &topology(&clean)).is_empty());
         assert_eq!(surface.faces, clean.triangles.len());
+    }
+    /// Two octahedra touching at a vertex: one component with a pinched vertex as faces go,
+    /// two closed surfaces as a manifold remesh can keep them, and so the surface compared.
+    #[test]
+    fn parts_that_touch_at_a_point_are_compared_apart() {
+        let a = octahedron(DVec3::ZERO);
+        // The second octahedron's vertex -X (index 1) at the first's +X (index 0).
+        let b = octahedron(DVec3::new(2.0, 0.0, 0.0));
+        let mut t = a.triangles.clone();
+        t.extend(
+            b.triangles
+                .iter()
+                .map(|f| f.map(|i| if i == 1 { 0 } else { i + 6 })),
+        );
+        let pinched = TriMesh::new([a.positions, b.positions].concat(), t);
+        let raw = topology(&pinched);
+        assert_eq!(
+            (
+                raw.components,
+                raw.non_manifold_vertices,
+                raw.euler_characteristic
+            ),
+            (1, 1, 3)
+        );
+        let surface = surface_topology(&pinched);
+        assert_eq!(
+            (
+                surface.components,
+                surface.non_manifold_vertices,
+                surface.euler_characteristic
+            ),
+            (2, 0, 4)
+        );
+        assert!(topology_changes(&surface, &topology(&two_octahedra())).is_empty());
+        // A vertex where faces fan once stays one vertex.
+        let one = split_pinched_vertices(&octahedron(DVec3::ZERO));
+        assert_eq!(one.positions.len(), 6);
     }
 }

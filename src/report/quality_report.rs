@@ -133,12 +133,16 @@ impl QualityReport {
     }
 
     /// Sets the input's topology ([`topology`] of `input`) and compares the output's with its
-    /// surface's ([`surface_topology`]: without zero-area, repeated-index or duplicate faces):
+    /// surface's ([`surface_topology`]: without zero-area, repeated-index or duplicate faces,
+    /// and split at vertices where parts touch at a point, as a manifold output must be):
     /// every difference of components, Euler characteristic and boundary loops goes into
     /// [`QualityReport::topology_changes`] and, in words, into one note.
     pub fn set_input(&mut self, input: &TriMesh) {
         let raw = topology(input);
-        let surface = if raw.degenerate_faces == 0 && raw.duplicate_faces == 0 {
+        let surface = if raw.degenerate_faces == 0
+            && raw.duplicate_faces == 0
+            && raw.non_manifold_vertices == 0
+        {
             raw.clone()
         } else {
             surface_topology(input)
