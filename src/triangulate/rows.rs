@@ -120,11 +120,6 @@ impl Rows {
         self.row(v).binary_search(&u).ok().map(|k| from + k)
     }
 
-    /// The number of slots (entries of all rows).
-    pub(super) fn slots(&self) -> usize {
-        self.values.len()
-    }
-
     pub(super) fn row(&self, r: u32) -> &[u32] {
         &self.values[self.start[r as usize] as usize..self.start[r as usize + 1] as usize]
     }

@@ -355,23 +355,25 @@ fn offending(
     scope: Option<&Scope>,
 ) -> (Vec<u32>, Vec<[u32; 2]>) {
     let n = refined.positions.len();
-    let every: (Vec<u32>, Vec<u32>);
-    let (vertices, faces) = match scope {
-        Some(s) => (&s.vertices, &s.faces),
-        None => {
-            every = (
-                (0..n as u32).collect(),
-                (0..refined.triangles.len() as u32).collect(),
-            );
-            (&every.0, &every.1)
-        }
+    // The vertices and faces looked at: all, or the scope's (one of the two parts of each
+    // chain is empty).
+    let (all_vertices, all_faces, listed_vertices, listed_faces) = match scope {
+        Some(s) => (0..0, 0..0, &s.vertices[..], &s.faces[..]),
+        None => (
+            0..n as u32,
+            0..refined.triangles.len() as u32,
+            &[][..],
+            &[][..],
+        ),
     };
+    let vertices = || all_vertices.clone().chain(listed_vertices.iter().copied());
+    let faces = || all_faces.clone().chain(listed_faces.iter().copied());
     let judged = |l: u32| l != u32::MAX && scope.is_none_or(|s| s.dirty[l as usize]);
     // Per label: vertices, edges and faces inside the cell, and its components.
     let mut chi = vec![0i64; count];
     let mut present = vec![false; count];
     let mut dsu = Dsu::new(n);
-    for &v in vertices {
+    for v in vertices() {
         let l = label[v as usize];
         if l == u32::MAX {
             continue;
@@ -385,7 +387,7 @@ fn offending(
             }
         }
     }
-    for &f in faces {
+    for f in faces() {
         let t = refined.triangles[f as usize];
         let l = label[t[0] as usize];
         if l != u32::MAX && label[t[1] as usize] == l && label[t[2] as usize] == l {
@@ -393,7 +395,7 @@ fn offending(
         }
     }
     let mut components = vec![0u32; count];
-    for &v in vertices {
+    for v in vertices() {
         let (v, l) = (v as usize, label[v as usize]);
         if l != u32::MAX && dsu.find(v).0 == v {
             components[l as usize] += 1;
@@ -403,45 +405,13 @@ fn offending(
         .filter(|&l| judged(l as u32) && present[l] && (components[l] != 1 || chi[l] != 1))
         .map(|l| l as u32)
         .collect();
-    // Mixed edges (between two cells), each by its slot in the row of its lower vertex, joined
-    // when they are edges of one face of the same pair.
+    // Mixed edges (between two cells), each once, by its slot in the row of its lower vertex:
+    // those at a vertex in the scope.
     let neighbours = refined.neighbours;
     let slot = |a: u32, b: u32| neighbours.slot(a.min(b), a.max(b));
-    let mut arcs = Dsu::new(neighbours.slots());
-    // Per slot: the faces on the edge (an edge of one face is on the input's boundary), and
-    // whether it ends an arc (an edge of a face of three cells).
-    let mut faces_on = vec![0u8; neighbours.slots()];
-    let mut ends = vec![false; neighbours.slots()];
-    for &f in faces {
-        let t = &refined.triangles[f as usize];
-        for k in 0..3 {
-            if let Some(e) = slot(t[k], t[(k + 1) % 3]) {
-                faces_on[e] = faces_on[e].saturating_add(1);
-            }
-        }
-        let [a, b, c] = t.map(|v| label[v as usize]);
-        if a == u32::MAX || b == u32::MAX || c == u32::MAX || (a == b && b == c) {
-            continue;
-        }
-        if a != b && b != c && a != c {
-            for k in 0..3 {
-                if let Some(e) = slot(t[k], t[(k + 1) % 3]) {
-                    ends[e] = true;
-                }
-            }
-            continue;
-        }
-        // Two of the three edges are mixed, of the same pair.
-        let mut mixed = (0..3)
-            .filter(|&k| label[t[k] as usize] != label[t[(k + 1) % 3] as usize])
-            .filter_map(|k| slot(t[k], t[(k + 1) % 3]));
-        if let (Some(e), Some(f)) = (mixed.next(), mixed.next()) {
-            arcs.union(e, f, false);
-        }
-    }
     let pair = |a: u32, b: u32| [a.min(b), a.max(b)];
     let mut edges: Vec<([u32; 2], usize)> = Vec::new();
-    for &v in vertices {
+    for v in vertices() {
         let l = label[v as usize];
         if l == u32::MAX {
             continue;
@@ -456,9 +426,53 @@ fn offending(
             }
         }
     }
+    // The mixed edges numbered in slot order (a fraction of all edges: the arrays below are
+    // per mixed edge, not per edge of the refined input).
+    let mut mixed: Vec<usize> = edges.iter().map(|e| e.1).collect();
+    mixed.sort_unstable();
+    mixed.dedup();
+    let id = |a: u32, b: u32| slot(a, b).and_then(|e| mixed.binary_search(&e).ok());
+    // Per mixed edge: the faces on it (an edge of one face is on the input's boundary), and
+    // whether it ends an arc (an edge of a face of three cells); the edges of one pair joined
+    // into arcs where they are edges of one face.
+    let mut arcs = Dsu::new(mixed.len());
+    let mut faces_on = vec![0u8; mixed.len()];
+    let mut ends = vec![false; mixed.len()];
+    for f in faces() {
+        let t = refined.triangles[f as usize];
+        let l = t.map(|v| label[v as usize]);
+        let mut on = [None; 3];
+        for k in 0..3 {
+            let (a, b) = (l[k], l[(k + 1) % 3]);
+            if a != b && a != u32::MAX && b != u32::MAX {
+                on[k] = id(t[k], t[(k + 1) % 3]);
+                if let Some(e) = on[k] {
+                    faces_on[e] = faces_on[e].saturating_add(1);
+                }
+            }
+        }
+        if l.contains(&u32::MAX) || (l[0] == l[1] && l[1] == l[2]) {
+            continue;
+        }
+        if l[0] != l[1] && l[1] != l[2] && l[0] != l[2] {
+            for e in on.into_iter().flatten() {
+                ends[e] = true;
+            }
+            continue;
+        }
+        // Two of the three edges are mixed, of the same pair.
+        let mut two = on.into_iter().flatten();
+        if let (Some(e), Some(g)) = (two.next(), two.next()) {
+            arcs.union(e, g, false);
+        }
+    }
     // An arc with no end (no face of three cells on it, no edge on the input's boundary) is a
     // closed curve: two cells that meet all around, as two on a sphere.
-    let mut ended = vec![false; neighbours.slots()];
+    let mut ended = vec![false; mixed.len()];
+    let edges: Vec<([u32; 2], usize)> = edges
+        .into_iter()
+        .filter_map(|(p, e)| mixed.binary_search(&e).ok().map(|i| (p, i)))
+        .collect();
     for &(_, e) in &edges {
         if ends[e] || faces_on[e] == 1 {
             ended[arcs.find(e).0] = true;
@@ -479,9 +493,8 @@ fn offending(
     // Three cells meet in at most one point: the faces of three cells of one triple, joined
     // where they share an edge, are one group. Where they are not, the three cells are judged
     // as cells that are not discs.
-    let mut triples: Vec<([u32; 3], usize)> = faces
-        .iter()
-        .filter_map(|&f| {
+    let mut triples: Vec<([u32; 3], usize)> = faces()
+        .filter_map(|f| {
             let f = f as usize;
             let mut l = refined.triangles[f].map(|v| label[v as usize]);
             if l.contains(&u32::MAX) || l[0] == l[1] || l[1] == l[2] || l[0] == l[2] {
@@ -531,13 +544,9 @@ fn insertion_points(
     scope: Option<&Scope>,
 ) -> Vec<(f64, u32)> {
     let n = refined.positions.len();
-    let every: Vec<u32>;
-    let vertices = match scope {
-        Some(s) => &s.vertices,
-        None => {
-            every = (0..n as u32).collect();
-            &every
-        }
+    let (all, listed) = match scope {
+        Some(s) => (0..0, &s.vertices[..]),
+        None => (0..n as u32, &[][..]),
     };
     let outside = |l: u32| scope.is_some_and(|s| !s.dirty[l as usize]);
     let mut cell_best: FxHashMap<u32, (f64, u32)> = cells.iter().map(|&c| (c, (-1.0, 0))).collect();
@@ -548,7 +557,7 @@ fn insertion_points(
             *best = (d, v);
         }
     };
-    for &v in vertices {
+    for v in all.chain(listed.iter().copied()) {
         let l = label[v as usize];
         if l == u32::MAX {
             continue;
