@@ -600,6 +600,21 @@ mod tests {
         Rows::new(positions.len(), triangles)
     }
 
+    /// Triangles of `bands` bands of quads between rings of `around` vertices (ring j's
+    /// vertices numbered j · around onward, ring `rings` being ring 0 again: a torus when
+    /// `bands == rings`, a tube when `rings == bands + 1`).
+    fn ring_grid(around: usize, rings: usize, bands: usize) -> Vec<[u32; 3]> {
+        let id = |i: usize, j: usize| ((j % rings) * around + i % around) as u32;
+        let mut triangles = Vec::new();
+        for j in 0..bands {
+            for i in 0..around {
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        triangles
+    }
+
     /// Nearest-sample labels (no growth: enough on convex test shapes).
     fn nearest(positions: &[DVec3], samples: &[DVec3]) -> Vec<u32> {
         positions
@@ -673,14 +688,7 @@ mod tests {
                 ));
             }
         }
-        let id = |i: usize, j: usize| (j * around + i % around) as u32;
-        let mut triangles = Vec::new();
-        for j in 0..along {
-            for i in 0..around {
-                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
+        let triangles = ring_grid(around, along + 1, along);
         let neighbours = rows(&positions, &triangles);
         let refined = Refined {
             positions: &positions,
@@ -695,6 +703,7 @@ mod tests {
         assert!(!added.is_empty());
         assert_eq!(stats.bad_cells_left + stats.bad_pairs_left, 0, "{stats:?}");
     }
+
     /// The checks after the first look only at the cells a round changed: the same samples
     /// are inserted, the same cells come out, in the same rounds, as when every check looks at
     /// every cell. A torus (R 3, r 0.5) with a few samples: cells wrap around the tube and
@@ -711,14 +720,7 @@ mod tests {
                 positions.push(DVec3::new(rho * b.cos(), rho * b.sin(), 0.5 * a.sin()));
             }
         }
-        let id = |i: usize, j: usize| ((j % along) * around + i % around) as u32;
-        let mut triangles = Vec::new();
-        for j in 0..along {
-            for i in 0..around {
-                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
+        let triangles = ring_grid(around, along, along);
         let neighbours = rows(&positions, &triangles);
         let refined = Refined {
             positions: &positions,
