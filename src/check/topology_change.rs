@@ -94,7 +94,7 @@ pub fn topology_changes(input: &Topology, output: &Topology) -> Vec<TopologyChan
 /// surface: faces with a repeated index or zero area
 /// ([`is_degenerate_face`]), and repeats of an earlier face's vertex set; and, where the faces
 /// meet at non-manifold vertices but at no non-manifold edge, with each such vertex split into
-/// one vertex per fan of faces around it ([`split_pinched_vertices`]). This is what a remesh
+/// one vertex per fan of faces around it (`split_pinched_vertices`). This is what a remesh
 /// is compared with: it keeps no such face and no such vertex (its output is a manifold), so
 /// they would otherwise show as differences (a lone zero-area face as a component of its own;
 /// two parts that touch at a point as one component).
