@@ -247,7 +247,7 @@ fn the_reader_sees_the_known_arrows() {
         ("sampling::features", "sampling::curves"),
         ("surface::front_regions", "surface::winding_number"),
         ("finish::optimize", "mesh::edit"),
-        ("finish::optimize", "triangulate::flip"),
+        ("finish::optimize::relax", "triangulate::flip"),
     ] {
         assert!(
             a[from].contains(to),

@@ -93,12 +93,33 @@ pub(crate) fn flip_in_order<L: Copy + Send + Sync>(
     label: L,
     decide: impl Fn(&EditMesh<L>, u32, u32) -> bool + Sync,
 ) -> usize {
+    flip_in_order_vetoed(m, edges, label, decide, |_, _, _| true, |_, _| {})
+}
+
+/// [`flip_in_order`] with a last word read from the whole mesh: `veto(m, x, y)`, asked in
+/// order right before each flip `decide` allows (false: the edge is left), and `flipped(m,
+/// [x, y, c, d])` told after each flip (the new edge is `c`–`d`). Both run sequentially, so
+/// they may read and keep anything (a crossing guard over every face); the result stays the
+/// sequential pass's.
+pub(crate) fn flip_in_order_vetoed<L: Copy + Send + Sync>(
+    m: &mut EditMesh<L>,
+    edges: &[(u32, u32)],
+    label: L,
+    decide: impl Fn(&EditMesh<L>, u32, u32) -> bool + Sync,
+    mut veto: impl FnMut(&EditMesh<L>, u32, u32) -> bool,
+    mut flipped: impl FnMut(&EditMesh<L>, [u32; 4]),
+) -> usize {
     use rayon::prelude::*;
     let mut flips = 0;
     if edges.len() < PARALLEL_EDGES {
         for &(x, y) in edges {
-            if decide(m, x, y) && m.flip_edge(x, y, label).is_ok() {
+            if !(decide(m, x, y) && veto(m, x, y)) {
+                continue;
+            }
+            let [_, _, c, d] = quad(m, x, y).unwrap_or([x, y, x, y]);
+            if m.flip_edge(x, y, label).is_ok() {
                 flips += 1;
+                flipped(m, [x, y, c, d]);
             }
         }
         return flips;
@@ -118,7 +139,7 @@ pub(crate) fn flip_in_order<L: Copy + Send + Sync>(
         let stale = [x, y, apexes[0], apexes[1]]
             .iter()
             .any(|&v| touched.get(v as usize).copied().unwrap_or(true));
-        if !(if stale { decide(m, x, y) } else { yes }) {
+        if !(if stale { decide(m, x, y) } else { yes }) || !veto(m, x, y) {
             continue;
         }
         let [_, _, c, d] = quad(m, x, y).unwrap_or([x, y, x, y]);
@@ -127,6 +148,7 @@ pub(crate) fn flip_in_order<L: Copy + Send + Sync>(
             for v in [x, y, c, d] {
                 touched[v as usize] = true;
             }
+            flipped(m, [x, y, c, d]);
         }
     }
     flips

@@ -1,5 +1,5 @@
 //! Collapses of the short edges of poor triangles, under the link condition and guarded against
-//! the input surface.
+//! the input surface and against making a crossing.
 
 use glam::DVec3;
 
@@ -19,6 +19,7 @@ pub(super) fn collapse_short<S: SurfaceQuery + ?Sized>(
     short: f64,
     params: &Limits,
     poor: &PoorFaces,
+    guard: &mut SweepGuard,
 ) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let mut edges: Vec<(f64, u32, u32)> = Vec::new();
@@ -70,6 +71,7 @@ pub(super) fn collapse_short<S: SurfaceQuery + ?Sized>(
             .map(|&g| score(m, face(m, g)))
             .fold(f64::INFINITY, f64::min);
         let old_normals: Vec<DVec3> = involved.iter().map(|&g| normal(m, face(m, g))).collect();
+        let replaced: Vec<u32> = involved.iter().copied().chain([f1, f2]).collect();
         let mut best: Option<(f64, u32, u32, DVec3)> = None;
         for (removed, kept, q) in options {
             let saved = m.position(kept);
@@ -87,13 +89,15 @@ pub(super) fn collapse_short<S: SurfaceQuery + ?Sized>(
                 .fold(f64::INFINITY, f64::min);
             let dist = |p: DVec3| distance_to(m, new_faces.iter().copied(), p);
             let near = dist(pa) <= params.collapse_offset && dist(pb) <= params.collapse_offset;
-            // The old position was finite: restoring it cannot fail.
-            let _ = m.relocate_vertex(kept, saved);
-            if !turned
+            let wanted = !turned
                 && near
                 && worst > before + IMPROVEMENT_TOLERANCE
-                && best.is_none_or(|b| worst > b.0)
-            {
+                && best.is_none_or(|b| worst > b.0);
+            // The faces after the collapse (the kept vertex at q) must cross none.
+            let crossing = wanted && guard.refuses(m, &new_faces, &replaced);
+            // The old position was finite: restoring it cannot fail.
+            let _ = m.relocate_vertex(kept, saved);
+            if wanted && !crossing {
                 best = Some((worst, removed, kept, q));
             }
         }
@@ -102,6 +106,8 @@ pub(super) fn collapse_short<S: SurfaceQuery + ?Sized>(
         };
         if m.collapse_edge(removed, kept, q, None).is_ok() {
             collapses += 1;
+            let around = m.faces_around(kept).to_vec();
+            guard.changed(m, &around);
         }
     }
     collapses

@@ -11,12 +11,12 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 
 use crate::geometry::triangle::{triangle_min_angle_deg, triangle_q, AngleBounds};
+use crate::mesh::crossing_guard::CrossingGuard;
 use crate::mesh::edit::{starting_at, EditMesh, SlotPolicy};
 use crate::mesh::TriMesh;
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::mesh_projection::MeshSurface;
 use crate::surface::SurfaceQuery;
-use crate::triangulate::flip::max_min_flips;
 
 mod angles;
 mod collapse;
@@ -310,7 +310,9 @@ pub(super) fn turned(m: &Mesh, faces: &[[u32; 3]], old_normals: &[DVec3], cos_tu
 /// # Operations
 ///
 /// Four local operations, each kept only when it keeps the mesh near the input surface (see the
-/// offsets in [`OptimizeParams`]):
+/// offsets in [`OptimizeParams`]); collapse, flip and relax also only when their new faces cross
+/// no face, except where they meet `input_crossings` (`SweepGuard`;
+/// `docs/decisions/sweeps-crossing-guard.md`):
 /// - **Cover:** an input-surface point farther than `cover_distance_sigma_p` · sigma_p from the
 ///   mesh (the tip of an ear or a horn that the samples around it cut off) becomes a vertex: it
 ///   splits the face it is closest to, or the edge it lies beyond. This bounds the one-sided
@@ -364,15 +366,20 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
                 break;
             }
         }
+        // The sweeps make no crossing: each operation is checked against every face.
+        let mut guard = SweepGuard {
+            faces: CrossingGuard::new(&m),
+            input_crossings,
+        };
         for _ in 0..params.sweeps {
             poor.refresh(&mut m, params);
-            let c = collapse_short(&mut m, surface, &fixed, short, params, &poor);
+            let c = collapse_short(&mut m, surface, &fixed, short, params, &poor, &mut guard);
             poor.refresh(&mut m, params);
             let vertices = poor.vertices(&m);
-            let f = flip_poor(&mut m, surface, params, &vertices);
+            let f = flip_poor(&mut m, surface, params, &vertices, &mut guard);
             poor.refresh(&mut m, params);
             let vertices = poor.vertices(&m);
-            let r = relax_poor(&mut m, surface, &fixed, params, &vertices);
+            let r = relax_poor(&mut m, surface, &fixed, params, &vertices, &mut guard);
             stats.collapses += c;
             stats.flips += f;
             stats.moves += r;
@@ -397,6 +404,31 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
     );
     stats.mends = stats.mend.ops;
     (stats, written(m, mesh, &pairs))
+}
+
+/// The crossing guard of the sweeps (collapses, flips and moves of poor faces): an operation
+/// is refused when its new faces cross a face, except where they meet the regions where the
+/// input's own faces cross (there the output crosses as its input does, and the sweeps may
+/// still better its angles, as the last pass may).
+pub(super) struct SweepGuard<'a> {
+    pub faces: CrossingGuard,
+    pub input_crossings: Option<&'a CrossingRegions>,
+}
+
+impl SweepGuard<'_> {
+    /// Whether the faces `new` (as `m` places their corners now) would make a crossing, the
+    /// faces in `replaced` left out.
+    pub(super) fn refuses(&self, m: &Mesh, new: &[[u32; 3]], replaced: &[u32]) -> bool {
+        let at_input_crossing = self
+            .input_crossings
+            .is_some_and(|r| new.iter().any(|&t| r.meets(m.corners(t))));
+        !at_input_crossing && self.faces.crosses(m, new, replaced)
+    }
+
+    /// The faces in `slots` were made or moved.
+    pub(super) fn changed(&mut self, m: &Mesh, slots: &[u32]) {
+        self.faces.changed(m, slots);
+    }
 }
 
 /// `mesh` as the mesh the operations edit (each face labelled with its index), its `protected`
@@ -668,6 +700,57 @@ mod tests {
         assert_eq!(mesh.positions[3 * 7 + 3], original[3 * 7 + 3]);
         assert_eq!(topology(&mesh).boundary_edges, 24);
         assert_sane(&mesh);
+    }
+
+    /// A 4 × 4 grid of unit squares whose middle square's diagonal (0,0)–(1,1), shifted to
+    /// the grid's middle, is the long one: its other corners are pulled in and lifted by 0.04,
+    /// so the max-min rule flips it, and the flipped faces rise to 0.04 over the square's
+    /// centre. A small upright triangle stands there, from 0.005 to 0.06 high: clear of the
+    /// faces before the flip, through them after.
+    fn fold_under_a_fin() -> (TriMesh, [u32; 2]) {
+        let mut mesh = grid(4, 1.0);
+        let at = |i: usize, j: usize| j * 5 + i;
+        let (p10, p01) = (at(2, 1), at(1, 2));
+        let centre = DVec3::new(1.5, 1.5, 0.0);
+        for v in [p10, p01] {
+            let p = mesh.positions[v];
+            mesh.positions[v] = p + (centre - p) * 0.2 + DVec3::new(0.0, 0.0, 0.04);
+        }
+        let along = DVec3::new(1.0, 1.0, 0.0).normalize() * 0.02;
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend([
+            centre - along + DVec3::new(0.0, 0.0, 0.005),
+            centre + along + DVec3::new(0.0, 0.0, 0.005),
+            centre + DVec3::new(0.0, 0.0, 0.06),
+        ]);
+        mesh.triangles.push([base, base + 1, base + 2]);
+        (mesh, [at(1, 1) as u32, at(2, 2) as u32])
+    }
+
+    #[test]
+    fn the_sweeps_flips_make_no_crossing_with_the_guard() {
+        use crate::geometry::self_intersection::intersecting_pairs;
+        let crossings = |m: &Mesh| intersecting_pairs(m.positions(), &m.live_faces().0).len();
+        let params = Limits::new(&OptimizeParams::default(), 1.0);
+        let (mesh, [a, b]) = fold_under_a_fin();
+        let surface = MeshSurface::new(&mesh).unwrap();
+        let edges = [(a.min(b), a.max(b))];
+        // Without the guard the flip is made and crosses the fin.
+        let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+        assert_eq!(crossings(&m), 0);
+        assert_eq!(relax::flip_all(&mut m, &surface, &params, &edges, None), 1);
+        assert!(crossings(&m) > 0);
+        // With it, the flip is refused.
+        let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+        let mut guard = SweepGuard {
+            faces: CrossingGuard::new(&m),
+            input_crossings: None,
+        };
+        assert_eq!(
+            relax::flip_all(&mut m, &surface, &params, &edges, Some(&mut guard)),
+            0
+        );
+        assert_eq!(crossings(&m), 0);
     }
 
     #[test]

@@ -1,18 +1,21 @@
 //! Max-min flips and relaxation of the vertices of poor triangles, guarded against the input
-//! surface.
+//! surface and, with a [`CrossingGuard`], against making a crossing.
 
 use glam::DVec3;
 
 use super::*;
+use crate::triangulate::flip::{flip_in_order_vetoed, max_min_candidate};
 
 /// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around `poor_vertices`
-/// (the poor triangles' vertices, [`PoorFaces::vertices`]), where the new faces face the way the old ones did and stay within `max_offset` of
-/// the surface. Returns the number of flips.
+/// (the poor triangles' vertices, [`PoorFaces::vertices`]), where the new faces face the way
+/// the old ones did, stay within `max_offset` of the surface and cross no face (`guard`).
+/// Returns the number of flips.
 pub(super) fn flip_poor<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
     params: &Limits,
     poor_vertices: &[u32],
+    guard: &mut SweepGuard,
 ) -> usize {
     let mut edges: Vec<(u32, u32)> = Vec::new();
     for &v in poor_vertices {
@@ -26,22 +29,26 @@ pub(super) fn flip_poor<S: SurfaceQuery + ?Sized>(
     }
     edges.sort_unstable();
     edges.dedup();
-    flip_all(m, surface, params, &edges)
+    flip_all(m, surface, params, &edges, Some(guard))
 }
 
-/// Max-min angle flips ([`max_min_flips`]) of `edges`, in order, where the new faces face the
-/// way the old ones did and stay within `max_offset` of the surface. Returns the number of
-/// flips.
+/// Max-min angle flips ([`max_min_candidate`]) of `edges`, in order, where the new faces face
+/// the way the old ones did and stay within `max_offset` of the surface, and with a `guard`,
+/// cross no face (the guard is kept up to date). Returns the number of flips.
 pub(super) fn flip_all<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
     params: &Limits,
     edges: &[(u32, u32)],
+    mut guard: Option<&mut SweepGuard>,
 ) -> usize {
-    max_min_flips(m, edges, None, |m, flip| {
+    let accept = |m: &Mesh, x: u32, y: u32| {
+        let Some(flip) = max_min_candidate(m, x, y) else {
+            return false;
+        };
         let [t1, t2] = flip.old;
         let [new1, new2] = flip.new;
-        let (x, y, c, d) = (t1[0], t1[1], t1[2], t2[2]);
+        let (c, d) = (t1[2], t2[2]);
         // The new faces must face the way the old ones did and stay on the surface.
         let (n1, n2) = (normal(m, t1), normal(m, t2));
         let (m1, m2) = (normal(m, new1), normal(m, new2));
@@ -60,7 +67,32 @@ pub(super) fn flip_all<S: SurfaceQuery + ?Sized>(
             return false;
         };
         distance_to(m, [new1, new2], old_mid.position) <= params.max_offset
-    })
+    };
+    let guarded = guard.is_some();
+    let cell = std::cell::RefCell::new(guard.take());
+    flip_in_order_vetoed(
+        m,
+        edges,
+        None,
+        accept,
+        |m, x, y| {
+            !guarded
+                || max_min_candidate(m, x, y).is_some_and(|flip| {
+                    cell.borrow()
+                        .as_ref()
+                        .is_some_and(|g| !g.refuses(m, &flip.new, &flip.slots))
+                })
+        },
+        |m, [_, _, c, d]| {
+            if let Some(g) = cell.borrow_mut().as_mut() {
+                let slots: Vec<u32> = [m.face_on(c, d), m.face_on(d, c)]
+                    .into_iter()
+                    .flatten()
+                    .collect();
+                g.changed(m, &slots);
+            }
+        },
+    )
 }
 
 /// One sweep of relaxation over `poor_vertices` (the poor triangles' vertices,
@@ -72,6 +104,7 @@ pub(super) fn relax_poor<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     params: &Limits,
     poor_vertices: &[u32],
+    guard: &mut SweepGuard,
 ) -> usize {
     let cos_turn = params.max_normal_turn_deg.to_radians().cos();
     let mut moves = 0;
@@ -140,13 +173,22 @@ pub(super) fn relax_poor<S: SurfaceQuery + ?Sized>(
             if !turned
                 && q > best.0 + IMPROVEMENT_TOLERANCE
                 && distance_to_faces(m, &faces, old) <= params.max_offset
+                && !crosses_around(m, guard, &faces)
             {
                 best = (q, sp.position);
             }
         }
         if m.relocate_vertex(v, best.1).is_ok() && best.1 != old {
             moves += 1;
+            guard.changed(m, &faces);
         }
     }
     moves
+}
+
+/// Whether the faces in `slots` of `m`, as they are now, cross a face of `guard` (theirs left
+/// out) or one another.
+pub(super) fn crosses_around(m: &Mesh, guard: &SweepGuard, slots: &[u32]) -> bool {
+    let faces: Vec<[u32; 3]> = slots.iter().filter_map(|&f| m.face(f)).collect();
+    guard.refuses(m, &faces, slots)
 }

@@ -234,7 +234,7 @@ pub(super) fn smooth<S: SurfaceQuery + ?Sized>(
     let mut edges: Vec<(u32, u32)> = m.directed_edges().filter(|&(a, b)| a < b).collect();
     edges.sort_unstable();
     for _ in 0..3 {
-        let f = super::relax::flip_all(m, surface, params, &edges);
+        let f = super::relax::flip_all(m, surface, params, &edges, None);
         stats.delaunay_flips += f;
         if f == 0 {
             break;
