@@ -202,26 +202,30 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
                     || m.is_boundary_vertex(v)
             };
             let mut best: Option<(f64, Op)> = None;
-            let offer = |best: &mut Option<(f64, Op)>, value: Option<(f64, f64)>, op: Op| {
-                let Some((old, new)) = value else {
-                    return;
-                };
+            // Whether an operation taking the smallest angle score from `old` to `new` would be
+            // taken over `best`: only then are its new faces tested for crossings (the costly
+            // guard), which gives the same choices.
+            let better = |best: &Option<(f64, Op)>, old: f64, new: f64| {
                 let good = if crossing {
                     new >= old.min(bound)
                 } else {
                     new > old + IMPROVEMENT_TOLERANCE
                 };
-                if good && best.is_none_or(|b| new > b.0) {
+                good && best.is_none_or(|b| new > b.0)
+            };
+            let offer = |best: &mut Option<(f64, Op)>, value: Option<(f64, f64)>, op: Op| {
+                let Some((old, new)) = value else {
+                    return;
+                };
+                if better(best, old, new) {
                     *best = Some((new, op));
                 }
             };
             for k in 0..3 {
                 let (x, y) = (t[k], t[(k + 1) % 3]);
-                offer(
-                    &mut best,
-                    try_flip(m, surface, &guard, x, y, params),
-                    Op::Flip(x, y),
-                );
+                let worth = |old, new| better(&best, old, new);
+                let value = try_flip(m, surface, &guard, x, y, params, &worth);
+                offer(&mut best, value, Op::Flip(x, y));
                 for (removed, kept) in [(x, y), (y, x)] {
                     if stays(m, removed) {
                         continue;
@@ -234,11 +238,9 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
                         }
                     }
                     for q in aims {
-                        offer(
-                            &mut best,
-                            try_collapse(m, &guard, removed, kept, q, params),
-                            Op::Collapse(removed, kept, q),
-                        );
+                        let worth = |old, new| better(&best, old, new);
+                        let value = try_collapse(m, &guard, removed, kept, q, params, &worth);
+                        offer(&mut best, value, Op::Collapse(removed, kept, q));
                     }
                 }
             }
@@ -246,7 +248,9 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
                 if let (Some(lines), true) = (boundary, m.is_boundary_vertex(v)) {
                     // A boundary vertex moves along the input's boundary only.
                     if let Some(q) = slide_targets(m, lines, v, params) {
-                        offer(&mut best, try_move(m, &guard, v, q, params), Op::Move(v, q));
+                        let worth = |old, new| better(&best, old, new);
+                        let value = try_move(m, &guard, v, q, params, &worth);
+                        offer(&mut best, value, Op::Move(v, q));
                     }
                     continue;
                 }
@@ -254,7 +258,9 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
                     continue;
                 }
                 for q in move_targets(m, surface, v, params) {
-                    offer(&mut best, try_move(m, &guard, v, q, params), Op::Move(v, q));
+                    let worth = |old, new| better(&best, old, new);
+                    let value = try_move(m, &guard, v, q, params, &worth);
+                    offer(&mut best, value, Op::Move(v, q));
                 }
             }
             // Only where nothing else mends it, a face that crosses another (or folds onto a
@@ -436,6 +442,11 @@ fn worst_angle(m: &Mesh, faces: impl IntoIterator<Item = [u32; 3]>, params: &Lim
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Whether an operation that takes the smallest angle score from the first value to the second
+/// is worth the crossing guard: the operations below test crossings, the costliest guard, last
+/// and only when it says yes.
+type Worth<'a> = &'a dyn Fn(f64, f64) -> bool;
+
 /// The smallest angle of the two faces the max-min flip of `x`–`y` makes, when it passes the
 /// guards of [`mend_faces`].
 fn try_flip<S: SurfaceQuery + ?Sized>(
@@ -445,6 +456,7 @@ fn try_flip<S: SurfaceQuery + ?Sized>(
     x: u32,
     y: u32,
     params: &Limits,
+    worth: Worth<'_>,
 ) -> Option<(f64, f64)> {
     let flip = max_min_candidate(m, x, y)?;
     let [t1, t2] = flip.old;
@@ -470,7 +482,7 @@ fn try_flip<S: SurfaceQuery + ?Sized>(
         .max(distance_to(m, flip.new, old_mid.position));
     let old = worst_angle(m, flip.old, params);
     let new = worst_angle(m, flip.new, params);
-    if new_off > params.collapse_offset.max(old_off) {
+    if new_off > params.collapse_offset.max(old_off) || !worth(old, new) {
         return None;
     }
     if guard.crosses(m, &flip.new, &flip.slots) {
@@ -488,6 +500,7 @@ fn try_collapse(
     kept: u32,
     q: DVec3,
     params: &Limits,
+    worth: Worth<'_>,
 ) -> Option<(f64, f64)> {
     let (f1, f2, c, d) = m.edge_faces(removed, kept).ok()?;
     if !collapse_keeps_links(m, removed, kept, c, d) {
@@ -514,7 +527,7 @@ fn try_collapse(
     let new = worst_angle(m, new_faces.iter().copied(), params);
     let mut replaced = involved.clone();
     replaced.extend([f1, f2]);
-    let ok = !turned && near && !guard.crosses(m, &new_faces, &replaced);
+    let ok = !turned && near && worth(old, new) && !guard.crosses(m, &new_faces, &replaced);
     // The old position was finite: restoring it cannot fail.
     let _ = m.relocate_vertex(kept, pb);
     ok.then_some((old, new))
@@ -713,6 +726,7 @@ fn try_move(
     v: u32,
     q: DVec3,
     params: &Limits,
+    worth: Worth<'_>,
 ) -> Option<(f64, f64)> {
     let slots = m.faces_around(v).to_vec();
     let faces: Vec<[u32; 3]> = slots.iter().map(|&f| face(m, f)).collect();
@@ -725,6 +739,7 @@ fn try_move(
     let new = worst_angle(m, faces.iter().copied(), params);
     let ok = !turned
         && distance_to(m, faces.iter().copied(), p) <= params.collapse_offset
+        && worth(old, new)
         && !guard.crosses(m, &faces, &slots);
     let _ = m.relocate_vertex(v, p);
     ok.then_some((old, new))
