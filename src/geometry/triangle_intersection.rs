@@ -27,6 +27,34 @@ pub(crate) fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
     }
 }
 
+/// The sign of orient3d(a, b, c, d) when the floating-point determinant decides it (Shewchuk's
+/// first stage: its magnitude above the error bound `(7 + 56 ε) ε` times the permanent), `None`
+/// when only the exact stages can: the corners are nearly coplanar.
+fn orient_if_certain(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<i8> {
+    const EPS: f64 = f64::EPSILON * 0.5;
+    const BOUND: f64 = (7.0 + 56.0 * EPS) * EPS;
+    let (ad, bd, cd) = (a - d, b - d, c - d);
+    let (bdxcdy, cdxbdy) = (bd.x * cd.y, cd.x * bd.y);
+    let (cdxady, adxcdy) = (cd.x * ad.y, ad.x * cd.y);
+    let (adxbdy, bdxady) = (ad.x * bd.y, bd.x * ad.y);
+    let det = ad.z * (bdxcdy - cdxbdy) + bd.z * (cdxady - adxcdy) + cd.z * (adxbdy - bdxady);
+    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * ad.z.abs()
+        + (cdxady.abs() + adxcdy.abs()) * bd.z.abs()
+        + (adxbdy.abs() + bdxady.abs()) * cd.z.abs();
+    if det > BOUND * permanent {
+        Some(1)
+    } else if -det > BOUND * permanent {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+/// Whether all of `signs` are certain and strictly on one side.
+fn certainly_one_side(signs: [Option<i8>; 3]) -> bool {
+    signs.iter().all(|&s| s == Some(1)) || signs.iter().all(|&s| s == Some(-1))
+}
+
 /// Whether the closed triangles `a` and `b` (non-degenerate) share at least one point, decided
 /// exactly for the given coordinates (no tolerance: touching counts).
 ///
@@ -42,14 +70,23 @@ pub(crate) fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
 /// Precision Floating-Point Arithmetic and Fast Robust Geometric Predicates*, Discrete Comput.
 /// Geom. 18, 1997).
 pub fn triangles_intersect(a: [DVec3; 3], b: [DVec3; 3]) -> bool {
-    // Projections that are apart (see `segment_meets_triangle`): apart.
-    let axis = drop_axis(a);
-    let (a2, b2) = (a.map(|v| project(v, axis)), b.map(|v| project(v, axis)));
-    if orient_2d(a2[0], a2[1], a2[2]) != 0
-        && orient_2d(b2[0], b2[1], b2[2]) != 0
-        && !triangles_meet_2d(a2, b2)
-    {
+    // The floating-point determinants first: one triangle certainly on one side of the other's
+    // plane.
+    let fb = b.map(|p| orient_if_certain(a[0], a[1], a[2], p));
+    let fa = a.map(|p| orient_if_certain(b[0], b[1], b[2], p));
+    if certainly_one_side(fb) || certainly_one_side(fa) {
         return false;
+    }
+    // Nearly coplanar: projections that are apart (see `segment_meets_triangle`) are apart.
+    if fb.iter().chain(&fa).any(Option::is_none) {
+        let axis = drop_axis(a);
+        let (a2, b2) = (a.map(|v| project(v, axis)), b.map(|v| project(v, axis)));
+        if orient_2d(a2[0], a2[1], a2[2]) != 0
+            && orient_2d(b2[0], b2[1], b2[2]) != 0
+            && !triangles_meet_2d(a2, b2)
+        {
+            return false;
+        }
     }
     // Both of b's corners strictly on one side of a's plane (or the reverse): apart.
     let sb = b.map(|p| orient(a[0], a[1], a[2], p));
@@ -150,16 +187,25 @@ pub(crate) fn same_side_in_plane(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> bool
 
 /// Whether the closed segment `p q` meets the closed triangle `t` (non-degenerate), exactly.
 pub fn segment_meets_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
+    let (fp, fq) = (
+        orient_if_certain(t[0], t[1], t[2], p),
+        orient_if_certain(t[0], t[1], t[2], q),
+    );
+    if fp.is_some() && fp == fq && fp != Some(0) {
+        return false;
+    }
     // A point the two share projects to a point their projections share, so projections that
     // are apart (a coordinate dropped: exact) decide it with 2D predicates, which are fast where
     // the 3D ones are slowest: the nearly coplanar corners of a flat region's faces, which take
     // orient3d's exact stages (a flat part's mend spent 65% of its time there).
-    let axis = drop_axis(t);
-    let t2 = t.map(|v| project(v, axis));
-    if orient_2d(t2[0], t2[1], t2[2]) != 0
-        && !segment_meets_triangle_2d(project(p, axis), project(q, axis), t2)
-    {
-        return false;
+    if fp.is_none() || fq.is_none() {
+        let axis = drop_axis(t);
+        let t2 = t.map(|v| project(v, axis));
+        if orient_2d(t2[0], t2[1], t2[2]) != 0
+            && !segment_meets_triangle_2d(project(p, axis), project(q, axis), t2)
+        {
+            return false;
+        }
     }
     let sp = orient(t[0], t[1], t[2], p);
     let sq = orient(t[0], t[1], t[2], q);
@@ -379,6 +425,81 @@ mod tests {
         assert!(triangles_intersect(a, b));
         let b2 = [v(t, -1e-300, -1.), v(t, -1e-300, 1.), v(t, -1., 0.)];
         assert!(!triangles_intersect(a, b2));
+    }
+
+    /// The tests without the floating-point and projection filters: orient3d's signs alone.
+    fn segment_meets_triangle_exact(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
+        let (sp, sq) = (orient(t[0], t[1], t[2], p), orient(t[0], t[1], t[2], q));
+        if sp != 0 && sp == sq {
+            return false;
+        }
+        if sp == 0 && sq == 0 {
+            let axis = drop_axis(t);
+            let t2 = t.map(|v| project(v, axis));
+            return segment_meets_triangle_2d(project(p, axis), project(q, axis), t2);
+        }
+        let s = [
+            orient(p, q, t[0], t[1]),
+            orient(p, q, t[1], t[2]),
+            orient(p, q, t[2], t[0]),
+        ];
+        !(s.iter().any(|&x| x > 0) && s.iter().any(|&x| x < 0))
+    }
+
+    fn triangles_intersect_exact(a: [DVec3; 3], b: [DVec3; 3]) -> bool {
+        let sb = b.map(|p| orient(a[0], a[1], a[2], p));
+        let sa = a.map(|p| orient(b[0], b[1], b[2], p));
+        let one_side = |s: [i8; 3]| s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0);
+        if one_side(sb) || one_side(sa) {
+            return false;
+        }
+        if sb.iter().all(|&x| x == 0) {
+            return coplanar_triangles_intersect(a, b);
+        }
+        (0..3).any(|k| segment_meets_triangle_exact(a[k], a[(k + 1) % 3], b))
+            || (0..3).any(|k| segment_meets_triangle_exact(b[k], b[(k + 1) % 3], a))
+    }
+
+    #[test]
+    fn the_filters_give_the_exact_answers_on_nearly_coplanar_faces() {
+        // Faces of a tilted plane (corners rounded off it, as a flat part's are) and faces a
+        // rounding or a hair off it: the floating-point determinant is uncertain there, and the
+        // projection filter must agree with orient3d's exact stages.
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let (u, w) = (v(1.0, 0.3, 0.7).normalize(), v(-0.2, 1.0, 0.4));
+        let w = (w - u * u.dot(w)).normalize();
+        let n = u.cross(w);
+        let mut point = |rng: &mut ChaCha8Rng, off: f64| {
+            let (x, y) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            u * x + w * y + n * off * rng.random_range(-1.0..1.0)
+        };
+        let (mut met, mut apart, mut uncertain) = (0, 0, 0);
+        for i in 0..4000 {
+            let off = [0.0, 1e-17, 1e-12, 1e-3][i % 4];
+            let a = [0; 3].map(|_| point(&mut rng, off));
+            let b = [0; 3].map(|_| point(&mut rng, off));
+            if b.iter().any(|&p| orient_if_certain(a[0], a[1], a[2], p).is_none()) {
+                uncertain += 1;
+            }
+            for p in b {
+                if let Some(s) = orient_if_certain(a[0], a[1], a[2], p) {
+                    assert_eq!(s, orient(a[0], a[1], a[2], p));
+                }
+            }
+            let exact = triangles_intersect_exact(a, b);
+            assert_eq!(triangles_intersect(a, b), exact, "{a:?} {b:?}");
+            for k in 0..3 {
+                let (p, q) = (b[k], b[(k + 1) % 3]);
+                let e = segment_meets_triangle_exact(p, q, a);
+                assert_eq!(segment_meets_triangle(p, q, a), e, "{p:?} {q:?} {a:?}");
+            }
+            if exact {
+                met += 1;
+            } else {
+                apart += 1;
+            }
+        }
+        assert!(met > 500 && apart > 500 && uncertain > 1500, "{met} {apart} {uncertain}");
     }
 
     #[test]
