@@ -469,7 +469,7 @@ mod tests {
         let (u, w) = (v(1.0, 0.3, 0.7).normalize(), v(-0.2, 1.0, 0.4));
         let w = (w - u * u.dot(w)).normalize();
         let n = u.cross(w);
-        let mut point = |rng: &mut ChaCha8Rng, off: f64| {
+        let point = |rng: &mut ChaCha8Rng, off: f64| {
             let (x, y) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
             u * x + w * y + n * off * rng.random_range(-1.0..1.0)
         };
@@ -478,7 +478,9 @@ mod tests {
             let off = [0.0, 1e-17, 1e-12, 1e-3][i % 4];
             let a = [0; 3].map(|_| point(&mut rng, off));
             let b = [0; 3].map(|_| point(&mut rng, off));
-            if b.iter().any(|&p| orient_if_certain(a[0], a[1], a[2], p).is_none()) {
+            if b.iter()
+                .any(|&p| orient_if_certain(a[0], a[1], a[2], p).is_none())
+            {
                 uncertain += 1;
             }
             for p in b {
@@ -499,7 +501,10 @@ mod tests {
                 apart += 1;
             }
         }
-        assert!(met > 500 && apart > 500 && uncertain > 1500, "{met} {apart} {uncertain}");
+        assert!(
+            met > 500 && apart > 500 && uncertain > 1500,
+            "{met} {apart} {uncertain}"
+        );
     }
 
     #[test]
