@@ -248,9 +248,15 @@ fn run_once<'s>(
     // A sampling run again finer around the samples an earlier triangulation inserted asks
     // for a finer refinement of the input there than the budget against slivers allows.
     let mut tri_params = *params;
-    if let (true, TriangulationMethod::RestrictedDelaunay(rd)) =
-        (sizing.refinement.is_some(), &mut tri_params.triangulation)
-    {
+    // So does a field graded by thickness.
+    let graded = sizing
+        .grading
+        .as_ref()
+        .is_some_and(|g| g.grades_below(scanned.widths.sigma_ref));
+    if let (true, TriangulationMethod::RestrictedDelaunay(rd)) = (
+        sizing.refinement.is_some() || graded,
+        &mut tri_params.triangulation,
+    ) {
         rd.max_added_per_sample = rd.max_added_per_sample.max(REFINED_MAX_ADDED_PER_SAMPLE);
     }
     let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, &tri_params);

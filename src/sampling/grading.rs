@@ -361,4 +361,9 @@ impl SizingField for Thickness<'_> {
     fn width(&self, p: DVec3) -> f64 {
         self.grading.width(p, self.sigma_ref)
     }
+
+    /// No part is thin enough to be graded at `sigma_ref`: the field is left out.
+    fn is_uniform(&self) -> bool {
+        !self.grading.grades_below(self.sigma_ref)
+    }
 }
