@@ -123,20 +123,55 @@ pub fn untangle(
     params: &UntangleParams,
     input_crossings: Option<&CrossingRegions>,
 ) -> (UntangleStats, Vec<Option<u32>>) {
+    let u = untangle_known(mesh, fixed, sigma_p, params, input_crossings, None);
+    (u.stats, u.origin)
+}
+
+/// What [`untangle_known`] did and left.
+pub(crate) struct Untangled {
+    pub stats: UntangleStats,
+    /// Each face's index before, or `None` for a face a collapse changed.
+    pub origin: Vec<Option<u32>>,
+    /// When no collapse was made: the pairs of faces (indices into the mesh's triangles,
+    /// sorted) left within the parameters' `near` of intersecting, so that a later run on the
+    /// same mesh, or a test of its crossings, needs no search.
+    pub left: Option<Vec<[u32; 2]>>,
+    /// The vertices the rounds moved (`V` flags, the mesh's numbering).
+    pub moved: Vec<bool>,
+}
+
+/// [`untangle`] starting from `known`, the pairs of faces of `mesh` within `near` of
+/// intersecting (with the `near` of `params` as [`untangle`] takes it; `None`: searched for
+/// here), also giving the pairs it left.
+pub(crate) fn untangle_known(
+    mesh: &mut TriMesh,
+    fixed: &[bool],
+    sigma_p: f64,
+    params: &UntangleParams,
+    input_crossings: Option<&CrossingRegions>,
+    known: Option<Vec<[u32; 2]>>,
+) -> Untangled {
     let start = mesh.positions.clone();
     let mut m: Mesh = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
     let (triangles, slots) = m.live_faces();
     let mut stats = UntangleStats::default();
     let mut moved = vec![false; m.vertex_count()];
     let margin = params.margin_sigma_p * sigma_p;
-    let near = params.near.min(0.1 * margin).max(0.0);
-    let mut pairs = pairs_within(&mesh.positions, &mesh.triangles, near);
+    let near = untangle_near(params, sigma_p);
+    let mut pairs = match known {
+        Some(mut known) => {
+            known.sort_unstable();
+            known.dedup();
+            known
+        }
+        None => pairs_within(&mesh.positions, &mesh.triangles, near),
+    };
     stats.pairs_before = pairs.len();
+    // A face's slot is its index in `triangles` when every face is live, as here.
+    let in_order = slots.iter().enumerate().all(|(k, &f)| f as usize == k);
     // The rounds move a few vertices each: the pairs are updated around them through a guard
-    // whose leaves follow the moves, not searched for again over the whole mesh (a face's slot
-    // is its index in `triangles` when every face is live, as here).
-    let mut guard = (!pairs.is_empty() && slots.iter().enumerate().all(|(k, &f)| f as usize == k))
-        .then(|| CrossingGuard::within(&m, near));
+    // whose leaves follow the moves, not searched for again over the whole mesh.
+    let mut guard = (!pairs.is_empty() && in_order).then(|| CrossingGuard::within(&m, near));
     drop(slots);
     // The pairs at the current positions from `pairs` (those at the positions before the
     // vertices in `changed` moved).
@@ -265,6 +300,7 @@ pub fn untangle(
         })
     };
     let mut pairs_after = pairs.len();
+    let left = pairs.clone();
     if !pairs.is_empty() && params.max_collapses > 0 {
         let offset = params.collapse_offset_sigma_p * sigma_p;
         // The rounds' guard and pairs are those of the mesh as it is now (when every face is
@@ -295,7 +331,22 @@ pub fn untangle(
         .map(|(a, b)| a.distance(*b))
         .fold(0.0, f64::max)
         / sigma_p;
-    (stats, origin)
+    let left = (stats.collapses == 0 && in_order).then_some(left);
+    Untangled {
+        stats,
+        origin,
+        left,
+        moved,
+    }
+}
+
+/// The `near` [`untangle`] takes from `params`: at most a tenth of the margin it moves faces
+/// apart by (model units as `sigma_p`).
+pub(crate) fn untangle_near(params: &UntangleParams, sigma_p: f64) -> f64 {
+    params
+        .near
+        .min(0.1 * params.margin_sigma_p * sigma_p)
+        .max(0.0)
 }
 
 /// Passes of a round that put back the moves that made a crossing pair outside the input's own

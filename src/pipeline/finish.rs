@@ -10,7 +10,8 @@ use crate::finish::degenerate::{mend_degenerate_faces, DegenerateStats};
 use crate::finish::fit::{fit_to_surface, FitStats};
 use crate::finish::optimize::{mend_near, optimize, MendStats, OptimizeParams, OptimizeStats};
 use crate::finish::stray_shells::{remove_stray_shells, StrayShells};
-use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
+use crate::finish::untangle::{untangle_known, UntangleParams, UntangleStats, Untangled};
+use crate::geometry::face_intersection::faces_intersect;
 use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
 use crate::mesh::{orient_consistently, OrientStats, TriMesh};
 use crate::surface::feature_lines::FeatureLines;
@@ -167,6 +168,9 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     let mut mend_after_untangle = MendStats::default();
     // The intersecting pairs of the mesh as the mending after untangle left it (no search).
     intersecting = None;
+    // The pairs within untangle's `near` the first stage left when it collapsed nothing: the
+    // second starts from them (no search).
+    let mut known: Option<Vec<[u32; 2]>> = None;
     for (stage, offset) in [f.untangle.collapse_offset_sigma_p, f64::INFINITY]
         .into_iter()
         .enumerate()
@@ -175,7 +179,19 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             collapse_offset_sigma_p: offset,
             ..f.untangle
         };
-        let (stats, origin) = untangle(mesh, untangle_fixed, f.sigma_p, &params, f.input_crossings);
+        let Untangled {
+            stats,
+            origin,
+            left,
+            moved,
+        } = untangle_known(
+            mesh,
+            untangle_fixed,
+            f.sigma_p,
+            &params,
+            f.input_crossings,
+            known.take(),
+        );
         untangle_stats = if stage == 0 {
             stats
         } else {
@@ -183,27 +199,44 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
         };
         if stats.collapses > 0 {
             *face_sources = carried_sources(&origin, face_sources);
+        }
+        let edited = stats.collapses > 0 || stats.vertices_moved > 0;
+        if let (Some(op), true) = (f.optimize, edited) {
             // The collapses leave the faces around them as they fall (a hub where a fold was
-            // collapsed away): the last pass of the optimization mends them, and the faces
-            // around them, under its guards (no new crossing, near the surface).
-            if let Some(op) = f.optimize {
-                let near = around_changed_faces(mesh, &origin);
-                let (stats, mended) = mend_near(
-                    mesh,
-                    f.surface,
-                    &fixed,
-                    &protected,
-                    f.boundary,
-                    f.input_crossings,
-                    f.sigma_p,
-                    op,
-                    &near,
-                );
-                *face_sources = carried_sources(&mended.origin, face_sources);
-                mend_after_untangle = mend_after_untangle.then(&stats);
-                intersecting = Some(mended.intersecting);
-            }
+            // collapsed away), and a press moves vertices by up to the round's step: the last
+            // pass of the optimization mends those faces, and the faces around them, under its
+            // guards (no new crossing, near the surface).
+            let near = around_changed_faces(mesh, &origin, &moved);
+            let (stats, mended) = mend_near(
+                mesh,
+                f.surface,
+                &fixed,
+                &protected,
+                f.boundary,
+                f.input_crossings,
+                f.sigma_p,
+                op,
+                &near,
+            );
+            *face_sources = carried_sources(&mended.origin, face_sources);
+            mend_after_untangle = mend_after_untangle.then(&stats);
+            intersecting = Some(mended.intersecting);
             later_dropped += mesh.remove_unreferenced_vertices();
+        } else if stats.collapses > 0 {
+            later_dropped += mesh.remove_unreferenced_vertices();
+        } else if let Some(left) = left {
+            // Of the pairs left within `near`, those that intersect.
+            let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
+            intersecting = Some(
+                left.iter()
+                    .copied()
+                    .filter(|&[f, g]| {
+                        let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
+                        faces_intersect(a, corners(a), b, corners(b)).is_some()
+                    })
+                    .collect(),
+            );
+            known = Some(left);
         }
         // The second stage only where the first left the output's own folds or crossings.
         // Untangle's pairs at the end are those within its `near` (0 or more) of the mesh as it
@@ -271,8 +304,11 @@ fn has_own_crossings(
 
 /// The vertices of the faces of `mesh` that an edit changed (`origin[f]` is `None`: as
 /// `EditMesh::into_parts` gives it) and of the faces that share a vertex with them: `V` flags.
-fn around_changed_faces(mesh: &TriMesh, origin: &[Option<u32>]) -> Vec<bool> {
+fn around_changed_faces(mesh: &TriMesh, origin: &[Option<u32>], moved: &[bool]) -> Vec<bool> {
     let mut changed = vec![false; mesh.positions.len()];
+    for (c, &m) in changed.iter_mut().zip(moved) {
+        *c |= m;
+    }
     for (t, o) in mesh.triangles.iter().zip(origin) {
         if o.is_none() {
             for &v in t {

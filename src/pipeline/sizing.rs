@@ -105,7 +105,7 @@ impl Sizing {
             thickness: self
                 .grading
                 .as_ref()
-                .map(|grading| Thickness { grading, sigma_ref }),
+                .map(|grading| Thickness::new(grading, sigma_ref)),
             curvature: self
                 .curvature
                 .as_ref()

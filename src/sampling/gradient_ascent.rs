@@ -170,10 +170,11 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
             // are neighbours (`sampling::sweep`).
             let neighbours = |i: usize| lists[i - fixed].as_slice();
             let sweep = batches.sweep(&order, neighbours, |members| {
-                let moves: Vec<(SurfaceSample, f64, f64)> = members
+                // Each move with its sample's new embedding (the field read in parallel too).
+                let moves: Vec<((SurfaceSample, f64, f64), KernelPoint)> = members
                     .par_iter()
                     .map(|&i| {
-                        SCRATCH.with_borrow_mut(|(ws, near, sorted)| {
+                        let moved = SCRATCH.with_borrow_mut(|(ws, near, sorted)| {
                             move_one(
                                 kernel,
                                 surface,
@@ -187,12 +188,14 @@ pub fn gradient_ascent<S: Projection + ?Sized>(
                                 near,
                                 sorted,
                             )
-                        })
+                        });
+                        let x = embed(&moved.0);
+                        (moved, x)
                     })
                     .collect();
-                for (&i, (moved, dist, s)) in members.iter().zip(moves) {
+                for (&i, ((moved, dist, s), x)) in members.iter().zip(moves) {
                     local[i] = moved;
-                    embedded[i] = embed(&moved);
+                    embedded[i] = x;
                     total_move += dist;
                     total_s += s;
                     min_s = f64::min(min_s, s);

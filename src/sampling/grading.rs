@@ -90,7 +90,17 @@ pub struct Grading {
     /// One kd-tree per boundary loop over its vertices (at most [`MAX_GAP_LOOPS`] loops), for
     /// the gap between loops ([`Grading::boundary_gap`]).
     loops: Vec<StaticTree>,
+    /// The vertices of all of `loops` in one kd-tree (`None` without `loops`): a point farther
+    /// than d from all of them has a gap of at least d.
+    loop_vertices: Option<StaticTree>,
 }
+
+/// How far (in estimate spacings, [`LocalFeatureSize::spacing`]) the thickness of an estimate
+/// point reaches: a point with no estimate point within this distance has no thickness (the
+/// area-uniform estimate points leave a hole that wide with probability about e^(−π · 64)).
+/// The bound lets [`Thickness`] find the ungraded points by a search among the graded
+/// estimate points alone.
+pub const ESTIMATE_REACH: f64 = 8.0;
 
 /// The most boundary loops whose gaps the grading follows (each point queries every loop).
 pub const MAX_GAP_LOOPS: usize = 64;
@@ -127,21 +137,21 @@ impl Grading {
         let slope = (params.gradation / params.lfs_factor).min(1.0);
         let filtered = median_filtered(&lfs, &values, MEDIAN_NEIGHBORS);
         let thickness = lfs.envelope_with_slope(&filtered, cap, slope);
-        let loops: Vec<StaticTree> = if curves.len() >= 2 && curves.len() <= MAX_GAP_LOOPS {
+        let loop_points: Vec<Vec<DVec3>> = if curves.len() >= 2 && curves.len() <= MAX_GAP_LOOPS {
             curves
                 .iter()
                 .map(|c| {
-                    let points: Vec<DVec3> = c
-                        .vertices
+                    c.vertices
                         .iter()
                         .map(|&v| mesh.positions[v as usize])
-                        .collect();
-                    StaticTree::new(&points)
+                        .collect()
                 })
                 .collect()
         } else {
             Vec::new()
         };
+        let loops: Vec<StaticTree> = loop_points.iter().map(|p| StaticTree::new(p)).collect();
+        let loop_vertices = (!loops.is_empty()).then(|| StaticTree::new(&loop_points.concat()));
         let mut grading = Grading {
             lfs,
             min_thickness: f64::INFINITY,
@@ -149,6 +159,7 @@ impl Grading {
             params,
             cap,
             loops,
+            loop_vertices,
         };
         let boundary_min = curves
             .iter()
@@ -164,21 +175,29 @@ impl Grading {
     }
 
     /// The thickness at `x` (bbox-100 units; [`LocalFeatureSize::thickness`], smoothed to its
-    /// 1-Lipschitz envelope): the local feature size where a medial ball reaches across to
-    /// another sheet; `f64::INFINITY` at or beyond the cap.
+    /// 1-Lipschitz envelope) at the nearest estimate point within [`ESTIMATE_REACH`]
+    /// spacings: the local feature size where a medial ball reaches across to another sheet;
+    /// `f64::INFINITY` at or beyond the cap.
     ///
     /// The smaller of that and [`Grading::boundary_gap`].
     pub fn lfs(&self, x: DVec3) -> f64 {
-        let l = self
-            .lfs
-            .nearest(x)
-            .map_or(f64::INFINITY, |j| self.thickness[j])
-            .min(self.boundary_gap(x));
+        let l = self.thickness_at(x).min(self.boundary_gap(x));
         if l >= self.cap {
             f64::INFINITY
         } else {
             l
         }
+    }
+
+    /// The thickness of the nearest estimate point within [`ESTIMATE_REACH`] spacings of `x`
+    /// (`f64::INFINITY` with none).
+    fn thickness_at(&self, x: DVec3) -> f64 {
+        let reach = ESTIMATE_REACH * self.lfs.spacing;
+        self.lfs
+            .tree()
+            .nearest(x)
+            .filter(|&(_, d2)| d2 <= reach * reach)
+            .map_or(f64::INFINITY, |(j, _)| self.thickness[j as usize])
     }
 
     /// Half the width of the strip of surface between two boundary loops at `x` (bbox-100
@@ -352,13 +371,62 @@ fn median_filtered(lfs: &LocalFeatureSize, of: &[f64], k: usize) -> Vec<f64> {
 
 /// The grading by thickness: `min(1, c · lfs(p) / sigma_ref)` ([`Grading::width`]) for the global
 /// `sigma_ref` (bbox-100 units).
+///
+/// Its cost is where it grades: a point with no graded estimate point (c · thickness <
+/// sigma_ref) within [`ESTIMATE_REACH`] spacings and no boundary vertex within sigma_ref / c is
+/// found to be at width 1 by a search among the graded estimate points alone (few: the thin
+/// parts), not among all of them.
 pub struct Thickness<'a> {
-    pub grading: &'a Grading,
-    pub sigma_ref: f64,
+    grading: &'a Grading,
+    sigma_ref: f64,
+    /// The estimate points graded at `sigma_ref`.
+    graded: StaticTree,
+    /// [`ESTIMATE_REACH`] spacings, squared.
+    reach_2: f64,
+}
+
+impl<'a> Thickness<'a> {
+    /// The field of `grading` for the global `sigma_ref` (bbox-100 units).
+    pub fn new(grading: &'a Grading, sigma_ref: f64) -> Self {
+        let c = grading.params.lfs_factor;
+        let graded: Vec<DVec3> = grading
+            .thickness
+            .iter()
+            .zip(&grading.lfs.positions)
+            .filter(|&(&t, _)| c * t < sigma_ref && t < grading.cap)
+            .map(|(_, &p)| p)
+            .collect();
+        let reach = ESTIMATE_REACH * grading.lfs.spacing;
+        Thickness {
+            grading,
+            sigma_ref,
+            graded: StaticTree::new(&graded),
+            reach_2: reach * reach,
+        }
+    }
+
+    /// Whether `p` is certainly at width 1 (see [`Thickness`]).
+    fn surely_ungraded(&self, p: DVec3) -> bool {
+        if self
+            .graded
+            .nearest(p)
+            .is_some_and(|(_, d2)| d2 <= self.reach_2)
+        {
+            return false;
+        }
+        let Some(loops) = &self.grading.loop_vertices else {
+            return true;
+        };
+        let d = self.sigma_ref / self.grading.params.lfs_factor;
+        loops.nearest(p).is_none_or(|(_, d2)| d2 >= d * d)
+    }
 }
 
 impl SizingField for Thickness<'_> {
     fn width(&self, p: DVec3) -> f64 {
+        if self.surely_ungraded(p) {
+            return 1.0;
+        }
         self.grading.width(p, self.sigma_ref)
     }
 

@@ -56,6 +56,8 @@ pub struct GradedPoints {
     spacing: f64,
     /// The farthest a point's width reaches before the grading brings it to 1, squared.
     reach_2: f64,
+    /// The smallest of `widths` (1 with none).
+    least: f64,
 }
 
 impl GradedPoints {
@@ -68,16 +70,33 @@ impl GradedPoints {
             widths,
             spacing,
             reach_2: (reach * (1.0 + 1e-9)).powi(2),
+            least,
         }
     }
 }
 
 impl SizingField for GradedPoints {
+    /// The nearest point's value first: a point q lowers it only within (value − least) ·
+    /// spacing / gradation of p (its w(q) is at least `least`), so only that ball is searched,
+    /// not the whole reach. The same smallest value either way.
     fn width(&self, p: DVec3) -> f64 {
-        let mut w = 1.0f64;
-        self.tree.visit_within(p, self.reach_2, |i, d2| {
-            w = w.min(self.widths[i as usize] + CURVATURE_GRADATION * d2.sqrt() / self.spacing);
-        });
+        let value = |i: u32, d2: f64| {
+            self.widths[i as usize] + CURVATURE_GRADATION * d2.sqrt() / self.spacing
+        };
+        let Some((i, d2)) = self.tree.nearest(p) else {
+            return 1.0;
+        };
+        if d2 > self.reach_2 {
+            return 1.0;
+        }
+        let mut w = value(i, d2).min(1.0);
+        let r = (w - self.least) * self.spacing / CURVATURE_GRADATION * (1.0 + 1e-9);
+        if r > 0.0 {
+            self.tree
+                .visit_within(p, (r * r).min(self.reach_2), |i, d2| {
+                    w = w.min(value(i, d2))
+                });
+        }
         w
     }
 

@@ -110,6 +110,11 @@ impl LocalFeatureSize {
         self.nearest(x).map_or(f64::INFINITY, |j| self.lfs[j])
     }
 
+    /// The kd-tree over `positions`.
+    pub fn tree(&self) -> &StaticTree {
+        &self.tree
+    }
+
     /// The index (into `positions`) of the estimate point nearest `x`; `None` when there are
     /// none.
     pub fn nearest(&self, x: DVec3) -> Option<usize> {
