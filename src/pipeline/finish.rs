@@ -13,6 +13,7 @@ use crate::finish::stray_shells::{remove_stray_shells, StrayShells};
 use crate::finish::untangle::{untangle_known, UntangleParams, UntangleStats, Untangled};
 use crate::geometry::face_intersection::faces_intersect;
 use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
+use crate::geometry::triangle::AngleBounds;
 use crate::mesh::{orient_consistently, OrientStats, TriMesh};
 use crate::surface::feature_lines::FeatureLines;
 use crate::surface::SurfaceQuery;
@@ -179,6 +180,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             collapse_offset_sigma_p: offset,
             ..f.untangle
         };
+        let before_untangle = mesh.positions.clone();
         let Untangled {
             stats,
             origin,
@@ -206,7 +208,8 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             // collapsed away), and a press moves vertices by up to the round's step: the last
             // pass of the optimization mends those faces, and the faces around them, under its
             // guards (no new crossing, near the surface).
-            let near = around_changed_faces(mesh, &origin, &moved);
+            let pressed = pressed_out_of_bounds(mesh, &before_untangle, &moved, op.angle_bounds());
+            let near = around_changed_faces(mesh, &origin, &pressed);
             let (stats, mended) = mend_near(
                 mesh,
                 f.surface,
@@ -300,6 +303,35 @@ fn has_own_crossings(
             let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
             regions.is_none_or(|r| !r.holds_faces(a, corners(a), b, corners(b)))
         })
+}
+
+/// The vertices of the faces of `mesh` that the presses of untangle put out of the angle
+/// `bounds` (a corner in `moved`, and a score now below the bound and below the one at the
+/// positions `before`): `V` flags. A face out of bounds before the presses (at a kept crease,
+/// say) is not the presses' doing, and the mending after them leaves it.
+fn pressed_out_of_bounds(
+    mesh: &TriMesh,
+    before: &[DVec3],
+    moved: &[bool],
+    bounds: AngleBounds,
+) -> Vec<bool> {
+    let mut flags = vec![false; mesh.positions.len()];
+    for t in &mesh.triangles {
+        if !t
+            .iter()
+            .any(|&v| moved.get(v as usize).copied().unwrap_or(false))
+        {
+            continue;
+        }
+        let now = bounds.score(t.map(|v| mesh.positions[v as usize]));
+        let was = bounds.score(t.map(|v| before[v as usize]));
+        if now < bounds.min_deg && now < was {
+            for &v in t {
+                flags[v as usize] = true;
+            }
+        }
+    }
+    flags
 }
 
 /// The vertices of the faces of `mesh` that an edit changed (`origin[f]` is `None`: as
