@@ -379,3 +379,48 @@ pub(crate) fn edges_present(mesh: &TriMesh, edges: &[[u32; 2]]) -> usize {
         .filter(|e| have.contains(&(e[0].min(e[1]), e[0].max(e[1]))))
         .count()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Of three faces around a pressed vertex: the one the press folded below the bound is
+    /// marked, the one already below it and no worse is not, and a face with no moved corner
+    /// is not either.
+    #[test]
+    fn only_the_faces_a_press_made_worse_are_mended() {
+        let bounds = AngleBounds {
+            min_deg: 35.0,
+            max_deg: 100.0,
+        };
+        // 0-1-2: equilateral, its corner 2 then pressed nearly onto edge 0-1 (out of bounds).
+        // 3-4-5: a sliver before and after (corner 5 moves along it, no worse). 6-7-8: untouched.
+        let h = 3f64.sqrt() / 2.0;
+        let before = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.5, h, 0.0),
+            DVec3::new(10.0, 0.0, 0.0),
+            DVec3::new(11.0, 0.0, 0.0),
+            DVec3::new(10.5, 0.05, 0.0),
+            DVec3::new(20.0, 0.0, 0.0),
+            DVec3::new(21.0, 0.0, 0.0),
+            DVec3::new(20.5, 0.1, 0.0),
+        ];
+        let mut after = before.clone();
+        after[2] = DVec3::new(0.5, 0.1, 0.0);
+        after[5] = DVec3::new(10.5, 0.06, 0.0);
+        let mesh = TriMesh::new(after, vec![[0, 1, 2], [3, 4, 5], [6, 7, 8]]);
+        let moved = [false, false, true, false, false, true, false, false, false];
+        let flags = pressed_out_of_bounds(&mesh, &before, &moved, bounds);
+        assert_eq!(
+            flags,
+            [true, true, true, false, false, false, false, false, false]
+        );
+        // Unmoved, the first face is left too.
+        let none = [false; 9];
+        assert!(!pressed_out_of_bounds(&mesh, &before, &none, bounds)
+            .iter()
+            .any(|&f| f));
+    }
+}
