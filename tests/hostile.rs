@@ -1283,3 +1283,71 @@ fn a_small_address_space_limit_is_named_not_max_memory() {
     );
     assert!(!out.exists());
 }
+
+/// A binary PCD header for `n` points of `x y z` (4-byte floats), then `payload`.
+fn pcd(dir: &Path, name: &str, n: u64, data: &str, payload: &[u8]) -> PathBuf {
+    let mut bytes = format!(
+        "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {n}\nHEIGHT 1\n\
+         VIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {data}\n"
+    )
+    .into_bytes();
+    bytes.extend_from_slice(payload);
+    write(dir, name, bytes)
+}
+
+/// Issue 76 (R1, R5, R6): a PCD whose header promises more than the file holds exits 3 naming
+/// the file, `remesh` and `simplify` alike, before anything the header sizes is allocated (at
+/// cc1f49d: an abort allocating 4 GB, or a panic inside pcd-rs).
+#[test]
+fn a_pcd_promising_more_than_it_holds_is_refused_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut block = 37_000u32.to_le_bytes().to_vec();
+    block.extend_from_slice(&(u32::MAX - 15).to_le_bytes());
+    block.extend(std::iter::repeat_n(7u8, 37_000));
+    let bomb = pcd(dir.path(), "bomb.pcd", 1, "binary_compressed", &block);
+    let huge = pcd(
+        dir.path(),
+        "huge.pcd",
+        1_000_000_000_000,
+        "binary",
+        &[0; 90_000],
+    );
+    let (out, simplified) = (dir.path().join("out.obj"), dir.path().join("out.ply"));
+    for (input, name) in [(&bomb, "bomb.pcd"), (&huge, "huge.pcd")] {
+        let o = remesh(&[arg(input), arg(&out), "--points", "1000"]);
+        assert_error(&o, 3, &[name]);
+        let o = remesh(&["simplify", arg(input), arg(&simplified), "--points", "100"]);
+        assert_error(&o, 3, &[name]);
+        assert!(!out.exists() && !simplified.exists());
+    }
+}
+
+/// Issue 76 (R2, R14): what a point set's reader holds counts in the memory limit, from the
+/// header, before the file is read: a million points of a PCD (read whole) with
+/// `--max-memory 100M` are refused (at cc1f49d the estimate left the input out and the run
+/// took 178 MB).
+#[test]
+fn a_point_sets_input_counts_in_the_memory_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 1_000_000u64;
+    let payload: Vec<u8> = (0..n)
+        .flat_map(|i| {
+            let (t, u) = (i as f32 * 0.618_034, i as f32 / n as f32);
+            let (z, r) = (2.0 * u - 1.0, (1.0 - (2.0 * u - 1.0).powi(2)).sqrt());
+            [r * t.cos(), r * t.sin(), z]
+        })
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    let input = pcd(dir.path(), "sphere.pcd", n, "binary", &payload);
+    let out = dir.path().join("out.obj");
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "3000",
+        "--max-memory",
+        "100M",
+    ]);
+    assert_error(&o, 2, &["--max-memory", "1000000 points"]);
+    assert!(!out.exists());
+}

@@ -36,6 +36,18 @@ pub(super) fn run(
     write: &dyn Fn(&TriMesh) -> Result<()>,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<QualityReport> {
+    if let Some(limit) = job.max_memory {
+        // What the reader holds is known from the header (a PCD's decompressed payload, an
+        // E57's points), before anything is allocated.
+        let size = source.input_size().map_err(|e| with_path(e, &job.input))?;
+        let points = match job.params.density {
+            Density::Points(n) if n <= MAX_POINTS => n as f64,
+            _ => 0.0,
+        };
+        let input_points = size.points.unwrap_or(0);
+        let (distance, held) = (job.measure_distance, size.reader_bytes);
+        memory::check_point_set_budget(input_points, held, points, distance, limit)?;
+    }
     let (orientation, camera) = source
         .orientation(job.viewpoint)
         .map_err(|e| with_path(e, &job.input))?;
@@ -44,11 +56,6 @@ pub(super) fn run(
         orientation,
         ..PointRemeshParams::default()
     };
-    if let (Some(limit), Density::Points(n)) = (job.max_memory, job.params.density) {
-        if n <= MAX_POINTS {
-            memory::check_remesh_budget(0, n as f64, job.measure_distance, limit)?;
-        }
-    }
     let out = remesh_points(source, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
 
     on_stage("check");

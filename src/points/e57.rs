@@ -33,7 +33,7 @@ use std::io::BufReader;
 use std::ops::Range;
 use std::path::Path;
 
-use e57::{E57Reader, PointCloud, Record, RecordName};
+use e57::{E57Reader, PointCloud, Record, RecordDataType, RecordName};
 use glam::{DQuat, DVec3};
 
 use crate::error::{Error, Result};
@@ -99,12 +99,8 @@ pub fn read_e57(path: &Path) -> Result<E57Points> {
         .map(|(k, pc)| Layout::of(&pc.prototype, namespace).ok_or_else(|| parse(no_coordinates(k))))
         .collect::<Result<Vec<_>>>()?;
     let has_normals = !layouts.is_empty() && layouts.iter().all(|l| l.normal.is_some());
-    let total = clouds
-        .iter()
-        .fold(0u64, |sum, pc| sum.saturating_add(pc.records));
-    // Sized by the XML's counts, but not beyond what a damaged count could make a reason to
-    // fail on before a point is read.
-    let capacity = total.min(1 << 26) as usize;
+    // Sized by the XML's counts, which `held_points` checked against the file's size.
+    let capacity = held_points(path, &clouds)? as usize;
     let mut positions = Vec::with_capacity(capacity);
     let mut normals = Vec::with_capacity(if has_normals { capacity } else { 0 });
     let mut scans = Vec::with_capacity(clouds.len());
@@ -164,6 +160,72 @@ pub fn read_e57_viewpoint(path: &Path) -> Result<Option<DVec3>> {
         [pc] => Ok(Some(pose(path, 0, pc)?.1)),
         _ => Ok(None),
     }
+}
+
+/// Bytes a point takes while an E57 file is read (its raw values, position and normal).
+pub const BYTES_PER_POINT_READ: u64 = 72;
+
+/// The points an E57 file's XML section announces, checked against the file's size: what
+/// [`read_e57`] will allocate ([`BYTES_PER_POINT_READ`] each), known before it reads a point.
+///
+/// # Errors
+/// As [`read_e57`] for the file's header and XML; [`Error::Parse`] naming the file for a scan
+/// whose points the file cannot hold (see `held_points`).
+pub fn e57_points(path: &Path) -> Result<u64> {
+    let reader = open(path)?;
+    held_points(path, &reader.pointclouds())
+}
+
+/// Bits one value of a record takes in the file: 0 for an integer whose minimum is its maximum
+/// (every value is that one), as the standard packs it.
+fn value_bits(data_type: &RecordDataType) -> u64 {
+    match *data_type {
+        RecordDataType::Single { .. } => 32,
+        RecordDataType::Double { .. } => 64,
+        RecordDataType::Integer { min, max } | RecordDataType::ScaledInteger { min, max, .. } => {
+            let range = (max as i128 - min as i128).max(0) as u128;
+            (128 - range.leading_zeros()) as u64
+        }
+    }
+}
+
+/// The points of `clouds` (the XML's record counts), each scan's checked against the file:
+/// its records' bits times its count fit in the file's bytes, and a scan of points has a
+/// record of at least one bit (every record an integer whose minimum is its maximum leaves the
+/// e57 crate no data to count the points by: it would generate them without end).
+fn held_points(path: &Path, clouds: &[PointCloud]) -> Result<u64> {
+    let length = std::fs::metadata(path)
+        .map_err(|e| Error::io(path, e))?
+        .len();
+    let mut total = 0u64;
+    for (k, pc) in clouds.iter().enumerate() {
+        let bits: u64 = pc.prototype.iter().map(|r| value_bits(&r.data_type)).sum();
+        if pc.records > 0 && bits == 0 {
+            return Err(parse_error(
+                path,
+                format!(
+                    "scan {} stores its {} points in no bits (every field an integer whose \
+                     minimum is its maximum): one position, no surface",
+                    k + 1,
+                    pc.records
+                ),
+            ));
+        }
+        let bytes = (pc.records as u128 * bits as u128).div_ceil(8);
+        if bytes > length as u128 {
+            return Err(parse_error(
+                path,
+                format!(
+                    "scan {} announces {} points of {bits} bits and the file holds {length} \
+                     bytes",
+                    k + 1,
+                    pc.records
+                ),
+            ));
+        }
+        total += pc.records;
+    }
+    Ok(total)
 }
 
 /// The crate's reader of `path`, its header and XML section read.

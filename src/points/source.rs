@@ -111,6 +111,44 @@ impl PointSource {
         }
     }
 
+    /// The points the source announces and the bytes its reader holds, from the header alone
+    /// (nothing of the payload read): a PCD or E57 file is read whole
+    /// (`points::pcd::pcd_payload`, `points::e57::e57_points`); the other files are read in
+    /// chunks (their reader holds no points) and announce their count in the header, but for
+    /// text files, whose count is not known before they are read (`None`). Points in memory
+    /// count as read.
+    ///
+    /// # Errors
+    /// Those of the header checks for a PCD or E57 file (a payload the file cannot hold) and of
+    /// [`PointReader::open`] for the others.
+    pub fn input_size(&self) -> Result<InputSize> {
+        Ok(match self {
+            PointSource::File(path) if super::pcd::is_pcd_extension(path) => {
+                let payload = super::pcd::pcd_payload(path)?;
+                InputSize {
+                    points: Some(payload.points),
+                    reader_bytes: payload.resident_bytes,
+                }
+            }
+            PointSource::File(path) if super::e57::is_e57_extension(path) => {
+                let points = super::e57::e57_points(path)?;
+                InputSize {
+                    points: Some(points),
+                    reader_bytes: points.saturating_mul(super::e57::BYTES_PER_POINT_READ),
+                }
+            }
+            PointSource::File(path) if !super::stream::is_text_extension(path) => InputSize {
+                points: Some(PointReader::open(path)?.count()),
+                reader_bytes: 0,
+            },
+            PointSource::Part(part) => part.whole.input_size()?,
+            _ => InputSize {
+                points: None,
+                reader_bytes: 0,
+            },
+        })
+    }
+
     /// How normals estimated for these points are oriented: towards `given` (model units) when
     /// there is one, else towards the file's viewpoint ([`PointSource::viewpoint`]) when there
     /// is one and it saw the points (at most `MAX_HIDDEN_FRACTION` (5%) of the first
@@ -217,6 +255,15 @@ impl PointSource {
             .collect();
         Ok((sources, outside))
     }
+}
+
+/// What reading a source takes ([`PointSource::input_size`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct InputSize {
+    /// The points the header announces (`None` where the format has no header count).
+    pub points: Option<u64>,
+    /// Bytes the reader holds (a file read whole).
+    pub reader_bytes: u64,
 }
 
 /// The reader of one part's points: the whole source's, those in the part.

@@ -147,3 +147,100 @@ fn a_viewpoint_that_did_not_see_the_points_is_not_used_for_their_normals() {
     assert_eq!(orientation, NormalOrientation::Viewpoint(DVec3::Z));
     assert!(camera.is_none());
 }
+
+/// A PCD header for `fields` (`x y z` of one 4-byte float each unless given) announcing
+/// `points` points in `data`, then `payload` as it is.
+fn hostile(path: &Path, counts: &str, points: u64, data: &str, payload: &[u8]) {
+    let mut bytes = format!(
+        "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT {counts}\nWIDTH {points}\n\
+         HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {points}\nDATA {data}\n"
+    )
+    .into_bytes();
+    bytes.extend_from_slice(payload);
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// Issue 76 (R1, R5, R6, R11): a header whose sizes the file cannot hold is refused naming the
+/// file before anything it sizes is allocated (at cc1f49d: an abort allocating 4 GB, a panic
+/// inside pcd-rs, "failed to fill whole buffer").
+#[test]
+fn a_header_promising_more_than_the_file_holds_is_refused_before_it_is_allocated() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("hostile.pcd");
+    let block = |compressed: u32, decompressed: u32, body: &[u8]| {
+        let mut b = compressed.to_le_bytes().to_vec();
+        b.extend_from_slice(&decompressed.to_le_bytes());
+        b.extend_from_slice(body);
+        b
+    };
+    let refused = |mentions: &[&str]| {
+        let e = read_pcd(&path).unwrap_err().to_string();
+        assert_one_line_naming(&e, &[&["hostile.pcd"], mentions].concat());
+        // The memory estimate reads the same header and refuses the same.
+        assert_eq!(pcd_payload(&path).unwrap_err().to_string(), e);
+    };
+    // A block claiming 4 GB decompressed for one point.
+    let body = vec![7u8; 37_000];
+    hostile(
+        &path,
+        "1 1 1",
+        1,
+        "binary_compressed",
+        &block(37_000, u32::MAX - 15, &body),
+    );
+    refused(&["decompresses to 4294967280", "need 12"]);
+    // The same with POINTS to match: more than LZF can expand 37 KB to.
+    hostile(
+        &path,
+        "1 1 1",
+        357_913_940,
+        "binary_compressed",
+        &block(37_000, u32::MAX - 15, &body),
+    );
+    refused(&["more than LZF can expand"]);
+    // A block larger than the file, and a block promising more than it holds.
+    hostile(
+        &path,
+        "1 1 1",
+        2,
+        "binary_compressed",
+        &block(1000, 24, &[0; 10]),
+    );
+    refused(&["compressed block of 1000 bytes"]);
+    hostile(
+        &path,
+        "1 1 1",
+        1_000_000_000,
+        "binary_compressed",
+        &block(10, 24, &[0; 10]),
+    );
+    refused(&["decompresses to 24 bytes"]);
+    // 10^12 points in a binary or ascii payload of a few bytes.
+    hostile(&path, "1 1 1", 1_000_000_000_000, "binary", &[0; 90]);
+    refused(&["1000000000000 points of 12 bytes"]);
+    hostile(&path, "1 1 1", 1_000_000_000_000, "ascii", b"1 2 3\n");
+    refused(&["1000000000000 ascii points"]);
+    // A coordinate of two values, and a COUNT whose record overflows.
+    hostile(&path, "2 1 1", 1, "ascii", b"1 2 3 4\n");
+    refused(&["`x` has COUNT 2"]);
+    std::fs::write(
+        &path,
+        "VERSION .7\nFIELDS x y z w\nSIZE 4 4 4 8\nTYPE F F F F\nCOUNT 1 1 1 4611686018427387904\n\
+         WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA binary\n",
+    )
+    .unwrap();
+    refused(&["overflows"]);
+    // The honest files these were made from read.
+    hostile(&path, "1 1 1", 2, "ascii", b"1 2 3\n4 5 6\n");
+    assert_eq!(read_pcd(&path).unwrap().positions.len(), 2);
+    // COUNT 0 is one value (PCL's convention, which pcd-rs follows).
+    hostile(&path, "0 1 1", 2, "ascii", b"1 2 3\n4 5 6");
+    assert_eq!(read_pcd(&path).unwrap().positions.len(), 2);
+    let binary: Vec<u8> = [1f32, 2., 3., 4., 5., 6.]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    hostile(&path, "1 1 1", 2, "binary", &binary);
+    assert_eq!(read_pcd(&path).unwrap().positions.len(), 2);
+    assert_eq!(pcd_payload(&path).unwrap().points, 2);
+}
