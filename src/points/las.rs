@@ -80,8 +80,79 @@ impl LasPoints {
     }
 }
 
-/// The crate's reader of `path`, its header read.
+/// The fewest bytes a LASzip chunk takes: its first point, stored raw (point format 0 is 20
+/// bytes, the smallest).
+const MIN_CHUNK_BYTES: u64 = 20;
+
+/// Checks a LAZ file's chunk table against the file before the `laz` crate reads it (it
+/// reserves the table's announced size): the table's offset (at the start of the point data,
+/// or in the file's last 8 bytes when the writer did not update it, as LASzip and `laz` look
+/// for it) lies within the file, and the table lists no more chunks than the point data's
+/// bytes can hold ([`MIN_CHUNK_BYTES`] each). A LAS file, or a LAZ without a chunk table, is
+/// left to the crate.
+///
+/// # Errors
+/// [`Error::Io`] when the file cannot be read; [`Error::Parse`] naming the file for a chunk
+/// table past its end or announcing more chunks than its bytes hold.
+fn check_chunk_table(path: &Path) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let bad = |message: String| Error::Parse {
+        path: path.to_path_buf(),
+        line: None,
+        message,
+    };
+    let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let length = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    let mut header = [0u8; 105];
+    if file.read_exact(&mut header).is_err() || &header[..4] != b"LASF" {
+        return Ok(()); // Not LAS: the crate says so.
+    }
+    let compressed = header[104] & 0x80 != 0;
+    if !compressed {
+        return Ok(());
+    }
+    let data_start = u32::from_le_bytes(header[96..100].try_into().unwrap()) as u64;
+    let mut read_i64_at = |at: SeekFrom| -> Option<i64> {
+        let mut b = [0u8; 8];
+        file.seek(at).ok()?;
+        file.read_exact(&mut b).ok()?;
+        Some(i64::from_le_bytes(b))
+    };
+    let Some(mut offset) = read_i64_at(SeekFrom::Start(data_start)) else {
+        return Ok(()); // No point data: the crate says so.
+    };
+    if offset <= data_start as i64 {
+        match read_i64_at(SeekFrom::End(-8)) {
+            Some(o) if o > data_start as i64 => offset = o,
+            _ => return Ok(()), // No chunk table: read from the start only.
+        }
+    }
+    let offset = offset as u64;
+    if offset.saturating_add(8) > length {
+        return Err(bad(format!(
+            "the LAZ chunk table's offset {offset} is past the end of the file ({length} bytes)"
+        )));
+    }
+    let mut table = [0u8; 8];
+    file.seek(SeekFrom::Start(offset))
+        .and_then(|_| file.read_exact(&mut table))
+        .map_err(|e| Error::io(path, e))?;
+    let chunks = u32::from_le_bytes(table[4..].try_into().unwrap()) as u64;
+    let most = offset.saturating_sub(data_start + 8) / MIN_CHUNK_BYTES;
+    if chunks > most.max(1) {
+        return Err(bad(format!(
+            "the LAZ chunk table lists {chunks} chunks and the {} bytes of point data hold at \
+             most {most}",
+            offset.saturating_sub(data_start + 8)
+        )));
+    }
+    Ok(())
+}
+
+/// The crate's reader of `path`, its header read (a LAZ's chunk table checked first:
+/// `check_chunk_table`).
 fn reader(path: &Path) -> Result<las::Reader> {
+    check_chunk_table(path)?;
     las::Reader::from_path(path).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
         line: None,

@@ -311,3 +311,92 @@ fn corrupted_e57_files_never_panic() {
         }
     }
 }
+
+/// Issue 76 (R3): a scan whose every record is an integer with minimum = maximum (0 bits a
+/// point, legal E57) is refused naming the file: the e57 crate would generate its points
+/// without end (at cc1f49d: 8.5 GB in 30 s, then an abort).
+#[test]
+fn a_scan_stored_in_no_bits_is_refused_not_read_without_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("constant.e57");
+    // The crate's writer cannot write records of no bits: written with maximum 6, then the
+    // XML's maximum set to 5 and the pages' checksums made again.
+    let mut writer = E57Writer::from_file(&path, "file-guid").unwrap();
+    let prototype = [
+        RecordName::CartesianX,
+        RecordName::CartesianY,
+        RecordName::CartesianZ,
+    ]
+    .map(|name| Record {
+        name,
+        data_type: RecordDataType::Integer { min: 5, max: 6 },
+    })
+    .to_vec();
+    let mut cloud = writer.add_pointcloud("scan-guid", prototype).unwrap();
+    for _ in 0..10 {
+        cloud.add_point(vec![RecordValue::Integer(5); 3]).unwrap();
+    }
+    cloud.finalize().unwrap();
+    writer.finalize().unwrap();
+    let mut bytes = std::fs::read(&path).unwrap();
+    let (from, to) = (b"maximum=\"6\"".as_slice(), b"maximum=\"5\"".as_slice());
+    let mut patched = 0;
+    for i in 0..bytes.len() - from.len() {
+        if &bytes[i..i + from.len()] == from {
+            bytes[i..i + to.len()].copy_from_slice(to);
+            patched += 1;
+        }
+    }
+    assert_eq!(patched, 3, "the XML's three maxima");
+    // E57's pages: 1020 bytes and their CRC-32C (big-endian).
+    for page in bytes.chunks_mut(1024) {
+        let crc = crc32c(&page[..1020]);
+        page[1020..].copy_from_slice(&crc.to_be_bytes());
+    }
+    std::fs::write(&path, bytes).unwrap();
+    let e = read_e57(&path).unwrap_err().to_string();
+    assert_one_line_naming(&e, &["constant.e57", "scan 1", "10 points in no bits"]);
+    assert_eq!(e57_points(&path).unwrap_err().to_string(), e);
+}
+
+/// Issue 76 (R5): a scan announcing more points than the file's bytes can hold is refused
+/// before anything is reserved for them (at cc1f49d: 2^26 points reserved from the count, an
+/// abort under a 1.5 GB address-space limit).
+#[test]
+fn a_scan_announcing_more_points_than_the_file_holds_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scan.e57");
+    std::fs::write(&path, [0u8; 44_000]).unwrap();
+    let cloud = |records: u64| {
+        let mut pc = PointCloud::default();
+        pc.records = records;
+        pc.prototype = vec![
+            Record::CARTESIAN_X_F64,
+            Record::CARTESIAN_Y_F64,
+            Record::CARTESIAN_Z_F64,
+        ];
+        pc
+    };
+    // 24 bytes a point: 1833 fit in 44,000 bytes, 10^12 do not.
+    assert_eq!(held_points(&path, &[cloud(1833)]).unwrap(), 1833);
+    let e = held_points(&path, &[cloud(1833), cloud(1_000_000_000_000)])
+        .unwrap_err()
+        .to_string();
+    assert_one_line_naming(&e, &["scan.e57", "scan 2 announces 1000000000000 points"]);
+}
+
+/// CRC-32C (Castagnoli), bitwise: the checksum of an E57 page.
+fn crc32c(data: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in data {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 {
+                (crc >> 1) ^ 0x82F6_3B78
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}

@@ -113,3 +113,31 @@ fn a_file_that_is_not_laz_is_an_error_naming_the_file() {
     let e = e.to_string();
     assert_one_line_naming(&e, &["scan.laz", "LAZ"]);
 }
+
+/// Issue 76 (R4, R9): a LAZ whose chunk table announces 0xFFFFFFFF chunks, or lies past the
+/// end of the file, is refused naming the file before the `laz` crate reserves the table (at
+/// cc1f49d: an abort on a 68 GB allocation whatever the limits; 556 MB then exit 3).
+#[test]
+fn a_laz_chunk_table_the_file_cannot_hold_is_refused_before_it_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("survey.laz");
+    let written = write_survey(&path, 2000);
+    let honest = std::fs::read(&path).unwrap();
+    let data_start = u32::from_le_bytes(honest[96..100].try_into().unwrap()) as usize;
+    let table = i64::from_le_bytes(honest[data_start..data_start + 8].try_into().unwrap());
+    assert!(table as usize > data_start && (table as usize) < honest.len());
+    read_back(&path, &written, 700);
+    // 0xFFFFFFFF chunks.
+    let mut bytes = honest.clone();
+    bytes[table as usize + 4..table as usize + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let e = LasPoints::open(&path).unwrap_err().to_string();
+    assert_one_line_naming(&e, &["survey.laz", "4294967295 chunks"]);
+    // The table's offset past the end of the file.
+    let mut bytes = honest.clone();
+    let past = (honest.len() as i64 + 1_000_000).to_le_bytes();
+    bytes[data_start..data_start + 8].copy_from_slice(&past);
+    std::fs::write(&path, &bytes).unwrap();
+    let e = LasPoints::open(&path).unwrap_err().to_string();
+    assert_one_line_naming(&e, &["survey.laz", "past the end of the file"]);
+}
