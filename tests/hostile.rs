@@ -1351,3 +1351,27 @@ fn a_point_sets_input_counts_in_the_memory_limit() {
     assert_error(&o, 2, &["--max-memory", "1000000 points"]);
     assert!(!out.exists());
 }
+
+/// Issue 76 (R8): a point set's `--points` outside 4 to 20 million is a usage error (exit 2
+/// naming `--points`), as for a mesh (at cc1f49d: 30 million and 10^12 gave exit 0 with the
+/// input's points, 0 and 3 exit 3).
+#[test]
+fn a_point_sets_count_out_of_range_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let points: String = (0..500)
+        .map(|i| {
+            let (t, z) = (i as f64 * 2.399_963, 1.0 - 2.0 * (i as f64 + 0.5) / 500.0);
+            let r = (1.0 - z * z).sqrt();
+            format!("{} {} {z}\n", r * t.cos(), r * t.sin())
+        })
+        .collect();
+    let input = write(dir.path(), "sphere.xyz", points);
+    let out = dir.path().join("out.ply");
+    for n in ["0", "3", "30000000", "1000000000000"] {
+        let o = remesh(&[arg(&input), arg(&out), "--points", n]);
+        assert_error(&o, 2, &["--points", n]);
+        assert!(!out.exists());
+    }
+    let o = remesh(&[arg(&input), arg(&out), "--points", "200", "-q", "--no-distance"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

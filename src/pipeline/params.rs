@@ -116,6 +116,29 @@ pub(super) enum Target {
     SigmaP(f64),
 }
 
+/// Checks an asked count of output points: 4 to [`MAX_POINTS`], for a mesh or a point set.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `points`.
+pub(crate) fn check_count(n: usize) -> Result<()> {
+    if n < 4 {
+        return Err(Error::InvalidParameter {
+            name: "points",
+            message: format!("at least 4 points are needed for a closed surface, got {n}"),
+        });
+    }
+    if n > MAX_POINTS {
+        return Err(Error::InvalidParameter {
+            name: "points",
+            message: format!(
+                "{n} is more than the {MAX_POINTS} points this remesher holds in memory; \
+                 for larger point sets use `remesh simplify`"
+            ),
+        });
+    }
+    Ok(())
+}
+
 impl Target {
     /// The density `params` ask of `input`, checked: a count of 4 to [`MAX_POINTS`], a positive
     /// finite sigma_p, and a valid sigma_n.
@@ -129,21 +152,7 @@ impl Target {
             Density::InputVertices => Target::Points(input.vertex_count()),
         };
         match target {
-            Target::Points(n) if n < 4 => {
-                return Err(Error::InvalidParameter {
-                    name: "points",
-                    message: format!("at least 4 points are needed for a closed surface, got {n}"),
-                })
-            }
-            Target::Points(n) if n > MAX_POINTS => {
-                return Err(Error::InvalidParameter {
-                    name: "points",
-                    message: format!(
-                        "{n} is more than the {MAX_POINTS} points this remesher holds in memory; \
-                         for larger point sets use `remesh simplify`"
-                    ),
-                })
-            }
+            Target::Points(n) => check_count(n)?,
             Target::SigmaP(s) if !(s.is_finite() && s > 0.0) => {
                 return Err(Error::InvalidParameter {
                     name: "sigma_p",

@@ -373,7 +373,7 @@ pub struct PointRemeshOutput {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming the parameter for a density other than a count or sigma_p
-/// (`points`), grading (`lfs_factor`), curvature (`chord_error`), a crease angle
+/// or a count outside 4 to [`MAX_POINTS`](crate::pipeline::MAX_POINTS) (`points`), grading (`lfs_factor`), curvature (`chord_error`), a crease angle
 /// (`feature_angle`) or a finite sigma_n (`sigma_n`) on points without normals; the errors of
 /// reading the points ([`PointReader`](crate::internal::PointReader)), naming the file;
 /// [`Error::InvalidMesh`] for an empty set, one with no extent, or one of which nothing could be
@@ -383,6 +383,9 @@ pub fn remesh_points(
     params: &PointRemeshParams,
     on_stage: &(dyn Fn(&str) + Sync),
 ) -> Result<PointRemeshOutput> {
+    if let Density::Points(n) = params.remesh.density {
+        super::params::check_count(n)?;
+    }
     match remesh_points_whole(source, params, on_stage)? {
         Run::Meshed(out) => Ok(*out),
         Run::Parts(parts) => remesh_parts(source, params, parts, on_stage),
