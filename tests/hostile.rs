@@ -1372,6 +1372,63 @@ fn a_point_sets_count_out_of_range_is_a_usage_error() {
         assert_error(&o, 2, &["--points", n]);
         assert!(!out.exists());
     }
-    let o = remesh(&[arg(&input), arg(&out), "--points", "200", "-q", "--no-distance"]);
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "200",
+        "-q",
+        "--no-distance",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// Issue 76 (R12): a PCD whose normals are NaN at some points (as PCL's normal estimation writes
+/// them where a point had too few neighbours) is meshed, those normals fitted from the points
+/// near them (at cc1f49d: exit 2 "invalid parameter normals: normal 5 …", no file named).
+#[test]
+fn a_pcd_with_some_nan_normals_is_meshed() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 5000u32;
+    let payload: Vec<u8> = (0..n)
+        .flat_map(|i| {
+            let (t, z) = (
+                i as f32 * 2.399_963,
+                1.0 - 2.0 * (i as f32 + 0.5) / n as f32,
+            );
+            let r = (1.0 - z * z).sqrt();
+            let p = [r * t.cos(), r * t.sin(), z];
+            let normal = if i % 20 == 5 { [f32::NAN; 3] } else { p };
+            [p, normal].concat()
+        })
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    let mut bytes = format!(
+        "VERSION .7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\n\
+         TYPE F F F F F F\nCOUNT 1 1 1 1 1 1\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n\
+         POINTS {n}\nDATA binary\n"
+    )
+    .into_bytes();
+    bytes.extend_from_slice(&payload);
+    let input = write(dir.path(), "normals.pcd", bytes);
+    let (out, report) = (dir.path().join("out.ply"), dir.path().join("r.json"));
+    let o = remesh(&[
+        arg(&input),
+        arg(&out),
+        "--points",
+        "800",
+        "-q",
+        "--no-distance",
+        "--report",
+        arg(&report),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    let t = &r["topology"];
+    assert_eq!(
+        (t["components"].as_u64(), t["genus"].as_u64()),
+        (Some(1), Some(0)),
+        "{t}"
+    );
+    assert_eq!(t["boundary_loops"].as_u64(), Some(0), "{t}");
 }

@@ -38,6 +38,50 @@ impl NormalOrientation {
     }
 }
 
+/// Fills the normals a file left unusable (zero or not finite: PCL's normal estimation writes
+/// NaN where a point had too few neighbours): each such point's is the least-variance
+/// direction of its `k` nearest neighbours, turned to agree with the given normals among its
+/// `k` nearest points that have one (their sum's side; kept as fitted where none is near).
+/// Returns how many were filled. Deterministic.
+pub fn fill_missing_normals(points: &[DVec3], normals: &mut [DVec3], k: usize) -> usize {
+    let usable = |n: &DVec3| n.is_finite() && n.length_squared() > 0.0;
+    let missing: Vec<usize> = (0..normals.len())
+        .filter(|&i| !usable(&normals[i]))
+        .collect();
+    if missing.is_empty() {
+        return 0;
+    }
+    let k = k.max(3);
+    let tree = StaticTree::new(points);
+    let given: Vec<u32> = (0..points.len() as u32)
+        .filter(|&i| usable(&normals[i as usize]))
+        .collect();
+    let given_points: Vec<DVec3> = given.iter().map(|&i| points[i as usize]).collect();
+    let given_tree = StaticTree::new(&given_points);
+    let filled: Vec<DVec3> = missing
+        .par_iter()
+        .map_init(Vec::new, |found, &i| {
+            tree.nearest_n(points[i], k, found);
+            let near: Vec<DVec3> = found.iter().map(|&(j, _)| points[j as usize]).collect();
+            let fitted = plane_normal(&near);
+            given_tree.nearest_n(points[i], k, found);
+            let side: DVec3 = found
+                .iter()
+                .map(|&(j, _)| normals[given[j as usize] as usize].normalize())
+                .sum();
+            if side.dot(fitted) < 0.0 {
+                -fitted
+            } else {
+                fitted
+            }
+        })
+        .collect();
+    for (&i, n) in missing.iter().zip(filled) {
+        normals[i] = n;
+    }
+    missing.len()
+}
+
 /// Unit normals of `points` (any units): the least-variance direction of each point's `k`
 /// nearest neighbours (itself included), oriented as `orientation` says. `k` below 3 is taken
 /// as 3. Deterministic.
@@ -220,6 +264,30 @@ mod tests {
         // A viewpoint inside turns them all inward.
         let inward = estimate_normals(&points, 12, NormalOrientation::Viewpoint(DVec3::ZERO));
         assert!(inward.iter().zip(&points).all(|(n, p)| n.dot(*p) < 0.0));
+    }
+
+    /// Issue 76 (R12): normals a file left NaN or zero at some points are fitted there and turned
+    /// to the side of the given ones; the given ones are kept.
+    #[test]
+    fn missing_normals_are_filled_on_the_given_ones_side() {
+        let points: Vec<DVec3> = crate::mesh::test_meshes::fibonacci_sphere(2000)
+            .into_iter()
+            .map(|u| u * 3.0)
+            .collect();
+        let mut normals: Vec<DVec3> = points.iter().map(|p| p.normalize()).collect();
+        let given = normals.clone();
+        for i in (0..2000).step_by(7) {
+            normals[i] = if i % 2 == 0 { DVec3::NAN } else { DVec3::ZERO };
+        }
+        assert_eq!(fill_missing_normals(&points, &mut normals, 10), 286);
+        for (i, (n, g)) in normals.iter().zip(&given).enumerate() {
+            if i % 7 == 0 {
+                assert!(n.dot(*g) > 0.99, "point {i}: {n} against {g}");
+            } else {
+                assert_eq!(n, g);
+            }
+        }
+        assert_eq!(fill_missing_normals(&points, &mut normals, 10), 0);
     }
 
     #[test]

@@ -477,6 +477,20 @@ pub(crate) fn rimls_of(
             let from = support.len() - samples.len();
             samples.copy_from_slice(&support[from..]);
         }
+    } else {
+        // A file's normals may be missing at some points (NaN or zero): those are fitted and
+        // turned to agree with the given ones near them.
+        let positions: Vec<DVec3> = support.iter().map(|p| p.position).collect();
+        let mut normals: Vec<DVec3> = support.iter().map(|p| p.normal).collect();
+        if super::normals::fill_missing_normals(&positions, &mut normals, 10) > 0 {
+            for (p, n) in support.iter_mut().zip(normals) {
+                p.normal = n;
+            }
+            if samples_in_support {
+                let from = support.len() - samples.len();
+                samples.copy_from_slice(&support[from..]);
+            }
+        }
     }
     let (mut positions, mut normals): (Vec<DVec3>, Vec<DVec3>) =
         support.iter().map(|p| (p.position, p.normal)).unzip();
