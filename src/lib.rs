@@ -302,7 +302,7 @@ pub mod internal {
         DOMAIN_GAP_SIGMA_P, MAX_SCANS, MAX_SURFACE_VARIATION, OPEN_GAP_SIGMA_P,
         RIMLS_POINTS_PER_SAMPLE,
     };
-    pub use crate::points::source::ReadPoints;
+    pub use crate::points::source::{InputSize, ReadPoints};
     pub use crate::points::{PlyPointWriter, Point, PointReader};
 
     // The jobs of the `remesh` command line: files in, files and report out.

@@ -400,3 +400,29 @@ fn crc32c(data: &[u8]) -> u32 {
     }
     !crc
 }
+
+/// Writes the seed of the `read_e57` fuzz target (`fuzz/seeds/read_e57`: two scans, one
+/// spherical with normals) into `$FUZZ_SEEDS/read_e57`.
+#[test]
+#[ignore = "writes the fuzz seeds: FUZZ_SEEDS=fuzz/seeds cargo test -- --ignored fuzz_seeds"]
+fn write_e57_fuzz_seeds() {
+    let dir = Path::new(&std::env::var("FUZZ_SEEDS").expect("FUZZ_SEEDS")).join("read_e57");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scans = [
+        Scan {
+            rotation: [1.0, 0.0, 0.0, 0.0],
+            translation: [1.0, 2.0, 3.0],
+            spherical: false,
+            points: vec![([1.0, 2.0, 3.0], 0), ([4.0, 5.0, 6.0], 2)],
+            normals: None,
+        },
+        Scan {
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            translation: [0.0, 0.0, 0.0],
+            spherical: true,
+            points: vec![([2.0, 0.5, 0.25], 0), ([3.0, -0.5, 0.0], 1)],
+            normals: Some(vec![[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]),
+        },
+    ];
+    write(&dir.join("scans.e57"), &scans);
+}

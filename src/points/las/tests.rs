@@ -141,3 +141,14 @@ fn a_laz_chunk_table_the_file_cannot_hold_is_refused_before_it_is_read() {
     let e = LasPoints::open(&path).unwrap_err().to_string();
     assert_one_line_naming(&e, &["survey.laz", "past the end of the file"]);
 }
+
+/// Writes the seeds of the `read_las` fuzz target (`fuzz/seeds/read_las`: a LAS and a LAZ of
+/// a few points) into `$FUZZ_SEEDS/read_las`.
+#[test]
+#[ignore = "writes the fuzz seeds: FUZZ_SEEDS=fuzz/seeds cargo test -- --ignored fuzz_seeds"]
+fn write_las_fuzz_seeds() {
+    let dir = Path::new(&std::env::var("FUZZ_SEEDS").expect("FUZZ_SEEDS")).join("read_las");
+    std::fs::create_dir_all(&dir).unwrap();
+    write_survey(&dir.join("survey.las"), 20);
+    write_survey(&dir.join("survey.laz"), 20);
+}

@@ -244,3 +244,30 @@ fn a_header_promising_more_than_the_file_holds_is_refused_before_it_is_allocated
     assert_eq!(read_pcd(&path).unwrap().positions.len(), 2);
     assert_eq!(pcd_payload(&path).unwrap().points, 2);
 }
+
+/// Writes the seeds of the `read_pcd` fuzz target (`fuzz/seeds/read_pcd`: the three
+/// encodings, with and without depth) into `$FUZZ_SEEDS/read_pcd`.
+#[test]
+#[ignore = "writes the fuzz seeds: FUZZ_SEEDS=fuzz/seeds cargo test -- --ignored fuzz_seeds"]
+fn write_pcd_fuzz_seeds() {
+    let dir = Path::new(&std::env::var("FUZZ_SEEDS").expect("FUZZ_SEEDS")).join("read_pcd");
+    std::fs::create_dir_all(&dir).unwrap();
+    let rows = [
+        [0.5, -1.25, 2.0, 7.0],
+        [f32::NAN, 1.0, 2.0, 0.0],
+        [1.5, 0.25, 2.5, 1.0],
+    ];
+    for kind in [
+        DataKind::Ascii,
+        DataKind::Binary,
+        DataKind::BinaryCompressed,
+    ] {
+        write(
+            &dir.join(format!("{kind:?}.pcd")),
+            kind,
+            &rows,
+            3,
+            [0.0, 0.0, 1.0],
+        );
+    }
+}

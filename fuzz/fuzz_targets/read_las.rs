@@ -1,0 +1,11 @@
+#![no_main]
+//! The LAS point reader on arbitrary bytes (seeds: `fuzz/seeds/read_las`): see points_common.rs.
+
+use libfuzzer_sys::fuzz_target;
+
+#[path = "points_common.rs"]
+mod points_common;
+
+fuzz_target!(|data: &[u8]| {
+    points_common::read_points(data, "las");
+});
