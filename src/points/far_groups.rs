@@ -264,7 +264,7 @@ impl SeparateParts {
             .map(|g| g.bbox.diagonal())
             .fold(0.0f64, f64::max);
         format!(
-            "the points form {} parts far apart ({} across in all, the largest part {}              across): one scale cannot hold them; give each part on its own",
+            "the points form {} parts far apart ({} across in all, the largest part {} across): one scale cannot hold them; give each part on its own",
             self.len(),
             short(self.whole.diagonal()),
             short(largest),
@@ -428,6 +428,13 @@ mod tests {
             parts.parts[0].subset_points + parts.parts[1].subset_points,
             two.len()
         );
+        // Issue 76 (R11): the refusal reads as one sentence (it had a run of spaces).
+        let refusal = parts.refusal();
+        assert!(
+            refusal.starts_with("the points form 2 parts far apart"),
+            "{refusal}"
+        );
+        assert!(!refusal.contains("  "), "{refusal:?}");
     }
 
     #[test]

@@ -84,17 +84,20 @@ impl LasPoints {
 /// bytes, the smallest).
 const MIN_CHUNK_BYTES: u64 = 20;
 
-/// Checks a LAZ file's chunk table against the file before the `laz` crate reads it (it
-/// reserves the table's announced size): the table's offset (at the start of the point data,
-/// or in the file's last 8 bytes when the writer did not update it, as LASzip and `laz` look
-/// for it) lies within the file, and the table lists no more chunks than the point data's
-/// bytes can hold ([`MIN_CHUNK_BYTES`] each). A LAS file, or a LAZ without a chunk table, is
-/// left to the crate.
+/// Checks a LAS file's header against the file before the `las` crate reads it: the scale
+/// factors are finite and not 0 (the format forbids 0, which would flatten every point onto
+/// the offset), an uncompressed file's announced points fit in its bytes (each of the
+/// header's record length), and a LAZ file's chunk table (which the `laz` crate reserves at
+/// its announced size) lies within the file, at its offset at the start of the point data or in
+/// the file's last 8 bytes when the writer did not update it (as LASzip and `laz` look for it),
+/// and lists no more chunks than the point data's bytes can hold ([`MIN_CHUNK_BYTES`] each). A
+/// file too short for a header, or without a chunk table, is left to the crate.
 ///
 /// # Errors
-/// [`Error::Io`] when the file cannot be read; [`Error::Parse`] naming the file for a chunk
-/// table past its end or announcing more chunks than its bytes hold.
-fn check_chunk_table(path: &Path) -> Result<()> {
+/// [`Error::Io`] when the file cannot be read; [`Error::Parse`] naming the file for a scale of
+/// 0 or not finite, more points than the file holds, or a chunk table past its end or
+/// announcing more chunks than its bytes hold.
+fn check_header(path: &Path) -> Result<()> {
     use std::io::{Read, Seek, SeekFrom};
     let bad = |message: String| Error::Parse {
         path: path.to_path_buf(),
@@ -103,15 +106,47 @@ fn check_chunk_table(path: &Path) -> Result<()> {
     };
     let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let length = file.metadata().map_err(|e| Error::io(path, e))?.len();
-    let mut header = [0u8; 105];
-    if file.read_exact(&mut header).is_err() || &header[..4] != b"LASF" {
-        return Ok(()); // Not LAS: the crate says so.
+    // LAS 1.0-1.3 headers are 227 bytes at least, 1.4's 375 (its 64-bit count at 247).
+    let mut header = Vec::with_capacity(255);
+    (&mut file)
+        .take(255)
+        .read_to_end(&mut header)
+        .map_err(|e| Error::io(path, e))?;
+    let version = (header.get(24).copied(), header.get(25).copied());
+    let needed = if version >= (Some(1), Some(4)) {
+        255
+    } else {
+        227
+    };
+    if header.len() < needed || &header[..4] != b"LASF" {
+        return Ok(()); // Not LAS, or a header cut short: the crate says so.
     }
-    let compressed = header[104] & 0x80 != 0;
-    if !compressed {
-        return Ok(());
+    let f64_at = |at: usize| f64::from_le_bytes(header[at..at + 8].try_into().unwrap());
+    for (axis, at) in [("x", 131), ("y", 139), ("z", 147)] {
+        let scale = f64_at(at);
+        if !(scale.is_finite() && scale != 0.0) {
+            return Err(bad(format!("the header's {axis} scale factor is {scale}")));
+        }
     }
     let data_start = u32::from_le_bytes(header[96..100].try_into().unwrap()) as u64;
+    let record = u16::from_le_bytes(header[105..107].try_into().unwrap()) as u64;
+    let legacy = u32::from_le_bytes(header[107..111].try_into().unwrap()) as u64;
+    let count = if needed == 255 {
+        u64::from_le_bytes(header[247..255].try_into().unwrap())
+    } else {
+        legacy
+    };
+    let compressed = header[104] & 0x80 != 0;
+    if !compressed {
+        let bytes = length.saturating_sub(data_start);
+        if (count as u128) * (record as u128) > bytes as u128 {
+            return Err(bad(format!(
+                "the header announces {count} points of {record} bytes and the file holds \
+                 {bytes} bytes of points"
+            )));
+        }
+        return Ok(());
+    }
     let mut read_i64_at = |at: SeekFrom| -> Option<i64> {
         let mut b = [0u8; 8];
         file.seek(at).ok()?;
@@ -149,10 +184,10 @@ fn check_chunk_table(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The crate's reader of `path`, its header read (a LAZ's chunk table checked first:
-/// `check_chunk_table`).
+/// The crate's reader of `path`, its header read (checked first against the file:
+/// `check_header`).
 fn reader(path: &Path) -> Result<las::Reader> {
-    check_chunk_table(path)?;
+    check_header(path)?;
     las::Reader::from_path(path).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
         line: None,

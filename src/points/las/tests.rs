@@ -152,3 +152,26 @@ fn write_las_fuzz_seeds() {
     write_survey(&dir.join("survey.las"), 20);
     write_survey(&dir.join("survey.laz"), 20);
 }
+
+/// Issue 76 (R11): a LAS header announcing more points than the file holds, or a scale factor
+/// of 0 (the format forbids it), is an error naming the field (at cc1f49d: "Invalid argument
+/// (os error 22)" for a count of 2^62; a z scale of 0 read silently, flattening the points).
+#[test]
+fn a_las_header_the_file_contradicts_is_an_error_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("survey.las");
+    write_survey(&path, 50);
+    let honest = std::fs::read(&path).unwrap();
+    let mut bytes = honest.clone();
+    bytes[107..111].copy_from_slice(&(1u32 << 30).to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let e = LasPoints::open(&path).unwrap_err().to_string();
+    assert_one_line_naming(&e, &["survey.las", "announces 1073741824 points"]);
+    let mut bytes = honest.clone();
+    bytes[147..155].copy_from_slice(&0f64.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    let e = LasPoints::open(&path).unwrap_err().to_string();
+    assert_one_line_naming(&e, &["survey.las", "z scale factor is 0"]);
+    std::fs::write(&path, &honest).unwrap();
+    assert_eq!(LasPoints::open(&path).unwrap().count(), 50);
+}
