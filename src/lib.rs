@@ -28,8 +28,10 @@
 //! gradient_ascent                move each sample up the gradient of s, projected back onto
 //!   │                            the input (Sec. 6.2, eq. 11; Projection)
 //!   │
-//! triangulate                    tangent-plane Delaunay umbrellas, merged by votes
-//!   (vote_triangles, assemble)   then cleaned up into a manifold mesh (holes filled, flips)
+//! triangulate                    the restricted Delaunay triangulation of the samples' cells
+//!   (restricted_delaunay,        on the input, the topological ball property checked (or
+//!    topological_ball)           tangent-plane umbrellas merged by votes, for point sets),
+//!                                then cleaned up into a manifold mesh (holes filled, flips)
 //!   │
 //! optimize                       local operations against the input surface (cover, collapse,
 //!   │                            flip, relax)

@@ -1,5 +1,10 @@
-//! Triangulating surface samples: local tangent-plane Delaunay umbrellas merged by votes, then a
-//! manifold clean-up. The finishing stage's operators on the triangulated samples are in
+//! Triangulating surface samples: the restricted Delaunay triangulation of the samples' Voronoi
+//! cells on the input (the default: cells grown over the input refined,
+//! [`restricted_delaunay`], or clipped exactly from its facets, [`restricted_voronoi`]; the
+//! topological ball property checked and samples inserted where it fails,
+//! [`topological_ball`]), or the local tangent-plane Delaunay umbrellas merged by votes
+//! ([`tangent_delaunay`]: point sets, and `--triangulation umbrellas`); then a manifold
+//! clean-up. The finishing stage's operators on the triangulated samples are in
 //! [`crate::finish`].
 
 pub mod cleanup;
