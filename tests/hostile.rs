@@ -1383,13 +1383,14 @@ fn a_point_sets_count_out_of_range_is_a_usage_error() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
-/// Issue 76 (R12): a PCD whose normals are NaN at some points (as PCL's normal estimation writes
-/// them where a point had too few neighbours) is meshed, those normals fitted from the points
-/// near them (at cc1f49d: exit 2 "invalid parameter normals: normal 5 …", no file named).
-#[test]
-fn a_pcd_with_some_nan_normals_is_meshed() {
-    let dir = tempfile::tempdir().unwrap();
-    let n = 5000u32;
+/// A PCD of `n` points on the unit sphere (a Fibonacci spiral) with normals: `normal(i, p)`
+/// gives point `i`'s from its position.
+fn sphere_pcd(
+    dir: &Path,
+    name: &str,
+    n: u32,
+    normal: impl Fn(u32, [f32; 3]) -> [f32; 3],
+) -> PathBuf {
     let payload: Vec<u8> = (0..n)
         .flat_map(|i| {
             let (t, z) = (
@@ -1398,8 +1399,7 @@ fn a_pcd_with_some_nan_normals_is_meshed() {
             );
             let r = (1.0 - z * z).sqrt();
             let p = [r * t.cos(), r * t.sin(), z];
-            let normal = if i % 20 == 5 { [f32::NAN; 3] } else { p };
-            [p, normal].concat()
+            [p, normal(i, p)].concat()
         })
         .flat_map(f32::to_le_bytes)
         .collect();
@@ -1410,10 +1410,14 @@ fn a_pcd_with_some_nan_normals_is_meshed() {
     )
     .into_bytes();
     bytes.extend_from_slice(&payload);
-    let input = write(dir.path(), "normals.pcd", bytes);
-    let (out, report) = (dir.path().join("out.ply"), dir.path().join("r.json"));
+    write(dir, name, bytes)
+}
+
+/// Runs `remesh input --points 800` and returns its report: the run must succeed.
+fn remesh_report(dir: &Path, input: &Path) -> serde_json::Value {
+    let (out, report) = (dir.join("out.ply"), dir.join("r.json"));
     let o = remesh(&[
-        arg(&input),
+        arg(input),
         arg(&out),
         "--points",
         "800",
@@ -1423,7 +1427,11 @@ fn a_pcd_with_some_nan_normals_is_meshed() {
         arg(&report),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap()
+}
+
+/// The report's output is one closed sphere.
+fn assert_one_closed_sphere(r: &serde_json::Value) {
     let t = &r["topology"];
     assert_eq!(
         (t["components"].as_u64(), t["genus"].as_u64()),
@@ -1431,4 +1439,52 @@ fn a_pcd_with_some_nan_normals_is_meshed() {
         "{t}"
     );
     assert_eq!(t["boundary_loops"].as_u64(), Some(0), "{t}");
+}
+
+/// Issue 76 (R13): a PCD whose normals have random signs (as Open3D leaves them unless asked to
+/// orient) is meshed as one closed surface and the note says the normals were oriented again
+/// (at cc1f49d: a closed sphere in 8 pieces and 3 boundary loops, nothing said).
+#[test]
+fn a_pcd_with_normals_of_random_signs_is_oriented_again_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let flip = |i: u32, p: [f32; 3]| {
+        let s = if (i.wrapping_mul(2_654_435_761) >> 16) % 2 == 0 {
+            1.0
+        } else {
+            -1.0
+        };
+        p.map(|v| s * v)
+    };
+    let input = sphere_pcd(dir.path(), "signs.pcd", 5000, flip);
+    let r = remesh_report(dir.path(), &input);
+    assert_one_closed_sphere(&r);
+    assert!(
+        r["extra"]["normals_turned"].as_u64().unwrap() > 0,
+        "{}",
+        r["extra"]
+    );
+    let notes = r["notes"].to_string();
+    assert!(notes.contains("not consistently oriented"), "{notes}");
+    // Oriented normals are left alone.
+    let input = sphere_pcd(dir.path(), "outward.pcd", 5000, |_, p| p);
+    let r = remesh_report(dir.path(), &input);
+    assert_one_closed_sphere(&r);
+    assert_eq!(r["extra"]["normals_turned"].as_u64(), Some(0));
+}
+
+/// Issue 76 (R12): a PCD whose normals are NaN at some points (as PCL's normal estimation writes
+/// them where a point had too few neighbours) is meshed, those normals fitted from the points
+/// near them (at cc1f49d: exit 2 "invalid parameter normals: normal 5 …", no file named).
+#[test]
+fn a_pcd_with_some_nan_normals_is_meshed() {
+    let dir = tempfile::tempdir().unwrap();
+    let nan = |i: u32, p: [f32; 3]| if i % 20 == 5 { [f32::NAN; 3] } else { p };
+    let input = sphere_pcd(dir.path(), "normals.pcd", 5000, nan);
+    let r = remesh_report(dir.path(), &input);
+    assert_one_closed_sphere(&r);
+    assert!(
+        r["extra"]["normals_filled"].as_u64().unwrap() > 0,
+        "{}",
+        r["extra"]
+    );
 }

@@ -118,6 +118,8 @@ pub(super) fn run(
     insert_kernel_extras(extra, out.sigma_p, &job.params, out.target);
     extra.insert("input_points".into(), out.input_points.into());
     extra.insert("had_normals".into(), out.had_normals.into());
+    extra.insert("normals_filled".into(), out.normal_repairs.filled.into());
+    extra.insert("normals_turned".into(), out.normal_repairs.turned.into());
     if let Some(c) = camera.filter(|_| !out.had_normals) {
         insert_json(extra, "camera_viewpoint", c.position.to_array());
         insert_json(extra, "camera_hidden_fraction", c.hidden);
@@ -164,7 +166,26 @@ pub(super) fn run(
          points and were connected by tangent-plane umbrellas",
         out.input_points,
         match (out.had_normals, camera) {
-            (true, _) => "with normals".to_string(),
+            (true, _) => {
+                let r = out.normal_repairs;
+                let mut said = "with normals".to_string();
+                if r.filled > 0 {
+                    said += &format!(
+                        "; {} of the surface's points had none (NaN or zero) and got one fitted \
+                         from the points near them",
+                        r.filled
+                    );
+                }
+                if r.turned > 0 {
+                    said += &format!(
+                        "; the file's normals were not consistently oriented (neighbours \
+                         pointing to opposite sides): oriented again, {} of the surface's \
+                         points turned",
+                        r.turned
+                    );
+                }
+                said
+            }
             (false, None) => "normals estimated".to_string(),
             (false, Some(c)) => {
                 let v = c.position;

@@ -30,7 +30,7 @@ use crate::points::far_groups::{KeptPoints, SeparateParts};
 use crate::points::flatness::median_surface_variation;
 use crate::points::normals::NormalOrientation;
 use crate::points::out_of_core::{
-    rimls_of, Opened, OutOfCoreParams, RimlsSupport, ScanOutput, ScannedInput,
+    rimls_of, NormalRepairs, Opened, OutOfCoreParams, RimlsSupport, ScanOutput, ScannedInput,
 };
 use crate::points::rimls::Rimls;
 use crate::points::rimls::RimlsParams;
@@ -289,6 +289,9 @@ pub struct PointRemeshOutput {
     pub separate_parts: Vec<usize>,
     /// Whether the input had normals (else they were estimated).
     pub had_normals: bool,
+    /// What was mended of the input's normals among the RIMLS surface's points: missing ones
+    /// fitted, random signs oriented again (`points::out_of_core::rimls_of`).
+    pub normal_repairs: NormalRepairs,
     /// Isolated points dropped from the samples and the RIMLS support.
     pub outliers_removed: usize,
     /// Samples after the scan and the outlier filter.
@@ -465,6 +468,8 @@ struct OnSurface {
     rescan_rejected: usize,
     /// See [`PointRemeshOutput::surface_variation`].
     surface_variation: Option<f64>,
+    /// See [`PointRemeshOutput::normal_repairs`].
+    repairs: NormalRepairs,
 }
 
 /// One run of [`remesh_points`] for the count (or sigma_p) `params` asks.
@@ -545,6 +550,7 @@ fn remesh_points_once(
         unprojected,
         rescan_rejected,
         surface_variation,
+        repairs,
     } = loop {
         scans += 1;
         let mut scan = source.scan(sigma_p, RIMLS_POINTS_PER_SAMPLE)?;
@@ -556,7 +562,7 @@ fn remesh_points_once(
         // Data sparser than the surface's support asks for: the support is all of it, and its
         // gaps are the data's own, not a random subset's.
         let sparse = scan.support.len() < RIMLS_POINTS_PER_SAMPLE * samples.len();
-        let rimls = rimls_of(
+        let (rimls, repairs) = rimls_of(
             rimls_params(sigma_p, rp.sigma_n),
             &mut samples,
             std::mem::take(&mut scan.support),
@@ -656,6 +662,7 @@ fn remesh_points_once(
                     unprojected,
                     rescan_rejected: rejected,
                     surface_variation,
+                    repairs,
                 }
             }
         }
@@ -880,6 +887,7 @@ fn remesh_points_once(
         kept: KeptPoints::whole(scan.far_groups.clone()),
         separate_parts: Vec::new(),
         had_normals: scan.had_normals,
+        normal_repairs: repairs,
         outliers_removed: scan.outliers_removed,
         samples: samples.len(),
         unprojected_samples: unprojected,

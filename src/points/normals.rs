@@ -98,7 +98,20 @@ pub fn estimate_normals(points: &[DVec3], k: usize, orientation: NormalOrientati
             (normal, ids)
         })
         .unzip();
-    let parts = orient_by_spanning_tree(points, &mut normals, &neighbors);
+    orient(points, &mut normals, &neighbors, orientation);
+    normals
+}
+
+/// Turns `normals` (lines: unit, any sign) consistent along the spanning tree
+/// ([`NormalOrientation::SpanningTree`]), each part of the forest then turned as a whole to face
+/// the viewpoint when `orientation` gives one.
+fn orient(
+    points: &[DVec3],
+    normals: &mut [DVec3],
+    neighbors: &[Vec<u32>],
+    orientation: NormalOrientation,
+) {
+    let parts = orient_by_spanning_tree(points, normals, neighbors);
     if let NormalOrientation::Viewpoint(v) = orientation {
         // Each part of the spanning forest, consistent in itself, turned as a whole to face
         // the viewpoint: by the vote of its normals, each weighted by the cosine to its line of
@@ -114,7 +127,53 @@ pub fn estimate_normals(points: &[DVec3], k: usize, orientation: NormalOrientati
             }
         }
     }
+}
+
+/// The share of neighbouring normals along one line (|n_i · n_j| > 0.7) that may point to
+/// opposite sides before a file's normals are taken as unoriented: on an oriented surface
+/// only points across a part thinner than the neighbourhood disagree, a few per cent; normals
+/// of random signs (as Open3D leaves them unless asked to orient) disagree about half the time.
+pub const UNORIENTED_SHARE: f64 = 0.2;
+
+/// A file's normals checked for a consistent orientation: when more than [`UNORIENTED_SHARE`]
+/// of neighbouring pairs (`k` nearest) along one line point to opposite sides, their lines are
+/// kept and their signs set again as estimated normals' are (`orientation`). Returns how many
+/// were turned (0 when they were consistent). Deterministic.
+pub fn orient_given_normals(
+    points: &[DVec3],
+    normals: &mut [DVec3],
+    k: usize,
+    orientation: NormalOrientation,
+) -> usize {
+    let k = k.max(3);
+    let tree = StaticTree::new(points);
+    let neighbors: Vec<Vec<u32>> = points
+        .par_iter()
+        .map_init(Vec::new, |found, &p| {
+            tree.nearest_n(p, k, found);
+            found.iter().map(|x| x.0).collect()
+        })
+        .collect();
+    let (mut along, mut opposite) = (0usize, 0usize);
+    for (i, near) in neighbors.iter().enumerate() {
+        for &j in near {
+            let d = normals[i].dot(normals[j as usize]);
+            if d.abs() > 0.7 {
+                along += 1;
+                opposite += usize::from(d < 0.0);
+            }
+        }
+    }
+    if (opposite as f64) <= UNORIENTED_SHARE * along as f64 {
+        return 0;
+    }
+    let given = normals.to_vec();
+    orient(points, normals, &neighbors, orientation);
     normals
+        .iter()
+        .zip(&given)
+        .filter(|(n, g)| n.dot(**g) < 0.0)
+        .count()
 }
 
 /// The least-variance direction of `points` (unit; zero when undefined).
@@ -288,6 +347,38 @@ mod tests {
             }
         }
         assert_eq!(fill_missing_normals(&points, &mut normals, 10), 0);
+    }
+
+    /// Issue 76 (R13): a file's normals of random signs are turned consistent (outward on a
+    /// closed surface); oriented normals are left as they are.
+    #[test]
+    fn normals_of_random_signs_are_oriented_again() {
+        let points: Vec<DVec3> = crate::mesh::test_meshes::fibonacci_sphere(2000)
+            .into_iter()
+            .map(|u| u * 3.0)
+            .collect();
+        let outward: Vec<DVec3> = points.iter().map(|p| p.normalize()).collect();
+        let mut normals = outward.clone();
+        let orientation = NormalOrientation::SpanningTree;
+        assert_eq!(
+            orient_given_normals(&points, &mut normals, 10, orientation),
+            0
+        );
+        assert_eq!(normals, outward);
+        let mut flipped = 0;
+        for (i, n) in normals.iter_mut().enumerate() {
+            if (i * 7919) % 13 < 6 {
+                *n = -*n;
+                flipped += 1;
+            }
+        }
+        assert_eq!(
+            orient_given_normals(&points, &mut normals, 10, orientation),
+            flipped
+        );
+        for (n, o) in normals.iter().zip(&outward) {
+            assert!(n.dot(*o) > 0.999, "{n} against {o}");
+        }
     }
 
     #[test]

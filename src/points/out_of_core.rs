@@ -369,6 +369,16 @@ fn estimate_sample_normals(points: &mut [Point], orientation: NormalOrientation)
     }
 }
 
+/// What was mended of a file's normals before the RIMLS surface was fitted to them
+/// ([`rimls_of`]), among the surface's support points.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct NormalRepairs {
+    /// Normals missing (NaN or zero) that were fitted from the points near them.
+    pub filled: usize,
+    /// Normals turned because the file's were not consistently oriented.
+    pub turned: usize,
+}
+
 /// Points per sample in the point set whose RIMLS surface the resampling projects onto: the
 /// samples and a random subset of the input, measured against 1 and 2 per sample and against the
 /// whole input (see `docs/decisions/simplify-resample.md`).
@@ -383,7 +393,7 @@ fn resample_on_rimls(
     had_normals: bool,
     params: &OutOfCoreParams,
 ) -> Result<()> {
-    let rimls = rimls_of(
+    let (rimls, _) = rimls_of(
         RimlsParams::new(kernel.sigma_p(), kernel.sigma_n()),
         samples,
         support,
@@ -449,6 +459,10 @@ pub(crate) struct RimlsSupport {
 /// off their neighbours' plane ([`off_surface`](super::outliers::off_surface)) are left out of
 /// the surface (the samples keep their entries).
 ///
+/// With input normals, those missing at some points are fitted there and normals of random
+/// signs oriented again (`points::normals::fill_missing_normals`, `orient_given_normals`):
+/// the counts are returned with the surface.
+///
 /// # Errors
 /// Those of [`Rimls::new`] (no points, a non-finite position or a zero normal).
 pub(crate) fn rimls_of(
@@ -458,13 +472,14 @@ pub(crate) fn rimls_of(
     which: RimlsSupport,
     had_normals: bool,
     orientation: NormalOrientation,
-) -> Result<Rimls> {
+) -> Result<(Rimls, NormalRepairs)> {
     let RimlsSupport {
         points_per_sample,
         samples_in_support,
         sheet_radius,
     } = which;
     let mut support = support;
+    let mut repairs = NormalRepairs::default();
     if samples_in_support {
         support.truncate(points_per_sample.saturating_sub(1) * samples.len());
         support.extend_from_slice(samples);
@@ -479,10 +494,14 @@ pub(crate) fn rimls_of(
         }
     } else {
         // A file's normals may be missing at some points (NaN or zero): those are fitted and
-        // turned to agree with the given ones near them.
+        // turned to agree with the given ones near them. And they may be unoriented (random
+        // signs): then their signs are set as estimated normals' are.
         let positions: Vec<DVec3> = support.iter().map(|p| p.position).collect();
         let mut normals: Vec<DVec3> = support.iter().map(|p| p.normal).collect();
-        if super::normals::fill_missing_normals(&positions, &mut normals, 10) > 0 {
+        repairs.filled = super::normals::fill_missing_normals(&positions, &mut normals, 10);
+        repairs.turned =
+            super::normals::orient_given_normals(&positions, &mut normals, 10, orientation);
+        if repairs.filled + repairs.turned > 0 {
             for (p, n) in support.iter_mut().zip(normals) {
                 p.normal = n;
             }
@@ -528,7 +547,7 @@ pub(crate) fn rimls_of(
     let order = crate::geometry::morton::morton_order(&positions);
     let positions = order.iter().map(|&i| positions[i as usize]).collect();
     let normals = order.iter().map(|&i| normals[i as usize]).collect();
-    Rimls::new(positions, normals, params)
+    Ok((Rimls::new(positions, normals, params)?, repairs))
 }
 
 /// The result of [`simplify_progressive`].
