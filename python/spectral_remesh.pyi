@@ -58,6 +58,37 @@ def read(
         used (no triangles, an index out of range, a non-finite coordinate).
     """
 
+def read_points(
+    path: Union[str, "PathLike[str]"], /
+) -> Tuple[npt.NDArray[np.float64], Optional[npt.NDArray[np.float64]]]:
+    """Read a point set through the library's point readers, as `remesh` reads a scan.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A point-set file: .ply (vertices, no faces), .pcd (ascii, binary or binary_compressed),
+        .las or .laz, .e57 (every scan posed into the file's frame), or .xyz / .csv / .txt text,
+        told by its extension; a file's header sizes are checked against the file before
+        anything is allocated.
+
+    Returns
+    -------
+    P : numpy.ndarray of float64, shape (n, 3)
+        The points with finite coordinates, in the file's own units and order.
+    N : numpy.ndarray of float64, shape (n, 3), or None
+        Their unit normals (zero where the file's are missing) when the file has normals.
+
+    Raises
+    ------
+    OSError
+        The file cannot be opened or read (FileNotFoundError, PermissionError or
+        IsADirectoryError where that is the cause).
+    ValueError
+        The extension names no point-set format, or the content does not parse or promises more
+        than the file holds.
+    """
+    ...
+
 def write(
     path: Union[str, "PathLike[str]"],
     V: npt.ArrayLike,
@@ -141,6 +172,7 @@ def remesh(
     viewpoint: Optional[Sequence[float]] = None,
     points: Optional[int] = None,
     sigma_p: Optional[float] = None,
+    edge_length: Optional[float] = None,
     sigma_n: Optional[float] = None,
     seed: int = 1,
     iterations: Optional[int] = None,
@@ -189,6 +221,10 @@ def remesh(
         With neither points nor sigma_p: as many as the input has vertices.
     sigma_p : float or None
         The kernel width in bbox-100 units, instead of points.
+    edge_length : float or None
+        Output edges about this long, in the input's own units, instead of points or sigma_p:
+        the count of equilateral triangles of that edge on the input's area (the report's notes
+        give it). Meshes only.
     sigma_n : float or None
         The normal width; finite values give feature-adaptive sampling. None: infinity.
     seed : int

@@ -882,3 +882,63 @@ fn shared_the_finishing_stage_meets_issue_17s_angle_and_quality_bounds_at_seeds_
         }
     }
 }
+
+/// Issue 76: `--edge-length L` (model units) gives output edges about L long, the count it
+/// implies in the notes; it excludes `--points`, and a point set (no area before its surface)
+/// and a length that is not positive are usage errors.
+#[test]
+fn edge_length_gives_edges_about_that_long() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere.obj");
+    // A sphere of radius 2 (area about 50.3): edges 0.25 give about 929 points.
+    let mut mesh = common::icosphere(4);
+    for p in &mut mesh.positions {
+        *p *= 2.0;
+    }
+    spectral_remesh::write_mesh(&input, &mesh).unwrap();
+    let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
+    let run = |extra: &[&str]| {
+        let mut args = vec![input.to_str().unwrap(), out.to_str().unwrap(), "-q"];
+        args.extend_from_slice(extra);
+        std::process::Command::new(env!("CARGO_BIN_EXE_remesh"))
+            .args(&args)
+            .output()
+            .unwrap()
+    };
+    let o = run(&[
+        "--edge-length",
+        "0.25",
+        "--no-distance",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (written, _) = spectral_remesh::read_mesh(&out).unwrap();
+    let mut lengths = Vec::new();
+    for t in &written.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            lengths.push(written.positions[a].distance(written.positions[b]));
+        }
+    }
+    let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
+    assert!((mean - 0.25).abs() < 0.025, "mean edge {mean}");
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert!(
+        r["notes"].to_string().contains("--edge-length 0.25: about"),
+        "{}",
+        r["notes"]
+    );
+    for bad in [
+        &["--edge-length", "0"][..],
+        &["--edge-length", "0.25", "--points", "100"],
+    ] {
+        let o = run(bad);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}

@@ -294,6 +294,59 @@ fn read<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshArrays<'py>> {
     Ok(mesh_arrays(py, mesh))
 }
 
+/// Read a point set through the library's point readers, as `remesh` reads a scan.
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///     A point-set file: .ply (vertices, no faces), .pcd (ascii, binary or binary_compressed),
+///     .las or .laz, .e57 (every scan posed into the file's frame), or .xyz / .csv / .txt text,
+///     told by its extension; a file's header sizes are checked against the file before
+///     anything is allocated.
+///
+/// Returns
+/// -------
+/// P : numpy.ndarray of float64, shape (n, 3)
+///     The points with finite coordinates, in the file's own units and order.
+/// N : numpy.ndarray of float64, shape (n, 3), or None
+///     Their unit normals (zero where the file's are missing) when the file has normals.
+///
+/// Raises
+/// ------
+/// OSError
+///     The file cannot be opened or read (FileNotFoundError, PermissionError or
+///     IsADirectoryError where that is the cause).
+/// ValueError
+///     The extension names no point-set format, or the content does not parse or promises more
+///     than the file holds.
+#[pyfunction]
+#[pyo3(signature = (path, /))]
+#[allow(clippy::type_complexity)]
+fn read_points<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray2<f64>>>)> {
+    let (positions, normals) = without_gil(py, move || {
+        use spectral::internal::{PointReader, ReadPoints};
+        let mut reader = PointReader::open(&path)?;
+        let has_normals = reader.has_normals();
+        let (mut positions, mut normals, mut chunk) = (Vec::new(), Vec::new(), Vec::new());
+        while reader.read_chunk(&mut chunk, 1 << 16)? > 0 {
+            for p in &chunk {
+                positions.extend(p.position.to_array());
+                if has_normals {
+                    normals.extend(p.normal.to_array());
+                }
+            }
+        }
+        Ok((positions, has_normals.then_some(normals)))
+    })?;
+    Ok((
+        rows_array(py, &positions, 3),
+        normals.map(|n| rows_array(py, &n, 3)),
+    ))
+}
+
 /// Write a triangle mesh to a file through the library's writers, as `remesh` writes its output.
 ///
 /// The format is the extension's: .obj and .off (coordinates in the shortest text that reads
@@ -529,6 +582,10 @@ type Remeshed<'py> = (
 ///     With neither points nor sigma_p: as many as the input has vertices.
 /// sigma_p : float or None
 ///     The kernel width in bbox-100 units, instead of points.
+/// edge_length : float or None
+///     Output edges about this long, in the input's own units, instead of points or sigma_p:
+///     the count of equilateral triangles of that edge on the input's area (the report's notes
+///     give it). Meshes only.
 /// sigma_n : float or None
 ///     The normal width; finite values give feature-adaptive sampling. None: infinity.
 /// seed : int
@@ -592,7 +649,8 @@ type Remeshed<'py> = (
 ///     internal failure.
 #[pyfunction]
 #[pyo3(signature = (
-    V, F = None, *, normals = None, viewpoint = None, points = None, sigma_p = None, sigma_n = None, seed = 1, iterations = None,
+    V, F = None, *, normals = None, viewpoint = None, points = None, sigma_p = None,
+    edge_length = None, sigma_n = None, seed = 1, iterations = None,
     lfs_factor = None, chord_error = None, fit = true, smooth = None, min_angle = None,
     max_angle = None, feature_angle = None, features = true, triangulation = None,
     distance = true, strict = false, max_memory = None, progress = None
@@ -606,6 +664,7 @@ fn remesh<'py>(
     viewpoint: Option<&Bound<'py, PyAny>>,
     points: Option<i128>,
     sigma_p: Option<f64>,
+    edge_length: Option<f64>,
     sigma_n: Option<f64>,
     seed: i128,
     iterations: Option<i128>,
@@ -633,6 +692,7 @@ fn remesh<'py>(
     let options = RemeshOptions {
         points: points.map(|n| count("points", n)).transpose()?,
         sigma_p,
+        edge_length,
         sigma_n,
         lfs_factor: lfs_factor.unwrap_or(defaults.lfs_factor),
         chord_error: chord_error.unwrap_or(defaults.chord_error),
@@ -1291,6 +1351,7 @@ fn resample<'py>(
 fn spectral_remesh(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(read_points, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(quality, m)?)?;
     m.add_function(wrap_pyfunction!(remesh, m)?)?;

@@ -457,3 +457,15 @@ def test_installed_package_has_stubs():
     package = Path(sr.__file__).parent
     assert (package / "py.typed").is_file()
     assert (package / "__init__.pyi").read_text() == STUBS.read_text()
+
+
+def test_edge_length_gives_edges_about_that_long(spot):
+    # Issue 76: edge_length (model units) instead of points, as `--edge-length`.
+    V, F = spot
+    V2, F2, report = sr.remesh(V, F, edge_length=0.1, distance=False)
+    e = np.concatenate([V2[F2[:, k]] - V2[F2[:, (k + 1) % 3]] for k in range(3)])
+    mean = np.linalg.norm(e, axis=1).mean()
+    assert abs(mean - 0.1) < 0.01, mean
+    assert any("--edge-length 0.1: about" in n for n in report["notes"])
+    with pytest.raises(ValueError, match="edge_length"):
+        sr.remesh(V, F, edge_length=0.1, points=100)

@@ -110,3 +110,46 @@ def test_parts_far_apart_are_meshed_each(tmp_path, remesh_bin):
     assert len(report["extra"]["separate_parts"]) == 2
     near_a = np.linalg.norm(V, axis=1) < 1e5
     assert 0.4 < near_a.mean() < 0.6
+
+
+def _pcd(path, points, normals=None, data="ascii"):
+    fields = "x y z" + (" normal_x normal_y normal_z" if normals is not None else "")
+    k = len(fields.split())
+    rows = points if normals is None else np.hstack([points, normals])
+    head = (
+        f"VERSION .7\nFIELDS {fields}\nSIZE {' '.join(['4'] * k)}\nTYPE {' '.join(['F'] * k)}\n"
+        f"COUNT {' '.join(['1'] * k)}\nWIDTH {len(rows)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+        f"POINTS {len(rows)}\nDATA {data}\n"
+    )
+    if data == "ascii":
+        body = "".join(" ".join(f"{v:.6f}" for v in r) + "\n" for r in rows).encode()
+    else:
+        body = np.asarray(rows, dtype=np.float32).tobytes()
+    path.write_bytes(head.encode() + body)
+
+
+def test_read_points_reads_the_point_formats_of_the_command_line(tmp_path):
+    # Issue 76 (R15): sr.read opened no .pcd, .las, .laz or .e57; sr.read_points reads what the
+    # command line reads, and a missing file is an OSError, not a ValueError.
+    rng = np.random.default_rng(3)
+    p = rng.normal(size=(50, 3))
+    n = p / np.linalg.norm(p, axis=1)[:, None]
+    _pcd(tmp_path / "a.pcd", p, n, data="binary")
+    P, N = sr.read_points(tmp_path / "a.pcd")
+    assert P.shape == (50, 3) and N.shape == (50, 3)
+    np.testing.assert_allclose(P, p.astype(np.float32), rtol=0, atol=0)
+    np.testing.assert_allclose(np.linalg.norm(N, axis=1), 1.0, atol=1e-6)
+    np.savetxt(tmp_path / "b.xyz", p)
+    P, N = sr.read_points(tmp_path / "b.xyz")
+    assert N is None
+    np.testing.assert_allclose(P, p, atol=1e-12)
+    with pytest.raises(FileNotFoundError, match="missing.pcd"):
+        sr.read_points(tmp_path / "missing.pcd")
+    with pytest.raises(FileNotFoundError, match="missing.laz"):
+        sr.read_points(tmp_path / "missing.laz")
+    # A header promising more than the file holds: a ValueError naming the file.
+    bad = tmp_path / "bad.pcd"
+    bad.write_bytes(b"VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 9\n"
+                    b"HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1000000000000\nDATA binary\n" + bytes(90))
+    with pytest.raises(ValueError, match="bad.pcd"):
+        sr.read_points(bad)

@@ -25,6 +25,10 @@ pub struct RemeshOptions {
     pub points: Option<usize>,
     /// `--sigma-p S`: the kernel width, instead of `points` (giving both is an error).
     pub sigma_p: Option<f64>,
+    /// `--edge-length L`: output edges about L long (model units, the input's own), instead of
+    /// `points` or `sigma_p`: the count of equilateral triangles of that edge on the input's
+    /// area (meshes).
+    pub edge_length: Option<f64>,
     /// `--sigma-n S`: the normal width; `None` is infinity (isotropic sampling).
     pub sigma_n: Option<f64>,
     /// `--lfs-factor C`: the kernel width follows the local thickness; 0 turns it off.
@@ -59,6 +63,7 @@ impl Default for RemeshOptions {
         RemeshOptions {
             points: None,
             sigma_p: None,
+            edge_length: None,
             sigma_n: None,
             lfs_factor: 0.0,
             chord_error: 0.0,
@@ -82,19 +87,21 @@ impl RemeshOptions {
     /// [`Error::InvalidParameter`], naming the flag as the command line spells it, for a
     /// negative or non-finite `lfs_factor` or `chord_error`, a `feature_angle` outside 0–180,
     /// an unknown `triangulation`, angle bounds outside their ranges, or options that exclude
-    /// each other (`points` with `sigma_p`, `feature_angle` with `no_features`). The other
+    /// each other (two of `points`, `sigma_p` and `edge_length`, `feature_angle` with
+    /// `no_features`). The other
     /// ranges (`points`, `sigma_p`, `sigma_n`) are checked by the pipeline itself.
     pub fn params(&self) -> Result<RemeshParams> {
-        let density = match (self.points, self.sigma_p) {
-            (Some(_), Some(_)) => {
+        let density = match (self.points, self.sigma_p, self.edge_length) {
+            (Some(n), None, None) => Density::Points(n),
+            (None, Some(s), None) => Density::SigmaP(s),
+            (None, None, Some(l)) => Density::EdgeLength(l),
+            (None, None, None) => Density::InputVertices,
+            _ => {
                 return Err(Error::InvalidParameter {
                     name: "points",
-                    message: "give `points` or `sigma_p`, not both".into(),
+                    message: "give one of `points`, `sigma_p` and `edge_length`".into(),
                 })
             }
-            (Some(n), None) => Density::Points(n),
-            (None, Some(s)) => Density::SigmaP(s),
-            (None, None) => Density::InputVertices,
         };
         let mut params = RemeshParams {
             density,

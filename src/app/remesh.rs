@@ -21,7 +21,8 @@ use crate::error::{Error, Result};
 use crate::io::{as_written, check_and_clean, read_mesh, AtomicFile, MeshFormat};
 use crate::mesh::TriMesh;
 use crate::pipeline::{
-    expected_samples, remesh, validate_input, Density, RemeshParams, MAX_POINTS,
+    expected_samples, points_for_edge_length, remesh, validate_input, Density, RemeshParams,
+    MAX_POINTS,
 };
 use crate::points::source::PointSource;
 use crate::report::{surface_distance_with, QualityReport};
@@ -175,6 +176,7 @@ pub(super) fn remesh_read(
         let points = match params.density {
             Density::Points(n) => n as f64,
             Density::InputVertices => input.vertex_count() as f64,
+            Density::EdgeLength(l) => points_for_edge_length(input.area(), l) as f64,
             Density::SigmaP(s) => {
                 // The count sigma_p gives on the area, in bbox-100 units (the interior term of
                 // the pipeline's expected count; the boundary samples are not counted here).
@@ -194,6 +196,7 @@ pub(super) fn remesh_read(
             )?;
         }
     }
+    let input_area = input.area();
     let out = remesh(&input, &params, on_stage).map_err(|e| with_path(e, &job.input))?;
     on_stage("check");
     let t = Clock::start();
@@ -410,6 +413,12 @@ pub(super) fn remesh_read(
     if welded_vertices > 0 {
         report.notes.push(format!(
             "{welded_vertices} input vertices at the position of another (identical, or a rounding apart) were merged"
+        ));
+    }
+    if let (Density::EdgeLength(l), Some(n)) = (job.params.density, out.target) {
+        report.notes.push(format!(
+            "--edge-length {l}: about {n} points (equilateral triangles of that edge on the \
+             input's area, {input_area:.6e} square units)"
         ));
     }
     count_note(&mut report.notes, out.target, out.mesh.vertex_count());

@@ -70,6 +70,12 @@ struct Cli {
     #[arg(long)]
     sigma_p: Option<f64>,
 
+    /// Output edges about L long, in the input's own units, instead of --points: the count of
+    /// equilateral triangles of that edge on the input's area (printed in the notes). Meshes
+    /// only.
+    #[arg(long, value_name = "L", conflicts_with_all = ["points", "sigma_p"])]
+    edge_length: Option<f64>,
+
     /// Normal width sigma_n: finite values turn on feature-adaptive sampling (more samples where
     /// normals vary; 0.5 to 1 is typical). Default: infinity (isotropic).
     #[arg(long)]
@@ -445,6 +451,7 @@ fn remesh_options(cli: &Cli) -> RemeshOptions {
     RemeshOptions {
         points: cli.points,
         sigma_p: cli.sigma_p,
+        edge_length: cli.edge_length,
         sigma_n: cli.sigma_n,
         lfs_factor: cli.lfs_factor,
         chord_error: cli.chord_error,

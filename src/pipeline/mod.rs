@@ -39,7 +39,7 @@ pub use crate::sampling::spacing::{
     expected_samples, BOUNDARY_SPACING_PER_SIGMA, SAMPLES_PER_SIGMA2,
 };
 pub use output::{FeatureStats, RemeshOutput};
-pub use params::{Density, RemeshParams, FIT_ITERATIONS, MAX_POINTS};
+pub use params::{points_for_edge_length, Density, RemeshParams, FIT_ITERATIONS, MAX_POINTS};
 
 /// Runs of the pipeline at most for one count: when the output's vertex count misses the target
 /// by more than the search tolerance (the triangulation may set a few samples aside, at parts

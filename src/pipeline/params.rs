@@ -22,6 +22,18 @@ pub enum Density {
     SigmaP(f64),
     /// As many output vertices as the input has vertices (the command line's default).
     InputVertices,
+    /// Output edges about this long, model units: the count of equilateral triangles of this
+    /// edge on the input's area ([`points_for_edge_length`]), then as for `Points` (meshes
+    /// only: a point set's area is known only once its surface is).
+    EdgeLength(f64),
+}
+
+/// The vertex count of a mesh of equilateral triangles of edge `length` on area `area` (both
+/// in the same units): 2 A / (√3 L²), a vertex per two triangles; at least 4.
+pub fn points_for_edge_length(area: f64, length: f64) -> usize {
+    (2.0 * area / (3f64.sqrt() * length * length))
+        .round()
+        .clamp(4.0, 1e15) as usize
 }
 
 /// The iterations of the least-squares fit, by default: the RMS distance is within 2% of its
@@ -150,6 +162,13 @@ impl Target {
             Density::Points(n) => Target::Points(n),
             Density::SigmaP(s) => Target::SigmaP(s),
             Density::InputVertices => Target::Points(input.vertex_count()),
+            Density::EdgeLength(l) if !(l.is_finite() && l > 0.0) => {
+                return Err(Error::InvalidParameter {
+                    name: "edge_length",
+                    message: format!("must be a positive number, got {}", crate::error::shown(l)),
+                })
+            }
+            Density::EdgeLength(l) => Target::Points(points_for_edge_length(input.area(), l)),
         };
         match target {
             Target::Points(n) => check_count(n)?,

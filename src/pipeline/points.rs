@@ -488,6 +488,16 @@ fn remesh_points_once(
         ),
     };
     let (target, sigma_p) = match rp.density {
+        Density::EdgeLength(_) => {
+            return Err(Error::InvalidParameter {
+                name: "edge_length",
+                message: format!(
+                    "{} is a point set, whose area is not known before its surface is: give the \
+                     output's vertex count with `points` (or its sigma_p with `sigma_p`)",
+                    input.display()
+                ),
+            })
+        }
         Density::Points(n) => (Some(n), 1.0),
         Density::SigmaP(s) => (None, s),
         Density::InputVertices => {
