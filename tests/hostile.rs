@@ -1488,3 +1488,52 @@ fn a_pcd_with_some_nan_normals_is_meshed() {
         r["extra"]
     );
 }
+
+/// Issue 76 (R7): three or ten parts far apart are each meshed (at cc1f49d only two were: three
+/// spheres 10^6 apart gave exit 3 "not near a surface"; the grouping joined evenly spaced parts).
+#[test]
+fn several_parts_far_apart_are_each_meshed() {
+    let dir = tempfile::tempdir().unwrap();
+    for (parts, gap) in [(3, 1e6), (10, 1e4)] {
+        let points: String = (0..parts)
+            .flat_map(|k| {
+                (0..800).map(move |i| {
+                    let (t, z) = (i as f64 * 2.399_963, 1.0 - 2.0 * (i as f64 + 0.5) / 800.0);
+                    let r = (1.0 - z * z).sqrt();
+                    format!("{} {} {z}\n", k as f64 * gap + r * t.cos(), r * t.sin())
+                })
+            })
+            .collect();
+        let input = write(dir.path(), &format!("parts{parts}.xyz"), points);
+        let (out, report) = (dir.path().join("out.ply"), dir.path().join("r.json"));
+        let o = remesh(&[
+            arg(&input),
+            arg(&out),
+            "--points",
+            "1500",
+            "-q",
+            "--no-distance",
+            "--report",
+            arg(&report),
+        ]);
+        assert!(
+            o.status.success(),
+            "{parts}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        assert_eq!(
+            r["topology"]["components"].as_u64(),
+            Some(parts),
+            "{}",
+            r["topology"]
+        );
+        assert_eq!(
+            r["topology"]["boundary_loops"].as_u64(),
+            Some(0),
+            "{}",
+            r["topology"]
+        );
+    }
+}

@@ -205,6 +205,14 @@ impl KeptPoints {
 /// 10 across, are 1e-5.
 pub const SEPARATE_PARTS_RATIO: f64 = 1e-3;
 
+/// The grid's cell when parts far apart are told apart, as a share of the whole's diagonal:
+/// single linkage over neighbouring cells joins points up to 2√3 cells apart, so at
+/// [`FAR_GAP`] three parts evenly spaced along a line were one group (the middle one's points
+/// straddle a cell boundary next to the first's); parts each within
+/// [`SEPARATE_PARTS_RATIO`] of the diagonal lie within two cells of this size, and parts more
+/// than 3.5% of the diagonal apart are told apart.
+pub const SEPARATE_PARTS_CELL: f64 = 0.01;
+
 /// One part of [`SeparateParts`], as the grouped subset saw it (model units).
 #[derive(Debug, Clone)]
 pub struct PartEstimate {
@@ -295,7 +303,7 @@ pub fn separate_parts(points: &[DVec3], far: Option<&FarGroups>) -> Option<Separ
     if !(whole_diagonal > 0.0 && whole_diagonal.is_finite()) {
         return None;
     }
-    let cell = FAR_GAP * whole_diagonal;
+    let cell = SEPARATE_PARTS_CELL * whole_diagonal;
     let (groups, count) = group(&kept, bbox.min, cell);
     if count < 2 {
         return None;
@@ -406,6 +414,17 @@ mod tests {
             assert!(bulk.iter().all(|&p| f.contains(p)), "a bulk point left out");
             assert!(far.iter().all(|&p| !f.contains(p)), "a far point kept");
         }
+    }
+
+    #[test]
+    fn three_parts_far_apart_are_three_parts() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let set: Vec<DVec3> = (0..3)
+            .flat_map(|k| sphere(1000, DVec3::new(k as f64 * 1e6, 0.0, 0.0), 1.0, &mut rng))
+            .collect();
+        assert!(far_groups(&set).is_none());
+        let parts = separate_parts(&set, None).expect("three parts far apart");
+        assert_eq!(parts.len(), 3, "{parts:?}");
     }
 
     #[test]
