@@ -256,10 +256,10 @@ pub fn check_remesh_budget(
 
 /// Bytes per input point of a point set besides what its reader holds: the out-of-core scan's
 /// buckets and chunks, the outlier and far-group passes. Peak RSS of `remesh F OUT --points
-/// 3000 -q --no-distance` on 0.5, 1 and 2 million points on a sphere: XYZ 99 and 130 MB (0.5,
-/// 1 million), binary PCD 98, 178 and 216 MB, against this estimate with the reader's bytes
-/// 113, 202 and 380 MB for the PCD.
-pub const BYTES_PER_INPUT_POINT: u64 = 130;
+/// 3000 -q --no-distance` on points on a sphere: XYZ 99 and 130 MB at 0.5 and 1 million points
+/// (62 bytes a point more); binary PCD 98, 178 and 216 MB at 0.5, 1 and 2 million, against
+/// this estimate with the PCD reader's bytes 103, 183 and 343 MB.
+pub const BYTES_PER_INPUT_POINT: u64 = 64;
 
 /// [`check_remesh_budget`] for a point set of `input_points` points whose reader holds
 /// `reader_bytes` (a PCD or E57 file is read whole: `PointSource::input_size`) besides the

@@ -52,8 +52,9 @@ pub struct PcdPoints {
 /// 88 times its size (plus a few bytes of a last literal run).
 pub const LZF_MAX_RATIO: u64 = 88;
 
-/// Bytes a point read from a PCD file holds in memory: its position and its normal (f64 each).
-const BYTES_PER_POINT_READ: u64 = 48;
+/// Bytes a point read from a PCD file holds in memory: its position and its normal (f64 each),
+/// and the point the stream makes of them (the same again).
+const BYTES_PER_POINT_READ: u64 = 96;
 
 /// What a PCD file's header promises of its payload, checked against the file
 /// ([`pcd_payload`]).
@@ -64,7 +65,7 @@ pub struct PcdPayload {
     /// Bytes of one point's record in the binary encodings (the sum of `SIZE` × `COUNT`).
     pub record_bytes: u64,
     /// Bytes the reading holds at its peak: a `binary_compressed` block, its decompressed
-    /// payload and that payload reordered by point, and the points read (48 bytes each).
+    /// payload and that payload reordered by point, and the points read (96 bytes each).
     pub resident_bytes: u64,
 }
 
