@@ -72,3 +72,41 @@ fn fuzz_regression_a_bvh_of_two_faces_not_numbered_0_and_1_panicked() {
     let dir = tempfile::tempdir().unwrap();
     small_meshes::assert_remesh_is_sound(data, dir.path());
 }
+
+/// Issue 76, found by the `read_las` target in its first half hour: a LAZ whose LASzip record
+/// lists no point items made the laz crate panic ("There should be at least one LazItem");
+/// now an error naming the file, `remesh` and `simplify` alike.
+#[test]
+fn fuzz_regression_a_laszip_record_of_no_items_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("items.laz");
+    std::fs::write(
+        &input,
+        include_bytes!("fuzz/read_las-laszip-record-of-no-items.laz"),
+    )
+    .unwrap();
+    let out = dir.path().join("out.ply");
+    for args in [vec!["--points", "100"], vec!["simplify"]] {
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_remesh"));
+        if args[0] == "simplify" {
+            cmd.args([
+                "simplify",
+                input.to_str().unwrap(),
+                out.to_str().unwrap(),
+                "--points",
+                "10",
+            ]);
+        } else {
+            cmd.args([input.to_str().unwrap(), out.to_str().unwrap()])
+                .args(&args);
+        }
+        let o = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(3), "{err}");
+        assert!(
+            err.contains("items.laz") && err.contains("LASzip record"),
+            "{err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    }
+}

@@ -710,6 +710,7 @@ mod tests {
         let given = RemeshOptions {
             points: Some(123),
             sigma_p: None,
+            edge_length: None,
             sigma_n: Some(0.5),
             lfs_factor: 0.75,
             chord_error: 0.003,

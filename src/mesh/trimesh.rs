@@ -5,6 +5,7 @@ use glam::DVec3;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::disjoint_sets::Dsu;
+use crate::error::{Error, Result};
 use crate::geometry::triangle::face_key;
 use crate::geometry::triangle_intersection::collinear;
 use crate::mesh::edit::starting_at;
@@ -263,11 +264,11 @@ impl TriMesh {
     /// Checks that every index is in range and every coordinate finite.
     ///
     /// # Errors
-    /// [`crate::Error::InvalidMesh`] (with an empty path, for the caller to fill in) naming the
+    /// [`Error::InvalidMesh`] (with an empty path, for the caller to fill in) naming the
     /// first face with an index out of range or the first vertex with a non-finite coordinate.
-    pub fn check_geometry(&self) -> crate::Result<()> {
+    pub fn check_geometry(&self) -> Result<()> {
         if let Some((f, i)) = self.check_indices() {
-            return Err(crate::Error::invalid_mesh(
+            return Err(Error::invalid_mesh(
                 "",
                 format!(
                     "face {f} refers to vertex {i}, but there are {} vertices",
@@ -276,7 +277,7 @@ impl TriMesh {
             ));
         }
         if let Some(v) = self.first_non_finite_vertex() {
-            return Err(crate::Error::invalid_mesh(
+            return Err(Error::invalid_mesh(
                 "",
                 format!("vertex {v} has a non-finite coordinate"),
             ));

@@ -137,6 +137,9 @@ fn check_header(path: &Path) -> Result<()> {
         legacy
     };
     let compressed = header[104] & 0x80 != 0;
+    if compressed {
+        check_laszip_record(path, &mut file, &header, length)?;
+    }
     if !compressed {
         let bytes = length.saturating_sub(data_start);
         if (count as u128) * (record as u128) > bytes as u128 {
@@ -180,6 +183,63 @@ fn check_header(path: &Path) -> Result<()> {
              most {most}",
             offset.saturating_sub(data_start + 8)
         )));
+    }
+    Ok(())
+}
+
+/// The LASzip record's user id and record id (the VLR that describes a LAZ's point items).
+const LASZIP_RECORD: (&[u8], u16) = (b"laszip encoded", 22204);
+
+/// Checks a LAZ file's LASzip record (the variable-length record after the header that lists
+/// the compressed point's items): when present, it lists at least one item and holds them (the
+/// `laz` crate panics on a record of no items). A missing record is left to the crate, which
+/// says so.
+///
+/// # Errors
+/// [`Error::Io`] when the file cannot be read; [`Error::Parse`] naming the file for a LASzip
+/// record of no items or shorter than its items.
+fn check_laszip_record(
+    path: &Path,
+    file: &mut std::fs::File,
+    header: &[u8],
+    length: u64,
+) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let header_size = u16::from_le_bytes(header[94..96].try_into().unwrap()) as u64;
+    let records = u32::from_le_bytes(header[100..104].try_into().unwrap());
+    let mut at = header_size;
+    for _ in 0..records.min(1 << 16) {
+        let mut vlr = [0u8; 54];
+        if at + 54 > length
+            || file.seek(SeekFrom::Start(at)).is_err()
+            || file.read_exact(&mut vlr).is_err()
+        {
+            return Ok(()); // Records cut short: the crate says so.
+        }
+        let user = &vlr[2..18];
+        let user = &user[..user.iter().position(|&b| b == 0).unwrap_or(16)];
+        let id = u16::from_le_bytes(vlr[18..20].try_into().unwrap());
+        let size = u16::from_le_bytes(vlr[20..22].try_into().unwrap()) as u64;
+        if (user, id) == LASZIP_RECORD {
+            let mut data = vec![0u8; size as usize];
+            let items = if file.read_exact(&mut data).is_ok() && data.len() >= 36 {
+                u16::from_le_bytes(data[34..36].try_into().unwrap()) as u64
+            } else {
+                0
+            };
+            if items == 0 || size < 36 + 6 * items {
+                return Err(Error::Parse {
+                    path: path.to_path_buf(),
+                    line: None,
+                    message: format!(
+                        "the LAZ's LASzip record lists {items} point items in {size} bytes (at \
+                         least one, 6 bytes each after 36)"
+                    ),
+                });
+            }
+            return Ok(());
+        }
+        at += 54 + size;
     }
     Ok(())
 }
