@@ -73,40 +73,40 @@ fn fuzz_regression_a_bvh_of_two_faces_not_numbered_0_and_1_panicked() {
     small_meshes::assert_remesh_is_sound(data, dir.path());
 }
 
-/// Issue 76, found by the `read_las` target in its first half hour: a LAZ whose LASzip record
-/// lists no point items made the laz crate panic ("There should be at least one LazItem");
-/// now an error naming the file, `remesh` and `simplify` alike.
+/// Issue 76, found by the `read_las` target: a LAZ whose LASzip record lists no point items
+/// made the laz crate panic ("There should be at least one LazItem"), and a LAS 1.4 extended
+/// record announcing 10^19 bytes made the las crate's reservation overflow; now each is an
+/// error naming the file, `remesh` and `simplify` alike.
 #[test]
-fn fuzz_regression_a_laszip_record_of_no_items_is_an_error() {
+fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("items.laz");
-    std::fs::write(
-        &input,
-        include_bytes!("fuzz/read_las-laszip-record-of-no-items.laz"),
-    )
-    .unwrap();
-    let out = dir.path().join("out.ply");
-    for args in [vec!["--points", "100"], vec!["simplify"]] {
-        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_remesh"));
-        if args[0] == "simplify" {
-            cmd.args([
-                "simplify",
-                input.to_str().unwrap(),
-                out.to_str().unwrap(),
-                "--points",
-                "10",
-            ]);
-        } else {
-            cmd.args([input.to_str().unwrap(), out.to_str().unwrap()])
-                .args(&args);
+    let cases: [(&[u8], &str); 2] = [
+        (
+            include_bytes!("fuzz/read_las-laszip-record-of-no-items.laz"),
+            "LASzip record",
+        ),
+        (
+            include_bytes!("fuzz/read_las-extended-record-past-the-end.laz"),
+            "extended record",
+        ),
+    ];
+    for (bytes, says) in cases {
+        let input = dir.path().join("records.laz");
+        std::fs::write(&input, bytes).unwrap();
+        let out = dir.path().join("out.ply");
+        let (i, o) = (input.to_str().unwrap(), out.to_str().unwrap());
+        for args in [
+            vec![i, o, "--points", "100"],
+            vec!["simplify", i, o, "--points", "10"],
+        ] {
+            let run = std::process::Command::new(env!("CARGO_BIN_EXE_remesh"))
+                .args(&args)
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&run.stderr);
+            assert_eq!(run.status.code(), Some(3), "{err}");
+            assert!(err.contains("records.laz") && err.contains(says), "{err}");
+            assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         }
-        let o = cmd.output().unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(3), "{err}");
-        assert!(
-            err.contains("items.laz") && err.contains("LASzip record"),
-            "{err}"
-        );
-        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     }
 }

@@ -136,6 +136,9 @@ fn check_header(path: &Path) -> Result<()> {
     } else {
         legacy
     };
+    if needed == 255 {
+        check_extended_records(path, &mut file, &header, length)?;
+    }
     let compressed = header[104] & 0x80 != 0;
     if compressed {
         check_laszip_record(path, &mut file, &header, length)?;
@@ -187,6 +190,44 @@ fn check_header(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Checks a LAS 1.4 file's extended variable-length records (after the points; each announces
+/// its length in 64 bits, which the `las` crate reserves as it reads): each lies within the
+/// file.
+///
+/// # Errors
+/// [`Error::Parse`] naming the file for an extended record past its end.
+fn check_extended_records(
+    path: &Path,
+    file: &mut std::fs::File,
+    header: &[u8],
+    length: u64,
+) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut at = u64::from_le_bytes(header[235..243].try_into().unwrap());
+    let count = u32::from_le_bytes(header[243..247].try_into().unwrap());
+    for k in 0..count {
+        let mut record = [0u8; 60];
+        let read = at.checked_add(60).is_some_and(|end| end <= length)
+            && file.seek(SeekFrom::Start(at)).is_ok()
+            && file.read_exact(&mut record).is_ok();
+        let size = u64::from_le_bytes(record[20..28].try_into().unwrap());
+        let end = at.saturating_add(60).saturating_add(size);
+        if !read || end > length {
+            return Err(Error::Parse {
+                path: path.to_path_buf(),
+                line: None,
+                message: format!(
+                    "extended record {} of {count} (at byte {at}, {size} bytes) is past the end \
+                     of the file ({length} bytes)",
+                    k + 1
+                ),
+            });
+        }
+        at = end;
+    }
+    Ok(())
+}
+
 /// The LASzip record's user id and record id (the VLR that describes a LAZ's point items).
 const LASZIP_RECORD: (&[u8], u16) = (b"laszip encoded", 22204);
 
@@ -222,18 +263,21 @@ fn check_laszip_record(
         let size = u16::from_le_bytes(vlr[20..22].try_into().unwrap()) as u64;
         if (user, id) == LASZIP_RECORD {
             let mut data = vec![0u8; size as usize];
-            let items = if file.read_exact(&mut data).is_ok() && data.len() >= 36 {
-                u16::from_le_bytes(data[34..36].try_into().unwrap()) as u64
+            // compressor, coder (u16 each), version (u8, u8, u16), options, chunk size (u32
+            // each), special EVLRs' count and offset (i64 each): the item count at 32, the
+            // items (type, size, version: u16 each) from 34.
+            let items = if file.read_exact(&mut data).is_ok() && data.len() >= 34 {
+                u16::from_le_bytes(data[32..34].try_into().unwrap()) as u64
             } else {
                 0
             };
-            if items == 0 || size < 36 + 6 * items {
+            if items == 0 || size < 34 + 6 * items {
                 return Err(Error::Parse {
                     path: path.to_path_buf(),
                     line: None,
                     message: format!(
                         "the LAZ's LASzip record lists {items} point items in {size} bytes (at \
-                         least one, 6 bytes each after 36)"
+                         least one, 6 bytes each after 34)"
                     ),
                 });
             }
