@@ -531,7 +531,7 @@ fn messages_name_the_file_briefly_on_one_line() {
         "nan.xyz",
         "x y z nx ny nz\n0 0 0 nan 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n1 1 0 0 0 1\n",
     );
-    let o = remesh(&[arg(&nan), arg(&out), "--points", "3", "--sigma-n", "1"]);
+    let o = remesh(&[arg(&nan), arg(&out), "--points", "4", "--sigma-n", "1"]);
     assert_error(&o, 3, &["nan.xyz", "non-finite normal"]);
     let odd = dir.path().join("a\nb.obj");
     let o = remesh(&[arg(&odd), arg(&out)]);
@@ -624,7 +624,7 @@ fn a_handful_of_points_is_too_few_for_a_surface() {
         }
         let name = format!("p{n}.ply");
         let input = write(dir.path(), &name, text);
-        let o = remesh(&[arg(&input), arg(&out), "--points", "2"]);
+        let o = remesh(&[arg(&input), arg(&out), "--points", "4"]);
         assert_error(&o, 3, &[&name, &format!("{n} points are too few")]);
     }
 }

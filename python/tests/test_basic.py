@@ -235,7 +235,7 @@ def test_bad_reference_raises_value_error():
     [
         ({"points": -5}, r"invalid parameter points: must be an integer >= 0, got -5"),
         ({"points": 2}, r"invalid parameter points"),
-        ({"points": 100, "sigma_p": 2.0}, r"give `points` or `sigma_p`, not both"),
+        ({"points": 100, "sigma_p": 2.0}, r"give one of `points`, `sigma_p` and `edge_length`"),
         ({"sigma_p": -1.0}, r"invalid parameter sigma_p"),
         ({"sigma_p": float("nan")}, r"invalid parameter sigma_p"),
         ({"sigma_n": 0.0}, r"invalid parameter sigma_n"),

@@ -213,6 +213,10 @@ pub const SEPARATE_PARTS_RATIO: f64 = 1e-3;
 /// than 3.5% of the diagonal apart are told apart.
 pub const SEPARATE_PARTS_CELL: f64 = 0.01;
 
+/// The fewest points of the grouped subset a part far apart holds: fewer, and the groups are
+/// the isolated points of a sparse set, not parts.
+pub const MIN_PART_POINTS: usize = 8;
+
 /// One part of [`SeparateParts`], as the grouped subset saw it (model units).
 #[derive(Debug, Clone)]
 pub struct PartEstimate {
@@ -320,6 +324,11 @@ pub fn separate_parts(points: &[DVec3], far: Option<&FarGroups>) -> Option<Separ
         .collect();
     let largest = boxes.iter().map(Aabb::diagonal).fold(0.0f64, f64::max);
     if largest >= SEPARATE_PARTS_RATIO * whole_diagonal {
+        return None;
+    }
+    // A part holds a surface's points: on the fine grid, isolated points of a sparse set (200
+    // points on a sphere) are groups of one, and are not parts.
+    if members.iter().any(|m| m.len() < MIN_PART_POINTS) {
         return None;
     }
     let mut cells = HashMap::new();
