@@ -1448,7 +1448,7 @@ fn assert_one_closed_sphere(r: &serde_json::Value) {
 fn a_pcd_with_normals_of_random_signs_is_oriented_again_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let flip = |i: u32, p: [f32; 3]| {
-        let s = if (i.wrapping_mul(2_654_435_761) >> 16) % 2 == 0 {
+        let s = if (i.wrapping_mul(2_654_435_761) >> 16).is_multiple_of(2) {
             1.0
         } else {
             -1.0

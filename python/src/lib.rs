@@ -327,7 +327,7 @@ fn read_points<'py>(
     path: PathBuf,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Option<Bound<'py, PyArray2<f64>>>)> {
     let (positions, normals) = without_gil(py, move || {
-        use spectral::internal::{PointReader, ReadPoints};
+        use spectral::internal::PointReader;
         let mut reader = PointReader::open(&path)?;
         let has_normals = reader.has_normals();
         let (mut positions, mut normals, mut chunk) = (Vec::new(), Vec::new(), Vec::new());

@@ -23,7 +23,7 @@ pub enum Density {
     /// As many output vertices as the input has vertices (the command line's default).
     InputVertices,
     /// Output edges about this long, model units: the count of equilateral triangles of this
-    /// edge on the input's area ([`points_for_edge_length`]), then as for `Points` (meshes
+    /// edge on the input's area, 2 A / (√3 L²), then as for `Points` (meshes
     /// only: a point set's area is known only once its surface is).
     EdgeLength(f64),
 }
