@@ -7,6 +7,9 @@ mod noisy_points;
 #[path = "../fuzz/fuzz_targets/small_meshes.rs"]
 mod small_meshes;
 
+#[path = "../fuzz/fuzz_targets/whole_job.rs"]
+mod whole_job;
+
 use noisy_points::{assert_triangulation_is_clean, noisy_points as fuzz_points};
 
 /// Found by the triangulate fuzz target: hundreds of samples at the same few positions (the
@@ -108,5 +111,23 @@ fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
             assert!(err.contains("records.laz") && err.contains(says), "{err}");
             assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         }
+    }
+}
+
+/// Found by the `remesh` target's fixed sample once the sizing field was on by default (and at
+/// seed 2 without it): a folded sliver box whose seam corners (vertices 5 and 8) lie a rounding
+/// apart, unwelded (the edges at them are slivers). The crease curves along the two coincident
+/// edges put a sample of each at the same places; the output wrote them as two vertices, which
+/// a reader welds, and the file held a duplicate face and two non-manifold edges. Curve samples
+/// that coincide are now one.
+#[test]
+fn fuzz_regression_curves_along_coincident_edges_gave_duplicate_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fuzz/remesh-coincident-seam-curves.obj");
+    let output = dir.path().join("out.obj");
+    for seed in 1..=4 {
+        // Only crossings may remain (the input passes through itself).
+        let _ = whole_job::run_whole_job(&input, &output, 161, seed);
     }
 }

@@ -21,6 +21,13 @@ pub const WELD_RELATIVE: f64 = 1e-10;
 /// 1e-15 of their edges and closer. Dimensionless.
 pub const WELD_EDGE_RELATIVE: f64 = 1e-7;
 
+/// Curve samples closer than this (bbox-100 units) are one sample
+/// (`sampling::curves::sample_curves`): two boundary or crease curves along input edges that
+/// coincide (a seam whose corners are a rounding apart but not welded, the edges at them being
+/// slivers) otherwise put a sample of each at the same place, which the output would write as
+/// two vertices a reader welds into duplicate faces. Far above rounding at bbox 100.
+pub const CURVE_SAMPLE_COINCIDENT: f64 = 1e-9;
+
 /// Relative tolerance of the zero-area test: a triangle is degenerate when
 /// `|(b-a)×(c-a)| <= DEGENERATE_AREA_TOLERANCE · h²`, with `h` its longest edge. The test is
 /// scale-free (both sides scale with length²); `|(b-a)×(c-a)| / h²` is about the sine of the

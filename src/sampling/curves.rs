@@ -6,6 +6,7 @@
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
+use crate::geometry::tolerance::CURVE_SAMPLE_COINCIDENT;
 use crate::mesh::TriMesh;
 use crate::sampling::sizing::{SizingField, Uniform};
 use crate::surface::SurfaceSample;
@@ -202,6 +203,8 @@ pub(crate) fn sample_curves(
     };
     let mut out = BoundarySamples::default();
     let mut at_vertex: FxHashMap<u32, u32> = FxHashMap::default();
+    let mut coincident = Coincident::default();
+    let mut seen_edges: rustc_hash::FxHashSet<[u32; 2]> = Default::default();
     let all = curves
         .iter()
         .map(|c| (c, None))
@@ -233,8 +236,15 @@ pub(crate) fn sample_curves(
                 ids.push(id);
                 continue;
             }
+            // A sample already placed at this point (by a curve along coincident edges) is
+            // this one.
+            if let Some(id) = coincident.find(position) {
+                ids.push(id);
+                continue;
+            }
             let face = curve.faces[edge];
             let id = out.samples.len() as u32;
+            coincident.insert(position, id);
             out.samples.push(SurfaceSample {
                 position,
                 normal: mesh.face_normal(face as usize),
@@ -250,14 +260,40 @@ pub(crate) fn sample_curves(
         } else {
             &mut out.edges
         };
-        for k in 0..ids.len() - 1 {
-            edges.push([ids[k], ids[k + 1]]);
-        }
-        if curve.closed {
-            edges.push([ids[ids.len() - 1], ids[0]]);
+        let closing = curve.closed.then(|| [ids[ids.len() - 1], ids[0]]);
+        // An edge of no length or one already taken (along coincident curves) is left out.
+        for e in ids.windows(2).map(|w| [w[0], w[1]]).chain(closing) {
+            if e[0] != e[1] && seen_edges.insert([e[0].min(e[1]), e[0].max(e[1])]) {
+                edges.push(e);
+            }
         }
     }
     out
+}
+
+/// The curve samples placed so far on a grid of [`CURVE_SAMPLE_COINCIDENT`] cells: the one
+/// within that distance of a point, if any.
+#[derive(Default)]
+struct Coincident(FxHashMap<[i64; 3], Vec<(DVec3, u32)>>);
+
+impl Coincident {
+    fn cell(p: DVec3) -> [i64; 3] {
+        (p / CURVE_SAMPLE_COINCIDENT).floor().as_i64vec3().to_array()
+    }
+
+    fn insert(&mut self, p: DVec3, id: u32) {
+        self.0.entry(Self::cell(p)).or_default().push((p, id));
+    }
+
+    fn find(&self, p: DVec3) -> Option<u32> {
+        let [x, y, z] = Self::cell(p);
+        (-1..=1)
+            .flat_map(|i| (-1..=1).flat_map(move |j| (-1..=1).map(move |k| [x + i, y + j, z + k])))
+            .filter_map(|c| self.0.get(&c))
+            .flatten()
+            .find(|(q, _)| q.distance(p) <= CURVE_SAMPLE_COINCIDENT)
+            .map(|&(_, id)| id)
+    }
 }
 
 /// A feature curve to sample: the curve, and at each end where it leaves a corner at a small angle
