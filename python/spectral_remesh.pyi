@@ -232,8 +232,11 @@ def remesh(
     iterations : int or None
         Gradient-ascent sweeps (10).
     lfs_factor : float or None
-        Thin parts: the kernel width follows the local thickness (0: off, the default; 0.75 is
-        the measured setting).
+        ε of the sizing field (meshes): the spacing follows the local feature size,
+        h = ε · lfs where that is below sigma_p, in absolute units, so walls, tubes, holes and
+        gaps narrower than the spacing get the samples they need and the count may grow (at
+        most 4 times; strict refuses). 2.5 is the bound of the topological ball property; 0,
+        the default, turns it off.
     chord_error : float or None
         Curved parts: the spacing follows the curvature (0: off, the default; 0.003 for CAD
         parts).

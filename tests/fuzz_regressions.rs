@@ -7,9 +7,6 @@ mod noisy_points;
 #[path = "../fuzz/fuzz_targets/small_meshes.rs"]
 mod small_meshes;
 
-#[path = "../fuzz/fuzz_targets/whole_job.rs"]
-mod whole_job;
-
 use noisy_points::{assert_triangulation_is_clean, noisy_points as fuzz_points};
 
 /// Found by the triangulate fuzz target: hundreds of samples at the same few positions (the
@@ -128,6 +125,6 @@ fn fuzz_regression_curves_along_coincident_edges_gave_duplicate_faces() {
     let output = dir.path().join("out.obj");
     for seed in 1..=4 {
         // Only crossings may remain (the input passes through itself).
-        let _ = whole_job::run_whole_job(&input, &output, 161, seed);
+        let _ = small_meshes::run_whole_job(&input, &output, 161, seed);
     }
 }

@@ -12,7 +12,7 @@ use std::path::Path;
 
 #[path = "whole_job.rs"]
 mod whole_job;
-use whole_job::run_whole_job;
+pub use whole_job::run_whole_job;
 
 /// Bytes read in order (0x5a once they run out).
 struct Bytes<'a>(&'a [u8], usize);

@@ -99,11 +99,13 @@ pub(super) fn orientation_notes(
     notes
 }
 
-/// The report's notes on the grading by the local feature size: how many samples it moved to a
-/// finer spacing and where, and the parts too thin for the count.
+/// The report's notes on the sizing field from the local feature size: where it spaced samples
+/// finer than sigma_p, with the count asked and written when it grew the count past
+/// `target` (1%), and the parts it could not resolve within its growth bound.
 pub(super) fn grading_notes(
     g: &crate::sampling::grading::GradingStats,
     vertices: usize,
+    target: Option<usize>,
 ) -> Vec<String> {
     let bbox = |r: &crate::sampling::grading::GradedRegion| {
         format!(
@@ -119,9 +121,17 @@ pub(super) fn grading_notes(
             .take(3)
             .map(|r| format!("{} in {}", r.samples, bbox(r)))
             .collect();
+        let asked = match target {
+            Some(n) if grew_the_count(g, vertices, target) => format!(
+                "{n} asked, {vertices} written: the input is narrower than the spacing for {n} \
+                 (without --lfs-factor the count is kept with one sigma_p; --strict refuses); "
+            ),
+            _ => String::new(),
+        };
         notes.push(format!(
-            "local feature size: {} of {vertices} samples are spaced finer than sigma_p (down to \
-             {:.2} sigma_p) at thin parts, in {} regions (largest: {})",
+            "{asked}sizing field: {} of {vertices} samples are spaced by the local feature size, \
+             finer than sigma_p (down to {:.2} sigma_p), where walls, tubes, holes or gaps are \
+             narrower than the spacing, in {} regions (largest: {})",
             g.graded_samples,
             g.min_width,
             g.regions.len(),
@@ -137,17 +147,28 @@ pub(super) fn grading_notes(
             .map(|r| format!("{} in {}", r.unresolved, bbox(r)))
             .collect();
         let resolve = g.resolving_count.map_or(String::new(), |n| {
-            format!("; about --points {} would resolve them", round_up_2(n))
+            format!("; about {} samples would resolve them", round_up_2(n))
         });
         notes.push(format!(
-            "{} samples lie on parts thinner than this count can resolve (held at the finest \
-             spacing the grading allows, so the output there may split, fuse or lose a tip): \
-             {}{resolve}",
+            "{} samples lie on parts thinner than the sizing field resolves within its bound \
+             (held at its smallest spacing, {:.4} model units, so the output there may split, \
+             fuse or lose a tip): {}{resolve}",
             g.unresolved_samples,
+            g.floor,
             shown.join("; ")
         ));
     }
     notes
+}
+
+/// Whether the sizing field took the count `vertices` more than 1% past `target`: some
+/// samples graded, and the count over.
+pub(super) fn grew_the_count(
+    g: &crate::sampling::grading::GradingStats,
+    vertices: usize,
+    target: Option<usize>,
+) -> bool {
+    g.graded_samples > 0 && target.is_some_and(|n| vertices as f64 > 1.01 * n as f64)
 }
 
 /// "1 `one`" or "n `many`" (a count in a note).

@@ -31,7 +31,9 @@ pub struct RemeshOptions {
     pub edge_length: Option<f64>,
     /// `--sigma-n S`: the normal width; `None` is infinity (isotropic sampling).
     pub sigma_n: Option<f64>,
-    /// `--lfs-factor C`: the kernel width follows the local thickness; 0 turns it off.
+    /// `--lfs-factor C`: the sizing field from the local feature size with ε = C, the spacing
+    /// h(x) = ε · lfs(x) where that is below sigma_p; 0 turns it off (one sigma_p everywhere,
+    /// the paper's sampling).
     pub lfs_factor: f64,
     /// `--chord-error E`: the spacing follows the curvature; 0 turns it off.
     pub chord_error: f64,

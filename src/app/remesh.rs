@@ -8,8 +8,8 @@ use super::files::{is_stdout, output_format, refuse_input_as_output, report_clas
 use super::job::{RemeshJob, RemeshedMesh};
 use super::memory;
 use super::notes::{
-    count_note, dropped_note, features_note, grading_notes, holes_note, orientation_notes,
-    topological_ball_notes,
+    count_note, dropped_note, features_note, grading_notes, grew_the_count, holes_note,
+    orientation_notes, topological_ball_notes,
 };
 use super::output::{check_and_write, insert_json, insert_kernel_extras, write_output, Outputs};
 use super::quality::{
@@ -266,6 +266,22 @@ pub(super) fn remesh_read(
             });
         }
     }
+    // With `strict`, a count the sizing field had to grow is refused too.
+    if let (true, Some(g), Some(n)) = (job.strict, &out.grading, out.target) {
+        let written = mesh_out.vertex_count();
+        if grew_the_count(g, written, out.target) {
+            return Err(Error::Internal {
+                stage: "invariant check",
+                message: format!(
+                    "{n} points are too few for the input's local feature size ({written} \
+                     written, {} of them spaced by it); {} was not written (`strict`; \
+                     without `lfs_factor` the count is kept with one sigma_p)",
+                    g.graded_samples,
+                    job.output.display()
+                ),
+            });
+        }
+    }
     let check_seconds = t.elapsed();
     report.push_stage("read", read_seconds.0, read_seconds.1);
     check_and_write(
@@ -421,7 +437,14 @@ pub(super) fn remesh_read(
              input's area, {input_area:.6e} square units)"
         ));
     }
-    count_note(&mut report.notes, out.target, out.mesh.vertex_count());
+    // A count the sizing field grew is the field's note, not a miss.
+    let grown = out
+        .grading
+        .as_ref()
+        .is_some_and(|g| grew_the_count(g, out.mesh.vertex_count(), out.target));
+    if !grown {
+        count_note(&mut report.notes, out.target, out.mesh.vertex_count());
+    }
     if let Some(rd) = &out.restricted_delaunay {
         let (target, vertices) = (out.target, out.mesh.vertex_count());
         topological_ball_notes(&mut report.notes, &rd.topological_ball, target, vertices);
@@ -452,7 +475,7 @@ pub(super) fn remesh_read(
         );
         report
             .notes
-            .extend(grading_notes(g, out.mesh.vertex_count()));
+            .extend(grading_notes(g, out.mesh.vertex_count(), out.target));
         let st = &out.stray_shells;
         if st.shells > 0 {
             let (lo, hi) = (

@@ -81,10 +81,12 @@ struct Cli {
     #[arg(long)]
     sigma_n: Option<f64>,
 
-    /// Thin parts: the kernel width follows the local thickness, sigma_p(x) = min(sigma_p,
-    /// C · thickness(x)), so tubes, plates, close sheets and tips get enough samples around
-    /// them (0.75 is the measured choice). 0, the default, turns it off (one sigma_p
-    /// everywhere, as in the paper).
+    /// The sizing field (meshes): the spacing follows the local feature size, h(x) = C · lfs(x)
+    /// where that is below sigma_p (walls, tubes, holes and gaps narrower than the spacing), in
+    /// absolute units: a part thinner than the count resolves gets the samples it needs, and the
+    /// count grows (at most 4 times; the report says so, --strict refuses). 2.5 is the bound
+    /// of the topological ball property. 0, the default, turns it off (one sigma_p everywhere,
+    /// as in the paper).
     #[arg(long, default_value_t = 0.0, value_name = "C")]
     lfs_factor: f64,
 

@@ -123,6 +123,12 @@ pub fn remesh(
         goal: target.count().unwrap_or(0),
         start: first_sigma_p,
         sigma_ref: first_sigma_p,
+        // sigma_p is bounded only where the sizing field holds part of the count.
+        max_sigma: params
+            .grading
+            .map(|g| g.max_coarsening * first_sigma_p)
+            .filter(|&cap| sizing.grading.as_ref().is_some_and(|g| g.grades_below(cap)))
+            .unwrap_or(f64::INFINITY),
         history: Vec::new(),
     };
     let mut attempt = 1;

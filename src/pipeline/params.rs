@@ -67,10 +67,11 @@ pub struct RemeshParams {
     pub optimize: Option<OptimizeParams>,
     /// The separation of crossing faces, last.
     pub untangle: UntangleParams,
-    /// Sample density graded by the local feature size (issue 15; `None`, the default: one
-    /// sigma_p everywhere, as in the paper). Not yet the default: it keeps the topology of thin
-    /// parts at low counts but raises the Hausdorff distance of a scan at its ears
-    /// (`docs/decisions/lfs-grading-off.md`).
+    /// The sizing field from the local feature size (`sampling::grading`, meshes only; the
+    /// command line's `--lfs-factor`). `None`, the default: one sigma_p everywhere, as in the
+    /// paper. Not yet the default: on the shared models it grades nothing at the eval counts,
+    /// and where it grades, the wedges at kept creases and the points where sheets touch (a local
+    /// feature size of 0) cost crease edges and parts (`docs/decisions/sizing-field.md`).
     pub grading: Option<GradingParams>,
     /// Sample density graded by curvature (`None`, the default: one sigma_p everywhere).
     pub curvature: Option<CurvatureParams>,

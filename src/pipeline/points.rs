@@ -376,7 +376,7 @@ pub struct PointRemeshOutput {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming the parameter for a density other than a count or sigma_p
-/// or a count outside 4 to [`MAX_POINTS`](crate::pipeline::MAX_POINTS) (`points`), grading (`lfs_factor`), curvature (`chord_error`), a crease angle
+/// or a count outside 4 to [`MAX_POINTS`](crate::pipeline::MAX_POINTS) (`points`), the sizing field (`lfs_factor`), curvature (`chord_error`), a crease angle
 /// (`feature_angle`) or a finite sigma_n (`sigma_n`) on points without normals; the errors of
 /// reading the points ([`PointReader`](crate::internal::PointReader)), naming the file;
 /// [`Error::InvalidMesh`] for an empty set, one with no extent, or one of which nothing could be

@@ -47,6 +47,9 @@ pub(super) struct Search {
     pub goal: usize,
     pub start: f64,
     pub sigma_ref: f64,
+    /// The largest sigma_p the search tries (infinity without a sizing field; see
+    /// `GradingParams::max_coarsening`).
+    pub max_sigma: f64,
     pub history: Vec<(f64, usize)>,
 }
 
@@ -265,6 +268,7 @@ pub(super) fn scan<'s>(
         Target::Points(_) => {
             let count_search = TargetCountParams {
                 tolerance: params.count_tolerance,
+                max_sigma: search.max_sigma,
                 ..TargetCountParams::new(search.goal)
             };
             let mut history = Vec::new();

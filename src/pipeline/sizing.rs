@@ -9,6 +9,7 @@ use crate::sampling::crease_separation::CreaseSeparation;
 use crate::sampling::features::Corners;
 use crate::sampling::grading::{Grading, Thickness};
 use crate::sampling::sizing::{GradedPoints, SizingField, Smallest};
+use crate::sampling::spacing::SAMPLES_PER_SIGMA2;
 use crate::surface::curvature::{Curvature, CurvatureParams, CurvatureWidths};
 use crate::surface::{MeshSurface, SurfaceSample};
 use crate::timing::StageTimer;
@@ -57,11 +58,15 @@ impl Sizing {
         let grading = match params.grading {
             Some(g) => {
                 on_stage("local feature size");
-                let cap = 1.5 * first_sigma_p / g.lfs_factor;
+                let cap = 1.5 * g.max_coarsening * first_sigma_p / g.lfs_factor;
                 // Estimate points every first_sigma_p (about one per expected sample), at most
                 // MAX_GRADING_POINTS of them.
                 let spacing = first_sigma_p.max((input.area / MAX_GRADING_POINTS).sqrt());
-                let grading = Grading::new(&input.mesh, &input.curves, g, cap, spacing)?;
+                let mut grading = Grading::new(&input.mesh, &input.curves, g, cap, spacing)?;
+                // The count the field may grow to is bounded against the paper's count at
+                // the first sigma_p.
+                let uniform = SAMPLES_PER_SIGMA2 * input.area / (first_sigma_p * first_sigma_p);
+                grading.bound_growth(input.area, first_sigma_p, uniform);
                 timer.lap("local feature size");
                 Some(grading)
             }

@@ -278,7 +278,10 @@ struct Coincident(FxHashMap<[i64; 3], Vec<(DVec3, u32)>>);
 
 impl Coincident {
     fn cell(p: DVec3) -> [i64; 3] {
-        (p / CURVE_SAMPLE_COINCIDENT).floor().as_i64vec3().to_array()
+        (p / CURVE_SAMPLE_COINCIDENT)
+            .floor()
+            .as_i64vec3()
+            .to_array()
     }
 
     fn insert(&mut self, p: DVec3, id: u32) {

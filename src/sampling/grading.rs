@@ -1,13 +1,18 @@
-//! Sample density graded by the local feature size (issue 15): a kernel width
-//! sigma_p(x) = min(sigma_p, c · lfs(x)), so that a part thinner than the sampling (a tube, a
-//! plate, two sheets close together, a tip) gets enough samples around it to be triangulated as
-//! itself.
+//! The sizing field from the local feature size (issue 75): the spacing
+//! h(x) = clamp(ε · lfs(x), h_floor, sigma_p) in absolute units (bbox-100), so that a part
+//! thinner than the sampling (a tube, a plate, two sheets close together, a hole or a gap
+//! between two boundary loops) gets the samples its own size needs, whatever the count asked;
+//! sigma_p, searched for the count, sets the spacing only where the field does not bound it.
 //!
-//! The local feature size comes from [`crate::surface::local_feature_size`] (shrinking balls),
-//! smoothed to its 1-Lipschitz envelope, so sigma_p(x) is c-Lipschitz and the spacing changes
-//! gradually. The width is bounded below by `min_width` · sigma_p: where c · lfs is smaller
-//! still, the part cannot be resolved at the asked count, and [`Grading::resolving_count`] says
-//! how many samples would resolve it.
+//! The local feature size comes from [`crate::surface::local_feature_size`] (shrinking balls:
+//! the balls that reach across to another sheet, Amenta & Bern 1999's distance to the medial
+//! axis where it is a thickness, a gap or a hole's radius; the curvature radius of one sheet and
+//! the creases are the crease and curvature terms' to follow), median-filtered and smoothed to
+//! its Lipschitz envelope, so the spacing changes gradually. The floor h_floor is
+//! [`GradingParams::h_min`], raised when the count the field asks for would pass
+//! [`GradingParams::max_growth`] times the one asked ([`Grading::bound_growth`]): the parts
+//! below the floor are unresolved, and [`Grading::resolving_count`] says how many samples would
+//! resolve them.
 
 use glam::DVec3;
 
@@ -20,27 +25,41 @@ use crate::sampling::spacing::SAMPLES_PER_SIGMA2;
 use crate::spatial::StaticTree;
 use crate::surface::local_feature_size::{local_feature_size, LfsParams, LocalFeatureSize};
 
-/// Parameters of the grading.
+/// Parameters of the sizing field from the local feature size: the spacing
+/// h(x) = clamp(ε · lfs(x), h_floor, sigma_p), h_floor the larger of `h_min` and the spacing the
+/// growth bound allows, with neighbouring spacings within the Lipschitz factor `gradation`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GradingParams {
-    /// c in sigma_p(x) = min(sigma_p, c · lfs(x)) (default 0.75: a tube of radius r is graded
-    /// once it would get fewer than 2π / (1.2 c) ≈ 7 samples around it at the sampler's mean
-    /// edge of 1.2 sigma_p, and then keeps about 7).
+    /// ε in h(x) = ε · lfs(x) (default 2.5: two sides of a wall of thickness 2 lfs meet in one
+    /// restricted Voronoi cell when the samples' covering radius on a side, about mean edge /
+    /// √3 with the mean edge about 1.2 h, exceeds it, so the topological ball property needs
+    /// h ≲ 2.8 lfs; `docs/decisions/sizing-field.md`).
     pub lfs_factor: f64,
-    /// The smallest width relative to sigma_p (default 0.25: at most 16 times the density).
-    pub min_width: f64,
-    /// The Lipschitz constant L of the spacing: h(x) ≤ h(y) + L |x − y| (default 0.75, the
-    /// local feature size's own 1-Lipschitz bound times the default `lfs_factor`; gentler
+    /// The smallest spacing, absolute (bbox-100 units; default 0.05, a 2000th of the bounding
+    /// box): a part thinner than h_min / ε is held at it and reported unresolved.
+    pub h_min: f64,
+    /// The Lipschitz constant L of the spacing: h(x) ≤ h(y) + L |x − y| (default 0.75; gentler
     /// gradations, 0.4 and 0.25, measured no better Qave on horse, bunny and spot).
     pub gradation: f64,
+    /// The most the field may raise the count above the one asked (default 4: at most 4 N
+    /// samples for `--points N`); where the field asks for more, its floor is raised until the
+    /// expected count fits, and the parts below it are reported unresolved.
+    pub max_growth: f64,
+    /// The most sigma_p may grow over the paper's sigma_p for the count (the one of a uniform
+    /// sampling) while the search holds `--points N` with the field's samples in it (default
+    /// √2: the surface the field does not bound keeps at least half the paper's density; past
+    /// it, the count grows instead).
+    pub max_coarsening: f64,
 }
 
 impl Default for GradingParams {
     fn default() -> Self {
         GradingParams {
-            lfs_factor: 0.75,
-            min_width: 0.25,
+            lfs_factor: 2.5,
+            h_min: 0.05,
             gradation: 0.75,
+            max_growth: 4.0,
+            max_coarsening: std::f64::consts::SQRT_2,
         }
     }
 }
@@ -52,6 +71,8 @@ pub struct GradingStats {
     pub graded_samples: usize,
     /// The smallest width of an output sample (relative to sigma_p).
     pub min_width: f64,
+    /// The field's smallest spacing (model units; [`Grading::floor`]).
+    pub floor: f64,
     /// Output samples held at the smallest width although the local feature size asks for a
     /// finer one: parts too thin for the asked count.
     pub unresolved_samples: usize,
@@ -87,6 +108,9 @@ pub struct Grading {
     cap: f64,
     /// The smallest of `thickness` and of the boundary gaps.
     min_thickness: f64,
+    /// The smallest spacing (bbox-100 units): [`GradingParams::h_min`], or the larger floor
+    /// [`Grading::bound_growth`] set.
+    floor: f64,
     /// One kd-tree per boundary loop over its vertices (at most [`MAX_GAP_LOOPS`] loops), for
     /// the gap between loops ([`Grading::boundary_gap`]).
     loops: Vec<StaticTree>,
@@ -155,6 +179,7 @@ impl Grading {
         let mut grading = Grading {
             lfs,
             min_thickness: f64::INFINITY,
+            floor: params.h_min,
             thickness,
             params,
             cap,
@@ -225,51 +250,92 @@ impl Grading {
         0.5 * (d1 + d2)
     }
 
-    /// The relative kernel width at `x` for the global `sigma_p`: `min(1, c · lfs(x) / sigma_p)`,
-    /// at least `min_width`.
-    pub fn width(&self, x: DVec3, sigma_p: f64) -> f64 {
+    /// The spacing at `x` (bbox-100 units): ε · lfs(x), at least the floor;
+    /// `f64::INFINITY` where no feature bounds it.
+    pub fn spacing(&self, x: DVec3) -> f64 {
         let l = self.lfs(x);
         if !l.is_finite() {
-            return 1.0;
+            return f64::INFINITY;
         }
-        (self.params.lfs_factor * l / sigma_p).clamp(self.params.min_width, 1.0)
+        (self.params.lfs_factor * l).max(self.floor)
+    }
+
+    /// The relative kernel width at `x` for the global `sigma_p`: `min(1, h(x) / sigma_p)`,
+    /// h the absolute spacing ([`Grading::spacing`]).
+    pub fn width(&self, x: DVec3, sigma_p: f64) -> f64 {
+        (self.spacing(x) / sigma_p).min(1.0)
     }
 
     /// Whether some width is below 1 at a global `sigma_p` of `sigma_p` or less (some
-    /// thickness t has c · t < sigma_p).
+    /// thickness t has max(ε · t, floor) < sigma_p).
     pub fn grades_below(&self, sigma_p: f64) -> bool {
-        self.params.lfs_factor * self.min_thickness < sigma_p
+        (self.params.lfs_factor * self.min_thickness).max(self.floor) < sigma_p
     }
 
-    /// Whether the width at `x` is held at `min_width` although c · lfs(x) asks for less: a part
-    /// too thin for the sampling at `sigma_p`.
+    /// Whether the spacing at `x` is held at the floor although ε · lfs(x) asks for less: a
+    /// part thinner than the field resolves ([`Grading::bound_growth`]), when the floor is
+    /// below `sigma_p` (above it, the part is not graded at all).
     pub fn is_unresolved(&self, x: DVec3, sigma_p: f64) -> bool {
         let l = self.lfs(x);
-        l.is_finite() && self.params.lfs_factor * l < self.params.min_width * sigma_p
+        l.is_finite() && self.params.lfs_factor * l < self.floor && self.floor < sigma_p
     }
 
-    /// The count of samples at which every part of a surface of area `area` (bbox-100 units)
-    /// is resolved: the global sigma_p* at which the thinnest part's width c · t_min / sigma_p*
-    /// is `min_width`, and the expected samples there with sigma_p(x) = min(sigma_p*, c · t(x)),
-    /// `SAMPLES_PER_SIGMA2` per sigma², summed over the estimate points (area-uniform, each
-    /// standing for `area / points`). `None` without a graded part.
-    pub fn resolving_count(&self, area: f64) -> Option<f64> {
+    /// The smallest spacing (bbox-100 units).
+    pub fn floor(&self) -> f64 {
+        self.floor
+    }
+
+    /// The expected sample count on a surface of area `area` (bbox-100 units) with the spacing
+    /// min(sigma_p, max(ε · t, floor)): `SAMPLES_PER_SIGMA2` per sigma², summed over the
+    /// estimate points (area-uniform, each standing for `area / points`; the boundary gaps are
+    /// left out).
+    pub fn expected_count(&self, area: f64, sigma_p: f64, floor: f64) -> f64 {
         let c = self.params.lfs_factor;
+        let points = self.thickness.len().max(1) as f64;
+        let per_point = area / points;
+        self.thickness
+            .iter()
+            .map(|&t| {
+                let h = if t < self.cap {
+                    (c * t).max(floor).min(sigma_p)
+                } else {
+                    sigma_p
+                };
+                SAMPLES_PER_SIGMA2 * per_point / (h * h)
+            })
+            .sum()
+    }
+
+    /// Raises the floor so that the field asks for at most [`GradingParams::max_growth`] times
+    /// `count` samples on a surface of area `area` at the global `sigma_p` (bbox-100 units):
+    /// the smallest floor from [`GradingParams::h_min`] up that does (bisection in log space).
+    pub fn bound_growth(&mut self, area: f64, sigma_p: f64, count: f64) {
+        let most = self.params.max_growth.max(1.0) * count;
+        let (mut lo, mut hi) = (self.params.h_min, sigma_p.max(self.params.h_min));
+        if self.expected_count(area, sigma_p, lo) <= most {
+            self.floor = lo;
+            return;
+        }
+        for _ in 0..40 {
+            let mid = (lo * hi).sqrt();
+            if self.expected_count(area, sigma_p, mid) <= most {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        self.floor = hi;
+    }
+
+    /// The count at which every part of a surface of area `area` (bbox-100 units) is resolved
+    /// at the global `sigma_p`: the expected count with the floor at the thinnest part's
+    /// spacing ε · t_min (at least [`GradingParams::h_min`]). `None` without a graded part.
+    pub fn resolving_count(&self, area: f64, sigma_p: f64) -> Option<f64> {
         if !(self.min_thickness.is_finite() && self.min_thickness > 0.0) {
             return None;
         }
-        let sigma_star = c * self.min_thickness / self.params.min_width;
-        let points = self.thickness.len().max(1) as f64;
-        let per_point = area / points;
-        Some(
-            self.thickness
-                .iter()
-                .map(|&t| {
-                    let s = (c * t).min(sigma_star);
-                    SAMPLES_PER_SIGMA2 * per_point / (s * s)
-                })
-                .sum(),
-        )
+        let floor = (self.params.lfs_factor * self.min_thickness).max(self.params.h_min);
+        Some(self.expected_count(area, sigma_p, floor))
     }
 
     /// The grading's record over the output's vertices `positions` (bbox-100 units in, model
@@ -328,9 +394,10 @@ impl Grading {
         GradingStats {
             graded_samples: graded.len(),
             min_width,
+            floor: self.floor / normalization.scale,
             unresolved_samples,
             resolving_count: if unresolved_samples > 0 {
-                grading.resolving_count(area)
+                grading.resolving_count(area, sigma_p)
             } else {
                 None
             },
@@ -369,8 +436,8 @@ fn median_filtered(lfs: &LocalFeatureSize, of: &[f64], k: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The grading by thickness: `min(1, c · lfs(p) / sigma_ref)` ([`Grading::width`]) for the global
-/// `sigma_ref` (bbox-100 units).
+/// The sizing field's relative widths: `min(1, h(p) / sigma_ref)` ([`Grading::width`]) for the
+/// global `sigma_ref` (bbox-100 units).
 ///
 /// Its cost is where it grades: a point with no graded estimate point (c · thickness <
 /// sigma_ref) within [`ESTIMATE_REACH`] spacings and no boundary vertex within sigma_ref / c is
@@ -393,7 +460,7 @@ impl<'a> Thickness<'a> {
             .thickness
             .iter()
             .zip(&grading.lfs.positions)
-            .filter(|&(&t, _)| c * t < sigma_ref && t < grading.cap)
+            .filter(|&(&t, _)| (c * t).max(grading.floor) < sigma_ref && t < grading.cap)
             .map(|(_, &p)| p)
             .collect();
         let reach = ESTIMATE_REACH * grading.lfs.spacing;

@@ -34,6 +34,10 @@ pub struct TargetCountParams {
     /// The dimension m of the sampled manifold (default 2, a surface): the count is taken to
     /// fall like sigma_p^-m for the first step; the secant steps after it measure the slope.
     pub dimension: f64,
+    /// The largest sigma_p tried (default infinity): when the count there is still above the
+    /// target, the search stops there, not reached (a sizing field that bounds the spacing on
+    /// most of the surface holds a count sigma_p cannot bring down).
+    pub max_sigma: f64,
 }
 
 impl TargetCountParams {
@@ -44,6 +48,7 @@ impl TargetCountParams {
             tolerance: 0.005,
             max_evaluations: 16,
             dimension: 2.0,
+            max_sigma: f64::INFINITY,
         }
     }
 }
@@ -79,7 +84,8 @@ pub fn find_sigma_p<T>(
     // Bracket in log sigma: lo has count > target, hi has count < target.
     let mut lo: Option<(f64, f64)> = None; // (ln sigma, ln count)
     let mut hi: Option<(f64, f64)> = None;
-    let mut ln_sigma = sigma_start.ln();
+    let ln_max = params.max_sigma.ln();
+    let mut ln_sigma = sigma_start.ln().min(ln_max);
     let mut previous: Option<(f64, f64)> = None; // (ln sigma, ln count) of the last evaluation
     for _ in 0..params.max_evaluations.max(1) {
         let sigma = ln_sigma.exp();
@@ -91,7 +97,7 @@ pub fn find_sigma_p<T>(
         if better {
             best = Some((sigma, count, value));
         }
-        if within(count) {
+        if within(count) || (ln_sigma >= ln_max && count as f64 > target) {
             break;
         }
         let ln_count = (count.max(1) as f64).ln();
@@ -131,7 +137,7 @@ pub fn find_sigma_p<T>(
                 break;
             }
         }
-        ln_sigma = next;
+        ln_sigma = next.min(ln_max);
     }
     let (sigma_p, count, value) = best.expect("at least one evaluation");
     TargetCountResult {
@@ -183,5 +189,24 @@ mod tests {
         assert!(!r.reached);
         assert!(r.count == 1000 || r.count == 10);
         assert!(r.history.len() <= 16);
+    }
+
+    #[test]
+    fn stops_at_the_largest_sigma_when_the_count_there_is_still_above() {
+        // A count held above the target by a bounded part (3000 samples whatever sigma_p) and a
+        // free part of 4000 at sigma_p 1: the target 4000 needs sigma_p ≈ 2, past the bound 1.5.
+        let f = |s: f64| ((3000.0 + 4000.0 / (s * s)).round() as usize, s);
+        let params = TargetCountParams {
+            max_sigma: 1.5,
+            ..TargetCountParams::new(4000)
+        };
+        let r = find_sigma_p(&params, 1.0, f);
+        assert!(!r.reached);
+        assert!(r.history.iter().all(|h| h.0 <= 1.5), "{:?}", r.history);
+        assert_eq!(r.sigma_p, 1.5, "{:?}", r.history);
+        // Without the bound, the same search reaches it.
+        let r = find_sigma_p(&TargetCountParams::new(4000), 1.0, f);
+        assert!(r.reached, "{:?}", r.history);
+        assert!(r.sigma_p > 1.5);
     }
 }
