@@ -12,11 +12,11 @@ Runs (each in its own process, `--timeout` seconds at most, 600 by default):
   `--as-points`), timed as a whole process (reading the scan and writing the mesh included). The
   normals are ours to estimate: towards the PCD's VIEWPOINT, face000's camera, and for bun000.xyz
   (no viewpoint) outward by a spanning tree.
-- `meshlab_poisson_isotropic`: eval/points.py's `run_poisson_isotropic` (normals k = 10 turned
+- `meshlab_poisson_isotropic`: eval/pointsets.py's `run_poisson_isotropic` (normals k = 10 turned
   towards the scan's viewpoint where it has one; screened Poisson depth 10 with preclean, no density
   trim; isotropic remeshing, 10 iterations, to about N vertices: at most five edge lengths, h ← h·√(V/N),
   until within 2%).
-- `meshlab_ball_pivoting`: eval/points.py's `run_ball_pivoting` (the same normals; Poisson-disk
+- `meshlab_ball_pivoting`: eval/pointsets.py's `run_ball_pivoting` (the same normals; Poisson-disk
   subset of N points, ball pivoting at its defaults).
 - `open3d_poisson`: Open3D (`open3d-cpu` on PyPI, the project's CPU build): normals by
   `estimate_normals` (30 nearest neighbours) turned towards the viewpoint
@@ -177,13 +177,13 @@ def load_scan(name):
 
 
 def meshlab_poisson_isotropic(points, n, viewpoint, out):
-    import points as pts
+    import pointsets as pts
 
     return {"seconds": pts.run_poisson_isotropic(Path(points), n, False, Path(out), viewpoint, tries=5)}
 
 
 def meshlab_ball_pivoting(points, n, viewpoint, out):
-    import points as pts
+    import pointsets as pts
 
     return {"seconds": pts.run_ball_pivoting(Path(points), n, False, Path(out), viewpoint)}
 
@@ -223,7 +223,7 @@ CHILD = ("import sys, json; sys.path.insert(0, sys.argv[1]); import points_real 
 
 def run_child(key, points, n, viewpoint, out, timeout):
     """A reference in a child process: its result dict; a crash or a timeout raises."""
-    import points as pts
+    import pointsets as pts
 
     arg = json.dumps({"f": key, "kw": {"points": str(points), "n": n, "viewpoint": viewpoint, "out": str(out)}})
     return json.loads(pts.child_last_line([sys.executable, "-c", CHILD, str(HERE), arg], timeout, "child"))
@@ -413,7 +413,7 @@ def fmt(x, f):
 
 
 def run_real(a, out_dir, parse_seeds, command, commit):
-    from points import write_points
+    from pointsets import write_points
 
     seeds = parse_seeds(a.seeds)
     names = a.real_scans.split(",")

@@ -90,7 +90,7 @@ def make_points(kind, work):
         subprocess.run([str(REMESH), "points", str(SHARED / "spot.obj"), str(path), "--count", "5000",
                         "--seed", "7"], check=True, capture_output=True)
     elif kind.startswith("horse"):
-        import points as pts  # eval/points.py: the same variants
+        import pointsets as pts  # eval/points.py's variants, from the same points
 
         base = work / "horse-1M.ply"
         if not base.exists():
