@@ -446,3 +446,29 @@ fn shared_the_scans_are_read_from_their_own_files() {
         assert_eq!(reader.viewpoint().is_some(), pcd, "{name}");
     }
 }
+
+/// `remesh simplify --points N` lands within the README's 2% at small counts too (issue 76's
+/// tail): the sigma_p search runs on a subset of the first bucket, and a scan's count wobbles
+/// with its random order, so one scan at the searched sigma_p gave a sphere's 50 as 48 to 53 and
+/// 100 as 107; the scan now runs again while it misses.
+#[test]
+fn simplify_lands_within_two_percent_at_small_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere-100k.ply");
+    write_surface_points(&common::icosphere(5), 100_000, 1, &input).unwrap();
+    for n in [50, 100, 200, 500] {
+        for seed in 1..=5 {
+            let params = OutOfCoreParams {
+                target: Some(n),
+                seed,
+                temp_dir: Some(dir.path().to_path_buf()),
+                ..Default::default()
+            };
+            let got = simplify_out_of_core(&input, &params).unwrap().samples.len();
+            assert!(
+                (got as f64 - n as f64).abs() <= 0.02 * n as f64,
+                "--points {n} seed {seed}: {got}"
+            );
+        }
+    }
+}
