@@ -1537,3 +1537,71 @@ fn several_parts_far_apart_are_each_meshed() {
         );
     }
 }
+
+/// `n` points of the Fibonacci sphere of `radius` around `(cx, 0, 0)`, with their normals, as
+/// `.xyzn` lines.
+fn sphere_xyzn(n: usize, radius: f64, cx: f64) -> String {
+    (0..n)
+        .map(|i| {
+            let (t, z) = (
+                i as f64 * 2.399_963,
+                1.0 - 2.0 * (i as f64 + 0.5) / n as f64,
+            );
+            let r = (1.0 - z * z).sqrt();
+            let (x, y) = (r * t.cos(), r * t.sin());
+            format!(
+                "{} {} {} {x} {y} {z}\n",
+                cx + radius * x,
+                radius * y,
+                radius * z
+            )
+        })
+        .collect()
+}
+
+/// Issue 76 (R7): one big sphere (radius 1000) and a small one (radius 1) 10^6 away. The big one
+/// is large enough for the whole's scale, so the parts were not told apart: the small sphere
+/// took one sample and was dropped with nothing said. Now each part is meshed on its own (the
+/// small one at the fewest points a part is asked, 20); and a small far part that holds no
+/// surface (points along a segment) is left out with a note naming it, not the run refused.
+#[test]
+fn a_small_part_far_from_a_big_one_is_meshed_or_left_out_with_a_note() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = sphere_xyzn(20_000, 1000.0, 0.0);
+    let run = |name: &str, points: String| {
+        let input = write(dir.path(), name, points);
+        let (out, report) = (dir.path().join("out.ply"), dir.path().join("r.json"));
+        let o = remesh(&[
+            arg(&input),
+            arg(&out),
+            "--points",
+            "3000",
+            "-q",
+            "--no-distance",
+            "--report",
+            arg(&report),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        r
+    };
+    let r = run("spheres.xyzn", big.clone() + &sphere_xyzn(2000, 1.0, 1e6));
+    assert_eq!(r["topology"]["components"].as_u64(), Some(2), "{r}");
+    assert_eq!(r["topology"]["boundary_loops"].as_u64(), Some(0), "{r}");
+    let parts = r["extra"]["separate_parts"].as_array().unwrap();
+    assert!(parts.iter().all(|v| v.as_u64() > Some(0)), "{r}");
+    // A segment: 2000 points along a line 2 long, 10^6 away (no surface at any count).
+    let line: String = (0..2000)
+        .map(|i| format!("{} 0 0 0 0 1\n", 1e6 + 2.0 * i as f64 / 2000.0))
+        .collect();
+    let r = run("sphere-and-line.xyzn", big + &line);
+    assert_eq!(r["topology"]["components"].as_u64(), Some(1), "{r}");
+    let notes = r["notes"].to_string();
+    assert!(notes.contains("was left out"), "{notes}");
+    assert_eq!(
+        r["extra"]["left_out_part_points"].as_array().map(Vec::len),
+        Some(1),
+        "{r}"
+    );
+}

@@ -235,6 +235,25 @@ pub(super) fn run(
                 .join(", ")
         ));
     }
+    for part in &out.left_out_parts {
+        let (lo, hi) = (part.min, part.max);
+        report.notes.push(format!(
+            "a part far from the rest ({} points in [{:.4}, {:.4}, {:.4}]-[{:.4}, {:.4}, {:.4}]) \
+             was left out: at its share of the count it holds no surface ({}); a larger count \
+             meshes it",
+            part.points, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, part.reason
+        ));
+    }
+    if !out.left_out_parts.is_empty() {
+        insert_json(
+            extra,
+            "left_out_part_points",
+            &out.left_out_parts
+                .iter()
+                .map(|p| p.points)
+                .collect::<Vec<_>>(),
+        );
+    }
     if out.far_points > 0 {
         report.notes.push(format!(
             "{} left out, in groups far from the rest and much smaller: they would have set the \

@@ -54,7 +54,9 @@ use crate::triangulate::unsupported::{
 use crate::triangulate::{triangulate, AssemblyStats, SampleSet};
 
 mod parts;
+
 use parts::remesh_parts;
+pub use parts::LeftOutPart;
 
 /// Points of the RIMLS surface per output sample: random input points (the first bucket's), the
 /// samples not among them (a sample is an input point: a near outlier taken as a sample would
@@ -287,6 +289,9 @@ pub struct PointRemeshOutput {
     /// (`gradient_ascent` to `output_orientation`) are then the first part's; the counts and
     /// times are summed over the parts.
     pub separate_parts: Vec<usize>,
+    /// Of those parts, the ones left out: no surface at their share of the count (a part other
+    /// than the largest; the largest's errors are the run's).
+    pub left_out_parts: Vec<LeftOutPart>,
     /// Whether the input had normals (else they were estimated).
     pub had_normals: bool,
     /// What was mended of the input's normals among the RIMLS surface's points: missing ones
@@ -896,6 +901,7 @@ fn remesh_points_once(
         far_points: scan.far_points,
         kept: KeptPoints::whole(scan.far_groups.clone()),
         separate_parts: Vec::new(),
+        left_out_parts: Vec::new(),
         had_normals: scan.had_normals,
         normal_repairs: repairs,
         outliers_removed: scan.outliers_removed,

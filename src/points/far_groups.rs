@@ -156,6 +156,8 @@ pub struct KeptPoints {
     parts: Option<std::sync::Arc<SeparateParts>>,
     /// Each part's far groups (one entry when there are no parts).
     far: Vec<Option<FarGroups>>,
+    /// The parts left out whole (none kept; empty when there are no parts).
+    left_out: Vec<bool>,
 }
 
 impl KeptPoints {
@@ -164,14 +166,21 @@ impl KeptPoints {
         KeptPoints {
             parts: None,
             far: vec![far],
+            left_out: Vec::new(),
         }
     }
 
-    /// The points in `parts`, each part's own far groups (`far`, in the parts' order) left out.
-    pub fn in_parts(parts: std::sync::Arc<SeparateParts>, far: Vec<Option<FarGroups>>) -> Self {
+    /// The points in `parts`, each part's own far groups (`far`, in the parts' order) left out,
+    /// and the parts `left_out` whole.
+    pub fn in_parts(
+        parts: std::sync::Arc<SeparateParts>,
+        far: Vec<Option<FarGroups>>,
+        left_out: Vec<bool>,
+    ) -> Self {
         KeptPoints {
             parts: Some(parts),
             far,
+            left_out,
         }
     }
 
@@ -192,6 +201,9 @@ impl KeptPoints {
             },
             None => 0,
         };
+        if self.left_out.get(k).copied().unwrap_or(false) {
+            return false;
+        }
         self.far
             .get(k)
             .and_then(Option::as_ref)
@@ -199,7 +211,7 @@ impl KeptPoints {
     }
 }
 
-/// Parts of a point set far apart are meshed each on its own when every part's diagonal is
+/// Parts of a point set far apart are meshed each on its own when some part's diagonal is
 /// under this share of the whole's: one scale cannot hold them all (a sample spacing of a
 /// part's size is below the precision of the whole's tolerances). Two objects 10^6 apart, each
 /// 10 across, are 1e-5.
@@ -229,7 +241,7 @@ pub struct PartEstimate {
     pub area: f64,
 }
 
-/// The parts of a point set far apart compared with their own sizes (each part's diagonal
+/// The parts of a point set far apart compared with their own sizes (some part's diagonal
 /// under [`SEPARATE_PARTS_RATIO`] of the whole's: two objects 10^6 apart, each 10 across), found
 /// on a random subset of its points with the far groups left out: which part a point is in.
 #[derive(Debug)]
@@ -322,8 +334,14 @@ pub fn separate_parts(points: &[DVec3], far: Option<&FarGroups>) -> Option<Separ
         .iter()
         .map(|m| Aabb::of(m).expect("a group has points"))
         .collect();
-    let largest = boxes.iter().map(Aabb::diagonal).fold(0.0f64, f64::max);
-    if largest >= SEPARATE_PARTS_RATIO * whole_diagonal {
+    // One scale holds the parts when each is large enough for it; one part below the share is
+    // lost at the whole's scale (a sphere 2 across beside one 2000 across, 10^6 away, took one
+    // sample and was dropped), so then each part is meshed on its own.
+    let smallest = boxes
+        .iter()
+        .map(Aabb::diagonal)
+        .fold(f64::INFINITY, f64::min);
+    if smallest >= SEPARATE_PARTS_RATIO * whole_diagonal {
         return None;
     }
     // A part holds a surface's points: on the fine grid, isolated points of a sparse set (200
@@ -445,9 +463,14 @@ mod tests {
         let c = sphere(130, DVec3::new(0.0, 2e3, 0.0), 1.0, &mut rng);
         let set = [a.clone(), b, c].concat();
         assert!(far_groups(&set).is_none());
-        // Two parts 10^6 apart, one 2·10^3 across (the first sphere and the third): 2 thousandths
-        // of the whole, which one scale holds.
-        assert!(separate_parts(&set, None).is_none());
+        // Two groups 10^6 apart: the first sphere with the third (2·10^3 across, 2 thousandths
+        // of the whole) and the second sphere (10^-5 of the whole, under the share: at one
+        // scale a part that small may take no sample), so each group is meshed on its own, and
+        // the third sphere stays with the first.
+        let groups = separate_parts(&set, None).expect("two groups");
+        assert_eq!(groups.len(), 2, "{groups:?}");
+        assert_eq!(groups.parts[0].subset_points, 3130);
+        assert_eq!(groups.parts[1].subset_points, 3000);
         // Without the third, two parts each 10^-5 of the whole: separate, every point in one.
         let two = [a, sphere(3000, DVec3::new(1e6, 0.0, 0.0), 5.0, &mut rng)].concat();
         let parts = separate_parts(&two, None).expect("parts far apart");

@@ -56,7 +56,7 @@ pub struct PointPart {
     whole: Box<PointSource>,
     parts: Arc<super::far_groups::SeparateParts>,
     index: usize,
-    count: u64,
+    pub(crate) count: u64,
 }
 
 impl PointSource {
