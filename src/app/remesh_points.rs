@@ -248,7 +248,7 @@ pub(super) fn run(
         insert_json(
             extra,
             "left_out_part_points",
-            &out.left_out_parts
+            out.left_out_parts
                 .iter()
                 .map(|p| p.points)
                 .collect::<Vec<_>>(),
