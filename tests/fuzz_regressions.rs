@@ -75,12 +75,13 @@ fn fuzz_regression_a_bvh_of_two_faces_not_numbered_0_and_1_panicked() {
 
 /// Issue 76, found by the `read_las` target: a LAZ whose LASzip record lists no point items
 /// made the laz crate panic ("There should be at least one LazItem"), and a LAS 1.4 extended
-/// record announcing 10^19 bytes made the las crate's reservation overflow; now each is an
-/// error naming the file, `remesh` and `simplify` alike.
+/// record announcing 10^19 bytes made the las crate's reservation overflow, and a table of
+/// variable-size chunks listing fewer points than the header made the laz crate index past it;
+/// now each is an error naming the file, `remesh` and `simplify` alike.
 #[test]
 fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[u8], &str); 2] = [
+    let cases: [(&[u8], &str); 3] = [
         (
             include_bytes!("fuzz/read_las-laszip-record-of-no-items.laz"),
             "LASzip record",
@@ -88,6 +89,12 @@ fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
         (
             include_bytes!("fuzz/read_las-extended-record-past-the-end.laz"),
             "extended record",
+        ),
+        // A table of variable-size chunks listing fewer points than the header: the laz crate
+        // indexed past it ("index out of bounds: the len is 0").
+        (
+            include_bytes!("fuzz/read_las-chunk-table-of-fewer-points.laz"),
+            "chunk table lists 0 points",
         ),
     ];
     for (bytes, says) in cases {
