@@ -76,12 +76,13 @@ fn fuzz_regression_a_bvh_of_two_faces_not_numbered_0_and_1_panicked() {
 /// Issue 76, found by the `read_las` target: a LAZ whose LASzip record lists no point items
 /// made the laz crate panic ("There should be at least one LazItem"), and a LAS 1.4 extended
 /// record announcing 10^19 bytes made the las crate's reservation overflow, and a table of
-/// variable-size chunks listing fewer points than the header made the laz crate index past it;
+/// variable-size chunks listing fewer points than the header made the laz crate index past it
+/// (and a header whose size field is short of its version's hid a LASzip record of no items);
 /// now each is an error naming the file, `remesh` and `simplify` alike.
 #[test]
 fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[u8], &str); 3] = [
+    let cases: [(&[u8], &str); 4] = [
         (
             include_bytes!("fuzz/read_las-laszip-record-of-no-items.laz"),
             "LASzip record",
@@ -95,6 +96,12 @@ fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
         (
             include_bytes!("fuzz/read_las-chunk-table-of-fewer-points.laz"),
             "chunk table lists 0 points",
+        ),
+        // A LAS 1.2 header whose size field says 226: the crate reads 227 bytes and found a
+        // LASzip record of no items one byte past where the check looked.
+        (
+            include_bytes!("fuzz/read_las-header-size-short-of-its-version.laz"),
+            "LASzip record",
         ),
     ];
     for (bytes, says) in cases {
