@@ -1605,3 +1605,69 @@ fn a_small_part_far_from_a_big_one_is_meshed_or_left_out_with_a_note() {
         "{r}"
     );
 }
+
+/// Issue 76 (R10): the weld and the zero-area test at tiny scales. A closed sphere scaled by
+/// 1e-300 was refused as "no faces with area" (the cross products' squares underflowed), and its
+/// triangle soup with corners a rounding apart (1e-15 relative) at 1e-200 and 1e-300 was refused
+/// the same (the weld's lengths underflowed to 0); at unit size the soup is welded into one
+/// closed sphere. Now every scale gives what unit size gives.
+#[test]
+fn tiny_scales_weld_and_remesh_as_unit_size_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = common::icosphere(3);
+    let obj = |scale: f64, soup: bool| -> String {
+        let mut s = String::new();
+        if soup {
+            for (f, t) in sphere.triangles.iter().enumerate() {
+                for (k, &v) in t.iter().enumerate() {
+                    // A rounding apart: each corner's copy off by about 1e-15 of its size.
+                    let e = 1.0 + 1e-15 * (((f * 3 + k) % 7) as f64 - 3.0);
+                    let p = sphere.positions[v as usize] * e * scale;
+                    s += &format!("v {:e} {:e} {:e}\n", p.x, p.y, p.z);
+                }
+                s += &format!("f {} {} {}\n", 3 * f + 1, 3 * f + 2, 3 * f + 3);
+            }
+        } else {
+            for p in &sphere.positions {
+                let p = *p * scale;
+                s += &format!("v {:e} {:e} {:e}\n", p.x, p.y, p.z);
+            }
+            for t in &sphere.triangles {
+                s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+            }
+        }
+        s
+    };
+    for (scale, soup) in [(1.0, true), (1e-300, false), (1e-200, true), (1e-300, true)] {
+        let input = write(dir.path(), "in.obj", obj(scale, soup));
+        let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
+        let o = remesh(&[
+            arg(&input),
+            arg(&out),
+            "--points",
+            "300",
+            "-q",
+            "--no-distance",
+            "--report",
+            arg(&report),
+        ]);
+        let at = format!("scale {scale:e}, soup {soup}");
+        assert!(
+            o.status.success(),
+            "{at}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        let t = &r["topology"];
+        assert_eq!(
+            (
+                t["components"].as_u64(),
+                t["boundary_loops"].as_u64(),
+                t["genus"].as_u64()
+            ),
+            (Some(1), Some(0), Some(0)),
+            "{at}: {t}"
+        );
+    }
+}

@@ -194,15 +194,21 @@ pub(super) fn own_frame(mesh: &TriMesh, path: &Path) -> Result<Normalization> {
 }
 
 /// A model too small for the bbox-100 frame's `f64` scale (a longest side below about
-/// 5.6e-307 model units: subnormal coordinates) scaled up by `2^k` so its longest side is
-/// between 1 and 2, and `k`; every other model as it is, and 0. Scaling by a power of two
+/// 5.6e-307 model units: subnormal coordinates), or one whose squared lengths leave `f64`'s
+/// range (a longest side below 2^-256 or above 2^256: the zero-area test's cross products
+/// underflowed at 1e-300), scaled by `2^k` so its longest side is between 1 and 2, and `k`;
+/// every other model as it is, and 0. Scaling by a power of two
 /// changes no digit, so the model is the same one in other units.
 pub(super) fn into_normal_range(mesh: TriMesh) -> (TriMesh, i32) {
     let Some(bbox) = mesh.bbox() else {
         return (mesh, 0);
     };
     let side = bbox.longest_side();
-    if !(side.is_finite() && side > 0.0) || Normalization::for_bbox(&bbox).is_some() {
+    // Also where squared lengths (the zero-area test's) leave f64's normal range.
+    let squares_in_range = (2f64.powi(-256)..=2f64.powi(256)).contains(&side);
+    if !(side.is_finite() && side > 0.0)
+        || (Normalization::for_bbox(&bbox).is_some() && squares_in_range)
+    {
         return (mesh, 0);
     }
     let k = -(side.log2().floor() as i32);

@@ -424,7 +424,13 @@ fn weld_tolerance(mesh: &TriMesh) -> f64 {
     if lo.x > hi.x {
         return 0.0;
     }
-    WELD_RELATIVE * lo.distance(hi)
+    // The diagonal without squaring the sides (at 1e-200 their squares underflow to 0).
+    let d = hi - lo;
+    let m = d.abs().max_element();
+    if !(m > 0.0 && m.is_finite()) {
+        return 0.0;
+    }
+    WELD_RELATIVE * m * (d / m).length()
 }
 
 /// Reads a whole file, mapping failure to [`Error::Io`] naming `path`.

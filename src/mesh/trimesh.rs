@@ -470,6 +470,33 @@ impl TriMesh {
         if !(tolerance > 0.0 && tolerance.is_finite()) || self.positions.is_empty() {
             return identical;
         }
+        // At scales where squared lengths leave f64's range (a model 1e-200 across: its edges'
+        // squares underflow to 0), the lengths are taken on the positions scaled by a power of
+        // two (exact), with the tolerance alike; the merged vertices keep their own positions.
+        let k = scale_exponent(tolerance);
+        if k != 0 {
+            let f = 2f64.powi(k);
+            let mut scaled = TriMesh {
+                positions: self.positions.iter().map(|&p| p * f).collect(),
+                triangles: self.triangles.clone(),
+            };
+            let near =
+                scaled.weld_close_scaled(tolerance * f, edge_fraction, Some(&self.positions));
+            self.positions = scaled.positions;
+            self.triangles = scaled.triangles;
+            return identical + near;
+        }
+        identical + self.weld_close_scaled(tolerance, edge_fraction, None)
+    }
+
+    /// The second step of [`TriMesh::weld_close_positions`] on positions whose squared lengths
+    /// are in range; `original`: the positions to keep (unscaled) when these are scaled.
+    fn weld_close_scaled(
+        &mut self,
+        tolerance: f64,
+        edge_fraction: f64,
+        original: Option<&[DVec3]>,
+    ) -> usize {
         let shortest = self.shortest_edges();
         let lo = self
             .positions
@@ -528,11 +555,40 @@ impl TriMesh {
             remap.push(idx);
         }
         let near = self.positions.len() - kept.len();
+        if let Some(original) = original {
+            // Back to the positions as given: each kept vertex's own.
+            let mut first = vec![u32::MAX; kept.len()];
+            for (i, &j) in remap.iter().enumerate() {
+                if first[j as usize] == u32::MAX {
+                    first[j as usize] = i as u32;
+                }
+            }
+            self.positions = original.to_vec();
+            if near == 0 {
+                return 0;
+            }
+            let kept = first.iter().map(|&i| original[i as usize]).collect();
+            self.merge_vertices(kept, &remap);
+            return near;
+        }
         if near == 0 {
-            return identical;
+            return 0;
         }
         self.merge_vertices(kept.into_iter().map(|(p, _)| p).collect(), &remap);
-        identical + near
+        near
+    }
+}
+
+/// The power of two that brings a length `tolerance` (a share of a model's size) to where squared
+/// lengths of the model stay in f64's normal range: 0 for tolerances from 2^-400 to 2^400 (models
+/// from about 2^-370 to 2^430 across at the weld's 1e-10), else the exponent that brings the
+/// tolerance to about 2^-34 (a model about 1 across).
+fn scale_exponent(tolerance: f64) -> i32 {
+    let e = tolerance.log2();
+    if (-400.0..=400.0).contains(&e) {
+        0
+    } else {
+        (-34.0 - e).round() as i32
     }
 }
 
