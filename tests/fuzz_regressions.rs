@@ -77,12 +77,13 @@ fn fuzz_regression_a_bvh_of_two_faces_not_numbered_0_and_1_panicked() {
 /// made the laz crate panic ("There should be at least one LazItem"), and a LAS 1.4 extended
 /// record announcing 10^19 bytes made the las crate's reservation overflow, and a table of
 /// variable-size chunks listing fewer points than the header made the laz crate index past it
-/// (and a header whose size field is short of its version's hid a LASzip record of no items);
+/// (a header whose size field is short of its version's hid a LASzip record of no items, and an
+/// item declared shorter than its type made the crate split the record past its end);
 /// now each is an error naming the file, `remesh` and `simplify` alike.
 #[test]
 fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[u8], &str); 4] = [
+    let cases: [(&[u8], &str); 5] = [
         (
             include_bytes!("fuzz/read_las-laszip-record-of-no-items.laz"),
             "LASzip record",
@@ -102,6 +103,12 @@ fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
         (
             include_bytes!("fuzz/read_las-header-size-short-of-its-version.laz"),
             "LASzip record",
+        ),
+        // A wave packet item declared 20 bytes (its type has 29): the laz crate split the
+        // record past its end ("mid > len").
+        (
+            include_bytes!("fuzz/read_las-item-size-not-its-types.laz"),
+            "that type has 29",
         ),
     ];
     for (bytes, says) in cases {

@@ -312,6 +312,48 @@ fn check_laszip_record(
                     ),
                 });
             }
+            // Each item of a fixed size as LASzip defines it (the laz crate splits the record
+            // by the sizes it knows: a wave packet item declared 20 bytes split past the
+            // record), and the items fill the header's record.
+            let record = u16::from_le_bytes(header[105..107].try_into().unwrap()) as u64;
+            let mut total = 0u64;
+            for i in 0..items as usize {
+                let at = 34 + 6 * i;
+                let kind = u16::from_le_bytes(data[at..at + 2].try_into().unwrap());
+                let declared = u16::from_le_bytes(data[at + 2..at + 4].try_into().unwrap());
+                let fixed = match kind {
+                    6 => Some(20),      // Point10
+                    7 => Some(8),       // GpsTime11
+                    8 | 11 => Some(6),  // RGB12, RGB14
+                    9 | 13 => Some(29), // WavePacket13, WavePacket14
+                    10 => Some(30),     // Point14
+                    12 => Some(8),      // RGBNIR14
+                    _ => None,          // extra bytes: any size
+                };
+                if fixed.is_some_and(|f| f != declared) {
+                    return Err(Error::Parse {
+                        path: path.to_path_buf(),
+                        line: None,
+                        message: format!(
+                            "the LAZ's LASzip record gives its item {} (type {kind}) {declared} \
+                             bytes, and that type has {}",
+                            i + 1,
+                            fixed.unwrap_or(0)
+                        ),
+                    });
+                }
+                total += declared as u64;
+            }
+            if total != record {
+                return Err(Error::Parse {
+                    path: path.to_path_buf(),
+                    line: None,
+                    message: format!(
+                        "the LAZ's LASzip items take {total} bytes and the header's point \
+                         record {record}"
+                    ),
+                });
+            }
             return Ok(Some(data));
         }
         at += 54 + size;
