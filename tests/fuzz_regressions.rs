@@ -83,7 +83,7 @@ fn fuzz_regression_a_bvh_of_two_faces_not_numbered_0_and_1_panicked() {
 #[test]
 fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[u8], &str); 5] = [
+    let cases: [(&[u8], &str); 6] = [
         (
             include_bytes!("fuzz/read_las-laszip-record-of-no-items.laz"),
             "LASzip record",
@@ -109,6 +109,12 @@ fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
         (
             include_bytes!("fuzz/read_las-item-size-not-its-types.laz"),
             "that type has 29",
+        ),
+        // Chunks of variable size with the pointwise compressor (no chunk table): the laz
+        // crate panicked ("Variable-size chunks, but no chunk table").
+        (
+            include_bytes!("fuzz/read_las-variable-chunks-without-a-table.laz"),
+            "chunks of variable size",
         ),
     ];
     for (bytes, says) in cases {

@@ -354,6 +354,21 @@ fn check_laszip_record(
                     ),
                 });
             }
+            // Chunks of variable size (chunk size 0 or 2^32 - 1) need a chunked compressor: the
+            // `laz` crate panics ("Variable-size chunks, but no chunk table") on the pointwise
+            // one, which has no chunk table (found by the read_las fuzz target).
+            let compressor = u16::from_le_bytes(data[0..2].try_into().unwrap());
+            let chunk_size = u32::from_le_bytes(data[12..16].try_into().unwrap());
+            if (chunk_size == 0 || chunk_size == u32::MAX) && compressor < 2 {
+                return Err(Error::Parse {
+                    path: path.to_path_buf(),
+                    line: None,
+                    message: format!(
+                        "the LAZ's LASzip record asks for chunks of variable size with \
+                         compressor {compressor}, which has no chunks"
+                    ),
+                });
+            }
             return Ok(Some(data));
         }
         at += 54 + size;
