@@ -20,10 +20,13 @@ Outcomes of a run, worst first:
   timeout    over --timeout seconds
   crash      a non-zero exit other than 3 (a refusal), or a message of more than one line
   disagree   the run's report and `remesh quality` of the file it wrote differ (crossing pairs or
-             invariant violations), or CGAL's count of self-intersecting pairs differs from ours
-  violation  exit 0, and the output breaks an invariant, or its faces cross where the input's
-             neither cross nor meet (the report's extra.output_crossings counts the pairs that lie
-             where the input's own faces cross or its parts meet at a non-manifold edge)
+             invariant violations), or CGAL's count of self-intersecting pairs differs from ours,
+             or eval/crossing_ruler.py counts other than our report's number of the output's own
+             crossing pairs
+  violation  exit 0, and the output breaks an invariant, or it has crossing pairs of its own: a
+             pair is the input's when both faces lie within one output spacing (mean edge) of
+             the curve where the input's own faces cross or its sheets meet at a non-manifold
+             edge, whatever vertex they share (the report's extra.output_crossings)
   crossings  exit 0 and valid but for crossing faces, all where the input's own faces cross or
              its parts meet
   refused    exit 3 with a one-line message (a file that holds no surface)
@@ -157,6 +160,18 @@ def violations_key(report):
     return sorted((v["kind"], v.get("count", 1)) for v in report.get("invariant_violations", []))
 
 
+def crossing_ruler_check(input_path, output_path, timeout):
+    """eval/crossing_ruler.py's answer for an output of `input_path`, from a child process
+    (CGAL aborts the process on some inputs); None when it gave none."""
+    try:
+        p = subprocess.run([sys.executable, str(Path(__file__).resolve().parent / "crossing_ruler.py"),
+                            str(input_path), str(output_path)],
+                           capture_output=True, text=True, timeout=timeout)
+        return json.loads(p.stdout.strip().splitlines()[-1])
+    except (subprocess.TimeoutExpired, ValueError, IndexError):
+        return None
+
+
 def one_run(binary, path, seed, args, tmp, input_pairs):
     out = Path(tmp) / f"out-{seed}.obj"
     rep = Path(tmp) / f"r-{seed}.json"
@@ -201,6 +216,13 @@ def one_run(binary, path, seed, args, tmp, input_pairs):
     # or its parts meet at a non-manifold edge; any other crossing is the output's own.
     theirs = report.get("extra", {}).get("output_crossings", {}).get("where_input_crosses", 0)
     row["pairs_where_input_crosses"] = theirs
+    if row["pairs"] > 0 and not args.no_cgal:
+        # Whose the pairs are, by a ruler written apart (eval/crossing_ruler.py, on CGAL's
+        # pairs): it must find as many of the output's own as our report.
+        row["ruler"] = crossing_ruler_check(path, out, args.timeout)
+        if row["ruler"] is None or row["ruler"].get("own") != row["pairs"] - theirs:
+            row["outcome"] = "disagree"
+            return row
     if others or row["pairs"] > theirs:
         row["outcome"] = "violation"
     elif row["pairs"] > 0:

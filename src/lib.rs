@@ -252,7 +252,7 @@ pub mod internal {
     };
     pub use crate::finish::stray_shells::StrayShells;
     pub use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
-    pub use crate::geometry::self_intersection::CrossingRegions;
+    pub use crate::geometry::crossing_curve::CrossingCurve;
     pub use crate::geometry::triangle::AngleBounds;
 
     // The kernel and the spectral measure (Sec. 3, 4.3, 6.1, 6.2).

@@ -271,6 +271,63 @@ fn two_boxes_on_one_edge_come_out_as_two_closed_parts() {
 }
 
 #[test]
+fn two_spheres_passing_through_each_other_cross_only_at_their_circle() {
+    // Two unit spheres 1 apart: their surfaces cross on the circle x = 0.5, radius sqrt(0.75).
+    // The output's crossing pairs are the input's (issue 76's rule: both faces within one output
+    // spacing of the input's crossing curve, whatever vertex they share), the report counts
+    // them so, and each pair's faces do lie by that circle (measured here, apart from the
+    // code's own curve).
+    let a = common::icosphere(4);
+    let mut b = common::icosphere(4);
+    for p in &mut b.positions {
+        *p += DVec3::new(1.0, 0.0, 0.0);
+    }
+    let offset = a.positions.len() as u32;
+    let mut scene = a;
+    scene.positions.extend(b.positions);
+    scene
+        .triangles
+        .extend(b.triangles.iter().map(|t| t.map(|i| i + offset)));
+    let circle = |p: DVec3| {
+        let r = (p.y * p.y + p.z * p.z).sqrt();
+        ((p.x - 0.5).powi(2) + (r - 0.75f64.sqrt()).powi(2)).sqrt()
+    };
+    for seed in 1..=2 {
+        let (out, report) = remesh_guarded(scene.clone(), 2000, seed);
+        let pairs = spectral_remesh::geometry::intersecting_pairs(&out.positions, &out.triangles);
+        let crossings = &report.extra["output_crossings"];
+        assert_eq!(crossings["pairs"].as_u64().unwrap(), pairs.len() as u64);
+        assert_eq!(
+            crossings["where_input_crosses"], crossings["pairs"],
+            "seed {seed}: {crossings:?}"
+        );
+        // The output's mean edge, in the output's units (the input's: no file frame here).
+        let edges: Vec<f64> = out
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .map(|(u, v)| out.positions[u as usize].distance(out.positions[v as usize]))
+            .collect();
+        let spacing = edges.iter().sum::<f64>() / edges.len() as f64;
+        for [f, g] in pairs {
+            for face in [f, g] {
+                let t = out.triangles[face as usize];
+                let nearest = t
+                    .iter()
+                    .map(|&v| circle(out.positions[v as usize]))
+                    .fold(f64::INFINITY, f64::min);
+                // A face within one spacing of the circle has a corner within that plus its
+                // longest edge.
+                assert!(
+                    nearest <= 3.0 * spacing,
+                    "seed {seed}: face {face} is {nearest} from the circle (spacing {spacing})"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn a_zero_area_first_face_is_left_out() {
     // Issue 36, item 1: a collinear face first panicked in parry's BVH.
     let mesh = TriMesh::new(

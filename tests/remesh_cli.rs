@@ -884,8 +884,9 @@ fn shared_the_finishing_stage_meets_issue_17s_angle_and_quality_bounds_at_seeds_
 }
 
 /// Issue 76: `--edge-length L` (model units) gives output edges about L long, the count it
-/// implies in the notes; it excludes `--points`, and a point set (no area before its surface)
-/// and a length that is not positive are usage errors.
+/// implies in the notes, on a mesh and on a point set (sigma_p = L / 1.2 there, its area being
+/// known only once its surface is); it excludes `--points`, and a length that is not positive
+/// is a usage error.
 #[test]
 fn edge_length_gives_edges_about_that_long() {
     let dir = tempfile::tempdir().unwrap();
@@ -926,6 +927,43 @@ fn edge_length_gives_edges_about_that_long() {
     let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
     assert!(
         r["notes"].to_string().contains("--edge-length 0.25: about"),
+        "{}",
+        r["notes"]
+    );
+    // The same sphere as points with normals (20,000 drawn on it, a fixed sequence).
+    let points = dir.path().join("sphere.xyzn");
+    let mut text = String::new();
+    let mut state = 1u64;
+    let mut uniform = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..20_000 {
+        let z = 2.0 * uniform() - 1.0;
+        let phi = std::f64::consts::TAU * uniform();
+        let r = (1.0 - z * z).sqrt();
+        let n = [r * phi.cos(), r * phi.sin(), z];
+        text += &format!("{} {} {} {} {} {}\n", 2.0 * n[0], 2.0 * n[1], 2.0 * n[2], n[0], n[1], n[2]);
+    }
+    std::fs::write(&points, text).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_remesh"))
+        .args([points.to_str().unwrap(), out.to_str().unwrap(), "-q", "--edge-length", "0.25"])
+        .args(["--no-distance", "--report", report.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (written, _) = spectral_remesh::read_mesh(&out).unwrap();
+    let lengths: Vec<f64> = written
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k] as usize, t[(k + 1) % 3] as usize)))
+        .map(|(a, b)| written.positions[a].distance(written.positions[b]))
+        .collect();
+    let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
+    assert!((mean - 0.25).abs() < 0.025, "point set: mean edge {mean}");
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert!(
+        r["notes"].to_string().contains("--edge-length 0.25: sigma_p"),
         "{}",
         r["notes"]
     );

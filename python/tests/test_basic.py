@@ -469,3 +469,15 @@ def test_edge_length_gives_edges_about_that_long(spot):
     assert any("--edge-length 0.1: about" in n for n in report["notes"])
     with pytest.raises(ValueError, match="edge_length"):
         sr.remesh(V, F, edge_length=0.1, points=100)
+
+
+def test_edge_length_on_a_point_set_gives_edges_about_that_long():
+    # A point set's area is known only once its surface is: sigma_p = L / 1.2 (bbox-100).
+    rng = np.random.default_rng(1)
+    P = rng.normal(size=(20000, 3))
+    N = P / np.linalg.norm(P, axis=1)[:, None]
+    V2, F2, report = sr.remesh(2.0 * N, normals=N, edge_length=0.25, distance=False)
+    e = np.concatenate([V2[F2[:, k]] - V2[F2[:, (k + 1) % 3]] for k in range(3)])
+    mean = np.linalg.norm(e, axis=1).mean()
+    assert abs(mean - 0.25) < 0.025, mean
+    assert any("--edge-length 0.25: sigma_p" in n for n in report["notes"])

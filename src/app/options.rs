@@ -26,8 +26,9 @@ pub struct RemeshOptions {
     /// `--sigma-p S`: the kernel width, instead of `points` (giving both is an error).
     pub sigma_p: Option<f64>,
     /// `--edge-length L`: output edges about L long (model units, the input's own), instead of
-    /// `points` or `sigma_p`: the count of equilateral triangles of that edge on the input's
-    /// area (meshes).
+    /// `points` or `sigma_p`: for a mesh the count of equilateral triangles of that edge on the
+    /// input's area, for a point set sigma_p = L / 1.2 in bbox-100 units (its sampling's mean
+    /// edge is 1.2 sigma_p).
     pub edge_length: Option<f64>,
     /// `--sigma-n S`: the normal width; `None` is infinity (isotropic sampling).
     pub sigma_n: Option<f64>,

@@ -1,7 +1,8 @@
 //! The quality job: the report on any mesh, against a reference in the reference's bbox-100
 //! frame.
 
-use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
+use crate::geometry::crossing_curve::{output_spacing, CrossingCurve};
+use crate::geometry::self_intersection::intersecting_pairs;
 use crate::timing::Clock;
 use crate::RemeshOutput;
 use glam::DVec3;
@@ -147,9 +148,10 @@ impl FileFrame {
 }
 
 /// How many of the crossing pairs of `stored` (the written mesh as [`as_quality_reads`] gives
-/// it, at the file's coordinates; `checked` is the same in `file`'s frame) lie where the input's own faces cross or its closed parts meet (both
-/// faces reach into the input's [`CrossingRegions`], loosened by sigma_p, mapped into that
-/// frame).
+/// it, at the file's coordinates; `checked` is the same in `file`'s frame) are the input's:
+/// both faces lie within one output spacing (the mean edge of `checked`) of the curve where
+/// the input's own faces cross or its closed parts meet ([`CrossingCurve`]), whatever vertex
+/// they share.
 pub(super) fn crossings_of_the_input(
     out: &RemeshOutput,
     checked: &TriMesh,
@@ -157,7 +159,7 @@ pub(super) fn crossings_of_the_input(
     file: &FileFrame,
     run_up: i32,
 ) -> usize {
-    if out.input_crossing_pairs.is_empty() && out.junction_faces.is_empty() {
+    if out.input_crossing_pairs.is_empty() && out.junction.is_empty() {
         return 0;
     }
     let Some(to_file) = file.map(run_up) else {
@@ -169,15 +171,12 @@ pub(super) fn crossings_of_the_input(
         .iter()
         .map(|&p| to_file(out.normalization.invert(p)))
         .collect();
-    // sigma_p in the file's frame: the two frames differ by a scale.
-    let unit = to_file(out.normalization.invert(DVec3::X))
-        - to_file(out.normalization.invert(DVec3::ZERO));
-    let regions = CrossingRegions::new(
+    let regions = CrossingCurve::new(
         &positions,
         &input.triangles,
         &out.input_crossing_pairs,
-        &out.junction_faces,
-        out.sigma_p * unit.length(),
+        &out.junction,
+        output_spacing(&checked.positions, &checked.triangles),
     );
     let pairs = intersecting_pairs(&stored.positions, &stored.triangles);
     regions.count_inside(&checked.positions, &checked.triangles, &pairs)

@@ -114,6 +114,14 @@ pub(super) fn run(
         ));
     }
 
+    if let Density::EdgeLength(l) = job.params.density {
+        report.notes.push(format!(
+            "--edge-length {l}: sigma_p {:.6} (bbox-100; a point set's mean edge is 1.2 \
+             sigma_p), {} vertices written",
+            out.sigma_p,
+            out.mesh.vertex_count()
+        ));
+    }
     let extra = &mut report.extra;
     insert_kernel_extras(extra, out.sigma_p, &job.params, out.target);
     extra.insert("input_points".into(), out.input_points.into());

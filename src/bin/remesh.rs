@@ -70,9 +70,10 @@ struct Cli {
     #[arg(long)]
     sigma_p: Option<f64>,
 
-    /// Output edges about L long, in the input's own units, instead of --points: the count of
-    /// equilateral triangles of that edge on the input's area (printed in the notes). Meshes
-    /// only.
+    /// Output edges about L long, in the input's own units, instead of --points: for a mesh the
+    /// count of equilateral triangles of that edge on the input's area, for a point set (whose
+    /// area is known only once its surface is) sigma_p = L / 1.2 in bbox-100 units (its
+    /// sampling's mean edge is 1.2 sigma_p; printed in the notes).
     #[arg(long, value_name = "L", conflicts_with_all = ["points", "sigma_p"])]
     edge_length: Option<f64>,
 

@@ -10,7 +10,8 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::geometry::face_intersection::{faces_intersect, share_a_vertex};
-use crate::geometry::self_intersection::{pairs_within, CrossingRegions};
+use crate::geometry::crossing_curve::CrossingCurve;
+use crate::geometry::self_intersection::pairs_within;
 use crate::geometry::triangle::{
     is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,
 };
@@ -34,7 +35,7 @@ pub struct UntangleParams {
     pub max_step_sigma_p: f64,
     /// Edge collapses at most when moves leave crossing pairs (default 100). Only for pairs that
     /// are the triangulation's own folds, which collapsing their edges removes: where the input
-    /// mesh passes through itself or its parts meet (the [`CrossingRegions`] given to
+    /// mesh passes through itself or its parts meet (the [`CrossingCurve`] given to
     /// [`untangle`]) a crossing is the input's, and collapses would eat the part.
     pub max_collapses: usize,
     /// How far a collapse may leave the two old positions of its edge from the faces it makes
@@ -121,7 +122,7 @@ pub fn untangle(
     fixed: &[bool],
     sigma_p: f64,
     params: &UntangleParams,
-    input_crossings: Option<&CrossingRegions>,
+    input_crossings: Option<&CrossingCurve>,
 ) -> (UntangleStats, Vec<Option<u32>>) {
     let u = untangle_known(mesh, fixed, sigma_p, params, input_crossings, None);
     (u.stats, u.origin)
@@ -148,7 +149,7 @@ pub(crate) fn untangle_known(
     fixed: &[bool],
     sigma_p: f64,
     params: &UntangleParams,
-    input_crossings: Option<&CrossingRegions>,
+    input_crossings: Option<&CrossingCurve>,
     known: Option<Vec<[u32; 2]>>,
 ) -> Untangled {
     let start = mesh.positions.clone();
@@ -184,8 +185,16 @@ pub(crate) fn untangle_known(
         };
     // The pairs that lie outside the input's own crossings: a round may trade a pair where the
     // input crosses for nothing, never for one where it does not.
+    // A fold (faces that share a vertex) counts as outside wherever it lies: it is mended.
     let outside = |positions: &[DVec3], pairs: &[[u32; 2]]| match input_crossings {
-        Some(r) => pairs.len() - r.count_inside(positions, &triangles, pairs),
+        Some(r) => pairs
+            .iter()
+            .filter(|&&[f, g]| {
+                let (a, b) = (triangles[f as usize], triangles[g as usize]);
+                let c = |t: [u32; 3]| t.map(|v| positions[v as usize]);
+                !r.holds_faces(a, c(a), b, c(b))
+            })
+            .count(),
         None => pairs.len(),
     };
     let mut pairs_outside = outside(&mesh.positions, &pairs);
@@ -691,7 +700,7 @@ mod tests {
         m.positions[poke].z = -0.3;
         let input = m.clone();
         let pairs = intersecting_pairs(&input.positions, &input.triangles);
-        let regions = CrossingRegions::new(&input.positions, &input.triangles, &pairs, &[], 0.01);
+        let regions = CrossingCurve::new(&input.positions, &input.triangles, &pairs, &[], 0.01);
         let d0 = m.positions.len() as u32;
         let p = m.positions[poke];
         m.positions.extend([
@@ -831,11 +840,14 @@ mod tests {
         // faces that share no vertex is the input's, and no collapse eats it: a second flat grid
         // passing upright through the first.
         let everywhere = |m: &TriMesh| {
-            CrossingRegions::new(
+            CrossingCurve::new(
                 &m.positions,
                 &m.triangles,
                 &[],
-                &(0..m.triangles.len() as u32).collect::<Vec<_>>(),
+                &m.triangles
+                    .iter()
+                    .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+                    .collect::<Vec<_>>(),
                 0.1,
             )
         };

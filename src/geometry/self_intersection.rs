@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 #[cfg(doc)]
 use super::face_intersection::faces_intersect;
-use super::face_intersection::{faces_within, share_a_vertex, PairKind};
+use super::face_intersection::{faces_within, PairKind};
 use super::triangle::{face_key, is_degenerate_face};
 
 /// The pairs of `boxes` (items of [`face_boxes`]: a face index and its bounding box) whose
@@ -217,91 +217,6 @@ pub(crate) fn intersecting_pairs_in(
         .collect();
     pairs.sort_unstable();
     pairs
-}
-
-/// Where a mesh's own faces cross or touch: for each intersecting pair, the overlap of the two
-/// faces' bounding boxes, and the box of each face where two parts meet at a non-manifold edge
-/// (the faces at the junction of the input's sheets, `mesh::sheets`: parts that share an edge,
-/// or lie on each other along a face), each loosened by a margin, in a BVH. The finishing stage
-/// leaves alone the output faces that cross inside these regions (the crossing is the input's
-/// own: a scene's parts passing through or lying on each other, an STL's welded corners), and
-/// mends the others; the report counts the output's crossings inside them apart.
-pub struct CrossingRegions {
-    bvh: Bvh,
-    count: usize,
-}
-
-impl CrossingRegions {
-    /// The regions of the intersecting `pairs` (as [`intersecting_pairs`] gives them) and of the
-    /// `touching` faces of the faces `triangles` over `positions`, each box loosened by `margin`
-    /// (same units).
-    pub fn new(
-        positions: &[DVec3],
-        triangles: &[[u32; 3]],
-        pairs: &[[u32; 2]],
-        touching: &[u32],
-        margin: f64,
-    ) -> Self {
-        let face_box = |h: u32| triangle_aabb(triangles[h as usize].map(|v| positions[v as usize]));
-        let loosen = DVec3::splat(margin);
-        let overlaps = pairs.iter().map(|&[f, g]| {
-            let [a, b] = [f, g].map(face_box);
-            (a.mins.max(b.mins), a.maxs.min(b.maxs))
-        });
-        let faces = touching.iter().map(|&f| {
-            let a = face_box(f);
-            (a.mins, a.maxs)
-        });
-        let boxes = overlaps
-            .chain(faces)
-            .enumerate()
-            .map(|(i, (lo, hi))| (i, Aabb::new(lo - loosen, hi + loosen)));
-        CrossingRegions {
-            bvh: crate::geometry::bvh::bvh_of(boxes),
-            count: pairs.len() + touching.len(),
-        }
-    }
-
-    /// How many of the crossing `pairs` of the faces `triangles` over `positions` (another mesh
-    /// in the same frame, the output) lie in a region ([`Self::holds_faces`]).
-    pub fn count_inside(
-        &self,
-        positions: &[DVec3],
-        triangles: &[[u32; 3]],
-        pairs: &[[u32; 2]],
-    ) -> usize {
-        let corners = |f: u32| triangles[f as usize].map(|v| positions[v as usize]);
-        pairs
-            .iter()
-            .filter(|&&[f, g]| {
-                let (a, b) = (triangles[f as usize], triangles[g as usize]);
-                self.holds_faces(a, corners(f), b, corners(g))
-            })
-            .count()
-    }
-
-    /// Whether the crossing pair of faces `a` and `b` (vertex indices of one mesh) with corners
-    /// `pa` and `pb` is the input's: they share no vertex and both reach into a region. A pair
-    /// that shares a vertex (a fold of the output's own faces) never is.
-    pub fn holds_faces(&self, a: [u32; 3], pa: [DVec3; 3], b: [u32; 3], pb: [DVec3; 3]) -> bool {
-        !share_a_vertex(a, b) && self.holds(pa, pb)
-    }
-
-    /// Whether the crossing pair of triangles with corners `f` and `g` lies in a region: both
-    /// reach into one.
-    pub fn holds(&self, f: [DVec3; 3], g: [DVec3; 3]) -> bool {
-        self.meets(f) && self.meets(g)
-    }
-
-    /// Whether there is no region.
-    pub fn is_empty(&self) -> bool {
-        self.count == 0
-    }
-
-    /// Whether the triangle with corners `p` reaches into a region (its bounding box meets one).
-    pub fn meets(&self, p: [DVec3; 3]) -> bool {
-        self.count > 0 && self.bvh.intersect_aabb(&triangle_aabb(p)).next().is_some()
-    }
 }
 
 /// The intersecting pairs of [`intersecting_pairs_counted`], without the count of tests.

@@ -153,24 +153,6 @@ impl Sheets {
             .collect();
         Some(TriMesh::new(positions, triangles))
     }
-
-    /// The faces that have a corner on the junction, ascending.
-    pub fn junction_faces(&self, mesh: &TriMesh) -> Vec<u32> {
-        if self.junction.is_empty() {
-            return Vec::new();
-        }
-        let mut is_junction = vec![false; mesh.positions.len()];
-        for &v in &self.junction {
-            is_junction[v as usize] = true;
-        }
-        (0..mesh.triangles.len() as u32)
-            .filter(|&f| {
-                mesh.triangles[f as usize]
-                    .iter()
-                    .any(|&v| is_junction[v as usize])
-            })
-            .collect()
-    }
 }
 
 #[cfg(test)]
@@ -210,7 +192,6 @@ mod tests {
         assert_eq!(s.of_face, vec![0, 0, 0, 0, 4, 4, 4, 4]);
         assert_eq!(s.part, s.of_face);
         assert_eq!(s.junction, vec![0, 1]);
-        assert_eq!(s.junction_faces(&m), (0..8).collect::<Vec<u32>>());
         let split = s.split(&m).unwrap();
         // Vertices 0 and 1 get one copy each, for the second tetrahedron.
         assert_eq!(split.positions.len(), 8);

@@ -12,7 +12,8 @@ use crate::finish::optimize::{mend_near, optimize, MendStats, OptimizeParams, Op
 use crate::finish::stray_shells::{remove_stray_shells, StrayShells};
 use crate::finish::untangle::{untangle_known, UntangleParams, UntangleStats, Untangled};
 use crate::geometry::face_intersection::faces_intersect;
-use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
+use crate::geometry::crossing_curve::CrossingCurve;
+use crate::geometry::self_intersection::intersecting_pairs;
 use crate::geometry::triangle::AngleBounds;
 use crate::mesh::{orient_consistently, OrientStats, TriMesh};
 use crate::surface::feature_lines::FeatureLines;
@@ -58,7 +59,7 @@ pub(crate) struct Finishing<'a, S: SurfaceQuery + ?Sized> {
     /// The input's boundary curves, which boundary vertices slide along.
     pub boundary: Option<&'a FeatureLines>,
     /// Where the input crosses itself: the output's crossings there are left alone.
-    pub input_crossings: Option<&'a CrossingRegions>,
+    pub input_crossings: Option<&'a CrossingCurve>,
     /// The kernel width the samples were placed at.
     pub sigma_p: f64,
     /// The local optimization (`None`: skipped).
@@ -289,11 +290,11 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
 
 /// Whether faces of `mesh` intersect ([`intersecting_pairs`]; `known`: those pairs, when the
 /// caller has them) other than where the input's own faces cross (a pair that shares a vertex,
-/// a fold, always counts: as [`CrossingRegions::holds_faces`] says).
+/// a fold, always counts: as [`CrossingCurve::holds_faces`] says).
 fn has_own_crossings(
     mesh: &TriMesh,
     known: Option<Vec<[u32; 2]>>,
-    regions: Option<&CrossingRegions>,
+    regions: Option<&CrossingCurve>,
 ) -> bool {
     let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
     known

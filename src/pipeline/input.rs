@@ -142,11 +142,13 @@ impl NormalizedInput {
 pub(super) struct InputIndex<'a> {
     pub surface: MeshSurface,
     pub buried_test: Option<BuriedTest<'a>>,
-    /// Pairs of faces that cross (looked for only when the input passes through itself).
+    /// Pairs of faces that cross (looked for only when the input passes through itself), also
+    /// when there is no buried test.
     pub crossing_pairs: Vec<[u32; 2]>,
     pub sheets: Sheets,
-    /// The faces where closed parts meet at a non-manifold edge.
-    pub junction_faces: Vec<u32>,
+    /// The non-manifold edges (of more than two faces: where sheets meet), as vertex pairs
+    /// (lower first), ascending.
+    pub junction: Vec<[u32; 2]>,
     /// Whether every edge of the input has at most two faces: only then is the input's topology
     /// one the output can keep, and the triangulation inserts samples for it.
     pub manifold_edges: bool,
@@ -169,14 +171,20 @@ impl<'a> InputIndex<'a> {
         // Where parts of the input meet at non-manifold edges (the triangulation keeps them
         // apart).
         let sheets = Sheets::new(mesh);
-        let junction_faces = sheets.junction_faces(mesh);
-        let manifold_edges = mesh.edge_uses().values().all(|&(_, uses)| uses <= 2);
+        let mut junction: Vec<[u32; 2]> = mesh
+            .edge_uses()
+            .into_iter()
+            .filter(|&(_, (_, uses))| uses > 2)
+            .map(|((a, b), _)| [a, b])
+            .collect();
+        junction.sort_unstable();
+        let manifold_edges = junction.is_empty();
         Ok(InputIndex {
             surface,
             buried_test,
             crossing_pairs,
             sheets,
-            junction_faces,
+            junction,
             manifold_edges,
         })
     }

@@ -20,7 +20,7 @@ mod triangulation;
 
 use crate::error::{Error, Result};
 use crate::finish::untangle::UntangleParams;
-use crate::geometry::self_intersection::CrossingRegions;
+use crate::geometry::crossing_curve::{output_spacing, CrossingCurve};
 use crate::mesh::{Normalization, TriMesh};
 use crate::sampling::sizing::SizingField;
 use crate::sampling::spacing::sigma_p_for_count;
@@ -185,11 +185,11 @@ pub fn remesh(
     };
     let InputIndex {
         crossing_pairs,
-        junction_faces,
+        junction,
         ..
     } = index;
     let found = (&features, feature_stats, &sizing, search.sigma_ref);
-    let record = (crossing_pairs, junction_faces, &candidates, found);
+    let record = (crossing_pairs, junction, &candidates, found);
     let output = output::assemble(input, record, run, target, reached, search.history, timer);
     if output.mesh.triangles.is_empty() {
         // Too few samples for any triangle to form (a handful of points on a closed surface, or
@@ -268,14 +268,21 @@ fn run_once<'s>(
     let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, &tri_params);
     timer.lap("triangulate");
 
-    // Where the input's faces cross or its parts meet: an output face within a spacing of there
-    // is there.
-    let input_crossings = (!index.crossing_pairs.is_empty() || !index.junction_faces.is_empty())
-        .then(|| {
-            let m = &input.mesh;
-            let (pairs, junctions) = (&index.crossing_pairs, &index.junction_faces);
-            CrossingRegions::new(&m.positions, &m.triangles, pairs, junctions, sigma_p)
-        });
+    // Where the input's faces cross or its parts meet: an output face within one output
+    // spacing (the triangulation's mean edge) of there is there, and the finishing stage leaves
+    // its crossings there. Its crossings count only where the buried test made the output follow
+    // the outer surface: without the test (an open input too large for it) both sheets are
+    // sampled and pressed apart (the report still counts the pairs at every crossing).
+    let pairs: &[[u32; 2]] = match index.buried_test {
+        Some(_) => &index.crossing_pairs,
+        None => &[],
+    };
+    let input_crossings = (!pairs.is_empty() || !index.junction.is_empty()).then(|| {
+        let m = &input.mesh;
+        let t = &triangulated.mesh;
+        let reach = output_spacing(&t.positions, &t.triangles);
+        CrossingCurve::new(&m.positions, &m.triangles, pairs, &index.junction, reach)
+    });
     // With grading, tiny closed shells at tips too thin for the count go when the output has
     // more parts than the input.
     let sigma_ref = scanned.widths.sigma_ref;

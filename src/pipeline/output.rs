@@ -118,11 +118,11 @@ pub struct RemeshOutput {
     /// The pairs of `input_normalized`'s faces that cross (looked for only when the input
     /// passes through itself), as `geometry::self_intersection::intersecting_pairs` gives them.
     pub input_crossing_pairs: Vec<[u32; 2]>,
-    /// The faces of `input_normalized` where closed parts meet at a non-manifold edge (the junction
-    /// of `mesh::sheets::Sheets`). With `input_crossing_pairs`, what
-    /// [`CrossingRegions`](crate::internal::CrossingRegions) are built from: where the output's
+    /// The non-manifold edges of `input_normalized` (of more than two faces: where sheets
+    /// meet), as vertex pairs, ascending. With `input_crossing_pairs`, what the
+    /// [`CrossingCurve`](crate::internal::CrossingCurve) is built from: where the output's
     /// crossings are the input's own.
-    pub junction_faces: Vec<u32>,
+    pub junction: Vec<[u32; 2]>,
     /// What the least-squares fit to the input did (`None` when it was off).
     pub fit: Option<crate::finish::fit::FitStats>,
     /// How each face of `mesh` came in.
@@ -155,7 +155,7 @@ pub struct RemeshOutput {
 /// sigma_ref.
 pub(super) type Record<'a> = (
     Vec<[u32; 2]>,
-    Vec<u32>,
+    Vec<[u32; 2]>,
     &'a Candidates,
     (&'a Features, FeatureStats, &'a Sizing, f64),
 );
@@ -163,7 +163,7 @@ pub(super) type Record<'a> = (
 /// The output of the last run: the mesh back in model units, and the record of every stage.
 pub(super) fn assemble(
     input: NormalizedInput,
-    (input_crossing_pairs, junction_faces, candidates, found): Record,
+    (input_crossing_pairs, junction, candidates, found): Record,
     run: Run,
     target: Target,
     target_reached: bool,
@@ -217,7 +217,7 @@ pub(super) fn assemble(
         mend_after_untangle: finished.mend_after_untangle,
         degenerate: finished.degenerate,
         input_crossing_pairs,
-        junction_faces,
+        junction,
         fit: finished.fit,
         face_sources: triangulated.face_sources,
         dropped_samples: finished.dropped_samples,

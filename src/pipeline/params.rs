@@ -23,8 +23,9 @@ pub enum Density {
     /// As many output vertices as the input has vertices (the command line's default).
     InputVertices,
     /// Output edges about this long, model units: the count of equilateral triangles of this
-    /// edge on the input's area, 2 A / (√3 L²), then as for `Points` (meshes
-    /// only: a point set's area is known only once its surface is).
+    /// edge on the input's area, 2 A / (√3 L²), then as for `Points`; for a point set (whose
+    /// area is known only once its surface is) sigma_p = L / 1.2 in bbox-100 units
+    /// (`sampling::spacing::POINT_SET_EDGE_PER_SIGMA`).
     EdgeLength(f64),
 }
 

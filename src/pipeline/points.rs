@@ -492,16 +492,18 @@ fn remesh_points_once(
             input.display()
         ),
     };
+    let mut edge_length = None;
     let (target, sigma_p) = match rp.density {
-        Density::EdgeLength(_) => {
+        Density::EdgeLength(l) if !(l.is_finite() && l > 0.0) => {
             return Err(Error::InvalidParameter {
                 name: "edge_length",
-                message: format!(
-                    "{} is a point set, whose area is not known before its surface is: give the \
-                     output's vertex count with `points` (or its sigma_p with `sigma_p`)",
-                    input.display()
-                ),
+                message: format!("must be a positive number, got {}", crate::error::shown(l)),
             })
+        }
+        // sigma_p is the length in bbox-100 units, once the points' bounding box is known.
+        Density::EdgeLength(l) => {
+            edge_length = Some(l);
+            (None, 1.0)
         }
         Density::Points(n) => (Some(n), 1.0),
         Density::SigmaP(s) => (None, s),
@@ -538,6 +540,7 @@ fn remesh_points_once(
     let scan_params = OutOfCoreParams {
         target,
         sigma_p,
+        edge_length,
         sigma_n: rp.sigma_n,
         scan: rp.linear_scan,
         bucket_points: params.bucket_points,

@@ -31,8 +31,13 @@ use crate::surface::SurfaceSample;
 pub struct OutOfCoreParams {
     /// The output density: `Some(n)` searches sigma_p for about n samples.
     pub target: Option<usize>,
-    /// sigma_p in bbox-100 units, used when `target` is `None`.
+    /// sigma_p in bbox-100 units, used when `target` and `edge_length` are `None`.
     pub sigma_p: f64,
+    /// Output edges about this long, in model units, when `target` is `None`: sigma_p is that
+    /// length in bbox-100 units (the points' bounding box, known once they are read) over the
+    /// mean edge a point set's sampling gives per sigma_p
+    /// ([`POINT_SET_EDGE_PER_SIGMA`](crate::sampling::spacing::POINT_SET_EDGE_PER_SIGMA)).
+    pub edge_length: Option<f64>,
     /// sigma_n (infinity: positions only).
     pub sigma_n: f64,
     /// The linear scan's epsilon and support radius.
@@ -55,6 +60,7 @@ impl Default for OutOfCoreParams {
         OutOfCoreParams {
             target: None,
             sigma_p: 1.0,
+            edge_length: None,
             sigma_n: f64::INFINITY,
             scan: LinearScanParams::default(),
             bucket_points: 1 << 20,
@@ -299,10 +305,14 @@ impl ScannedInput {
             Bucketed::Parts(parts) => return Ok(Opened::Parts(parts)),
         };
         let t1 = Instant::now();
-        // sigma_p: given, or searched on a scaled-down problem (see `search_sigma_p`).
+        // sigma_p: given (as itself or as an edge length in model units), or searched on a
+        // scaled-down problem (see `search_sigma_p`).
+        let given = params.edge_length.map_or(params.sigma_p, |l| {
+            l * buckets.normalization.scale / crate::sampling::spacing::POINT_SET_EDGE_PER_SIGMA
+        });
         let mut filter = None;
         let sigma_p = if params.target.is_none() && !drop_outliers {
-            params.sigma_p
+            given
         } else {
             let mut first = buckets.load(0, &mut rng)?;
             if drop_outliers {
@@ -320,7 +330,7 @@ impl ScannedInput {
                 filter = Some(f);
             }
             match params.target {
-                None => params.sigma_p,
+                None => given,
                 Some(n) => search_sigma_p(&first, buckets.total, n, params)?,
             }
         };

@@ -18,6 +18,12 @@ pub const BOUNDARY_SPACING_PER_SIGMA: f64 = 1.0;
 /// `docs/decisions/feature-spacing.md`).
 pub const FEATURE_SPACING_PER_SIGMA: f64 = 1.15;
 
+/// The mean edge of a point set's output in units of sigma_p: its samples lie sparser than a
+/// mesh's at the same sigma_p (the RIMLS surface's projection). Measured at sigma_p 2 and 6.25:
+/// 1.18 (20,000 points on a sphere), 1.19 (../shared/scans/bun000.xyz), 1.22
+/// (../shared/scans/milk.pcd). `--edge-length L` on a point set takes sigma_p = L / this (bbox-100).
+pub const POINT_SET_EDGE_PER_SIGMA: f64 = 1.2;
+
 /// The samples a surface of area `area` with boundary curves `boundary_length` long (bbox-100
 /// units) is expected to get at `sigma_p`: `SAMPLES_PER_SIGMA2 · A / sigma_p²` inside and one
 /// per `BOUNDARY_SPACING_PER_SIGMA · sigma_p` along the boundary.

@@ -77,19 +77,17 @@ impl<'a> BuriedTest<'a> {
         Self::of_crossing(mesh, points, rays)
     }
 
-    /// [`BuriedTest::new`] and, when there is a test, the pairs of `mesh`'s faces that cross
+    /// [`BuriedTest::new`] and the pairs of `mesh`'s faces that cross
     /// ([`intersecting_pairs`](crate::geometry::self_intersection::intersecting_pairs), found
-    /// on the test's own BVH; empty without a test).
+    /// on the test's own BVH), also when there is no test (an open input too large for it): the
+    /// output's faces where the input's cross are the input's crossings either way.
     pub fn with_crossings(mesh: &'a TriMesh, points: usize) -> (Option<Self>, Vec<[u32; 2]>) {
         let rays = RayWinding::new(mesh);
         let pairs = rays.crossing_pairs();
         if pairs.is_empty() {
             return (None, pairs);
         }
-        match Self::of_crossing(mesh, points, rays) {
-            Some(test) => (Some(test), pairs),
-            None => (None, Vec::new()),
-        }
+        (Self::of_crossing(mesh, points, rays), pairs)
     }
 
     /// The test of a `mesh` that crosses itself, on its ray count `rays`.

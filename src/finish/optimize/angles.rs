@@ -7,7 +7,8 @@ use glam::DVec3;
 use super::*;
 use crate::geometry::face_intersection::share_a_vertex;
 use crate::geometry::polygon_triangulation::max_min_triangulation;
-use crate::geometry::self_intersection::{intersecting_pairs, CrossingRegions};
+use crate::geometry::crossing_curve::CrossingCurve;
+use crate::geometry::self_intersection::intersecting_pairs;
 use crate::mesh::crossing_guard::CrossingGuard;
 use crate::mesh::edit::EditError;
 use crate::surface::feature_lines::FeatureLines;
@@ -71,7 +72,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
     boundary: Option<&FeatureLines>,
-    input_crossings: Option<&CrossingRegions>,
+    input_crossings: Option<&CrossingCurve>,
     fixed: &[bool],
     params: &Limits,
     near: Option<&[bool]>,
@@ -84,7 +85,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     };
     // A crossing inside a region where the input's own faces cross is the input's: it is left
     // as it is (and costs no attempt). A fold (two faces that share a vertex) never is.
-    let own = |m: &Mesh, t: [u32; 3]| input_crossings.is_some_and(|r| r.meets(m.corners(t)));
+    let own = |m: &Mesh, t: [u32; 3]| input_crossings.is_some_and(|r| r.near(m.corners(t)));
     let bound = params.final_theta_deg;
     // The faces to mend: those with a small angle, smallest first, then those that cross
     // another face (of `pairs`, the intersecting pairs of live slots).

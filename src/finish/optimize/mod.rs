@@ -4,7 +4,7 @@
 //!
 //! The operations and their guards are described on [`optimize`].
 
-use crate::geometry::self_intersection::CrossingRegions;
+use crate::geometry::crossing_curve::CrossingCurve;
 use crate::geometry::tolerance::IMPROVEMENT_TOLERANCE;
 use glam::DVec3;
 use parry3d_f64::query::PointQuery;
@@ -344,7 +344,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     protected: &[[u32; 2]],
     boundary: Option<&FeatureLines>,
-    input_crossings: Option<&CrossingRegions>,
+    input_crossings: Option<&CrossingCurve>,
     sigma_p: f64,
     params: &OptimizeParams,
 ) -> (OptimizeStats, Edited) {
@@ -412,7 +412,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
 /// still better its angles, as the last pass may).
 pub(super) struct SweepGuard<'a> {
     pub faces: CrossingGuard,
-    pub input_crossings: Option<&'a CrossingRegions>,
+    pub input_crossings: Option<&'a CrossingCurve>,
 }
 
 impl SweepGuard<'_> {
@@ -421,7 +421,7 @@ impl SweepGuard<'_> {
     pub(super) fn refuses(&self, m: &Mesh, new: &[[u32; 3]], replaced: &[u32]) -> bool {
         let at_input_crossing = self
             .input_crossings
-            .is_some_and(|r| new.iter().any(|&t| r.meets(m.corners(t))));
+            .is_some_and(|r| new.iter().any(|&t| r.near(m.corners(t))));
         !at_input_crossing && self.faces.crosses(m, new, replaced)
     }
 
@@ -480,7 +480,7 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     protected: &[[u32; 2]],
     boundary: Option<&FeatureLines>,
-    input_crossings: Option<&CrossingRegions>,
+    input_crossings: Option<&CrossingCurve>,
     sigma_p: f64,
     params: &OptimizeParams,
     near: &[bool],
