@@ -223,8 +223,9 @@ def remesh(
         The kernel width in bbox-100 units, instead of points.
     edge_length : float or None
         Output edges about this long, in the input's own units, instead of points or sigma_p:
-        the count of equilateral triangles of that edge on the input's area (the report's notes
-        give it). Meshes only.
+        for a mesh the count of equilateral triangles of that edge on the input's area, for a
+        point set sigma_p = that length / 1.2 in bbox-100 units (its sampling's mean edge is
+        1.2 sigma_p); the report's notes give it.
     sigma_n : float or None
         The normal width; finite values give feature-adaptive sampling. None: infinity.
     seed : int
