@@ -83,7 +83,7 @@ fn fuzz_regression_a_bvh_of_two_faces_not_numbered_0_and_1_panicked() {
 #[test]
 fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[u8], &str); 6] = [
+    let cases: [(&[u8], &str); 7] = [
         (
             include_bytes!("fuzz/read_las-laszip-record-of-no-items.laz"),
             "LASzip record",
@@ -115,6 +115,12 @@ fn fuzz_regression_las_records_the_file_cannot_hold_are_errors() {
         (
             include_bytes!("fuzz/read_las-variable-chunks-without-a-table.laz"),
             "chunks of variable size",
+        ),
+        // Corrupt compressed extra bytes: the laz crate's arithmetic decoder indexed its table
+        // past its end ("index out of bounds: the len is 66 but the index is 96").
+        (
+            include_bytes!("fuzz/read_las-corrupt-extra-bytes-stream.laz"),
+            "compressed points are corrupt",
         ),
     ];
     for (bytes, says) in cases {

@@ -36,7 +36,7 @@ impl LasPoints {
     /// [`Error::Parse`] naming the file for a file the `las` crate cannot read (not LAS or LAZ,
     /// a damaged header, a LAZ without its LASzip record).
     pub(crate) fn open(path: &Path) -> Result<Self> {
-        let count = reader(path)?.header().number_of_points();
+        let count = decoding(path, || Ok(reader(path)?.header().number_of_points()))?;
         Ok(LasPoints { count })
     }
 
@@ -62,13 +62,15 @@ impl LasPoints {
             line: None,
             message: format!("a point record the las crate cannot read: {e}"),
         };
-        let mut reader = reader(path)?;
-        // A fresh reader is at the first point; seeking there would fail for a LAZ without a
-        // chunk table.
-        if from > 0 {
-            reader.seek(from).map_err(bad)?;
-        }
-        let data = reader.read_points(n as u64).map_err(bad)?;
+        let data = decoding(path, || {
+            let mut reader = reader(path)?;
+            // A fresh reader is at the first point; seeking there would fail for a LAZ without
+            // a chunk table.
+            if from > 0 {
+                reader.seek(from).map_err(bad)?;
+            }
+            reader.read_points(n as u64).map_err(bad)
+        })?;
         let before = out.len();
         out.extend(
             data.x()
@@ -384,6 +386,33 @@ fn reader(path: &Path) -> Result<las::Reader> {
         path: path.to_path_buf(),
         line: None,
         message: format!("not a LAS or LAZ file the las crate can read: {e}"),
+    })
+}
+
+/// Runs `read` (the `las` and `laz` crates at work on the file at `path`), a panic inside it an
+/// error naming the file. The `laz` crate's arithmetic decoder indexes its tables with values
+/// decoded from the compressed bytes and panics on corrupt ones ("index out of bounds" in
+/// `decoders.rs`, found by the read_las fuzz target): compressed data can be corrupt anywhere,
+/// which no check of the header rules out. (The process's panic hook still sees the panic: the
+/// command line's records it silently.)
+///
+/// # Errors
+/// `read`'s, or [`Error::Parse`] naming the file and the panic's message.
+fn decoding<T>(path: &Path, read: impl FnOnce() -> Result<T>) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)).unwrap_or_else(|payload| {
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown cause".into());
+        Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: None,
+            message: format!(
+                "the compressed points are corrupt (the LAZ decoder failed: {})",
+                message.replace('\n', " ")
+            ),
+        })
     })
 }
 
