@@ -211,12 +211,12 @@ fn a_double_sided_export_is_made_single() {
     assert_bounded_work(&report);
 }
 
-#[test]
-fn a_two_part_scene_keeps_both_parts_apart() {
-    let a = common::icosphere(3);
-    let mut b = common::icosphere(3);
+/// Two unit icospheres (subdivision `level`), the second `dx` along x from the first.
+fn two_spheres(level: u32, dx: f64) -> TriMesh {
+    let a = common::icosphere(level);
+    let mut b = common::icosphere(level);
     for p in &mut b.positions {
-        *p += DVec3::new(3.0, 0.0, 0.0);
+        *p += DVec3::new(dx, 0.0, 0.0);
     }
     let offset = a.positions.len() as u32;
     let mut scene = a;
@@ -224,7 +224,12 @@ fn a_two_part_scene_keeps_both_parts_apart() {
     scene
         .triangles
         .extend(b.triangles.iter().map(|t| t.map(|i| i + offset)));
-    let (_, report) = remesh_guarded(scene, 2000, 1);
+    scene
+}
+
+#[test]
+fn a_two_part_scene_keeps_both_parts_apart() {
+    let (_, report) = remesh_guarded(two_spheres(3, 3.0), 2000, 1);
     assert_valid(&report);
     assert_eq!(report.topology.components, 2);
     assert!(report.topology.is_closed_manifold());
@@ -277,17 +282,7 @@ fn two_spheres_passing_through_each_other_cross_only_at_their_circle() {
     // spacing of the input's crossing curve, whatever vertex they share), the report counts
     // them so, and each pair's faces do lie by that circle (measured here, apart from the
     // code's own curve).
-    let a = common::icosphere(4);
-    let mut b = common::icosphere(4);
-    for p in &mut b.positions {
-        *p += DVec3::new(1.0, 0.0, 0.0);
-    }
-    let offset = a.positions.len() as u32;
-    let mut scene = a;
-    scene.positions.extend(b.positions);
-    scene
-        .triangles
-        .extend(b.triangles.iter().map(|t| t.map(|i| i + offset)));
+    let scene = two_spheres(4, 1.0);
     let circle = |p: DVec3| {
         let r = (p.y * p.y + p.z * p.z).sqrt();
         ((p.x - 0.5).powi(2) + (r - 0.75f64.sqrt()).powi(2)).sqrt()

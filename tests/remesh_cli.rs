@@ -913,23 +913,23 @@ fn edge_length_gives_edges_about_that_long() {
         "--report",
         report.to_str().unwrap(),
     ]);
+    // The written mesh's mean edge is within 10% of 0.25, and the notes say `note`.
+    let check = |what: &str, note: &str| {
+        let (written, _) = spectral_remesh::read_mesh(&out).unwrap();
+        let lengths: Vec<f64> = written
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k] as usize, t[(k + 1) % 3] as usize)))
+            .map(|(a, b)| written.positions[a].distance(written.positions[b]))
+            .collect();
+        let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
+        assert!((mean - 0.25).abs() < 0.025, "{what}: mean edge {mean}");
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        assert!(r["notes"].to_string().contains(note), "{what}: {}", r["notes"]);
+    };
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let (written, _) = spectral_remesh::read_mesh(&out).unwrap();
-    let mut lengths = Vec::new();
-    for t in &written.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            lengths.push(written.positions[a].distance(written.positions[b]));
-        }
-    }
-    let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
-    assert!((mean - 0.25).abs() < 0.025, "mean edge {mean}");
-    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
-    assert!(
-        r["notes"].to_string().contains("--edge-length 0.25: about"),
-        "{}",
-        r["notes"]
-    );
+    check("mesh", "--edge-length 0.25: about");
     // The same sphere as points with normals (20,000 drawn on it, a fixed sequence).
     let points = dir.path().join("sphere.xyzn");
     let mut text = String::new();
@@ -952,21 +952,7 @@ fn edge_length_gives_edges_about_that_long() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let (written, _) = spectral_remesh::read_mesh(&out).unwrap();
-    let lengths: Vec<f64> = written
-        .triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k] as usize, t[(k + 1) % 3] as usize)))
-        .map(|(a, b)| written.positions[a].distance(written.positions[b]))
-        .collect();
-    let mean = lengths.iter().sum::<f64>() / lengths.len() as f64;
-    assert!((mean - 0.25).abs() < 0.025, "point set: mean edge {mean}");
-    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
-    assert!(
-        r["notes"].to_string().contains("--edge-length 0.25: sigma_p"),
-        "{}",
-        r["notes"]
-    );
+    check("point set", "--edge-length 0.25: sigma_p");
     for bad in [
         &["--edge-length", "0"][..],
         &["--edge-length", "0.25", "--points", "100"],
