@@ -149,6 +149,9 @@ pub(super) struct InputIndex<'a> {
     /// The non-manifold edges (of more than two faces: where sheets meet), as vertex pairs
     /// (lower first), ascending.
     pub junction: Vec<[u32; 2]>,
+    /// Of those, the edges where closed parts meet (both ends on the sheets' junction): the
+    /// finishing stage leaves the output's crossings there alone.
+    pub part_junction: Vec<[u32; 2]>,
     /// Whether every edge of the input has at most two faces: only then is the input's topology
     /// one the output can keep, and the triangulation inserts samples for it.
     pub manifold_edges: bool,
@@ -178,6 +181,12 @@ impl<'a> InputIndex<'a> {
             .map(|((a, b), _)| [a, b])
             .collect();
         junction.sort_unstable();
+        let on_junction = |v: u32| sheets.junction.binary_search(&v).is_ok();
+        let part_junction: Vec<[u32; 2]> = junction
+            .iter()
+            .copied()
+            .filter(|&[a, b]| on_junction(a) && on_junction(b))
+            .collect();
         let manifold_edges = junction.is_empty();
         Ok(InputIndex {
             surface,
@@ -185,6 +194,7 @@ impl<'a> InputIndex<'a> {
             crossing_pairs,
             sheets,
             junction,
+            part_junction,
             manifold_edges,
         })
     }
