@@ -926,7 +926,11 @@ fn edge_length_gives_edges_about_that_long() {
         assert!((mean - 0.25).abs() < 0.025, "{what}: mean edge {mean}");
         let r: serde_json::Value =
             serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
-        assert!(r["notes"].to_string().contains(note), "{what}: {}", r["notes"]);
+        assert!(
+            r["notes"].to_string().contains(note),
+            "{what}: {}",
+            r["notes"]
+        );
     };
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     check("mesh", "--edge-length 0.25: about");
@@ -935,7 +939,9 @@ fn edge_length_gives_edges_about_that_long() {
     let mut text = String::new();
     let mut state = 1u64;
     let mut uniform = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     for _ in 0..20_000 {
@@ -943,11 +949,25 @@ fn edge_length_gives_edges_about_that_long() {
         let phi = std::f64::consts::TAU * uniform();
         let r = (1.0 - z * z).sqrt();
         let n = [r * phi.cos(), r * phi.sin(), z];
-        text += &format!("{} {} {} {} {} {}\n", 2.0 * n[0], 2.0 * n[1], 2.0 * n[2], n[0], n[1], n[2]);
+        text += &format!(
+            "{} {} {} {} {} {}\n",
+            2.0 * n[0],
+            2.0 * n[1],
+            2.0 * n[2],
+            n[0],
+            n[1],
+            n[2]
+        );
     }
     std::fs::write(&points, text).unwrap();
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_remesh"))
-        .args([points.to_str().unwrap(), out.to_str().unwrap(), "-q", "--edge-length", "0.25"])
+        .args([
+            points.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "-q",
+            "--edge-length",
+            "0.25",
+        ])
         .args(["--no-distance", "--report", report.to_str().unwrap()])
         .output()
         .unwrap();

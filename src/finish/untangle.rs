@@ -9,8 +9,8 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::geometry::face_intersection::{faces_intersect, share_a_vertex};
 use crate::geometry::crossing_curve::CrossingCurve;
+use crate::geometry::face_intersection::{faces_intersect, share_a_vertex};
 use crate::geometry::self_intersection::pairs_within;
 use crate::geometry::triangle::{
     is_degenerate_face, is_degenerate_triangle, triangle_min_angle_deg,

@@ -18,7 +18,9 @@ use parry3d_f64::partitioning::Bvh;
 use super::bvh::bvh_of;
 use super::face_intersection::share_a_vertex;
 use super::self_intersection::triangle_aabb;
-use super::triangle_intersection::{point_triangle_distance, segment_triangle_distance, triangles_within};
+use super::triangle_intersection::{
+    point_triangle_distance, segment_triangle_distance, triangles_within,
+};
 
 /// A piece of the curve.
 #[derive(Debug, Clone, Copy)]
@@ -153,7 +155,10 @@ pub fn output_spacing(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
 fn meeting(a: [DVec3; 3], b: [DVec3; 3]) -> Piece {
     let area = |t: [DVec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).length();
     let smaller = if area(a) <= area(b) { a } else { b };
-    let scale = a.iter().chain(&b).fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    let scale = a
+        .iter()
+        .chain(&b)
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     let tolerance = 1e-9 * scale.max(f64::MIN_POSITIVE);
     let mut points: Vec<DVec3> = Vec::with_capacity(6);
     for (s, t) in [(a, b), (b, a)] {
@@ -224,7 +229,11 @@ mod tests {
 
     /// A small face (0.1 across) at `c`, in the plane z = c.z.
     fn small_at(c: DVec3) -> [DVec3; 3] {
-        [c, c + DVec3::new(0.1, 0.0, 0.0), c + DVec3::new(0.0, 0.1, 0.0)]
+        [
+            c,
+            c + DVec3::new(0.1, 0.0, 0.0),
+            c + DVec3::new(0.0, 0.1, 0.0),
+        ]
     }
 
     #[test]
@@ -238,7 +247,11 @@ mod tests {
         assert!(!curve.near(small_at(DVec3::new(0.1, 0.75, 0.0))));
         // A pair sharing a vertex counts like any other: both faces near.
         let f = small_at(DVec3::new(0.3, 0.2, 0.0));
-        let g = [f[0], f[0] + DVec3::new(0.0, 0.0, 0.1), f[0] + DVec3::new(0.1, 0.1, 0.0)];
+        let g = [
+            f[0],
+            f[0] + DVec3::new(0.0, 0.0, 0.1),
+            f[0] + DVec3::new(0.1, 0.1, 0.0),
+        ];
         assert!(curve.holds(f, g));
         assert!(!curve.holds(f, small_at(DVec3::new(0.1, 0.75, 0.0))));
     }

@@ -5,9 +5,9 @@
 use glam::DVec3;
 
 use super::*;
+use crate::geometry::crossing_curve::CrossingCurve;
 use crate::geometry::face_intersection::share_a_vertex;
 use crate::geometry::polygon_triangulation::max_min_triangulation;
-use crate::geometry::crossing_curve::CrossingCurve;
 use crate::geometry::self_intersection::intersecting_pairs;
 use crate::mesh::crossing_guard::CrossingGuard;
 use crate::mesh::edit::EditError;
