@@ -35,8 +35,8 @@ pub struct OutOfCoreParams {
     pub sigma_p: f64,
     /// Output edges about this long, in model units, when `target` is `None`: sigma_p is that
     /// length in bbox-100 units (the points' bounding box, known once they are read) over the
-    /// mean edge a point set's sampling gives per sigma_p
-    /// ([`POINT_SET_EDGE_PER_SIGMA`](crate::sampling::spacing::POINT_SET_EDGE_PER_SIGMA)).
+    /// mean edge a point set's sampling gives per sigma_p (1.2:
+    /// `sampling::spacing::POINT_SET_EDGE_PER_SIGMA`).
     pub edge_length: Option<f64>,
     /// sigma_n (infinity: positions only).
     pub sigma_n: f64,
