@@ -10,7 +10,8 @@ pair is the output's own (a violation). Written apart from the Rust code, on oth
   predicates, the standard definition), the input read welded as remesh reads it
   (`ruler_check.weld`), without faces that repeat an index or another face's three vertices
   (as remesh's input cleanup), and taken apart into single faces (CGAL builds no polyhedral surface of
-  an input whose parts meet at non-manifold edges), its pairs that share a vertex left out;
+  an input whose parts meet at non-manifold edges) for the pairs that share no vertex, and the
+  standard definition's two other cases in floating point for those that share one or two;
 - the input's crossing curve: for each of its pairs the segment where the two triangles meet (the
   points where an edge of one passes through the other's plane inside the other, the two
   farthest apart; a coplanar pair: the smaller triangle), and where closed parts meet, the
@@ -125,16 +126,65 @@ def curve_samples(v, f, pairs, step):
     return np.concatenate(out) if out else np.zeros((0, 3))
 
 
+def segment_meets_triangle(p, q, t, eps=1e-12):
+    """Whether the closed segment p q meets the closed triangle t (floating point, Möller and
+    Trumbore's test with a relative tolerance; a segment in the triangle's plane: no)."""
+    e1, e2, d = t[1] - t[0], t[2] - t[0], q - p
+    h = np.cross(d, e2)
+    det = e1 @ h
+    scale = max(np.linalg.norm(e1) * np.linalg.norm(e2) * np.linalg.norm(d), 1e-300)
+    if abs(det) <= eps * scale:
+        return False
+    s = p - t[0]
+    u = (s @ h) / det
+    w = np.cross(s, e1)
+    vv = (d @ w) / det
+    r = (e2 @ w) / det
+    return -eps <= u <= 1 + eps and -eps <= vv and u + vv <= 1 + eps and -eps <= r <= 1 + eps
+
+
 def input_pairs(v, f):
-    """The pairs of the input's faces that meet and share no vertex: CGAL's pairs of the faces
-    taken apart (each its own three vertices), as CGAL cannot build a polyhedral surface of an
-    input whose parts meet at non-manifold edges; pairs of faces that share a vertex (which
-    then meet there) are left out, and with them any fold of the input's."""
+    """The pairs of the input's faces that intersect by the standard definition. Those that
+    share no vertex: CGAL's pairs of the faces taken apart (each its own three vertices), as CGAL
+    cannot build a polyhedral surface of an input whose parts meet at non-manifold edges (pairs
+    that then share a vertex are left to the next step). Those that share one vertex: the edge
+    of one opposite the shared vertex meets the other triangle (floating point). Those that share
+    an edge: coplanar, the third corners on the same side of it."""
     soup_v = v[f].reshape(-1, 3)
     soup_f = np.arange(3 * len(f), dtype=np.int64).reshape(-1, 3)
     pairs = cgal_pairs(soup_v, soup_f)
     keep = [k for k, (a, b) in enumerate(pairs.tolist()) if not set(f[a].tolist()) & set(f[b].tolist())]
-    return pairs[keep]
+    out = [tuple(p) for p in pairs[keep].tolist()]
+    around = {}
+    for i, t in enumerate(f.tolist()):
+        for x in t:
+            around.setdefault(x, []).append(i)
+    seen = set()
+    for faces in around.values():
+        for i in faces:
+            for j in faces:
+                if j <= i or (i, j) in seen:
+                    continue
+                seen.add((i, j))
+                a, b = f[i].tolist(), f[j].tolist()
+                shared = set(a) & set(b)
+                ta, tb = v[f[i]], v[f[j]]
+                if len(shared) == 1:
+                    s = shared.pop()
+                    ea = [v[x] for x in a if x != s]
+                    eb = [v[x] for x in b if x != s]
+                    if segment_meets_triangle(ea[0], ea[1], tb) or segment_meets_triangle(eb[0], eb[1], ta):
+                        out.append((i, j))
+                elif len(shared) == 2:
+                    n = np.cross(ta[1] - ta[0], ta[2] - ta[0])
+                    ca = [v[x] for x in a if x not in shared][0]
+                    cb = [v[x] for x in b if x not in shared][0]
+                    if abs(n @ (cb - ta[0])) <= 1e-12 * np.linalg.norm(n) * max(np.linalg.norm(cb - ta[0]), 1e-300):
+                        e0, e1 = [v[x] for x in shared]
+                        m = np.cross(n, e1 - e0)
+                        if (m @ (ca - e0)) * (m @ (cb - e0)) > 0:
+                            out.append((i, j))
+    return np.array(sorted(set(out)), dtype=np.int64).reshape(-1, 2)
 
 
 def classify(input_path, output_path):
