@@ -19,6 +19,7 @@ mod sizing;
 mod triangulation;
 
 use crate::error::{Error, Result};
+use crate::finish::optimize::OptimizeParams;
 use crate::finish::untangle::UntangleParams;
 use crate::geometry::crossing_curve::CrossingCurve;
 use crate::mesh::{Normalization, TriMesh};
@@ -302,6 +303,16 @@ fn run_once<'s>(
                 .as_ref()
                 .is_some_and(|g| shell.iter().all(|&p| g.width(p, sigma_ref) < 1.0))
     };
+    // Faces that would touch once written in model units are separated too, and the
+    // optimization's guards keep them that far apart.
+    let near = params
+        .untangle
+        .near
+        .max(input.normalization.written_rounding());
+    let optimize = params.optimize.map(|op| OptimizeParams {
+        near: op.near.max(near),
+        ..op
+    });
     let finishing = Finishing {
         surface: &index.surface,
         cover_points: &candidates.cover_points,
@@ -311,14 +322,10 @@ fn run_once<'s>(
         boundary: input.boundary_lines.as_ref(),
         input_crossings: input_crossings.as_ref(),
         sigma_p,
-        optimize: params.optimize.as_ref(),
+        optimize: optimize.as_ref(),
         fit_iterations: params.fit_iterations,
-        // Faces that would touch once written in model units are separated too.
         untangle: UntangleParams {
-            near: params
-                .untangle
-                .near
-                .max(input.normalization.written_rounding()),
+            near,
             ..params.untangle
         },
         stray: sizing.grading.as_ref().map(|_| StrayRule {

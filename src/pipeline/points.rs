@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::finish::crossing_faces::{remove_crossing_faces, remove_faces_of_pairs, CrossingFaces};
-use crate::finish::optimize::{mend_near, MendStats, OptimizeStats};
+use crate::finish::optimize::{mend_near, MendStats, OptimizeParams, OptimizeStats};
 use crate::finish::stray_shells::{remove_tiny_pieces, StrayShells};
 use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
 use crate::kernel::Kernel;
@@ -770,6 +770,11 @@ fn remesh_points_once(
         near: rp.untangle.near.max(normalization.written_rounding()),
         ..rp.untangle
     };
+    // The optimization's guards keep faces that far apart too.
+    let optimize = rp.optimize.map(|op| OptimizeParams {
+        near: op.near.max(untangle_params.near),
+        ..op
+    });
     let no_fixed = vec![false; mesh.positions.len()];
     let (untangle_umbrellas, _) = untangle(&mut mesh, &no_fixed, sigma_p, &untangle_params, None);
     timer.lap("triangulate");
@@ -802,7 +807,7 @@ fn remesh_points_once(
         boundary: boundary_lines.as_ref(),
         input_crossings: None,
         sigma_p,
-        optimize: rp.optimize.as_ref(),
+        optimize: optimize.as_ref(),
         fit_iterations: 0,
         untangle: untangle_params,
         stray: Some(StrayRule {
@@ -857,7 +862,7 @@ fn remesh_points_once(
     // the optimization's last pass mends those of small angle again (the vertices of the new
     // boundary and their neighbours), under its guards (no new crossing, on the surface).
     let mut mend_after_removals = MendStats::default();
-    if let Some(op) = rp.optimize.as_ref() {
+    if let Some(op) = optimize.as_ref() {
         let near = around_new_boundary(&mesh, &boundary_before);
         if near.iter().any(|&n| n) {
             let fixed_now: Vec<bool> = (0..mesh.positions.len()).map(|i| i < fixed).collect();

@@ -8,7 +8,7 @@ use super::*;
 use crate::geometry::crossing_curve::CrossingCurve;
 use crate::geometry::face_intersection::share_a_vertex;
 use crate::geometry::polygon_triangulation::max_min_triangulation;
-use crate::geometry::self_intersection::intersecting_pairs;
+use crate::geometry::self_intersection::pairs_within;
 use crate::mesh::crossing_guard::CrossingGuard;
 use crate::mesh::edit::EditError;
 use crate::surface::feature_lines::FeatureLines;
@@ -31,7 +31,8 @@ enum Op {
 
 /// Mends the faces of `m` whose smallest angle is below `params.final_theta_deg` (worst first;
 /// with `near`, only those with a corner marked in it, vertices beyond it unmarked), then the
-/// faces that cross another face (the exact pairs of [`intersecting_pairs`]), in up to
+/// faces that cross another face (the pairs of [`pairs_within`] `params.near`: exact, or nearer
+/// than that), in up to
 /// `params.final_rounds` rounds. For each such face the candidates are: the max-min flip of each
 /// of its edges, the collapse of each of its edges (an end that may move merges into the other,
 /// at the other's position or, when both may move, at the surface point nearest the edge's
@@ -60,14 +61,16 @@ enum Op {
 ///   than the two old faces were (measured at the surface points nearest the two diagonals'
 ///   midpoints), a collapse leaves both old positions within it of the new faces, and a move
 ///   leaves the old position within it of them;
-/// - no new face shares a point with a face it has no vertex in common with (the exact test of
-///   [`triangles_intersect`], against the faces near it), so the pass makes no crossing and a
-///   crossing face is replaced only by faces that cross nothing.
+/// - no new face shares a point with a face it has no vertex in common with, nor comes within
+///   `params.near` of one (the crossing guard's test, against the faces near it), so the pass
+///   makes no crossing, nor faces that touch once written, and a crossing face is replaced only
+///   by faces that cross nothing.
 ///
 /// Returns what was done ([`MendStats`]): the operations made and the attempts against the
 /// pass's budget ([`MEND_BUDGET_PER_FACE`] per face, at most [`MEND_TRIES_PER_FACE`] failed
 /// attempts a face); and the pairs of faces (slots, the smaller first, sorted) that intersect
-/// at the end, as [`intersecting_pairs`] over the live faces gives them. Deterministic.
+/// or come within `params.near` of it at the end, as [`pairs_within`] over the live faces gives
+/// them. Deterministic.
 pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
@@ -119,7 +122,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     // faces it left alone stand), through the guard.
     let mut pairs: Vec<[u32; 2]> = {
         let (live, slots) = m.live_faces();
-        let mut pairs: Vec<[u32; 2]> = intersecting_pairs(m.positions(), &live)
+        let mut pairs: Vec<[u32; 2]> = pairs_within(m.positions(), &live, params.near)
             .into_iter()
             .map(|[f, g]| {
                 let (a, b) = (slots[f as usize], slots[g as usize]);
@@ -138,7 +141,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
         stats.left = faces_left(m, params, |t| own(m, t));
         return (stats, pairs);
     }
-    let mut guard = CrossingGuard::new(m);
+    let mut guard = CrossingGuard::within(m, params.near);
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(false);
     // The failed attempts at each face slot, and the vertices the previous round's operations
     // touched (`None` in the first round, when every target is tried): a later round tries a

@@ -76,6 +76,13 @@ pub struct OptimizeParams {
     /// Iterations of the tangential relaxation with valence flips before covering (`smooth.rs`;
     /// default [`SMOOTH_ITERATIONS`], 0 turns it off).
     pub smooth_iterations: usize,
+    /// Faces nearer than this count as crossing for the operations' crossing guard and the last
+    /// pass's crossing faces (bbox-100 units, not σ_p): faces that would share a point once the
+    /// mesh is written, whose coordinates are rounded (the finishing stage sets it, as
+    /// [`UntangleParams::near`](crate::finish::untangle::UntangleParams::near), to
+    /// [`Normalization::written_rounding`](crate::internal::Normalization::written_rounding)).
+    /// Default 0: the exact test alone.
+    pub near: f64,
 }
 
 impl OptimizeParams {
@@ -105,6 +112,7 @@ impl Default for OptimizeParams {
             final_theta_max_deg: 100.0,
             final_rounds: 8,
             smooth_iterations: SMOOTH_ITERATIONS,
+            near: 0.0,
         }
     }
 }
@@ -139,6 +147,8 @@ pub(super) struct Limits {
     pub(super) final_rounds: usize,
     /// [`OptimizeParams::smooth_iterations`].
     pub(super) smooth_iterations: usize,
+    /// [`OptimizeParams::near`], bbox-100 units.
+    pub(super) near: f64,
 }
 
 impl Limits {
@@ -165,6 +175,7 @@ impl Limits {
             final_theta_max_deg: params.final_theta_max_deg,
             final_rounds: params.final_rounds,
             smooth_iterations: params.smooth_iterations,
+            near: params.near.max(0.0),
         }
     }
 }

@@ -1,5 +1,6 @@
 use super::*;
 use crate::geometry::self_intersection::classified_pairs;
+use crate::geometry::self_intersection::intersecting_pairs;
 use crate::mesh::test_meshes::grid;
 
 /// The smallest angle of the live faces, degrees.
@@ -496,4 +497,66 @@ fn mend_near_says_which_faces_of_its_result_intersect() {
     assert!(!found.is_empty(), "the test case: a crossing left");
     assert_eq!(mended.intersecting, found);
     assert_eq!(mended.origin.len(), mesh.triangles.len());
+}
+
+#[test]
+fn with_a_near_distance_the_pass_brings_no_faces_that_close() {
+    // The poked sheets 0.2 apart, and a triangle hanging from above with its tip 0.05 over the
+    // upper sheet where the poke's faces will lie once the pass lifts the poke out of the
+    // lower sheet (they now slope down under it, 0.3 below the tip). With `near` 0.1 no pair
+    // of faces within 0.1 is made (faces that would touch once written are as bad as faces
+    // that cross), and the pairs the pass gives are those within 0.1.
+    let (surface, mut mesh, poke) = poked_sheets();
+    let p = mesh.positions[poke];
+    let tip = DVec3::new(p.x + 0.5, p.y + 0.15, 0.25);
+    let n = mesh.positions.len() as u32;
+    mesh.positions.extend([
+        DVec3::new(tip.x - 0.3, tip.y, 1.0),
+        DVec3::new(tip.x + 0.3, tip.y, 1.0),
+        tip,
+    ]);
+    mesh.triangles.push([n, n + 1, n + 2]);
+    let near = 0.1;
+    let within = |m: &Mesh| -> Vec<[u32; 2]> {
+        let (live, slots) = m.live_faces();
+        let mut pairs: Vec<[u32; 2]> = pairs_within(m.positions(), &live, near)
+            .into_iter()
+            .map(|p| {
+                let [a, b] = p.map(|i| slots[i as usize]);
+                [a.min(b), a.max(b)]
+            })
+            .collect();
+        pairs.sort_unstable();
+        pairs
+    };
+    let start: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+    let before = within(&start);
+    let made_close = |m: &Mesh| within(m).into_iter().any(|p| !before.contains(&p));
+    // The hanging triangle is the pass's own: fixed.
+    let fixed: Vec<bool> = (0..mesh.positions.len()).map(|v| v >= n as usize).collect();
+    let run = |near: f64| {
+        let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
+        let params = Limits::new(
+            &OptimizeParams {
+                near,
+                ..OptimizeParams::default()
+            },
+            4.0,
+        );
+        let (made, left) = mend_faces(&mut m, &surface, None, None, &fixed, &params, None);
+        (m, made, left)
+    };
+    // The test case: with the exact guard alone, the lift crosses nothing and leaves the tip
+    // closer than 0.1 to a face.
+    let (m, made, _) = run(0.0);
+    assert!(made.ops >= 1);
+    assert!(
+        slot_pairs(&m).is_empty(),
+        "the test case: the crossing mended"
+    );
+    assert!(made_close(&m), "the test case: faces brought close");
+    let (m, _, left) = run(near);
+    assert_eq!(left, within(&m));
+    assert!(!made_close(&m), "{left:?} from {before:?}");
+    assert_eq!(m.sanity_check(), Ok(()));
 }
