@@ -823,6 +823,52 @@ fn gltf_node_transforms_are_composed() {
     );
 }
 
+/// Node transforms are read in `f64` from the JSON, as written: a matrix and a translation with
+/// digits past `f32`'s (mode5.gltf writes its matrices with 16) place the vertices where the
+/// numbers say, not where their `f32` roundings would (4e-7 away here).
+#[test]
+fn gltf_node_transforms_keep_the_digits_written() {
+    let positions: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let bin: Vec<u8> = positions
+        .iter()
+        .flatten()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    let (x, y) = (-12.15649276676408_f64, 38.16685478814292_f64);
+    assert!(
+        (f64::from(x as f32) - x).abs() > 1e-7,
+        "the test case: digits past f32"
+    );
+    let doc = serde_json::json!({
+        "asset": { "version": "2.0" },
+        "scene": 0,
+        "scenes": [ { "nodes": [0, 1] } ],
+        "nodes": [
+            { "matrix": [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+                         x, y, 0.0, 1.0], "mesh": 0 },
+            { "translation": [x, y, 5.0], "rotation": [0.0, 0.0, 0.0, 1.0], "mesh": 0 }
+        ],
+        "meshes": [ { "primitives": [ { "attributes": { "POSITION": 0 } } ] } ],
+        "accessors": [ { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                         "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0] } ],
+        "bufferViews": [ { "buffer": 0, "byteLength": 36 } ],
+        "buffers": [ { "byteLength": 36,
+                       "uri": format!("data:application/octet-stream;base64,{}", base64(&bin)) } ]
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("digits.gltf");
+    fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
+    let (m, _) = read_mesh(&path).unwrap();
+    assert_eq!(m.vertex_count(), 6);
+    for (k, z) in [(0, 0.0), (3, 5.0)] {
+        let got = m.positions[k];
+        assert!(
+            got.distance(DVec3::new(x, y, z)) < 1e-12,
+            "{got} != ({x}, {y}, {z})"
+        );
+    }
+}
+
 #[test]
 fn gltf_strips_fans_and_scene_less_files() {
     // Four vertices of a unit square; a strip and a fan over them, u8 indices; no scene.
