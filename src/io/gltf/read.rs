@@ -725,10 +725,11 @@ fn component(b: &[u8], ty: DataType, normalized: bool) -> f64 {
 /// fields are not the numbers the specification asks for, which validation has refused already):
 /// the `matrix` as stored, or `translation`, `rotation` and `scale` composed as T · R · S (glTF
 /// 2.0 Sec. 3.5.3; the stored quaternion normalized). The `gltf` crate parses them into `f32`,
-/// which moves a point 50 units from the origin by up to 4e-6: faces of two nodes that touch in
-/// the file came apart or into each other by that much (mode5.gltf, whose matrices are written
-/// with 16 digits: 1704 crossing pairs read, where trimesh reading the same numbers in `f64`
-/// finds 1120). `json` is the file's JSON (a GLB's JSON chunk).
+/// each number rounded by up to half its unit in the last place (2e-6 for a translation of 50):
+/// faces of two nodes that touch or lie apart in the file came apart or into each other by that
+/// much (mode5.gltf, whose matrices are written with 16 digits: 1704 crossing pairs read, where
+/// trimesh reading the same numbers in `f64` finds 1120, and we now 1117). `json` is the file's
+/// JSON (a GLB's JSON chunk).
 fn node_transforms(json: &[u8]) -> Vec<Option<DMat4>> {
     let Ok(value) = serde_json::from_slice::<serde_json::Value>(json) else {
         return Vec::new();
