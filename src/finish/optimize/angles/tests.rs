@@ -23,8 +23,14 @@ fn flat(n: usize) -> (TriMesh, MeshSurface) {
 /// The intersecting pairs of `m`'s live faces ([`intersecting_pairs`]), as slots, the smaller
 /// first, sorted: a search of the whole mesh.
 fn slot_pairs(m: &Mesh) -> Vec<[u32; 2]> {
+    as_slots(m, intersecting_pairs)
+}
+
+/// The pairs `search` finds over `m`'s live faces (indices into them), as slots, the smaller
+/// first, sorted.
+fn as_slots(m: &Mesh, search: impl Fn(&[DVec3], &[[u32; 3]]) -> Vec<[u32; 2]>) -> Vec<[u32; 2]> {
     let (live, slots) = m.live_faces();
-    let mut pairs: Vec<[u32; 2]> = intersecting_pairs(m.positions(), &live)
+    let mut pairs: Vec<[u32; 2]> = search(m.positions(), &live)
         .into_iter()
         .map(|p| {
             let [a, b] = p.map(|i| slots[i as usize]);
@@ -517,18 +523,7 @@ fn with_a_near_distance_the_pass_brings_no_faces_that_close() {
     ]);
     mesh.triangles.push([n, n + 1, n + 2]);
     let near = 0.1;
-    let within = |m: &Mesh| -> Vec<[u32; 2]> {
-        let (live, slots) = m.live_faces();
-        let mut pairs: Vec<[u32; 2]> = pairs_within(m.positions(), &live, near)
-            .into_iter()
-            .map(|p| {
-                let [a, b] = p.map(|i| slots[i as usize]);
-                [a.min(b), a.max(b)]
-            })
-            .collect();
-        pairs.sort_unstable();
-        pairs
-    };
+    let within = |m: &Mesh| as_slots(m, |p, t| pairs_within(p, t, near));
     let start: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
     let before = within(&start);
     let made_close = |m: &Mesh| within(m).into_iter().any(|p| !before.contains(&p));
