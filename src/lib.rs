@@ -36,7 +36,8 @@
 //! optimize                       local operations against the input surface (cover, collapse,
 //!   │                            flip, relax)
 //! untangle                       move apart faces that still cross
-//!   │
+//!   (refine)                     where the output's own crossings are left: their faces'
+//!   │                            edges split at the surface, untangle again, in rounds
 //! check_invariants, topology,    manifold, oriented, no degenerate or duplicate face; counts;
 //!   self_intersections           crossing faces
 //!   │
@@ -250,6 +251,7 @@ pub mod internal {
         optimize, FacesLeft, MendStats, OptimizeParams, OptimizeStats, SmoothStats,
         SMOOTH_ITERATIONS,
     };
+    pub use crate::finish::refine::{refine_faces, RefineCrossingsParams, RefineCrossingsStats};
     pub use crate::finish::stray_shells::StrayShells;
     pub use crate::finish::untangle::{untangle, UntangleParams, UntangleStats};
     pub use crate::geometry::crossing_curve::CrossingCurve;

@@ -330,6 +330,9 @@ pub(super) fn remesh_read(
     if out.mend_after_untangle.attempts > 0 {
         insert_json(extra, "mend_after_untangle", out.mend_after_untangle);
     }
+    if out.refine.rounds > 0 {
+        insert_json(extra, "refine", out.refine);
+    }
     if out.degenerate.found > 0 {
         insert_json(extra, "degenerate", out.degenerate);
     }

@@ -167,6 +167,9 @@ pub(super) fn run(
     if out.mend_after_untangle.attempts > 0 {
         insert_json(extra, "mend_after_untangle", out.mend_after_untangle);
     }
+    if out.refine.rounds > 0 {
+        insert_json(extra, "refine", out.refine);
+    }
     insert_json(extra, "untangle_umbrellas", out.untangle_umbrellas);
     insert_json(extra, "output_orientation", out.output_orientation);
     report.notes.push(format!(

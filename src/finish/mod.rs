@@ -8,6 +8,7 @@
 //!   crossing another (`angles.rs`; `mend_near` runs it again after the untangling);
 //! - [`fit`]: the least-squares fit of the vertices to the surface, along their normals;
 //! - [`untangle`]: faces that cross each other moved apart;
+//! - [`refine`]: where faces still cross, their edges split at the surface (then untangle again);
 //! - [`degenerate`]: faces of no area mended;
 //! - [`stray_shells`]: the tiny closed shells left at unresolved tips removed;
 //! - [`crossing_faces`]: on an open output (a point set's), the faces that still cross removed.
@@ -19,5 +20,6 @@ pub mod crossing_faces;
 pub mod degenerate;
 pub mod fit;
 pub mod optimize;
+pub mod refine;
 pub mod stray_shells;
 pub mod untangle;

@@ -9,9 +9,10 @@ use glam::DVec3;
 use crate::finish::degenerate::{mend_degenerate_faces, DegenerateStats};
 use crate::finish::fit::{fit_to_surface, FitStats};
 use crate::finish::optimize::{mend_near, optimize, MendStats, OptimizeParams, OptimizeStats};
+use crate::finish::refine::{refine_faces, RefineCrossingsParams, RefineCrossingsStats};
 use crate::finish::stray_shells::{remove_stray_shells, StrayShells};
 use crate::finish::untangle::{untangle_known, UntangleParams, UntangleStats, Untangled};
-use crate::geometry::crossing_curve::CrossingCurve;
+use crate::geometry::crossing_curve::{output_spacing, CrossingCurve};
 use crate::geometry::face_intersection::faces_intersect;
 use crate::geometry::self_intersection::intersecting_pairs;
 use crate::geometry::triangle::AngleBounds;
@@ -60,6 +61,9 @@ pub(crate) struct Finishing<'a, S: SurfaceQuery + ?Sized> {
     pub boundary: Option<&'a FeatureLines>,
     /// Where the input crosses itself: the output's crossings there are left alone.
     pub input_crossings: Option<&'a CrossingCurve>,
+    /// The report's rule of whose a crossing is, which the refinement mends by (`None`: every
+    /// crossing is the output's own).
+    pub crossing_rule: Option<CrossingRule<'a>>,
     /// The kernel width the samples were placed at.
     pub sigma_p: f64,
     /// The local optimization (`None`: skipped).
@@ -68,8 +72,28 @@ pub(crate) struct Finishing<'a, S: SurfaceQuery + ?Sized> {
     pub fit_iterations: usize,
     /// The separation of crossing faces.
     pub untangle: UntangleParams,
+    /// The refinement where the output still crosses itself after that (`max_rounds` 0: none).
+    pub refine: RefineCrossingsParams,
     /// Stray shells to leave out (`None`: all kept).
     pub stray: Option<StrayRule<'a>>,
+}
+
+/// The mesh as a round of refinement found it, and the vertices removed until then.
+struct Kept {
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    sources: Vec<FaceSource>,
+    later_dropped: usize,
+}
+
+/// The input's crossings as the report counts them (`app::quality`): a crossing pair of the
+/// output is the input's when both faces lie within one output spacing of the curve of the
+/// input's crossing `pairs` and non-manifold `edges` (of `mesh`, bbox-100 units).
+#[derive(Clone, Copy)]
+pub(crate) struct CrossingRule<'a> {
+    pub mesh: &'a TriMesh,
+    pub pairs: &'a [[u32; 2]],
+    pub edges: &'a [[u32; 2]],
 }
 
 /// What the finishing stage did.
@@ -86,6 +110,8 @@ pub(crate) struct Finished {
     /// The optimization's last pass again around the faces untangle's collapses changed (none
     /// without collapses or without the optimization).
     pub mend_after_untangle: MendStats,
+    /// The rounds of refinement and untangling where the output's own crossings were left.
+    pub refine: RefineCrossingsStats,
     pub degenerate: DegenerateStats,
     pub stray_shells: StrayShells,
     /// What orienting the output did (closed parts turned outward).
@@ -130,14 +156,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     let renumbered = mesh.compact_vertices();
     let dropped_samples = renumbered.iter().filter(|&&i| i == u32::MAX).count();
     // The protected edges by the new numbers, for the mending after untangle.
-    let protected: Vec<[u32; 2]> = f
-        .protected
-        .iter()
-        .filter_map(|e| {
-            let [a, b] = e.map(|v| renumbered.get(v as usize).copied().unwrap_or(u32::MAX));
-            (a != u32::MAX && b != u32::MAX).then_some([a, b])
-        })
-        .collect();
+    let protected = renumber_edges(f.protected, &renumbered);
     timer.lap("optimize");
     on_stage("untangle");
     let fixed = fixed_prefix(mesh.positions.len());
@@ -173,6 +192,8 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     // The pairs within untangle's `near` the first stage left when it collapsed nothing: the
     // second starts from them (no search).
     let mut known: Option<Vec<[u32; 2]>> = None;
+    // The output's own crossing pairs the last stage left.
+    let mut own_left: Option<Vec<[u32; 2]>> = None;
     for (stage, offset) in [f.untangle.collapse_offset_sigma_p, f64::INFINITY]
         .into_iter()
         .enumerate()
@@ -230,25 +251,158 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             later_dropped += mesh.remove_unreferenced_vertices();
         } else if let Some(left) = left {
             // Of the pairs left within `near`, those that intersect.
-            let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
-            intersecting = Some(
-                left.iter()
-                    .copied()
-                    .filter(|&[f, g]| {
-                        let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
-                        faces_intersect(a, corners(a), b, corners(b)).is_some()
-                    })
-                    .collect(),
-            );
+            intersecting = Some(intersecting_of(mesh, left.clone()));
             known = Some(left);
         }
         // The second stage only where the first left the output's own folds or crossings.
         // Untangle's pairs at the end are those within its `near` (0 or more) of the mesh as it
         // is when it collapsed nothing: none of them, no face crossing either (no search).
         let none_left = stats.collapses == 0 && stats.pairs_after == 0;
-        if none_left || !has_own_crossings(mesh, intersecting.take(), f.input_crossings) {
+        let own = if none_left {
+            Vec::new()
+        } else {
+            own_crossings(mesh, intersecting.take(), f.input_crossings)
+        };
+        let done = own.is_empty();
+        own_left = Some(own);
+        if done {
             break;
         }
+    }
+    // Where the output's own crossings are left (its chords cut across a sheet of the input
+    // that lies closer than the spacing, or long faces fan out of fixed crease samples), the
+    // crossing faces' edges are split at the surface and untangle runs again, in rounds.
+    let mut refine = RefineCrossingsStats::default();
+    if f.refine.max_rounds > 0 {
+        // By the report's rule, at the output's spacing now (the splits change it little).
+        let rule = f
+            .crossing_rule
+            .filter(|r| !r.pairs.is_empty() || !r.edges.is_empty())
+            .map(|r| {
+                let reach = output_spacing(&mesh.positions, &mesh.triangles);
+                CrossingCurve::new(
+                    &r.mesh.positions,
+                    &r.mesh.triangles,
+                    r.pairs,
+                    r.edges,
+                    reach,
+                )
+            });
+        let by_rule = |mesh: &TriMesh, pairs: Vec<[u32; 2]>| -> Vec<[u32; 2]> {
+            let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
+            let mut pairs = pairs;
+            pairs.retain(|&[f, g]| {
+                let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
+                rule.as_ref()
+                    .is_none_or(|r| !r.holds(corners(a), corners(b)))
+            });
+            pairs
+        };
+        let mut own = by_rule(
+            mesh,
+            own_left.unwrap_or_else(|| own_crossings(mesh, None, f.input_crossings)),
+        );
+        let mut protected = protected;
+        refine.pairs_before = own.len();
+        // The fewest own pairs yet, and the mesh that had them once a later round changed it.
+        let mut best: (usize, Option<Kept>) = (own.len(), None);
+        while refine.rounds < f.refine.max_rounds && !own.is_empty() {
+            refine.rounds += 1;
+            if best.1.is_none() {
+                best.1 = Some(Kept {
+                    positions: mesh.positions.clone(),
+                    triangles: mesh.triangles.clone(),
+                    sources: face_sources.clone(),
+                    later_dropped,
+                });
+            }
+            let mut faces: Vec<u32> = own.iter().flatten().copied().collect();
+            faces.sort_unstable();
+            faces.dedup();
+            let (splits, refused, origin) = refine_faces(
+                mesh,
+                f.surface,
+                &faces,
+                &protected,
+                f.refine.min_edge_sigma_p * f.sigma_p,
+            );
+            refine.splits += splits;
+            refine.refused += refused;
+            if splits == 0 {
+                best.1 = None;
+                break;
+            }
+            *face_sources = carried_sources(&origin, face_sources);
+            // The vertices of the faces the splits made, for the mending after untangle.
+            let split_faces = around_changed_faces(mesh, &origin, &[]);
+            let fixed = fixed_prefix(mesh.positions.len());
+            let none_fixed = vec![false; mesh.positions.len()];
+            let untangle_fixed = if f.untangle_moves_fixed {
+                &none_fixed
+            } else {
+                &fixed
+            };
+            let params = UntangleParams {
+                collapse_offset_sigma_p: f64::INFINITY,
+                ..f.untangle
+            };
+            let Untangled {
+                stats,
+                origin,
+                left,
+                ..
+            } = untangle_known(
+                mesh,
+                untangle_fixed,
+                f.sigma_p,
+                &params,
+                f.input_crossings,
+                None,
+            );
+            untangle_stats = untangle_stats.then(&stats);
+            if stats.collapses > 0 {
+                *face_sources = carried_sources(&origin, face_sources);
+            }
+            let mut pairs = None;
+            if let Some(op) = f.optimize {
+                // The faces the splits made and those untangle changed, and their neighbours:
+                // the last pass mends their angles under its guards.
+                let mut near = around_changed_faces(mesh, &origin, &split_faces);
+                near.resize(mesh.positions.len(), false);
+                let (stats, mended) = mend_near(
+                    mesh,
+                    f.surface,
+                    &fixed,
+                    &protected,
+                    f.boundary,
+                    f.input_crossings,
+                    f.sigma_p,
+                    op,
+                    &near,
+                );
+                *face_sources = carried_sources(&mended.origin, face_sources);
+                mend_after_untangle = mend_after_untangle.then(&stats);
+                pairs = Some(mended.intersecting);
+            } else if stats.collapses == 0 {
+                pairs = left.map(|left| intersecting_of(mesh, left));
+            }
+            let renumbered = mesh.compact_vertices();
+            later_dropped += renumbered.iter().filter(|&&i| i == u32::MAX).count();
+            protected = renumber_edges(&protected, &renumbered);
+            own = by_rule(mesh, own_crossings(mesh, pairs, f.input_crossings));
+            if own.len() < best.0 {
+                best = (own.len(), None);
+            }
+        }
+        // The rounds after the one with the fewest own pairs are taken back.
+        if let (_, Some(kept)) = best {
+            mesh.positions = kept.positions;
+            mesh.triangles = kept.triangles;
+            *face_sources = kept.sources;
+            later_dropped = kept.later_dropped;
+            own = by_rule(mesh, own_crossings(mesh, None, f.input_crossings));
+        }
+        refine.pairs_after = own.len();
     }
     // No face of no area is written.
     let (degenerate, origin) = mend_degenerate_faces(mesh, &fixed);
@@ -282,28 +436,51 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
         fit,
         untangle: untangle_stats,
         mend_after_untangle,
+        refine,
         degenerate,
         stray_shells,
         orientation,
     }
 }
 
-/// Whether faces of `mesh` intersect ([`intersecting_pairs`]; `known`: those pairs, when the
-/// caller has them) other than where the input's own faces cross (a pair that shares a vertex,
-/// a fold, always counts: as [`CrossingCurve::holds_faces`] says).
-fn has_own_crossings(
+/// The pairs of faces of `mesh` that intersect ([`intersecting_pairs`]; `known`: those pairs,
+/// when the caller has them) other than where the input's own faces cross (a pair that shares a
+/// vertex, a fold, always counts: as [`CrossingCurve::holds_faces`] says).
+fn own_crossings(
     mesh: &TriMesh,
     known: Option<Vec<[u32; 2]>>,
     regions: Option<&CrossingCurve>,
-) -> bool {
+) -> Vec<[u32; 2]> {
     let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
-    known
-        .unwrap_or_else(|| intersecting_pairs(&mesh.positions, &mesh.triangles))
-        .iter()
-        .any(|&[f, g]| {
+    let mut pairs = known.unwrap_or_else(|| intersecting_pairs(&mesh.positions, &mesh.triangles));
+    pairs.retain(|&[f, g]| {
+        let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
+        regions.is_none_or(|r| !r.holds_faces(a, corners(a), b, corners(b)))
+    });
+    pairs
+}
+
+/// Of the pairs of faces `left` within untangle's `near` of each other, those that intersect.
+fn intersecting_of(mesh: &TriMesh, left: Vec<[u32; 2]>) -> Vec<[u32; 2]> {
+    let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
+    left.into_iter()
+        .filter(|&[f, g]| {
             let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
-            regions.is_none_or(|r| !r.holds_faces(a, corners(a), b, corners(b)))
+            faces_intersect(a, corners(a), b, corners(b)).is_some()
         })
+        .collect()
+}
+
+/// `edges` by the vertices' new indices (`renumbered`, as [`TriMesh::compact_vertices`] gives
+/// them), those with a removed end left out.
+fn renumber_edges(edges: &[[u32; 2]], renumbered: &[u32]) -> Vec<[u32; 2]> {
+    edges
+        .iter()
+        .filter_map(|e| {
+            let [a, b] = e.map(|v| renumbered.get(v as usize).copied().unwrap_or(u32::MAX));
+            (a != u32::MAX && b != u32::MAX).then_some([a, b])
+        })
+        .collect()
 }
 
 /// The vertices of the faces of `mesh` that the presses of untangle put out of the angle

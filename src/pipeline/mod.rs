@@ -29,7 +29,7 @@ use crate::surface::features::Features;
 use crate::timing::StageTimer;
 use crate::triangulate::TriangulationMethod;
 use ascent::{ascend, Ascended};
-use finish::{finish, Finished, Finishing, StrayRule};
+use finish::{finish, CrossingRule, Finished, Finishing, StrayRule};
 use input::{Candidates, InputIndex, NormalizedInput};
 use params::Target;
 use scan::{Scanned, Search};
@@ -328,6 +328,12 @@ fn run_once<'s>(
             near,
             ..params.untangle
         },
+        refine: params.refine,
+        crossing_rule: Some(CrossingRule {
+            mesh: &input.mesh,
+            pairs: &index.crossing_pairs,
+            edges: &index.junction,
+        }),
         stray: sizing.grading.as_ref().map(|_| StrayRule {
             keep: sizing.input_components,
             stray: &stray,

@@ -113,6 +113,8 @@ pub struct RemeshOutput {
     pub untangle: UntangleStats,
     /// The optimization's last pass again around the faces untangle's collapses changed.
     pub mend_after_untangle: MendStats,
+    /// The refinement where the output's own crossings were left after untangle.
+    pub refine: crate::finish::refine::RefineCrossingsStats,
     /// What the mending of faces of no area did.
     pub degenerate: crate::finish::degenerate::DegenerateStats,
     /// The pairs of `input_normalized`'s faces that cross (looked for only when the input
@@ -215,6 +217,7 @@ pub(super) fn assemble(
         optimize: finished.optimize,
         untangle: finished.untangle,
         mend_after_untangle: finished.mend_after_untangle,
+        refine: finished.refine,
         degenerate: finished.degenerate,
         input_crossing_pairs,
         junction,

@@ -2,6 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::finish::optimize::OptimizeParams;
+use crate::finish::refine::RefineCrossingsParams;
 use crate::finish::untangle::UntangleParams;
 use crate::kernel::Kernel;
 use crate::mesh::TriMesh;
@@ -68,6 +69,9 @@ pub struct RemeshParams {
     pub optimize: Option<OptimizeParams>,
     /// The separation of crossing faces, last.
     pub untangle: UntangleParams,
+    /// Where the output's own crossings are left after that: the refinement of the crossing
+    /// faces, untangle again after each round (`max_rounds` 0: none).
+    pub refine: RefineCrossingsParams,
     /// The sizing field from the local feature size (`sampling::grading`, meshes only; the
     /// command line's `--lfs-factor`). `None`, the default: one sigma_p everywhere, as in the
     /// paper. Not yet the default: on the shared models it grades nothing at the eval counts,
@@ -112,6 +116,7 @@ impl Default for RemeshParams {
             triangulate: TriangulateParams::default(),
             optimize: Some(OptimizeParams::default()),
             untangle: UntangleParams::default(),
+            refine: RefineCrossingsParams::default(),
             grading: None,
             curvature: None,
             fit_iterations: FIT_ITERATIONS,

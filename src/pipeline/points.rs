@@ -347,6 +347,8 @@ pub struct PointRemeshOutput {
     pub untangle: UntangleStats,
     /// The optimization's last pass again around the faces untangle's collapses changed.
     pub mend_after_untangle: MendStats,
+    /// The refinement where the output's own crossings were left after untangle.
+    pub refine: crate::finish::refine::RefineCrossingsStats,
     /// Samples that ended in no triangle (the optimization's and the untangling's collapses
     /// included).
     pub dropped_samples: usize,
@@ -810,6 +812,8 @@ fn remesh_points_once(
         optimize: optimize.as_ref(),
         fit_iterations: 0,
         untangle: untangle_params,
+        refine: rp.refine,
+        crossing_rule: None,
         stray: Some(StrayRule {
             keep: 1,
             stray: &stray,
@@ -933,6 +937,7 @@ fn remesh_points_once(
         untangle_umbrellas,
         untangle: finished.untangle,
         mend_after_untangle: finished.mend_after_untangle,
+        refine: finished.refine,
         dropped_samples: finished.dropped_samples
             + finished.later_dropped
             + dropped_after_finishing,

@@ -1,0 +1,207 @@
+//! Refining the output where it is coarser than the input's sheets lie apart.
+//!
+//! Where two sheets of the input lie closer than the output's spacing (plates meeting at a
+//! corner, a part's creases fanned out into long faces), the output's chords cut across the other
+//! sheet, and untangle's presses cannot separate them: every vertex is already on its own sheet,
+//! and the faces are too large to move apart without leaving it (or their corners are fixed
+//! crease samples). This operator splits the edges of each such face at the surface, so that the
+//! faces follow their sheet closer; untangle then separates what is left (`pipeline/finish.rs`
+//! runs it in rounds). It is red-green refinement's first half: every edge of a marked face is
+//! split, its neighbours across those edges with it (the edge split keeps the mesh conforming);
+//! the last pass of the optimization then mends the angles.
+
+#[cfg(test)]
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::mesh::edit::{EditMesh, SlotPolicy};
+use crate::mesh::TriMesh;
+use crate::surface::SurfaceQuery;
+
+/// Parameters of [`refine_faces`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RefineCrossingsParams {
+    /// Rounds of refinement and untangling at most (`pipeline/finish.rs`). Default 4: each
+    /// round halves the edges where crossings are left, so four take them to a sixteenth.
+    pub max_rounds: usize,
+    /// Edges shorter than this are not split (σ_p units). Default 1/16.
+    pub min_edge_sigma_p: f64,
+}
+
+impl Default for RefineCrossingsParams {
+    fn default() -> Self {
+        RefineCrossingsParams {
+            max_rounds: 8,
+            min_edge_sigma_p: 1.0 / 16.0,
+        }
+    }
+}
+
+/// What the rounds of refinement did (summed over rounds).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct RefineCrossingsStats {
+    /// Rounds run.
+    pub rounds: usize,
+    /// Edges split.
+    pub splits: usize,
+    /// Edges of marked faces not split: on the boundary, kept creases, shorter than
+    /// `min_edge_sigma_p`, or whose surface point lies on a sheet facing away from the edge's faces.
+    pub refused: usize,
+    /// Pairs of faces that cross outside the input's own crossings before the first round.
+    pub pairs_before: usize,
+    /// The same after the last round.
+    pub pairs_after: usize,
+}
+
+/// Splits each edge of the faces `faces` (indices into `mesh.triangles`) at the surface point
+/// nearest its middle (bbox-100 units). Not split: boundary edges, edges in `protected` (kept
+/// creases, either direction), edges shorter than `min_edge`, and edges whose surface point lies
+/// on a piece of the surface facing away from the mean normal of the edge's two faces (a sheet
+/// across a thin part, not the one the edge follows). Longest edges first, ties by vertex index:
+/// deterministic.
+///
+/// Returns the edges split and refused, and each face's index before (`None` for a face a split
+/// made). The new vertices are appended to `mesh.positions`.
+pub fn refine_faces<S: SurfaceQuery + ?Sized>(
+    mesh: &mut TriMesh,
+    surface: &S,
+    faces: &[u32],
+    protected: &[[u32; 2]],
+    min_edge: f64,
+) -> (usize, usize, Vec<Option<u32>>) {
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let protected: rustc_hash::FxHashSet<(u32, u32)> =
+        protected.iter().map(|e| key(e[0], e[1])).collect();
+    let mut edges: Vec<(u32, u32)> = faces
+        .iter()
+        .flat_map(|&f| {
+            let t = mesh.triangles[f as usize];
+            (0..3).map(move |k| key(t[k], t[(k + 1) % 3]))
+        })
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let length =
+        |&(a, b): &(u32, u32)| mesh.positions[a as usize].distance(mesh.positions[b as usize]);
+    edges.sort_by(|x, y| length(y).total_cmp(&length(x)).then(x.cmp(y)));
+    let mut m: EditMesh<Option<u32>> = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
+    let (mut splits, mut refused) = (0, 0);
+    for (a, b) in edges {
+        let (pa, pb) = (m.position(a), m.position(b));
+        if protected.contains(&(a, b)) || pa.distance(pb) < min_edge {
+            refused += 1;
+            continue;
+        }
+        let Ok((f1, f2, _, _)) = m.edge_faces(a, b) else {
+            refused += 1;
+            continue;
+        };
+        let normal = |f: u32| {
+            let [p, q, r] = m.corners(m.face(f).expect("a live face"));
+            (q - p).cross(r - p).normalize_or_zero()
+        };
+        let facing = normal(f1) + normal(f2);
+        let Some(sp) = surface.closest_point_to_midpoint(pa, pb) else {
+            refused += 1;
+            continue;
+        };
+        if surface.piece_normal(&sp).dot(facing) <= 0.0 {
+            refused += 1;
+            continue;
+        }
+        let v = m.add_vertex(sp.position);
+        if m.split_edge(a, b, v, None).is_ok() {
+            splits += 1;
+        } else {
+            m.pop_vertex();
+            refused += 1;
+        }
+    }
+    let (positions, triangles, origin) = m.into_parts();
+    mesh.positions = positions;
+    mesh.triangles = triangles;
+    (splits, refused, origin)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::MeshSurface;
+
+    /// A bent strip: two squares meeting at a crease along x = 1 (the second tilted up), each as
+    /// two triangles. Its coarse version spans the crease with a single chord plane.
+    fn bent() -> TriMesh {
+        let p = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 1.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(2.0, 1.0, 1.0),
+        ];
+        TriMesh::new(p, vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
+    }
+
+    #[test]
+    fn the_edges_of_a_marked_face_are_split_at_the_surface() {
+        let surface_mesh = bent();
+        let surface = MeshSurface::new(&surface_mesh).unwrap();
+        // The coarse mesh: one chord from x = 0 to x = 2 (it cuts under the crease).
+        let mut coarse = TriMesh::new(
+            vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(2.0, 0.0, 1.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(2.0, 1.0, 1.0),
+            ],
+            vec![[0, 1, 3], [0, 3, 2]],
+        );
+        let (splits, refused, origin) = refine_faces(&mut coarse, &surface, &[0], &[], 0.01);
+        // Of face 0's edges only the diagonal 0-3 is interior.
+        assert_eq!((splits, refused), (1, 2));
+        assert_eq!(coarse.positions.len(), 5);
+        assert_eq!(coarse.triangles.len(), 4);
+        assert!(origin.iter().all(Option::is_none));
+        // The new vertex is on the surface, the point nearest the diagonal's middle (1, 0.5,
+        // 0.5): on the tilted square, 1/(2√2) away, not the chord's middle.
+        let q = coarse.positions[4];
+        assert!(surface.closest_point(q).unwrap().distance < 1e-12);
+        assert!((q - DVec3::new(1.25, 0.5, 0.25)).length() < 1e-12, "{q}");
+        // A protected edge, or one shorter than the bound, is left.
+        let mut again = coarse.clone();
+        let (s, _, _) = refine_faces(&mut again, &surface, &[0, 1, 2, 3], &[[0, 4], [4, 3]], 10.0);
+        assert_eq!(s, 0);
+        assert_eq!(again.triangles, coarse.triangles);
+    }
+
+    #[test]
+    fn a_surface_point_on_a_sheet_facing_away_is_refused() {
+        // The surface: a square facing down, under the mesh's square facing up.
+        let below = TriMesh::new(
+            vec![
+                DVec3::new(0.0, 0.0, -0.1),
+                DVec3::new(1.0, 0.0, -0.1),
+                DVec3::new(0.0, 1.0, -0.1),
+                DVec3::new(1.0, 1.0, -0.1),
+            ],
+            vec![[0, 2, 3], [0, 3, 1]],
+        );
+        let surface = MeshSurface::new(&below).unwrap();
+        let mut up = TriMesh::new(
+            vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(1.0, 1.0, 0.0),
+            ],
+            vec![[0, 1, 3], [0, 3, 2]],
+        );
+        let (splits, refused, _) = refine_faces(&mut up, &surface, &[0, 1], &[], 0.01);
+        assert_eq!((splits, refused), (0, 5));
+        // Facing up, the same sheet is taken.
+        let above = TriMesh::new(below.positions.clone(), vec![[0, 3, 2], [0, 1, 3]]);
+        let surface = MeshSurface::new(&above).unwrap();
+        let (splits, _, _) = refine_faces(&mut up, &surface, &[0, 1], &[], 0.01);
+        assert_eq!(splits, 1);
+    }
+}
