@@ -1008,6 +1008,10 @@ fn shared_corpus_files_whose_parts_lie_closer_than_the_spacing_keep_no_crossing_
         );
         let pairs = int(&r, &["extra", "output_crossings", "pairs"]);
         let theirs = int(&r, &["extra", "output_crossings", "where_input_crosses"]);
-        assert_eq!(pairs - theirs, 0, "{name}: {pairs} pairs, {theirs} the input's");
+        assert_eq!(
+            pairs - theirs,
+            0,
+            "{name}: {pairs} pairs, {theirs} the input's"
+        );
     }
 }

@@ -70,7 +70,8 @@ pub struct RemeshParams {
     /// The separation of crossing faces, last.
     pub untangle: UntangleParams,
     /// Where the output's own crossings are left after that: the refinement of the crossing
-    /// faces, untangle again after each round (`max_rounds` 0: none).
+    /// faces, untangle again after each round (`max_rounds` 0: none). Meshes only: on a point
+    /// set the faces that still cross are removed instead.
     pub refine: RefineCrossingsParams,
     /// The sizing field from the local feature size (`sampling::grading`, meshes only; the
     /// command line's `--lfs-factor`). `None`, the default: one sigma_p everywhere, as in the
