@@ -232,20 +232,9 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             // guards (no new crossing, near the surface).
             let pressed = pressed_out_of_bounds(mesh, &before_untangle, &moved, op.angle_bounds());
             let near = around_changed_faces(mesh, &origin, &pressed);
-            let (stats, mended) = mend_near(
-                mesh,
-                f.surface,
-                &fixed,
-                &protected,
-                f.boundary,
-                f.input_crossings,
-                f.sigma_p,
-                op,
-                &near,
-            );
-            *face_sources = carried_sources(&mended.origin, face_sources);
+            let (stats, pairs) = mend_changed(mesh, face_sources, f, op, &fixed, &protected, &near);
             mend_after_untangle = mend_after_untangle.then(&stats);
-            intersecting = Some(mended.intersecting);
+            intersecting = Some(pairs);
             later_dropped += mesh.remove_unreferenced_vertices();
         } else if stats.collapses > 0 {
             later_dropped += mesh.remove_unreferenced_vertices();
@@ -272,138 +261,22 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     // Where the output's own crossings are left (its chords cut across a sheet of the input
     // that lies closer than the spacing, or long faces fan out of fixed crease samples), the
     // crossing faces' edges are split at the surface and untangle runs again, in rounds.
-    let mut refine = RefineCrossingsStats::default();
-    if f.refine.max_rounds > 0 {
-        // By the report's rule, at the output's spacing now (the splits change it little).
-        let rule = f
-            .crossing_rule
-            .filter(|r| !r.pairs.is_empty() || !r.edges.is_empty())
-            .map(|r| {
-                let reach = output_spacing(&mesh.positions, &mesh.triangles);
-                CrossingCurve::new(
-                    &r.mesh.positions,
-                    &r.mesh.triangles,
-                    r.pairs,
-                    r.edges,
-                    reach,
-                )
-            });
-        let by_rule = |mesh: &TriMesh, pairs: Vec<[u32; 2]>| -> Vec<[u32; 2]> {
-            let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
-            let mut pairs = pairs;
-            pairs.retain(|&[f, g]| {
-                let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
-                rule.as_ref()
-                    .is_none_or(|r| !r.holds(corners(a), corners(b)))
-            });
-            pairs
-        };
-        let mut own = by_rule(
+    let refine = if f.refine.max_rounds > 0 {
+        refine_rounds(
             mesh,
-            own_left.unwrap_or_else(|| own_crossings(mesh, None, f.input_crossings)),
-        );
-        let mut protected = protected;
-        refine.pairs_before = own.len();
-        // The fewest own pairs yet, and the mesh that had them once a later round changed it.
-        let mut best: (usize, Option<Kept>) = (own.len(), None);
-        while refine.rounds < f.refine.max_rounds && !own.is_empty() {
-            refine.rounds += 1;
-            if best.1.is_none() {
-                best.1 = Some(Kept {
-                    positions: mesh.positions.clone(),
-                    triangles: mesh.triangles.clone(),
-                    sources: face_sources.clone(),
-                    later_dropped,
-                });
-            }
-            let mut faces: Vec<u32> = own.iter().flatten().copied().collect();
-            faces.sort_unstable();
-            faces.dedup();
-            let (splits, refused, origin) = refine_faces(
-                mesh,
-                f.surface,
-                &faces,
-                &protected,
-                f.refine.min_edge_sigma_p * f.sigma_p,
-            );
-            refine.splits += splits;
-            refine.refused += refused;
-            if splits == 0 {
-                best.1 = None;
-                break;
-            }
-            *face_sources = carried_sources(&origin, face_sources);
-            // The vertices of the faces the splits made, for the mending after untangle.
-            let split_faces = around_changed_faces(mesh, &origin, &[]);
-            let fixed = fixed_prefix(mesh.positions.len());
-            let none_fixed = vec![false; mesh.positions.len()];
-            let untangle_fixed = if f.untangle_moves_fixed {
-                &none_fixed
-            } else {
-                &fixed
-            };
-            let params = UntangleParams {
-                collapse_offset_sigma_p: f64::INFINITY,
-                ..f.untangle
-            };
-            let Untangled {
-                stats,
-                origin,
-                left,
-                ..
-            } = untangle_known(
-                mesh,
-                untangle_fixed,
-                f.sigma_p,
-                &params,
-                f.input_crossings,
-                None,
-            );
-            untangle_stats = untangle_stats.then(&stats);
-            if stats.collapses > 0 {
-                *face_sources = carried_sources(&origin, face_sources);
-            }
-            let mut pairs = None;
-            if let Some(op) = f.optimize {
-                // The faces the splits made and those untangle changed, and their neighbours:
-                // the last pass mends their angles under its guards.
-                let mut near = around_changed_faces(mesh, &origin, &split_faces);
-                near.resize(mesh.positions.len(), false);
-                let (stats, mended) = mend_near(
-                    mesh,
-                    f.surface,
-                    &fixed,
-                    &protected,
-                    f.boundary,
-                    f.input_crossings,
-                    f.sigma_p,
-                    op,
-                    &near,
-                );
-                *face_sources = carried_sources(&mended.origin, face_sources);
-                mend_after_untangle = mend_after_untangle.then(&stats);
-                pairs = Some(mended.intersecting);
-            } else if stats.collapses == 0 {
-                pairs = left.map(|left| intersecting_of(mesh, left));
-            }
-            let renumbered = mesh.compact_vertices();
-            later_dropped += renumbered.iter().filter(|&&i| i == u32::MAX).count();
-            protected = renumber_edges(&protected, &renumbered);
-            own = by_rule(mesh, own_crossings(mesh, pairs, f.input_crossings));
-            if own.len() < best.0 {
-                best = (own.len(), None);
-            }
-        }
-        // The rounds after the one with the fewest own pairs are taken back.
-        if let (_, Some(kept)) = best {
-            mesh.positions = kept.positions;
-            mesh.triangles = kept.triangles;
-            *face_sources = kept.sources;
-            later_dropped = kept.later_dropped;
-            own = by_rule(mesh, own_crossings(mesh, None, f.input_crossings));
-        }
-        refine.pairs_after = own.len();
-    }
+            face_sources,
+            f,
+            protected,
+            own_left,
+            &mut Totals {
+                untangle: &mut untangle_stats,
+                mend: &mut mend_after_untangle,
+                later_dropped: &mut later_dropped,
+            },
+        )
+    } else {
+        RefineCrossingsStats::default()
+    };
     // No face of no area is written.
     let (degenerate, origin) = mend_degenerate_faces(mesh, &fixed);
     if let Some(origin) = origin {
@@ -441,6 +314,175 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
         stray_shells,
         orientation,
     }
+}
+
+/// The last pass of the optimization again around the vertices flagged in `near` (`V` flags),
+/// the faces' sources carried along: what it did, and the pairs of faces that intersect after
+/// it (or come within its `near`).
+fn mend_changed<S: SurfaceQuery + ?Sized>(
+    mesh: &mut TriMesh,
+    face_sources: &mut Vec<FaceSource>,
+    f: &Finishing<S>,
+    op: &OptimizeParams,
+    fixed: &[bool],
+    protected: &[[u32; 2]],
+    near: &[bool],
+) -> (MendStats, Vec<[u32; 2]>) {
+    let (stats, mended) = mend_near(
+        mesh,
+        f.surface,
+        fixed,
+        protected,
+        f.boundary,
+        f.input_crossings,
+        f.sigma_p,
+        op,
+        near,
+    );
+    *face_sources = carried_sources(&mended.origin, face_sources);
+    (stats, mended.intersecting)
+}
+
+/// What the rounds of refinement add to (the finishing stage's totals).
+struct Totals<'t> {
+    untangle: &'t mut UntangleStats,
+    mend: &'t mut MendStats,
+    later_dropped: &'t mut usize,
+}
+
+/// The refinement of the faces that cross outside the input's crossings (by the report's rule,
+/// [`CrossingRule`]; `own_left`: the pairs the finishing stage's narrower curve leaves, when
+/// known): in rounds, their edges split at the surface ([`refine_faces`]), untangle with any
+/// collapse, and the last pass around the changed faces; the round with the fewest such pairs
+/// is kept, the later ones taken back.
+fn refine_rounds<S: SurfaceQuery + ?Sized>(
+    mesh: &mut TriMesh,
+    face_sources: &mut Vec<FaceSource>,
+    f: &Finishing<S>,
+    mut protected: Vec<[u32; 2]>,
+    own_left: Option<Vec<[u32; 2]>>,
+    totals: &mut Totals,
+) -> RefineCrossingsStats {
+    let mut refine = RefineCrossingsStats::default();
+    let fixed_prefix = |n: usize| -> Vec<bool> { (0..n).map(|i| i < f.fixed).collect() };
+    // By the report's rule, at the output's spacing now (the splits change it little).
+    let rule = f
+        .crossing_rule
+        .filter(|r| !r.pairs.is_empty() || !r.edges.is_empty())
+        .map(|r| {
+            let reach = output_spacing(&mesh.positions, &mesh.triangles);
+            CrossingCurve::new(
+                &r.mesh.positions,
+                &r.mesh.triangles,
+                r.pairs,
+                r.edges,
+                reach,
+            )
+        });
+    let by_rule = |mesh: &TriMesh, pairs: Vec<[u32; 2]>| -> Vec<[u32; 2]> {
+        let corners = |t: [u32; 3]| t.map(|v| mesh.positions[v as usize]);
+        let mut pairs = pairs;
+        pairs.retain(|&[f, g]| {
+            let (a, b) = (mesh.triangles[f as usize], mesh.triangles[g as usize]);
+            rule.as_ref()
+                .is_none_or(|r| !r.holds(corners(a), corners(b)))
+        });
+        pairs
+    };
+    let mut own = by_rule(
+        mesh,
+        own_left.unwrap_or_else(|| own_crossings(mesh, None, f.input_crossings)),
+    );
+    refine.pairs_before = own.len();
+    // The fewest own pairs yet, and the mesh that had them once a later round changed it.
+    let mut best: (usize, Option<Kept>) = (own.len(), None);
+    while refine.rounds < f.refine.max_rounds && !own.is_empty() {
+        refine.rounds += 1;
+        if best.1.is_none() {
+            best.1 = Some(Kept {
+                positions: mesh.positions.clone(),
+                triangles: mesh.triangles.clone(),
+                sources: face_sources.clone(),
+                later_dropped: *totals.later_dropped,
+            });
+        }
+        let mut faces: Vec<u32> = own.iter().flatten().copied().collect();
+        faces.sort_unstable();
+        faces.dedup();
+        let (splits, refused, origin) = refine_faces(
+            mesh,
+            f.surface,
+            &faces,
+            &protected,
+            f.refine.min_edge_sigma_p * f.sigma_p,
+        );
+        refine.splits += splits;
+        refine.refused += refused;
+        if splits == 0 {
+            best.1 = None;
+            break;
+        }
+        *face_sources = carried_sources(&origin, face_sources);
+        // The vertices of the faces the splits made, for the mending after untangle.
+        let split_faces = around_changed_faces(mesh, &origin, &[]);
+        let fixed = fixed_prefix(mesh.positions.len());
+        let none_fixed = vec![false; mesh.positions.len()];
+        let untangle_fixed = if f.untangle_moves_fixed {
+            &none_fixed
+        } else {
+            &fixed
+        };
+        let params = UntangleParams {
+            collapse_offset_sigma_p: f64::INFINITY,
+            ..f.untangle
+        };
+        let Untangled {
+            stats,
+            origin,
+            left,
+            ..
+        } = untangle_known(
+            mesh,
+            untangle_fixed,
+            f.sigma_p,
+            &params,
+            f.input_crossings,
+            None,
+        );
+        *totals.untangle = totals.untangle.then(&stats);
+        if stats.collapses > 0 {
+            *face_sources = carried_sources(&origin, face_sources);
+        }
+        let mut pairs = None;
+        if let Some(op) = f.optimize {
+            // The faces the splits made and those untangle changed, and their neighbours:
+            // the last pass mends their angles under its guards.
+            let near = around_changed_faces(mesh, &origin, &split_faces);
+            let (stats, mended) =
+                mend_changed(mesh, face_sources, f, op, &fixed, &protected, &near);
+            *totals.mend = totals.mend.then(&stats);
+            pairs = Some(mended);
+        } else if stats.collapses == 0 {
+            pairs = left.map(|left| intersecting_of(mesh, left));
+        }
+        let renumbered = mesh.compact_vertices();
+        *totals.later_dropped += renumbered.iter().filter(|&&i| i == u32::MAX).count();
+        protected = renumber_edges(&protected, &renumbered);
+        own = by_rule(mesh, own_crossings(mesh, pairs, f.input_crossings));
+        if own.len() < best.0 {
+            best = (own.len(), None);
+        }
+    }
+    // The rounds after the one with the fewest own pairs are taken back.
+    if let (_, Some(kept)) = best {
+        mesh.positions = kept.positions;
+        mesh.triangles = kept.triangles;
+        *face_sources = kept.sources;
+        *totals.later_dropped = kept.later_dropped;
+        own = by_rule(mesh, own_crossings(mesh, None, f.input_crossings));
+    }
+    refine.pairs_after = own.len();
+    refine
 }
 
 /// The pairs of faces of `mesh` that intersect ([`intersecting_pairs`]; `known`: those pairs,
