@@ -148,33 +148,27 @@ pub fn remesh(
             candidates.grade(&input, &index, &field, search.sigma_ref, seed, round);
         }
         let stages = (&input, &index, &candidates, &features, &sizing);
-        let run = run_once(target, &mut search, stages, params, on_stage, &mut timer)?;
-        search.history.extend(run.scanned.history.iter().copied());
-        // Where the triangulation had to insert samples for the topological ball property, the
-        // sampling was too coarse for the surface there: the width is lowered around them and
-        // the sampling run again, so that the samples there are placed by the sampler itself.
-        // Only where the inserted samples take the count out of its tolerance: a few inserted
-        // samples are kept as they are.
-        let inserted = run.triangulated.inserted.len() as f64;
-        let aimed = run.ascended.samples.len().max(1) as f64;
-        // (Nothing is inserted where the triangulation does not check: see
-        // `triangulation::triangulate_samples`.)
-        if inserted > params.count_tolerance * aimed && refinements < params.topology_refinements {
-            let inserted = run.triangulated.inserted.clone();
-            let sigma_ref = run.scanned.widths.sigma_ref;
-            let corners = run.scanned.corner_term();
-            let creases = crease_terms(
-                &corners,
-                &run.scanned.scan.separation,
-                &run.scanned.scan.curvature,
-            );
-            let field = run.scanned.widths.field().with(&creases);
-            let widths: Vec<f64> = inserted.iter().map(|&p| field.width(p)).collect();
-            drop(run);
-            sizing.refine_at(&inserted, &widths, REFINEMENT_FACTOR, sigma_ref);
-            refinements += 1;
-            continue;
-        }
+        let refine_topology = refinements < params.topology_refinements;
+        let run = match run_once(
+            target,
+            &mut search,
+            stages,
+            params,
+            refine_topology,
+            on_stage,
+            &mut timer,
+        )? {
+            Attempt::Run(run) => run,
+            Attempt::Refine {
+                inserted,
+                widths,
+                sigma_ref,
+            } => {
+                sizing.refine_at(&inserted, &widths, REFINEMENT_FACTOR, sigma_ref);
+                refinements += 1;
+                continue;
+            }
+        };
         match next_goal(target, attempt, &run, search.goal, params.count_tolerance) {
             Next::Done { reached } => break (run, reached),
             Next::Again { goal } => {
@@ -233,9 +227,10 @@ fn run_once<'s>(
     search: &mut Search,
     (input, index, candidates, features, sizing): Prepared<'_, 's>,
     params: &RemeshParams,
+    refine_topology: bool,
     on_stage: &(dyn Fn(&str) + Sync),
     timer: &mut StageTimer,
-) -> Result<Run<'s>> {
+) -> Result<Attempt<'s>> {
     on_stage("linear scan");
     let mut scanned = scan::scan(target, search, input, features, candidates, sizing, params)?;
     timer.lap("linear scan");
@@ -268,6 +263,27 @@ fn run_once<'s>(
     }
     let mut triangulated = triangulate_samples(samples, sigma_p, &field, edges, index, &tri_params);
     timer.lap("triangulate");
+    search.history.extend(scanned.history.iter().copied());
+    // Where the triangulation had to insert samples for the topological ball property, the
+    // sampling was too coarse for the surface there: the width is lowered around them and the
+    // sampling run again (before this run is finished), so that the samples there are placed
+    // by the sampler itself. Only where the inserted samples take the count out of its
+    // tolerance: a few inserted samples are kept as they are. (Nothing is inserted where the
+    // triangulation does not check: see `triangulation::triangulate_samples`.)
+    let inserted = triangulated.inserted.len() as f64;
+    let aimed = samples.len().max(1) as f64;
+    if refine_topology && inserted > params.count_tolerance * aimed {
+        let widths = triangulated
+            .inserted
+            .iter()
+            .map(|&p| field.width(p))
+            .collect();
+        return Ok(Attempt::Refine {
+            inserted: std::mem::take(&mut triangulated.inserted),
+            widths,
+            sigma_ref: scanned.widths.sigma_ref,
+        });
+    }
 
     // Where the input's faces cross or its closed parts meet: the finishing stage leaves the
     // output's crossings within sigma_p of there alone. The input's crossings count only where
@@ -341,12 +357,26 @@ fn run_once<'s>(
     };
     let (mesh, sources) = (&mut triangulated.mesh, &mut triangulated.face_sources);
     let finished = finish(mesh, sources, &finishing, on_stage, timer);
-    Ok(Run {
+    Ok(Attempt::Run(Run {
         scanned,
         ascended,
         triangulated,
         finished,
-    })
+    }))
+}
+
+/// What a run of [`run_once`] ends in.
+enum Attempt<'s> {
+    /// A finished run.
+    Run(Run<'s>),
+    /// The triangulation inserted too many samples for the topological ball property: the
+    /// positions inserted (bbox-100 units) and the width there, relative to `sigma_ref`, for
+    /// the sizing field's refinement.
+    Refine {
+        inserted: Vec<glam::DVec3>,
+        widths: Vec<f64>,
+        sigma_ref: f64,
+    },
 }
 
 /// What follows a run.
