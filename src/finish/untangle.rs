@@ -292,7 +292,7 @@ pub(crate) fn untangle_known(
             if let Some(guard) = &mut guard {
                 // The pairs are those before the round again; the guard follows the positions.
                 let vertices: Vec<u32> = saved.iter().map(|&(v, _)| v).collect();
-                guard.moved(&m, &pairs, &vertices);
+                guard.vertices_moved(&m, &vertices);
             }
             scale *= 0.5;
             if scale < 0.1 {

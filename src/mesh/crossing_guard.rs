@@ -87,13 +87,21 @@ impl CrossingGuard {
         let p = m.positions();
         let usable =
             |t: [u32; 3]| t.iter().all(|&v| p[v as usize].is_finite()) && !is_degenerate_face(p, t);
+        let mut listed = faces.to_vec();
+        listed.sort_unstable();
+        listed.dedup();
         let mut pairs = Vec::new();
-        for &f in faces {
+        for &f in &listed {
             let Some(t) = m.face(f).filter(|&t| usable(t)) else {
                 continue;
             };
             let query = triangle_aabb(m.corners(t)).loosened(self.near);
             for g in self.bvh.intersect_aabb(&query) {
+                // A pair of two listed faces is tested once, from its smaller slot (the boxes'
+                // overlap within `near` is symmetric).
+                if g < f && listed.binary_search(&g).is_ok() {
+                    continue;
+                }
                 let Some(u) = m.face(g).filter(|&u| g != f && usable(u)) else {
                     continue;
                 };
@@ -117,13 +125,13 @@ impl CrossingGuard {
         pairs: &[[u32; 2]],
         moved: &[u32],
     ) -> Vec<[u32; 2]> {
+        self.vertices_moved(m, moved);
         let mut faces: Vec<u32> = moved
             .iter()
             .flat_map(|&v| m.faces_around(v).iter().copied())
             .collect();
         faces.sort_unstable();
         faces.dedup();
-        self.changed(m, &faces);
         let mut after: Vec<[u32; 2]> = pairs
             .iter()
             .copied()
@@ -133,6 +141,18 @@ impl CrossingGuard {
         after.sort_unstable();
         after.dedup();
         after
+    }
+
+    /// Records that the vertices in `moved` moved: the faces around them take their new boxes
+    /// (as [`Self::moved`] does, without searching their pairs).
+    pub(crate) fn vertices_moved<L: Copy>(&mut self, m: &EditMesh<L>, moved: &[u32]) {
+        let mut faces: Vec<u32> = moved
+            .iter()
+            .flat_map(|&v| m.faces_around(v).iter().copied())
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        self.changed(m, &faces);
     }
 
     /// How many live faces the face `t` with corners `p` crosses (as [`Self::visit_crossed`]).
