@@ -167,6 +167,11 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     'rounds: for _ in 0..params.final_rounds {
         let mut made = 0;
         let mut touched = vec![false; m.vertex_count()];
+        // The faces in a pair as the round starts (sorted slots): no operation makes a pair
+        // (the crossing guard refuses it), so no other face crosses one during the round.
+        let mut paired: Vec<u32> = pairs.iter().flatten().copied().collect();
+        paired.sort_unstable();
+        paired.dedup();
         for &f in &faces {
             let Some(t) = m.face(f) else {
                 continue;
@@ -178,9 +183,10 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
             // A face that crosses another is mended by any operation that replaces or moves it
             // without a crossing or a new angle below the bound; there, a covering vertex may
             // go too. A face with a small angle is mended by one that raises that angle.
-            let crossing = guard.visit_crossed(m, t, m.corners(t), &[f], |g| {
-                !own(m, t) || m.face(g).is_some_and(|u| share_a_vertex(t, u))
-            });
+            let crossing = paired.binary_search(&f).is_ok()
+                && guard.visit_crossed(m, t, m.corners(t), &[f], |g| {
+                    !own(m, t) || m.face(g).is_some_and(|u| share_a_vertex(t, u))
+                });
             if !crossing && angle_score(m, t, params) >= bound {
                 continue;
             }
