@@ -578,6 +578,10 @@ struct FaceAdjacency<'a> {
     mesh: &'a TriMesh,
     across: Vec<[u32; 3]>,
     candidate: Vec<[bool; 3]>,
+    /// Each face's centroid ([`centroid`]) and twice its area-weighted normal (the cross
+    /// product of two edges), computed once: the patch tests visit a face from many edges.
+    centroids: Vec<DVec3>,
+    area_normals: Vec<DVec3>,
 }
 
 impl<'a> FaceAdjacency<'a> {
@@ -604,10 +608,20 @@ impl<'a> FaceAdjacency<'a> {
                 across
             })
             .collect();
+        let area_normals = (0..mesh.triangles.len())
+            .map(|f| {
+                let t = mesh.corners(f);
+                (t[1] - t[0]).cross(t[2] - t[0])
+            })
+            .collect();
         FaceAdjacency {
             mesh,
             across,
             candidate: vec![[false; 3]; mesh.triangles.len()],
+            centroids: (0..mesh.triangles.len() as u32)
+                .map(|f| centroid(mesh, f))
+                .collect(),
+            area_normals,
         }
     }
 
@@ -657,16 +671,14 @@ impl PatchScratch {
         true
     }
 
-    /// The faces reached with their bits, in face order; the scratch is empty after.
-    fn take_sorted(&mut self) -> Vec<(u32, u8)> {
-        self.reached.sort_unstable();
-        let out = self
-            .reached
-            .iter()
-            .map(|&f| (f, std::mem::take(&mut self.bits[f as usize])))
-            .collect();
+    /// Calls `visit` with each face reached and its bits, in the order they were first reached
+    /// (the same for the same input: the patches grow in a fixed order); the scratch is empty
+    /// after.
+    fn drain(&mut self, mut visit: impl FnMut(u32, u8)) {
+        for &f in &self.reached {
+            visit(f, std::mem::take(&mut self.bits[f as usize]));
+        }
         self.reached.clear();
-        out
     }
 }
 
@@ -718,7 +730,10 @@ fn sharp_at_scale(
                 if g == FaceAdjacency::NONE || (barriers && adjacency.candidate[f as usize][k]) {
                     continue;
                 }
-                if centroid(mesh, g).distance_squared(mid) <= scale_2 && scratch.mark(g, bit) {
+                if !scratch.has(g, bit)
+                    && adjacency.centroids[g as usize].distance_squared(mid) <= scale_2
+                    && scratch.mark(g, bit)
+                {
                     queue.push_back(g);
                     taken += 1;
                 }
@@ -728,11 +743,10 @@ fn sharp_at_scale(
     // A face reached from one side only counts on that side; one reached from both (round the
     // end of a crease, or across a fold that is not one) on the side of the edge it lies on.
     let mut sides = [DVec3::ZERO; 2];
-    for (f, bits) in scratch.take_sorted() {
-        let t = mesh.corners(f as usize);
+    scratch.drain(|f, bits| {
         // Area-weighted normal: the cross product's half.
-        sides[frame.side(mesh, f, bits)] += (t[1] - t[0]).cross(t[2] - t[0]);
-    }
+        sides[frame.side(adjacency, f, bits)] += adjacency.area_normals[f as usize];
+    });
     let (n0, n1) = (sides[0].normalize_or_zero(), sides[1].normalize_or_zero());
     n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) <= cos_bound
 }
@@ -769,11 +783,11 @@ impl EdgeFrame {
     /// it was reached from (`bits`: 1, 2 or both): one reached from one side only counts on that
     /// side; one reached from both (round the end of a crease, or across a fold that is not
     /// one) on the side of the edge it lies on.
-    fn side(&self, mesh: &TriMesh, f: u32, bits: u8) -> usize {
+    fn side(&self, adjacency: &FaceAdjacency, f: u32, bits: u8) -> usize {
         match bits {
             1 => 0,
             2 => 1,
-            _ => usize::from((centroid(mesh, f) - self.mid).dot(self.split) < 0.0),
+            _ => usize::from((adjacency.centroids[f as usize] - self.mid).dot(self.split) < 0.0),
         }
     }
 }
@@ -817,7 +831,7 @@ pub const NEAR_TURN_SHARE: f64 = 0.85;
 /// ball (2 `r` over its longest edge: a CAD export's long sliver beside a hole's rim reaches
 /// round the rim's curve, where it is on neither side). A sliver's normal thus counts with its
 /// area: tilted or flipped by noise on a flat, it turns nothing, where a crease turns about as
-/// much near it as between its two faces. Deterministic (faces summed in index order).
+/// much near it as between its two faces. Deterministic (faces summed in the order they are reached).
 fn sharp_near_edge(
     adjacency: &FaceAdjacency,
     scratch: &mut PatchScratch,
@@ -868,7 +882,7 @@ fn turns_near(
     let near = |f: u32| -> bool {
         let c = mesh.corners(f as usize);
         (0..3).any(|k| distance_to_segment(at, c[k], c[(k + 1) % 3]) <= r)
-            || centroid(mesh, f).distance(at) <= r
+            || adjacency.centroids[f as usize].distance(at) <= r
     };
     // The faces near the edge, a bit per side they were reached from (depth first over any
     // edge but `e`).
@@ -896,10 +910,9 @@ fn turns_near(
             }
         }
     }
-    let marked = scratch.take_sorted();
     let mut sides = [DVec3::ZERO; 2];
-    for (f, bits) in marked {
-        let side = frame.side(mesh, f, bits);
+    scratch.drain(|f, bits| {
+        let side = frame.side(adjacency, f, bits);
         let t = mesh.corners(f as usize);
         let longest = (0..3)
             .map(|k| t[k].distance(t[(k + 1) % 3]))
@@ -909,8 +922,8 @@ fn turns_near(
         } else {
             1.0
         };
-        sides[side] += share * (t[1] - t[0]).cross(t[2] - t[0]);
-    }
+        sides[side] += share * adjacency.area_normals[f as usize];
+    });
     let (n0, n1) = (sides[0].normalize_or_zero(), sides[1].normalize_or_zero());
     n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) <= cos_bound
 }
