@@ -827,7 +827,16 @@ fn remesh_points_once(
         }),
     };
     // The points' normals point outward (given, or oriented so): so does the output.
-    let finished = finish(&mut mesh, &mut sources, &finishing, on_stage, &mut timer);
+    let Some(finished) = finish(
+        &mut mesh,
+        &mut sources,
+        &finishing,
+        &|_| true,
+        on_stage,
+        &mut timer,
+    ) else {
+        unreachable!("a run asked to go on is finished")
+    };
     // The same rule once more: no output face spans a gap in the data. (Removing faces makes no
     // angle smaller and no faces cross.)
     let unsupported_after_finishing = remove_unsupported_faces(&mut mesh, &mut sources, supported);
