@@ -126,13 +126,9 @@ impl CrossingCurve {
             return false;
         }
         let key = corner_key(t);
-        let answers = |f: &mut dyn FnMut(&mut HashMap<[u64; 9], bool>)| {
-            // An answer is a pure function of the corners: a poisoned lock's map is still right.
-            let mut map = self.answers.lock().unwrap_or_else(|e| e.into_inner());
-            f(&mut map)
-        };
-        let mut known = None;
-        answers(&mut |map| known = map.get(&key).copied());
+        // An answer is a pure function of the corners: a poisoned lock's map is still right.
+        let lock = || self.answers.lock().unwrap_or_else(|e| e.into_inner());
+        let known = lock().get(&key).copied();
         if let Some(answer) = known {
             return answer;
         }
@@ -140,12 +136,11 @@ impl CrossingCurve {
             .bvh
             .intersect_aabb(&triangle_aabb(t))
             .any(|i| self.pieces[i as usize].within(t, self.reach));
-        answers(&mut |map| {
-            if map.len() >= MAX_ANSWERS {
-                map.clear();
-            }
-            map.insert(key, answer);
-        });
+        let mut map = lock();
+        if map.len() >= MAX_ANSWERS {
+            map.clear();
+        }
+        map.insert(key, answer);
         answer
     }
 

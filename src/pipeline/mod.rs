@@ -158,7 +158,7 @@ pub fn remesh(
             on_stage,
             &mut timer,
         )? {
-            Attempt::Run(run) => run,
+            Attempt::Run(run) => *run,
             Attempt::Again { goal, sigma_p } => {
                 search.start = sigma_p * (search.goal as f64 / goal as f64).sqrt();
                 search.goal = goal;
@@ -378,18 +378,18 @@ fn run_once<'s>(
             sigma_p: scanned.sigma_p,
         });
     };
-    Ok(Attempt::Run(Run {
+    Ok(Attempt::Run(Box::new(Run {
         scanned,
         ascended,
         triangulated,
         finished,
-    }))
+    })))
 }
 
 /// What a run of [`run_once`] ends in.
 enum Attempt<'s> {
     /// A finished run.
-    Run(Run<'s>),
+    Run(Box<Run<'s>>),
     /// The triangulation inserted too many samples for the topological ball property: the
     /// positions inserted (bbox-100 units) and the width there, relative to `sigma_ref`, for
     /// the sizing field's refinement.
