@@ -119,18 +119,14 @@ pub(crate) struct Finished {
 }
 
 /// Finishes `mesh` (its faces' sources carried along) as `f` says, in the stages "optimize" and
-/// "untangle". After the optimization (its vertices then numbered anew, those no face uses
-/// dropped) `go_on` is asked whether the run is still wanted (the count search asks for another
-/// run when the count is off by more than its promise): `None` when it is not, the mesh then as
-/// the optimization left it.
+/// "untangle".
 pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     mesh: &mut TriMesh,
     face_sources: &mut Vec<FaceSource>,
     f: &Finishing<S>,
-    go_on: &dyn Fn(&TriMesh) -> bool,
     on_stage: &(dyn Fn(&str) + Sync),
     timer: &mut StageTimer,
-) -> Option<Finished> {
+) -> Finished {
     on_stage("optimize");
     // The intersecting pairs of the mesh as the optimization left it (`None`: not known).
     let mut intersecting: Option<Vec<[u32; 2]>> = None;
@@ -162,9 +158,6 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     // The protected edges by the new numbers, for the mending after untangle.
     let protected = renumber_edges(f.protected, &renumbered);
     timer.lap("optimize");
-    if !go_on(mesh) {
-        return None;
-    }
     on_stage("untangle");
     let fixed = fixed_prefix(mesh.positions.len());
     // The least-squares fit to the surface, before the separation of crossing faces (which then
@@ -308,7 +301,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
     // The output follows the surface's orientation: its closed parts are turned outward.
     let orientation = orient_consistently(mesh, true);
     timer.lap("untangle");
-    Some(Finished {
+    Finished {
         optimize: optimize_stats,
         protected_kept,
         dropped_samples,
@@ -320,7 +313,7 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
         degenerate,
         stray_shells,
         orientation,
-    })
+    }
 }
 
 /// The last pass of the optimization again around the vertices flagged in `near` (`V` flags),

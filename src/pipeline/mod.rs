@@ -154,17 +154,11 @@ pub fn remesh(
             &mut search,
             stages,
             params,
-            (attempt, refine_topology),
+            refine_topology,
             on_stage,
             &mut timer,
         )? {
             Attempt::Run(run) => *run,
-            Attempt::Again { goal, sigma_p } => {
-                search.start = sigma_p * (search.goal as f64 / goal as f64).sqrt();
-                search.goal = goal;
-                attempt += 1;
-                continue;
-            }
             Attempt::Refine {
                 inserted,
                 widths,
@@ -233,7 +227,7 @@ fn run_once<'s>(
     search: &mut Search,
     (input, index, candidates, features, sizing): Prepared<'_, 's>,
     params: &RemeshParams,
-    (attempt, refine_topology): (usize, bool),
+    refine_topology: bool,
     on_stage: &(dyn Fn(&str) + Sync),
     timer: &mut StageTimer,
 ) -> Result<Attempt<'s>> {
@@ -362,22 +356,7 @@ fn run_once<'s>(
         }),
     };
     let (mesh, sources) = (&mut triangulated.mesh, &mut triangulated.face_sources);
-    // The count is all but settled once the optimization has collapsed, covered and dropped
-    // vertices (untangle's collapses are a few): a run the count search will run again is not
-    // untangled first.
-    let (goal, reached) = (search.goal, scanned.target_reached);
-    let again = |m: &TriMesh| match goal_after(target, attempt, m.vertex_count(), reached, goal) {
-        Next::Again { goal } => Some(goal),
-        Next::Done { .. } => None,
-    };
-    let go_on = |m: &TriMesh| again(m).is_none();
-    let Some(finished) = finish(mesh, sources, &finishing, &go_on, on_stage, timer) else {
-        let goal = again(mesh).unwrap_or(goal);
-        return Ok(Attempt::Again {
-            goal,
-            sigma_p: scanned.sigma_p,
-        });
-    };
+    let finished = finish(mesh, sources, &finishing, on_stage, timer);
     Ok(Attempt::Run(Box::new(Run {
         scanned,
         ascended,
@@ -398,9 +377,6 @@ enum Attempt<'s> {
         widths: Vec<f64>,
         sigma_ref: f64,
     },
-    /// The count after the optimization is off by more than its promise: the search runs again
-    /// for `goal` samples, from the run's `sigma_p` ([`goal_after`]).
-    Again { goal: usize, sigma_p: f64 },
 }
 
 /// What follows a run.
@@ -421,29 +397,16 @@ const COUNT_PROMISE: f64 = 0.01;
 /// aim closer than the promise, and did not always (boolean.glb at 3000, seed 1: 2978, then
 /// 2959); the search's own tolerance is finer, for the samples it places.
 fn next_goal(target: Target, attempt: usize, run: &Run, goal: usize) -> Next {
-    let count = run.triangulated.mesh.vertex_count();
-    goal_after(target, attempt, count, run.scanned.target_reached, goal)
-}
-
-/// [`next_goal`] for an output of `count` vertices, `target_reached` whether the scan reached
-/// its goal.
-fn goal_after(
-    target: Target,
-    attempt: usize,
-    count: usize,
-    target_reached: bool,
-    goal: usize,
-) -> Next {
     let Target::Points(n) = target else {
         return Next::Done {
-            reached: target_reached,
+            reached: run.scanned.target_reached,
         };
     };
-    let miss = n as f64 - count as f64;
+    let miss = n as f64 - run.triangulated.mesh.vertex_count() as f64;
     let within = miss.abs() <= COUNT_PROMISE * n as f64;
     // A raised target helps only where the sampler reached its own: a count the search could
     // not reach is not reached by asking for more.
-    if attempt >= MAX_ATTEMPTS || within || !target_reached {
+    if attempt >= MAX_ATTEMPTS || within || !run.scanned.target_reached {
         return Next::Done { reached: within };
     }
     Next::Again {

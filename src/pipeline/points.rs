@@ -827,16 +827,7 @@ fn remesh_points_once(
         }),
     };
     // The points' normals point outward (given, or oriented so): so does the output.
-    let Some(finished) = finish(
-        &mut mesh,
-        &mut sources,
-        &finishing,
-        &|_| true,
-        on_stage,
-        &mut timer,
-    ) else {
-        unreachable!("a run asked to go on is finished")
-    };
+    let finished = finish(&mut mesh, &mut sources, &finishing, on_stage, &mut timer);
     // The same rule once more: no output face spans a gap in the data. (Removing faces makes no
     // angle smaller and no faces cross.)
     let unsupported_after_finishing = remove_unsupported_faces(&mut mesh, &mut sources, supported);
