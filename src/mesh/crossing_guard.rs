@@ -125,13 +125,7 @@ impl CrossingGuard {
         pairs: &[[u32; 2]],
         moved: &[u32],
     ) -> Vec<[u32; 2]> {
-        self.vertices_moved(m, moved);
-        let mut faces: Vec<u32> = moved
-            .iter()
-            .flat_map(|&v| m.faces_around(v).iter().copied())
-            .collect();
-        faces.sort_unstable();
-        faces.dedup();
+        let faces = self.vertices_moved(m, moved);
         let mut after: Vec<[u32; 2]> = pairs
             .iter()
             .copied()
@@ -143,9 +137,9 @@ impl CrossingGuard {
         after
     }
 
-    /// Records that the vertices in `moved` moved: the faces around them take their new boxes
-    /// (as [`Self::moved`] does, without searching their pairs).
-    pub(crate) fn vertices_moved<L: Copy>(&mut self, m: &EditMesh<L>, moved: &[u32]) {
+    /// Records that the vertices in `moved` moved: the faces around them (returned, sorted) take
+    /// their new boxes (as [`Self::moved`] does, without searching their pairs).
+    pub(crate) fn vertices_moved<L: Copy>(&mut self, m: &EditMesh<L>, moved: &[u32]) -> Vec<u32> {
         let mut faces: Vec<u32> = moved
             .iter()
             .flat_map(|&v| m.faces_around(v).iter().copied())
@@ -153,6 +147,7 @@ impl CrossingGuard {
         faces.sort_unstable();
         faces.dedup();
         self.changed(m, &faces);
+        faces
     }
 
     /// How many live faces the face `t` with corners `p` crosses (as [`Self::visit_crossed`]).
