@@ -380,6 +380,7 @@ enum Attempt<'s> {
 }
 
 /// What follows a run.
+#[derive(Debug, PartialEq)]
 enum Next {
     /// The output: `reached` whether the count came within 1% of the target (for a sigma_p,
     /// whether the scan reached it).
@@ -397,19 +398,72 @@ const COUNT_PROMISE: f64 = 0.01;
 /// aim closer than the promise, and did not always (boolean.glb at 3000, seed 1: 2978, then
 /// 2959); the search's own tolerance is finer, for the samples it places.
 fn next_goal(target: Target, attempt: usize, run: &Run, goal: usize) -> Next {
+    let count = run.triangulated.mesh.vertex_count();
+    goal_after(target, attempt, count, run.scanned.target_reached, goal)
+}
+
+/// [`next_goal`] for an output of `count` vertices, `scan_reached` whether the scan reached its
+/// goal.
+fn goal_after(
+    target: Target,
+    attempt: usize,
+    count: usize,
+    scan_reached: bool,
+    goal: usize,
+) -> Next {
     let Target::Points(n) = target else {
         return Next::Done {
-            reached: run.scanned.target_reached,
+            reached: scan_reached,
         };
     };
-    let miss = n as f64 - run.triangulated.mesh.vertex_count() as f64;
+    let miss = n as f64 - count as f64;
     let within = miss.abs() <= COUNT_PROMISE * n as f64;
     // A raised target helps only where the sampler reached its own: a count the search could
     // not reach is not reached by asking for more.
-    if attempt >= MAX_ATTEMPTS || within || !run.scanned.target_reached {
+    if attempt >= MAX_ATTEMPTS || within || !scan_reached {
         return Next::Done { reached: within };
     }
     Next::Again {
         goal: ((goal as f64 + miss).round() as usize).max(4),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_count_within_the_promise_is_kept_and_one_past_it_is_run_again_once() {
+        let n = Target::Points(3000);
+        // 0.73% off (boolean.glb seed 1's first run): kept, though past the search's 0.5%.
+        assert_eq!(
+            goal_after(n, 1, 2978, true, 3000),
+            Next::Done { reached: true }
+        );
+        assert_eq!(
+            goal_after(n, 1, 3030, true, 3000),
+            Next::Done { reached: true }
+        );
+        // Past 1%: run again for the goal moved by the miss, once.
+        assert_eq!(
+            goal_after(n, 1, 3249, true, 3000),
+            Next::Again { goal: 2751 }
+        );
+        assert_eq!(
+            goal_after(n, 1, 2969, true, 3000),
+            Next::Again { goal: 3031 }
+        );
+        assert_eq!(
+            goal_after(n, 2, 3086, true, 2224),
+            Next::Done { reached: false }
+        );
+        // A scan that did not reach its goal is not asked for more.
+        assert_eq!(
+            goal_after(n, 1, 2000, false, 3000),
+            Next::Done { reached: false }
+        );
+        // A sigma_p is reached when the scan reached it.
+        let s = Target::SigmaP(2.0);
+        assert_eq!(goal_after(s, 1, 10, true, 0), Next::Done { reached: true });
     }
 }
