@@ -115,9 +115,9 @@ impl Rows {
     }
 
     /// The index in `values` of `u` in the row of `v` (an edge's slot), if it is there.
-    pub(super) fn slot(&self, v: u32, u: u32) -> Option<usize> {
-        let from = self.start[v as usize] as usize;
-        self.row(v).binary_search(&u).ok().map(|k| from + k)
+    pub(super) fn slot(&self, v: u32, u: u32) -> Option<u32> {
+        let from = self.start[v as usize];
+        self.row(v).binary_search(&u).ok().map(|k| from + k as u32)
     }
 
     pub(super) fn row(&self, r: u32) -> &[u32] {

@@ -27,6 +27,8 @@ use rustc_hash::FxHashMap;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
+use rayon::prelude::*;
+
 use super::rows::Rows;
 use crate::disjoint_sets::Dsu;
 
@@ -95,8 +97,9 @@ pub(super) fn enforce(
     checked_in_scope(refined, samples, label, params, true)
 }
 
-/// [`enforce`], the checks after the first one over the cells a round changed (`incremental`)
-/// or over every cell (the same answer, at more cost: the tests compare them).
+/// [`enforce`], the checks after the first one over the cells a round changed, and the cells
+/// made connected again among those the round took vertices from (`incremental`), or over
+/// every cell (the same answer, at more cost: the tests compare them).
 fn checked_in_scope(
     refined: &Refined,
     samples: &[DVec3],
@@ -131,7 +134,7 @@ fn checked_in_scope(
         .collect();
     // A cell grown in pieces (a piece reached through vertices later taken by a nearer sample)
     // is made one before it is judged: its other pieces go to the cells around them.
-    connect_cells(refined, label, &mut dist, samples.len(), |l| {
+    connect_cells(refined, label, &mut dist, samples.len(), None, |l| {
         site(l, &added)
     });
     // The first check looks at every cell; the next ones only at the cells a round changed
@@ -162,6 +165,8 @@ fn checked_in_scope(
             .iter()
             .map(|&(_, v)| (v, label[v as usize]))
             .collect();
+        // The cells the insertions took refined vertices from: only they can have come apart.
+        let mut lost: Vec<u32> = Vec::new();
         for (&(_, v), &(_, l0)) in candidates.iter().zip(&start_label) {
             if added.len() >= budget {
                 break;
@@ -172,10 +177,15 @@ fn checked_in_scope(
             let x = refined.positions[v as usize];
             let s = (samples.len() + added.len()) as u32;
             added.push(x);
-            take_over(refined, label, &mut dist, s, v, x);
+            take_over(refined, label, &mut dist, s, v, x, &mut lost);
         }
         let count = samples.len() + added.len();
-        connect_cells(refined, label, &mut dist, count, |l| site(l, &added));
+        let mut torn = vec![false; count];
+        for l in lost {
+            torn[l as usize] = true;
+        }
+        let torn = incremental.then_some(&torn[..]);
+        connect_cells(refined, label, &mut dist, count, torn, |l| site(l, &added));
         stats.inserted = added.len();
         scope = incremental.then(|| Scope::changed(refined, &before, label, count, &cells, &pairs));
     }
@@ -183,17 +193,31 @@ fn checked_in_scope(
 }
 
 /// The refined vertices nearer to the new sample `s` at `x` (refined vertex `v`) than to their
-/// own, reached from `v` through such vertices, relabelled `s`.
-fn take_over(refined: &Refined, label: &mut [u32], dist: &mut [f64], s: u32, v: u32, x: DVec3) {
-    label[v as usize] = s;
-    dist[v as usize] = 0.0;
+/// own, reached from `v` through such vertices, relabelled `s`; the labels they had are pushed
+/// to `lost` (`u32::MAX` left out; a label may come more than once).
+fn take_over(
+    refined: &Refined,
+    label: &mut [u32],
+    dist: &mut [f64],
+    s: u32,
+    v: u32,
+    x: DVec3,
+    lost: &mut Vec<u32>,
+) {
+    let mut take = |u: u32, d: f64, label: &mut [u32], dist: &mut [f64]| {
+        let l = std::mem::replace(&mut label[u as usize], s);
+        if l != u32::MAX && lost.last() != Some(&l) {
+            lost.push(l);
+        }
+        dist[u as usize] = d;
+    };
+    take(v, 0.0, label, dist);
     let mut stack = vec![v];
     while let Some(a) = stack.pop() {
         for &b in refined.neighbours.row(a) {
             let d = refined.positions[b as usize].distance(x);
             if d < dist[b as usize] {
-                dist[b as usize] = d;
-                label[b as usize] = s;
+                take(b, d, label, dist);
                 stack.push(b);
             }
         }
@@ -203,23 +227,36 @@ fn take_over(refined: &Refined, label: &mut [u32], dist: &mut [f64], s: u32, v: 
 /// Each cell made connected again after insertions took parts of it over: the vertices of a
 /// cell not joined to its vertex nearest its sample through the cell are labelled anew, by a
 /// search from the cells around them (the nearest sample that reaches them, as
-/// `restricted_delaunay` grows the cells).
+/// `restricted_delaunay` grows the cells). Afterwards every cell is connected.
+///
+/// `torn`: per label, whether the cell may have come apart (the others are connected, as this
+/// function left them); `None`: any may have.
 fn connect_cells(
     refined: &Refined,
     label: &mut [u32],
     dist: &mut [f64],
     count: usize,
+    torn: Option<&[bool]>,
     site: impl Fn(u32) -> DVec3,
 ) {
     let n = refined.positions.len();
+    let checked = |l: u32| l != u32::MAX && torn.is_none_or(|t| t[l as usize]);
+    if torn.is_some_and(|t| !t.contains(&true)) {
+        return;
+    }
     let mut anchor = vec![(f64::INFINITY, u32::MAX); count];
     for v in 0..n {
         let l = label[v];
-        if l != u32::MAX && (dist[v], v as u32) < anchor[l as usize] {
+        if checked(l) && (dist[v], v as u32) < anchor[l as usize] {
             anchor[l as usize] = (dist[v], v as u32);
         }
     }
-    let mut joined = vec![false; n];
+    // Per refined vertex: whether it is labelled and joined to its cell's anchor (the cells not
+    // checked are).
+    let mut joined: Vec<bool> = label
+        .iter()
+        .map(|&l| l != u32::MAX && !checked(l))
+        .collect();
     let mut stack: Vec<u32> = anchor
         .iter()
         .filter(|a| a.1 != u32::MAX)
@@ -369,10 +406,10 @@ fn offending(
     let vertices = || all_vertices.clone().chain(listed_vertices.iter().copied());
     let faces = || all_faces.clone().chain(listed_faces.iter().copied());
     let judged = |l: u32| l != u32::MAX && scope.is_none_or(|s| s.dirty[l as usize]);
-    // Per label: vertices, edges and faces inside the cell, and its components.
+    // Per label: vertices, edges and faces inside the cell. Every cell is connected
+    // (`connect_cells` made it so), so a cell is a disc when its Euler characteristic is 1.
     let mut chi = vec![0i64; count];
     let mut present = vec![false; count];
-    let mut dsu = Dsu::new(n);
     for v in vertices() {
         let l = label[v as usize];
         if l == u32::MAX {
@@ -383,7 +420,6 @@ fn offending(
         for &u in refined.neighbours.row(v) {
             if u > v && label[u as usize] == l {
                 chi[l as usize] -= 1;
-                dsu.union(v as usize, u as usize, false);
             }
         }
     }
@@ -394,102 +430,72 @@ fn offending(
             chi[l as usize] += 1;
         }
     }
-    let mut components = vec![0u32; count];
-    for v in vertices() {
-        let (v, l) = (v as usize, label[v as usize]);
-        if l != u32::MAX && dsu.find(v).0 == v {
-            components[l as usize] += 1;
-        }
-    }
     let cells: Vec<u32> = (0..count)
-        .filter(|&l| judged(l as u32) && present[l] && (components[l] != 1 || chi[l] != 1))
+        .filter(|&l| judged(l as u32) && present[l] && chi[l] != 1)
         .map(|l| l as u32)
         .collect();
-    // Mixed edges (between two cells), each once, by its slot in the row of its lower vertex:
-    // those at a vertex in the scope.
-    let neighbours = refined.neighbours;
-    let slot = |a: u32, b: u32| neighbours.slot(a.min(b), a.max(b));
-    let pair = |a: u32, b: u32| [a.min(b), a.max(b)];
-    let mut edges: Vec<([u32; 2], usize)> = Vec::new();
-    for v in vertices() {
-        let l = label[v as usize];
-        if l == u32::MAX {
-            continue;
-        }
-        for &u in neighbours.row(v) {
-            let k = label[u as usize];
-            // Each mixed edge once: from its lower end, or from its end in the scope.
-            if k != l && k != u32::MAX && (u > v || !judged(k)) {
-                if let Some(e) = slot(v, u) {
-                    edges.push((pair(l, k), e));
-                }
-            }
-        }
-    }
-    // The mixed edges numbered in slot order (a fraction of all edges: the arrays below are
-    // per mixed edge, not per edge of the refined input).
-    let mut mixed: Vec<usize> = edges.iter().map(|e| e.1).collect();
-    mixed.sort_unstable();
-    mixed.dedup();
-    let id = |a: u32, b: u32| slot(a, b).and_then(|e| mixed.binary_search(&e).ok());
-    // Per mixed edge: the faces on it (an edge of one face is on the input's boundary), and
-    // whether it ends an arc (an edge of a face of three cells); the edges of one pair joined
-    // into arcs where they are edges of one face.
-    let mut arcs = Dsu::new(mixed.len());
-    let mut faces_on = vec![0u8; mixed.len()];
-    let mut ends = vec![false; mixed.len()];
-    for f in faces() {
+    // Pairs of cells that meet in more than one arc or in a closed curve, from the faces at
+    // their mixed edges (edges between two cells): one record per face and mixed edge, sorted
+    // by pair, each pair's arcs counted on its own (`pair_offends`). The pairs judged are those
+    // with a judged cell: all their mixed edges and the faces on them are in the scope.
+    let records = |f: u32| {
         let t = refined.triangles[f as usize];
         let l = t.map(|v| label[v as usize]);
-        let mut on = [None; 3];
-        for k in 0..3 {
+        let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+        let labelled = !l.contains(&u32::MAX);
+        let three = labelled && l[0] != l[1] && l[1] != l[2] && l[0] != l[2];
+        let mixed = [0, 1, 2].map(|k| {
             let (a, b) = (l[k], l[(k + 1) % 3]);
-            if a != b && a != u32::MAX && b != u32::MAX {
-                on[k] = id(t[k], t[(k + 1) % 3]);
-                if let Some(e) = on[k] {
-                    faces_on[e] = faces_on[e].saturating_add(1);
-                }
-            }
+            a != b && a != u32::MAX && b != u32::MAX && (judged(a) || judged(b))
+        });
+        // An edge by its slot in the row of its lower vertex.
+        let edge = |k: usize| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            refined
+                .neighbours
+                .slot(a.min(b), a.max(b))
+                .unwrap_or(NO_PARTNER)
+        };
+        // A face of two cells (no vertex unlabelled) has two mixed edges, which it joins: one
+        // record for both.
+        if labelled && !three && mixed.iter().filter(|&&m| m).count() == 2 {
+            let mut two = (0..3).filter(|&k| mixed[k]);
+            let (a, b) = (two.next().unwrap_or(0), two.next().unwrap_or(0));
+            let (ea, eb) = (edge(a), edge(b));
+            return [
+                Some((key(l[a], l[(a + 1) % 3]), ea.min(eb), ea.max(eb))),
+                None,
+                None,
+            ];
         }
-        if l.contains(&u32::MAX) || (l[0] == l[1] && l[1] == l[2]) {
-            continue;
-        }
-        if l[0] != l[1] && l[1] != l[2] && l[0] != l[2] {
-            for e in on.into_iter().flatten() {
-                ends[e] = true;
-            }
-            continue;
-        }
-        // Two of the three edges are mixed, of the same pair.
-        let mut two = on.into_iter().flatten();
-        if let (Some(e), Some(g)) = (two.next(), two.next()) {
-            arcs.union(e, g, false);
-        }
-    }
-    // An arc with no end (no face of three cells on it, no edge on the input's boundary) is a
-    // closed curve: two cells that meet all around, as two on a sphere.
-    let mut ended = vec![false; mixed.len()];
-    let edges: Vec<([u32; 2], usize)> = edges
-        .into_iter()
-        .filter_map(|(p, e)| mixed.binary_search(&e).ok().map(|i| (p, i)))
+        [0, 1, 2].map(|k| {
+            mixed[k].then(|| {
+                let partner = if three { ARC_END } else { NO_PARTNER };
+                (key(l[k], l[(k + 1) % 3]), edge(k), partner)
+            })
+        })
+    };
+    let mut recs: Vec<(u64, u32, u32)> = match scope {
+        Some(s) => s
+            .faces
+            .par_iter()
+            .flat_map_iter(|&f| records(f).into_iter().flatten())
+            .collect(),
+        None => (0..refined.triangles.len() as u32)
+            .into_par_iter()
+            .flat_map_iter(|f| records(f).into_iter().flatten())
+            .collect(),
+    };
+    recs.par_sort_unstable();
+    let pairs: Vec<[u32; 2]> = recs
+        .par_chunk_by(|a, b| a.0 == b.0)
+        .map_init(Vec::new, |edges, group| {
+            let pair = [(group[0].0 >> 32) as u32, group[0].0 as u32];
+            pair_offends(group, edges).then_some(pair)
+        })
+        .flatten()
         .collect();
-    for &(_, e) in &edges {
-        if ends[e] || faces_on[e] == 1 {
-            ended[arcs.find(e).0] = true;
-        }
-    }
-    let mut roots: Vec<([u32; 2], usize)> = edges
-        .into_iter()
-        .map(|(p, e)| (p, arcs.find(e).0))
-        .collect();
-    roots.sort_unstable();
-    roots.dedup();
-    let mut pairs: Vec<[u32; 2]> = roots
-        .chunk_by(|a, b| a.0 == b.0)
-        .filter(|group| group.len() > 1 || !ended[group[0].1])
-        .map(|group| group[0].0)
-        .collect();
-    pairs.sort_unstable();
+    drop(recs);
     // Three cells meet in at most one point: the faces of three cells of one triple, joined
     // where they share an edge, are one group. Where they are not, the three cells are judged
     // as cells that are not discs.
@@ -529,6 +535,52 @@ fn offending(
     cells.sort_unstable();
     cells.dedup();
     (cells, pairs)
+}
+
+/// [`offending`]'s record of a mixed edge on a face of three cells: it ends the arc through it.
+const ARC_END: u32 = u32::MAX;
+/// [`offending`]'s record of a mixed edge on a face with an unlabelled vertex: neither joined
+/// nor ended there.
+const NO_PARTNER: u32 = u32::MAX - 1;
+
+/// Whether two cells meet in more than one arc or in a closed curve, from the records of their
+/// mixed edges (`group`, sorted: (pair, edge, other) per face on a mixed edge, the pair as two
+/// labels, edges by their slots in the refined input's rows; a face of the two cells gives one
+/// record of its two mixed edges, a face of three cells one per edge with [`ARC_END`], a face
+/// with an unlabelled vertex one per edge with [`NO_PARTNER`]). The mixed edges joined through
+/// faces of the two cells are arcs; an arc is ended by a face of three cells on one of its
+/// edges or by an edge of one face (on the input's boundary); an arc with no end is a closed
+/// curve. `edges`: scratch.
+fn pair_offends(group: &[(u64, u32, u32)], edges: &mut Vec<u32>) -> bool {
+    let joins = |other: u32| other != ARC_END && other != NO_PARTNER;
+    edges.clear();
+    for &(_, e, other) in group {
+        edges.push(e);
+        if joins(other) {
+            edges.push(other);
+        }
+    }
+    edges.sort_unstable();
+    edges.dedup();
+    let at = |e: u32| edges.binary_search(&e).unwrap_or(0);
+    let mut arcs = Dsu::new(edges.len());
+    // Per edge: the faces on it, and whether a face of three cells is one of them.
+    let mut faces_on = vec![0u32; edges.len()];
+    let mut ends = vec![false; edges.len()];
+    for &(_, e, other) in group {
+        let i = at(e);
+        faces_on[i] += 1;
+        if other == ARC_END {
+            ends[i] = true;
+        } else if joins(other) {
+            let j = at(other);
+            faces_on[j] += 1;
+            arcs.union(i, j, false);
+        }
+    }
+    let first = arcs.find(0).0;
+    let one_arc = (0..edges.len()).all(|i| arcs.find(i).0 == first);
+    !one_arc || !(0..edges.len()).any(|i| ends[i] || faces_on[i] == 1)
 }
 
 /// Where to insert for the offending `cells` and `pairs`: for a cell, its refined vertex
@@ -648,6 +700,67 @@ mod tests {
         assert!(added.len() >= 3 && added.len() <= 6, "{stats:?}");
         let (cells, pairs) = offending(&refined, &label, 1 + added.len(), None);
         assert!(cells.is_empty() && pairs.is_empty());
+    }
+
+    /// Whether the refined vertices of each label are joined through vertices of that label.
+    fn every_cell_connected(refined: &Refined, label: &[u32]) -> bool {
+        let mut dsu = Dsu::new(label.len());
+        for v in 0..label.len() as u32 {
+            for &u in refined.neighbours.row(v) {
+                if label[u as usize] == label[v as usize] {
+                    dsu.union(v as usize, u as usize, false);
+                }
+            }
+        }
+        let mut root: FxHashMap<u32, usize> = FxHashMap::default();
+        (0..label.len()).all(|v| {
+            let r = dsu.find(v).0;
+            label[v] == u32::MAX || *root.entry(label[v]).or_insert(r) == r
+        })
+    }
+
+    /// The check judges a cell by its Euler characteristic alone, which holds only for a
+    /// connected cell: a cell in two pieces (each a disc: χ = 2) is made one by
+    /// `connect_cells`, its far piece going to the cell around it, whether every cell is looked
+    /// at or only the torn ones.
+    #[test]
+    fn a_cell_in_pieces_is_made_one() {
+        let n = 12;
+        let mesh = test_meshes::grid(n, |i, j| DVec3::new(i as f64, j as f64, 0.0));
+        let neighbours = rows(&mesh.positions, &mesh.triangles);
+        let refined = Refined {
+            positions: &mesh.positions,
+            triangles: &mesh.triangles,
+            neighbours: &neighbours,
+        };
+        let samples = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(8.0, 8.0, 0.0)];
+        // Sample 0's cell: the corner square around it and the far corner's square, cut off by
+        // sample 1's cell.
+        let in_square = |p: DVec3, c: f64| (p.x - c).abs() <= 1.0 && (p.y - c).abs() <= 1.0;
+        let start: Vec<u32> = mesh
+            .positions
+            .iter()
+            .map(|&p| u32::from(!(in_square(p, 0.0) || in_square(p, 12.0))))
+            .collect();
+        assert!(!every_cell_connected(&refined, &start));
+        let (cells, _) = offending(&refined, &start, 2, None);
+        assert_eq!(cells, vec![0], "χ 2 for the two pieces");
+        for torn in [None, Some(&[true, false][..])] {
+            let mut label = start.clone();
+            let mut dist: Vec<f64> = label
+                .iter()
+                .zip(&mesh.positions)
+                .map(|(&l, p)| p.distance(samples[l as usize]))
+                .collect();
+            connect_cells(&refined, &mut label, &mut dist, 2, torn, |l| {
+                samples[l as usize]
+            });
+            assert!(every_cell_connected(&refined, &label), "{torn:?}");
+            let far = mesh.positions.iter().position(|p| in_square(*p, 12.0));
+            assert_eq!(far.map(|v| label[v]), Some(1), "{torn:?}");
+            let (cells, pairs) = offending(&refined, &label, 2, None);
+            assert!(cells.is_empty() && pairs.is_empty(), "{cells:?} {pairs:?}");
+        }
     }
 
     #[test]
