@@ -204,13 +204,13 @@ impl<'a> InputIndex<'a> {
 pub(super) struct Candidates {
     /// Area-uniform random points with their face's normal (bbox-100 units).
     pub pool: Vec<SurfaceSample>,
-    /// Input-surface points the optimization keeps within its cover distance of the output:
-    /// the input's vertices and the candidates, those buried left out.
-    pub cover_points: Vec<DVec3>,
+    /// The input's vertices, those buried left out: with the pool as drawn, the points the
+    /// optimization keeps covered ([`Candidates::cover_points`]).
+    input_points: Vec<DVec3>,
     /// Candidates left out as buried inside the input's own solid.
     pub buried: usize,
-    /// The pool as drawn, area-uniform (kept once a graded supplement is added, for the next
-    /// grading), and its density per unit area.
+    /// The pool as drawn, area-uniform, and its density per unit area, while a graded
+    /// supplement is in `pool` (for the next grading; `None` while `pool` is as drawn).
     uniform: Option<(Vec<SurfaceSample>, f64)>,
 }
 
@@ -249,17 +249,24 @@ impl Candidates {
             test.remove_buried(&mut vertices, |&v| v);
             input_points = vertices.into_iter().map(|(p, _, _)| p).collect();
         }
-        let cover_points: Vec<DVec3> = input_points
-            .iter()
-            .copied()
-            .chain(pool.iter().map(|c| c.position))
-            .collect();
         Candidates {
             pool,
-            cover_points,
+            input_points,
             buried,
             uniform: None,
         }
+    }
+
+    /// Input-surface points the optimization keeps within its cover distance of the output:
+    /// the input's vertices and the candidates as drawn (area-uniform), those buried left out.
+    /// Made when the finishing stage needs them, not kept (bbox-100 units).
+    pub(super) fn cover_points(&self) -> Vec<DVec3> {
+        let drawn = self.uniform.as_ref().map_or(&self.pool, |u| &u.0);
+        self.input_points
+            .iter()
+            .copied()
+            .chain(drawn.iter().map(|c| c.position))
+            .collect()
     }
 
     /// The pool made to follow the sizing `field` (relative widths in (0, 1]): the area-uniform
@@ -277,14 +284,17 @@ impl Candidates {
         seed: u64,
         round: u64,
     ) {
+        if field.is_uniform() {
+            // The pool as drawn again (no copy of it is kept while the pool is that).
+            if let Some((uniform, _)) = self.uniform.take() {
+                self.pool = uniform;
+            }
+            return;
+        }
         let (uniform, density) = self.uniform.get_or_insert_with(|| {
             let density = self.pool.len() as f64 / input.area.max(f64::MIN_POSITIVE);
             (self.pool.clone(), density)
         });
-        if field.is_uniform() {
-            self.pool.clone_from(uniform);
-            return;
-        }
         let mesh = &input.mesh;
         let widths: Vec<f64> = (0..mesh.face_count())
             .into_par_iter()

@@ -329,9 +329,10 @@ fn run_once<'s>(
         near: op.near.max(near),
         ..op
     });
+    let cover_points = candidates.cover_points();
     let finishing = Finishing {
         surface: &index.surface,
-        cover_points: &candidates.cover_points,
+        cover_points: &cover_points,
         fixed: ascended.boundary_count,
         untangle_moves_fixed: false,
         protected: feature_edges,
