@@ -50,18 +50,28 @@ impl CreaseBand {
     /// The distance from `x` to the nearest feature edge (bbox-100 units), to within half the
     /// step.
     pub fn distance(&self, x: DVec3) -> f64 {
-        let mut near = Vec::with_capacity(1);
-        self.tree.nearest_n(x, 1, &mut near);
-        near.first().map_or(f64::INFINITY, |&(_, d2)| d2.sqrt())
+        self.tree
+            .nearest(x)
+            .map_or(f64::INFINITY, |(_, d2)| d2.sqrt())
     }
 
     /// Whether a move from `from` to `to` of a sample of relative kernel width `width` is
     /// refused: it ends inside the band (half-width [`CREASE_BAND_PER_SPACING`] · `width` ·
     /// spacing) and nearer to a feature edge than it started.
+    ///
+    /// Most moves end far from every crease: the distance at `to` is searched only within the
+    /// band (a little wider, against rounding), where it is the nearest point's as
+    /// [`CreaseBand::distance`] gives it; beyond, the move is taken without the search of
+    /// everything.
     pub fn refuses(&self, from: DVec3, to: DVec3, width: f64) -> bool {
-        let d = self.distance(to);
-        d < CREASE_BAND_PER_SPACING * width * self.spacing
-            && d < self.distance(from) - 0.5 * self.step
+        let band = CREASE_BAND_PER_SPACING * width * self.spacing;
+        let mut nearest_2 = f64::INFINITY;
+        self.tree
+            .visit_within(to, band * band * (1.0 + 1e-9), |_, d2| {
+                nearest_2 = nearest_2.min(d2);
+            });
+        let d = nearest_2.sqrt();
+        d < band && d < self.distance(from) - 0.5 * self.step
     }
 }
 
@@ -110,5 +120,48 @@ mod tests {
         ));
         // No edges, no band.
         assert!(CreaseBand::new(&positions, &[], 1.0, 0.01).is_none());
+    }
+
+    /// The search within the band decides as the distances to the nearest point do, on moves
+    /// that end inside, at the edge of and beyond the band around a bent crease.
+    #[test]
+    fn the_search_within_the_band_decides_as_the_distances_do() {
+        use rand::{RngExt, SeedableRng};
+        let positions: Vec<DVec3> = (0..12)
+            .map(|i| {
+                let t = i as f64 * 0.5;
+                DVec3::new(t, (0.7 * t).sin(), 0.2 * t)
+            })
+            .collect();
+        let edges: Vec<[u32; 2]> = (0..11).map(|i| [i, i + 1]).collect();
+        let band = CreaseBand::new(&positions, &edges, 1.0, 0.05).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let (mut refused, mut taken) = (0, 0);
+        for _ in 0..4000 {
+            let at = |rng: &mut rand_chacha::ChaCha8Rng| {
+                DVec3::new(
+                    rng.random_range(-0.5..6.0),
+                    rng.random_range(-1.5..1.5),
+                    rng.random_range(-0.5..1.5),
+                )
+            };
+            let from = at(&mut rng);
+            let to = from + 0.3 * (at(&mut rng) - from).normalize_or_zero();
+            let width = rng.random_range(0.2..1.0);
+            let d = band.distance(to);
+            let by_distances = d < CREASE_BAND_PER_SPACING * width * band.spacing
+                && d < band.distance(from) - 0.5 * band.step;
+            assert_eq!(
+                band.refuses(from, to, width),
+                by_distances,
+                "{from} {to} {width}"
+            );
+            if by_distances {
+                refused += 1;
+            } else {
+                taken += 1;
+            }
+        }
+        assert!(refused > 50 && taken > 50, "{refused} {taken}");
     }
 }
