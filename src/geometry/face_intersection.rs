@@ -23,8 +23,8 @@ use glam::DVec3;
 use serde::Serialize;
 
 use super::triangle_intersection::{
-    orient, point_triangle_distance, same_side_in_plane, segment_meets_triangle,
-    segment_triangle_distance, triangles_within,
+    apart_segment_within, orient, point_triangle_distance, same_side_in_plane,
+    segment_meets_triangle, triangles_within,
 };
 
 /// How the two faces of an intersecting pair are joined in the mesh.
@@ -141,11 +141,13 @@ pub(crate) fn faces_within(
         Shared::Vertex(i, j) => {
             let (a1, a2) = (pa[(i + 1) % 3], pa[(i + 2) % 3]);
             let (b1, b2) = (pb[(j + 1) % 3], pb[(j + 2) % 3]);
+            // Neither segment meets the other face past the first two tests: the distances
+            // are those of segments apart.
             let meet = segment_meets_triangle(a1, a2, pb)
                 || segment_meets_triangle(b1, b2, pa)
                 || (near > 0.0
-                    && (segment_triangle_distance(a1, a2, pb) <= near
-                        || segment_triangle_distance(b1, b2, pa) <= near));
+                    && (apart_segment_within(a1, a2, pb, near)
+                        || apart_segment_within(b1, b2, pa, near)));
             meet.then_some(PairKind::AtVertex)
         }
         Shared::Edge(k, l) => {

@@ -174,6 +174,25 @@ pub(crate) fn segment_triangle_distance(p: DVec3, q: DVec3, t: [DVec3; 3]) -> f6
     ends.into_iter().chain(edges).fold(f64::INFINITY, f64::min)
 }
 
+/// Whether the closed segment `p q` comes within `near` of the closed triangle `t`
+/// (non-degenerate) that it does not meet (`segment_meets_triangle` false): as
+/// `segment_triangle_distance(p, q, t) <= near`, without its distances where both ends lie on
+/// one side of the triangle's plane and farther from it than `near` (with a margin far above
+/// the rounding of either computation, 1e-9 of the lengths involved): the plane's distance is a
+/// lower bound of the triangle's.
+pub(crate) fn apart_segment_within(p: DVec3, q: DVec3, t: [DVec3; 3], near: f64) -> bool {
+    let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+    let (dp, dq) = ((p - t[0]).dot(n), (q - t[0]).dot(n));
+    let scale = (p - t[0]).length() + (q - t[0]).length() + (t[1] - t[0]).length();
+    let margin = near + 1e-9 * scale;
+    if n != DVec3::ZERO && ((dp > margin && dq > margin) || (dp < -margin && dq < -margin)) {
+        return false;
+    }
+    let ends = [p, q].map(|x| point_triangle_distance(x, t));
+    let edges = (0..3).map(|k| segment_distance(p, q, t[k], t[(k + 1) % 3]));
+    ends.into_iter().chain(edges).fold(f64::INFINITY, f64::min) <= near
+}
+
 /// Whether `r` and `s`, coplanar with the segment `p q` (`orient(p, q, r, s) == 0`, `p q r` a
 /// non-degenerate triangle), lie strictly on the same side of the line through `p` and `q`,
 /// decided exactly: in the plane's projection along the largest component of its normal, which
@@ -330,6 +349,46 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// The plane's bound leaves the answer of the distances: segments apart from a triangle,
+    /// on one side of its plane, across it, in it, and at distances around `near`.
+    #[test]
+    fn the_plane_bound_answers_as_the_distances_do() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let t = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.1, 0.0),
+            DVec3::new(0.2, 0.9, 0.0),
+        ];
+        let (mut within, mut apart) = (0, 0);
+        for k in 0..20_000 {
+            let near = [1e-3, 0.05, 0.3][k % 3];
+            let lift = [0.0, 1.0, 0.1, 1e-3][k % 4];
+            let mut at = |z: f64| {
+                DVec3::new(
+                    rng.random_range(-0.5..1.5),
+                    rng.random_range(-0.5..1.5),
+                    z * rng.random_range(-1.0..1.0),
+                )
+            };
+            let (p, q) = (at(lift), at(lift));
+            if segment_meets_triangle(p, q, t) {
+                continue;
+            }
+            let expected = segment_triangle_distance(p, q, t) <= near;
+            assert_eq!(
+                apart_segment_within(p, q, t, near),
+                expected,
+                "{p} {q} {near}"
+            );
+            if expected {
+                within += 1;
+            } else {
+                apart += 1;
+            }
+        }
+        assert!(within > 500 && apart > 500, "{within} {apart}");
+    }
 
     fn v(x: f64, y: f64, z: f64) -> DVec3 {
         DVec3::new(x, y, z)
