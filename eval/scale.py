@@ -168,7 +168,7 @@ def sitting(path, n, tools, repeats, seed, work, geogram_tool, args, unavailable
                 continue
             cmd, out = command(tool, path, n, seed, work, geogram_tool, args.distance)
             try:
-                wall, rss, _ = run_timed(cmd, timeout=args.timeout)
+                wall, rss, _, cpu = run_timed(cmd, timeout=args.timeout, cpu=True)
                 if k == 0:
                     measured[tool] = output_measures(out)
                 if tool == "ours":
@@ -182,16 +182,17 @@ def sitting(path, n, tools, repeats, seed, work, geogram_tool, args, unavailable
             finally:
                 for f in work.glob(f"{tool}*"):
                     f.unlink()
-            runs[tool].append((wall, rss))
-            print(f"  {n:,} run {k + 1}: {TOOLS[tool]}: {wall:.2f} s, {rss:.0f} MiB"
+            runs[tool].append((wall, rss, cpu))
+            print(f"  {n:,} run {k + 1}: {TOOLS[tool]}: {wall:.2f} s, {cpu:.2f} processor s, {rss:.0f} MiB"
                   + (f", {measured[tool]['vertices']:,} vertices" if k == 0 else ""), flush=True)
     results = {}
     for tool in tools:
         if tool in failed:
             results[tool] = {"failed": failed[tool]}
             continue
-        walls, rss = [w for w, _ in runs[tool]], [r for _, r in runs[tool]]
-        r = {"wall_s": statistics.median(walls), "wall_runs": walls, "peak_rss_mib": max(rss), "rss_runs": rss}
+        walls, rss, cpus = ([x[i] for x in runs[tool]] for i in range(3))
+        r = {"wall_s": statistics.median(walls), "wall_runs": walls, "peak_rss_mib": max(rss), "rss_runs": rss,
+             "cpu_s": statistics.median(cpus), "cpu_runs": cpus}
         r.update(measured[tool])
         r["us_per_vertex"] = 1e6 * r["wall_s"] / r["vertices"]
         results[tool] = r
@@ -327,52 +328,62 @@ def stage_table(rows):
     return "\n".join(lines)
 
 
-def ratio(sizes_row, reference):
-    """Ours' median wall seconds over the reference's at one size, or None."""
+def ratio(sizes_row, reference, key="wall_s"):
+    """Ours' median wall seconds (`key` "cpu_s": processor seconds) over the reference's at one
+    size, or None (a run failed, or a sitting from before processor seconds were kept)."""
     ours, ref = sizes_row["tools"].get("ours", {}), sizes_row["tools"].get(reference, {})
-    if "wall_s" in ours and "wall_s" in ref:
-        return ours["wall_s"] / ref["wall_s"]
+    if key in ours and key in ref:
+        return ours[key] / ref[key]
     return None
 
 
 def comparison_table(sizes, tools):
-    """One row per size: each tool's median wall seconds, peak MiB, vertices, Qave and θmin, then
-    ours' time over CGAL's and over MeshLib's."""
+    """One row per size: each tool's median wall and processor seconds, peak MiB, vertices, Qave
+    and θmin, then ours' time over CGAL's and over MeshLib's, and ours' processor time over
+    CGAL's."""
     head = ["asked"]
     for t in tools:
-        head += [f"{SHORT[t]} s", f"{SHORT[t]} MiB", f"{SHORT[t]} V", f"{SHORT[t]} Qave", f"{SHORT[t]} θmin"]
+        head += [f"{SHORT[t]} s", f"{SHORT[t]} cpu s", f"{SHORT[t]} MiB", f"{SHORT[t]} V", f"{SHORT[t]} Qave",
+                 f"{SHORT[t]} θmin"]
     ratios = [r for r in ("cgal", "meshlib") if r in tools]
     head += [f"ours / {SHORT[r]}" for r in ratios]
+    head += ["ours cpu / CGAL cpu"] if "cgal" in tools else []
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for s in sizes:
         cells = [f"{s['target']:,}"]
         for t in tools:
             r = s["tools"][t]
             if "failed" in r:
-                cells += [f"failed: {r['failed']}", "–", "–", "–", "–"]
+                cells += [f"failed: {r['failed']}", "–", "–", "–", "–", "–"]
             else:
-                cells += [f"{r['wall_s']:.2f}", f"{r['peak_rss_mib']:.0f}", f"{r['vertices']:,}",
+                cpu = f"{r['cpu_s']:.2f}" if "cpu_s" in r else "–"
+                cells += [f"{r['wall_s']:.2f}", cpu, f"{r['peak_rss_mib']:.0f}", f"{r['vertices']:,}",
                           f"{r['q_ave']:.4f}", f"{r['theta_min']:.2f}"]
         for ref in ratios:
             x = ratio(s, ref)
+            cells.append("–" if x is None else f"{x:.2f}")
+        if "cgal" in tools:
+            x = ratio(s, "cgal", "cpu_s")
             cells.append("–" if x is None else f"{x:.2f}")
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
 def runs_table(sizes, tools):
-    """One row per size and tool: every run's wall seconds and peak MiB, time per vertex, faces
-    and θmax."""
-    lines = ["| asked | tool | wall s (runs) | peak MiB (runs) | µs/vertex | vertices | faces | θmax |",
-             "|---|---|---|---|---|---|---|---|"]
+    """One row per size and tool: every run's wall and processor seconds and peak MiB, time per
+    vertex, faces and θmax."""
+    lines = ["| asked | tool | wall s (runs) | processor s (runs) | peak MiB (runs) | µs/vertex | vertices | faces "
+             "| θmax |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for s in sizes:
         for t in tools:
             r = s["tools"][t]
             if "failed" in r:
-                lines.append(f"| {s['target']:,} | {TOOLS[t]} | failed: {r['failed']} | | | | | |")
+                lines.append(f"| {s['target']:,} | {TOOLS[t]} | failed: {r['failed']} | | | | | | |")
                 continue
             lines.append(
                 f"| {s['target']:,} | {TOOLS[t]} | {', '.join(f'{w:.2f}' for w in r['wall_runs'])} | "
+                f"{', '.join(f'{c:.2f}' for c in r.get('cpu_runs', [])) or '–'} | "
                 f"{', '.join(f'{m:.0f}' for m in r['rss_runs'])} | {r['us_per_vertex']:.0f} | {r['vertices']:,} | "
                 f"{r['faces']:,} | {r['theta_max']:.2f} |")
     return "\n".join(lines)
@@ -393,6 +404,30 @@ def targets_lines(sizes):
             else:
                 verdict = "met" if x <= bound else "not met"
                 parts.append(f"ours / {SHORT[ref]} {x:.2f} (target ≤ {bound:g}: {verdict})")
+        if parts:
+            lines.append(f"- {s['target']:,}: " + "; ".join(parts))
+    return lines
+
+
+def targets_77(sizes):
+    """Issue 77's targets at each size: ours' processor seconds at most twice CGAL 1-iteration's,
+    its wall seconds at most CGAL's; at 1,000,000, at most 60 s and 1 GiB."""
+    lines = []
+    for s in sizes:
+        ours = s["tools"].get("ours", {})
+        if "cpu_s" not in ours:
+            continue
+        parts = []
+        x = ratio(s, "cgal", "cpu_s")
+        if x is not None:
+            parts.append(f"processor ours / CGAL {x:.2f} (target ≤ 2: {'met' if x <= 2 else 'not met'})")
+        x = ratio(s, "cgal")
+        if x is not None:
+            parts.append(f"wall ours / CGAL {x:.2f} (target ≤ 1: {'met' if x <= 1 else 'not met'})")
+        if s["target"] == 1_000_000:
+            w, m = ours["wall_s"], ours["peak_rss_mib"]
+            parts.append(f"{w:.1f} s (target ≤ 60: {'met' if w <= 60 else 'not met'}), "
+                         f"{m:.0f} MiB (target ≤ 1024: {'met' if m <= 1024 else 'not met'})")
         if parts:
             lines.append(f"- {s['target']:,}: " + "; ".join(parts))
     return lines
@@ -461,6 +496,8 @@ def markdown(data, args, label):
             "",
             *targets_lines(sizes),
             "",
+            *(["Issue 77's targets (processor seconds at most twice CGAL 1-iteration's, wall at most its; "
+               "1,000,000 in 60 s and 1 GiB):", "", *targets_77(sizes), ""] if targets_77(sizes) else []),
             "![time per vertex](time-per-vertex{0}.png) ![memory](memory{0}.png)".format(label),
             "",
             "## Every run",

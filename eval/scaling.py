@@ -54,9 +54,10 @@ class RunFailed(Exception):
         self.timed_out = timed_out
 
 
-def run_timed(cmd, timeout=None):
+def run_timed(cmd, timeout=None, cpu=False):
     """Runs cmd under GNU time -v (its figures written to a file of their own, apart from the
-    command's stderr); returns (wall seconds, peak RSS in MiB, stdout). Raises RunFailed when the
+    command's stderr); returns (wall seconds, peak RSS in MiB, stdout), and with `cpu` the
+    processor seconds (user + system, every thread) after them. Raises RunFailed when the
     command exits non-zero (with the last line of its stderr) or is still running after `timeout`
     seconds (then its whole process group is killed)."""
     with tempfile.NamedTemporaryFile("r", prefix="gnu-time-", suffix=".txt") as figures:
@@ -78,6 +79,10 @@ def run_timed(cmd, timeout=None):
     for part in wall.split(":"):
         seconds = seconds * 60 + float(part)
     rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", report).group(1))
+    if cpu:
+        processor = sum(float(re.search(rf"{kind} time \(seconds\): (\S+)", report).group(1))
+                        for kind in ("User", "System"))
+        return seconds, rss_kb / 1024, stdout, processor
     return seconds, rss_kb / 1024, stdout
 
 

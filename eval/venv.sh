@@ -14,5 +14,6 @@ if [[ ! -x "$venv/bin/python" || ! -f "$stamp" || "$(cat "$stamp")" != "$want" ]
 fi
 echo "eval: building remesh (release)" >&2
 (cd "$root" && cargo build --release --quiet --bin remesh)
-export REMESH_BIN="${CARGO_TARGET_DIR:-$root/target}/release/remesh"
+# A REMESH_BIN given (another build, to compare) is kept.
+export REMESH_BIN="${REMESH_BIN:-${CARGO_TARGET_DIR:-$root/target}/release/remesh}"
 PYTHON="$venv/bin/python"
