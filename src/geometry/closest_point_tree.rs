@@ -10,8 +10,11 @@
 //! begins with that triangle's distance as the bound, so the walk visits only the boxes that
 //! could hold something closer: the root-to-leaf paths near the point. The answer is the
 //! exact closest point either way (Ericson, *Real-Time Collision Detection*, 2005, Sec. 5.1.5,
-//! for the point-triangle test); a start only decides among triangles at exactly equal
-//! distances, where it keeps the start.
+//! for the point-triangle test); among triangles at exactly equal distances (a point whose
+//! closest point is a vertex or an edge they share) every query keeps the one of the smallest
+//! identifier, so the answer is one with or without a start and in any order of visits
+//! ([`ClosestPointTree::closest_each`], and the walk over a face's ring that is asked first,
+//! `geometry::closest_point_walk`).
 
 use glam::DVec3;
 
@@ -103,6 +106,19 @@ impl ClosestPointTree {
         self.walk(p, max_distance_squared, None, true).is_some()
     }
 
+    /// [`ClosestPointTree::any_within`], trying the triangle `start` names first (the one a
+    /// previous point near `p` found): the identifier of a triangle that close, `None` when
+    /// there is none.
+    pub fn any_within_from(
+        &self,
+        p: DVec3,
+        max_distance_squared: f64,
+        start: Option<u32>,
+    ) -> Option<u32> {
+        self.walk(p, max_distance_squared, start, true)
+            .map(|c| c.id)
+    }
+
     /// Whether the tree has no triangle.
     pub fn is_empty(&self) -> bool {
         self.ids.is_empty()
@@ -111,8 +127,8 @@ impl ClosestPointTree {
     /// The closest point of the triangles to `p` at a squared distance below
     /// `max_distance_squared`, or `None` (no triangle that close, or `p` not finite). `start`,
     /// when it names a triangle of the tree, is tried first and bounds the search: give the
-    /// triangle of a previous answer near `p`. The answer is the same with or without it, up to
-    /// the choice among triangles at exactly equal distances.
+    /// triangle of a previous answer near `p`. The answer is the same with or without it (among
+    /// triangles at exactly equal distances, the smallest identifier).
     pub fn closest(
         &self,
         p: DVec3,
@@ -127,10 +143,9 @@ impl ClosestPointTree {
     /// `max_distance_squared[k]` and started from `start[k]`. One walk serves them all: a box is
     /// entered when it meets the box around every point's ball of its best distance so far
     /// (one test per box instead of one per point), and a leaf's triangles are tried for the
-    /// points its box is closer to than their best. Each answer is exact, as for one point;
-    /// among triangles at exactly equal distances the one kept can differ from
-    /// [`ClosestPointTree::closest`]'s, which visits the boxes in another order. The four slices
-    /// have one length (more than [`GROUP`] points are answered in groups).
+    /// points its box is closer to than their best. Each answer is [`ClosestPointTree::closest`]'s
+    /// for that point. The four slices have one length (more than [`GROUP`] points are answered
+    /// in groups).
     pub fn closest_each(
         &self,
         points: &[DVec3],
@@ -203,12 +218,12 @@ impl ClosestPointTree {
                 let mut closer = false;
                 for t in first..first + node.count as usize {
                     for k in 0..n {
-                        if to_box[k] >= best[k] {
+                        if to_box[k] > best[k] {
                             continue;
                         }
                         let (q, bary) = closest_on_triangle(points[k], &self.corners[t]);
                         let d = q.distance_squared(points[k]);
-                        if d < best[k] {
+                        if self.nearer(d, t, best[k], found[k].map(|f| f.0)) {
                             best[k] = d;
                             found[k] = Some((t, q, bary));
                             closer = true;
@@ -269,6 +284,95 @@ impl ClosestPointTree {
         })
     }
 
+    /// The number of triangles (slots `0..len`, in leaf order).
+    pub(crate) fn len(&self) -> usize {
+        self.ids.len()
+    }
+
+    /// The caller's identifier of the triangle at `slot`.
+    pub(crate) fn id(&self, slot: usize) -> u32 {
+        self.ids[slot]
+    }
+
+    /// The slot of the triangle the caller calls `id`, if the tree holds it.
+    pub(crate) fn slot_of(&self, id: u32) -> Option<usize> {
+        let k = *self.slot.get(id as usize)?;
+        (k != u32::MAX).then_some(k as usize)
+    }
+
+    /// The corners of the triangle at `slot`, as given.
+    pub(crate) fn corners_at(&self, slot: usize) -> &[DVec3; 3] {
+        &self.corners[slot]
+    }
+
+    /// The box around every triangle (`None` without triangles).
+    pub(crate) fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        self.nodes.first().map(|n| (n.lo, n.hi))
+    }
+
+    /// [`ClosestPointTree::closest`] (no start) among the triangles whose slot `skip` is false
+    /// for.
+    pub(crate) fn closest_skipping(
+        &self,
+        p: DVec3,
+        max_distance_squared: f64,
+        skip: impl Fn(usize) -> bool,
+    ) -> Option<Closest> {
+        self.walk_by(p, max_distance_squared, None, false, skip)
+    }
+
+    /// The slots of the triangles at a squared distance below `max_distance_squared` from `p`
+    /// whose slot `skip` is false for, with those squared distances, into `out` (cleared first;
+    /// in no particular order).
+    pub(crate) fn within_skipping(
+        &self,
+        p: DVec3,
+        max_distance_squared: f64,
+        skip: impl Fn(usize) -> bool,
+        out: &mut Vec<(usize, f64)>,
+    ) {
+        out.clear();
+        if !p.is_finite() || self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = [0u32; STACK];
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let node = self.nodes[stack[len] as usize];
+            if box_distance_squared(p, &node) >= max_distance_squared {
+                continue;
+            }
+            if node.count > 0 {
+                let first = node.first as usize;
+                for k in first..first + node.count as usize {
+                    if skip(k) {
+                        continue;
+                    }
+                    let d = closest_on_triangle(p, &self.corners[k])
+                        .0
+                        .distance_squared(p);
+                    if d < max_distance_squared {
+                        out.push((k, d));
+                    }
+                }
+            } else {
+                stack[len] = node.first;
+                stack[len + 1] = node.first + 1;
+                len += 2;
+            }
+        }
+    }
+
+    /// Whether the triangle at `slot`, at squared distance `d`, is a better answer than the one
+    /// at slot `found` at `best` (`None`: nothing below the bound `best` yet): nearer, or as near
+    /// with a smaller identifier. Every search keeps the least in this order, so its answer
+    /// does not depend on the order it visits the triangles in or where it starts.
+    #[inline]
+    pub(crate) fn nearer(&self, d: f64, slot: usize, best: f64, found: Option<usize>) -> bool {
+        d < best || (d == best && found.is_some_and(|f| self.ids[slot] < self.ids[f]))
+    }
+
     /// The depth-first walk of both queries: nearer child first, pruned by the best squared
     /// distance so far (first `start`'s, when it names a triangle); with `first_hit`, it ends at
     /// the first triangle below the bound.
@@ -279,33 +383,57 @@ impl ClosestPointTree {
         start: Option<u32>,
         first_hit: bool,
     ) -> Option<Closest> {
+        self.walk_by(p, max_distance_squared, start, first_hit, |_| false)
+    }
+
+    /// [`ClosestPointTree::walk`] over the triangles whose slot `skip` is false for.
+    #[inline(always)]
+    fn walk_by(
+        &self,
+        p: DVec3,
+        max_distance_squared: f64,
+        start: Option<u32>,
+        first_hit: bool,
+        skip: impl Fn(usize) -> bool,
+    ) -> Option<Closest> {
         if !p.is_finite() || self.nodes.is_empty() {
             return None;
         }
         let mut best = max_distance_squared;
         let mut found = self.start_answer(p, start, &mut best);
+        if first_hit && found.is_some() {
+            return found.map(|(k, point, barycentric)| Closest {
+                id: self.ids[k],
+                point,
+                barycentric,
+                distance_squared: best,
+            });
+        }
         // The stack grows by at most one entry per level, and median splits keep the depth
         // below 32 for any u32 count of triangles.
         let mut stack = [(0u32, 0.0f64); STACK];
         let mut len = 0;
         let root = box_distance_squared(p, &self.nodes[0]);
-        if root < best {
+        if root <= best {
             stack[0] = (0, root);
             len = 1;
         }
         'walk: while len > 0 {
             len -= 1;
             let (n, d) = stack[len];
-            if d >= best {
+            if d > best {
                 continue;
             }
             let node = self.nodes[n as usize];
             if node.count > 0 {
                 let first = node.first as usize;
                 for k in first..first + node.count as usize {
+                    if skip(k) {
+                        continue;
+                    }
                     let (q, bary) = closest_on_triangle(p, &self.corners[k]);
                     let d = q.distance_squared(p);
-                    if d < best {
+                    if self.nearer(d, k, best, found.map(|f| f.0)) {
                         best = d;
                         found = Some((k, q, bary));
                         if first_hit {
@@ -323,7 +451,7 @@ impl ClosestPointTree {
                     ((r, dr), (l, dl))
                 };
                 for entry in [(far, df), (near, dn)] {
-                    if entry.1 < best {
+                    if entry.1 <= best {
                         stack[len] = entry;
                         len += 1;
                     }
@@ -572,6 +700,15 @@ mod tests {
             let r2: f64 = rng.random_range(0.0..0.05);
             let want = brute(&tris, p) < r2;
             assert_eq!(tree.any_within(p, r2), want, "{p:?} {r2}");
+            // From any start (near or not, within or not): the same decision, and a triangle
+            // found is that close.
+            let start = rng.random_range(0..3 * tris.len() as u32 + 5);
+            let hit = tree.any_within_from(p, r2, Some(start));
+            assert_eq!(hit.is_some(), want, "{p:?} {r2} from {start}");
+            if let Some(id) = hit {
+                let t: Vec<_> = tris.iter().filter(|t| t.0 == id).copied().collect();
+                assert!(t.len() == 1 && brute(&t, p) < r2);
+            }
             if want {
                 inside += 1;
             } else {

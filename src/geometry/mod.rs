@@ -7,6 +7,7 @@
 
 pub(crate) mod bvh;
 pub(crate) mod closest_point_tree;
+pub(crate) mod closest_point_walk;
 pub(crate) mod crossing_curve;
 pub(crate) mod face_intersection;
 pub(crate) mod morton;

@@ -132,6 +132,17 @@ pub(crate) fn triangles_within(a: [DVec3; 3], b: [DVec3; 3], near: f64) -> bool 
     triangle_distance(a, b) <= near
 }
 
+/// The distance between the closed triangles `a` and `b` (non-degenerate): 0 when they meet
+/// ([`triangles_intersect`], exact), else the least distance from a corner of one to the other
+/// triangle and between an edge of one and an edge of the other.
+pub(crate) fn triangles_distance(a: [DVec3; 3], b: [DVec3; 3]) -> f64 {
+    if triangles_intersect(a, b) {
+        0.0
+    } else {
+        triangle_distance(a, b)
+    }
+}
+
 /// The distance between the closed triangles `a` and `b`, which do not meet: the least distance
 /// from a corner of one to the other triangle and between an edge of one and an edge of the
 /// other.

@@ -167,7 +167,7 @@ impl<'a> InputIndex<'a> {
         // With the buried test, where the input's own faces cross (looked for on the test's
         // BVH): the finishing stage leaves the output's crossings there alone.
         let (surface, (buried_test, crossing_pairs)) = rayon::join(
-            || MeshSurface::new(mesh),
+            || MeshSurface::new(mesh).map(MeshSurface::with_face_rings),
             || BuriedTest::with_crossings(mesh, points),
         );
         let surface = surface?;

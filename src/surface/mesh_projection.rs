@@ -4,7 +4,8 @@
 //! to measure the distance between two surfaces (Hausdorff, RMS).
 
 use crate::error::{Error, Result};
-use crate::geometry::closest_point_tree::{ClosestPointTree, GROUP};
+use crate::geometry::closest_point_tree::{Closest, ClosestPointTree, GROUP};
+use crate::geometry::closest_point_walk::{FaceRings, Walked};
 use crate::geometry::tolerance::SEARCH_BOUND_SLACK;
 use crate::mesh::TriMesh;
 use glam::DVec3;
@@ -29,6 +30,9 @@ pub struct SurfacePoint {
 pub struct MeshSurface {
     mesh: TriMesh,
     tree: ClosestPointTree,
+    /// The faces' rings for warm-started queries ([`MeshSurface::with_face_rings`]; empty:
+    /// every query asks the tree).
+    rings: FaceRings,
     face_normals: Vec<DVec3>,
     vertex_normals: Vec<DVec3>,
 }
@@ -56,8 +60,19 @@ impl MeshSurface {
             vertex_normals: mesh.vertex_normals(),
             mesh: mesh.clone(),
             tree,
+            rings: FaceRings::default(),
             face_normals,
         })
+    }
+
+    /// The surface with each face's ring and clearance built (one tree query per face, in
+    /// parallel), so that a query started from a face ([`MeshSurface::closest_point_from`],
+    /// [`MeshSurface::closest_points_near`]) walks from it and asks the tree only where the
+    /// walk cannot certify its answer (`geometry::closest_point_walk`). For a surface queried
+    /// many times from previous answers (the input, through sampling and finishing).
+    pub fn with_face_rings(mut self) -> Self {
+        self.rings = FaceRings::new(&self.tree, &self.mesh.triangles);
+        self
     }
 
     /// The source mesh.
@@ -83,10 +98,19 @@ impl MeshSurface {
         self.tree.any_within(p, bound)
     }
 
+    /// [`MeshSurface::is_within`], trying face `start` first (the face the last point near `p`
+    /// found within the distance): the face found, `None` when the surface does not come that
+    /// close. The same decision as `is_within`.
+    pub fn within_from(&self, p: DVec3, max_dist: f64, start: Option<u32>) -> Option<u32> {
+        let bound = max_dist * max_dist * (1.0 + SEARCH_BOUND_SLACK);
+        self.tree.any_within_from(p, bound, start)
+    }
+
     /// [`MeshSurface::closest_point_within`] warm-started from face `start` (the face of a
     /// previous answer near `p`): the search begins with that face's distance as its bound.
-    /// The same answer, up to the choice among faces at exactly equal distances (where `start`
-    /// is kept).
+    /// The same answer (among faces at exactly equal distances, the smallest index); where the
+    /// surface has its faces' rings ([`MeshSurface::with_face_rings`]), found by a walk from
+    /// `start` when the walk can certify it.
     pub fn closest_point_from(&self, p: DVec3, start: u32, max_dist: f64) -> Option<SurfacePoint> {
         self.search(p, max_dist, Some(start))
     }
@@ -129,17 +153,39 @@ impl MeshSurface {
             bounds[k] = within[k] * within[k] * (1.0 + SEARCH_BOUND_SLACK);
             starts[k] = from[k].map(|f| f.face);
         }
+        // The points a walk from their start answers; the others asked of the tree together.
         let mut found = [None; GROUP];
-        self.tree
-            .closest_each(points, &bounds[..n], &starts[..n], &mut found[..n]);
+        let mut ask = [0usize; GROUP];
+        let mut asked = 0;
+        for k in 0..n {
+            match starts[k].map(|s| self.walk(points[k], bounds[k], s)) {
+                Some(Walked::Certified(c)) => found[k] = c,
+                unsure => {
+                    if let Some(Walked::Unsure(s)) = unsure {
+                        starts[k] = Some(s);
+                    }
+                    ask[asked] = k;
+                    asked += 1;
+                }
+            }
+        }
+        if asked > 0 {
+            let mut ps = [DVec3::ZERO; GROUP];
+            let mut bs = [0.0; GROUP];
+            let mut ss = [None; GROUP];
+            for (j, &k) in ask[..asked].iter().enumerate() {
+                (ps[j], bs[j], ss[j]) = (points[k], bounds[k], starts[k]);
+            }
+            let mut got = [None; GROUP];
+            self.tree
+                .closest_each(&ps[..asked], &bs[..asked], &ss[..asked], &mut got[..asked]);
+            for (j, &k) in ask[..asked].iter().enumerate() {
+                found[k] = got[j];
+            }
+        }
         for k in 0..n {
             out[k] = match found[k] {
-                Some(c) => Some(SurfacePoint {
-                    position: c.point,
-                    face: c.id,
-                    barycentric: c.barycentric,
-                    distance: c.distance_squared.sqrt(),
-                }),
+                Some(c) => Some(surface_point(c)),
                 None if within[k] < max_dist => self.search(points[k], max_dist, None),
                 None => None,
             };
@@ -149,13 +195,21 @@ impl MeshSurface {
     fn search(&self, p: DVec3, max_dist: f64, start: Option<u32>) -> Option<SurfacePoint> {
         // Squared bound a hair above max_dist², so that a point exactly at max_dist is kept.
         let bound = max_dist * max_dist * (1.0 + SEARCH_BOUND_SLACK);
-        let c = self.tree.closest(p, bound, start)?;
-        Some(SurfacePoint {
-            position: c.point,
-            face: c.id,
-            barycentric: c.barycentric,
-            distance: c.distance_squared.sqrt(),
-        })
+        let start = match start.map(|s| self.walk(p, bound, s)) {
+            Some(Walked::Certified(c)) => return c.map(surface_point),
+            Some(Walked::Unsure(s)) => Some(s),
+            None => None,
+        };
+        self.tree.closest(p, bound, start).map(surface_point)
+    }
+
+    /// The walk from face `start` where the rings are built, else `Unsure(start)`.
+    fn walk(&self, p: DVec3, bound: f64, start: u32) -> Walked {
+        if self.rings.fits(self.tree.len()) {
+            self.rings.closest_from(&self.tree, p, bound, start)
+        } else {
+            Walked::Unsure(start)
+        }
     }
 
     /// [`MeshSurface::closest_point_within`] with a hint: `hint` is the distance from `p` to a
@@ -198,6 +252,16 @@ impl MeshSurface {
         } else {
             n
         }
+    }
+}
+
+/// A closest point of the tree as a point of the surface.
+fn surface_point(c: Closest) -> SurfacePoint {
+    SurfacePoint {
+        position: c.point,
+        face: c.id,
+        barycentric: c.barycentric,
+        distance: c.distance_squared.sqrt(),
     }
 }
 

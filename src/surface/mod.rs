@@ -120,8 +120,7 @@ pub trait SurfaceQuery: Sync {
     /// face): `out[k]` is [`SurfaceQuery::closest_point_near`] of `points[k]` from `from[k]`
     /// where that is given, and [`SurfaceQuery::closest_point_hinted`] with `hint[k]` where
     /// not, each within `max_dist`. The same answers as one query at a time (on a mesh one
-    /// walk of its tree serves them all, which can keep another of several faces at exactly
-    /// the same distance). The four slices have one length.
+    /// walk of its tree serves them all). The four slices have one length.
     fn closest_points_near(
         &self,
         points: &[DVec3],

@@ -31,9 +31,19 @@ pub(super) fn cover(
         // Asked in Morton order (the points are drawn in random order), which keeps the
         // output's tree in cache; the answers are the same in any order.
         let reach = (params.cover_distance - params.collapse_offset).max(0.0);
+        // Each point tries first the face the point before it found (a neighbour in Morton
+        // order, usually as close to the same face).
         let mut far: Vec<u32> = morton_order(points)
             .into_par_iter()
-            .filter(|&i| !output.is_within(points[i as usize], reach))
+            .map_init(
+                || None,
+                |last: &mut Option<u32>, i| {
+                    let hit = output.within_from(points[i as usize], reach, *last);
+                    *last = hit.or(*last);
+                    (i, hit.is_none())
+                },
+            )
+            .filter_map(|(i, far)| far.then_some(i))
             .collect();
         far.sort_unstable();
         *watch = Some(far);
