@@ -51,6 +51,10 @@ pub struct FaceRings {
     /// Half of slot `k`'s clearance less the rounding margin: a walk that ends at `k` at a
     /// distance below it is certified.
     half_clearance: Vec<f64>,
+    /// Slot `k`'s centroid and the radius of the ball around it that holds the face (a rounding
+    /// margin wider): a face whose ball lies farther from a point than the best distance so far
+    /// is not tried.
+    balls: Vec<(DVec3, f64)>,
 }
 
 /// Where a walk ended.
@@ -96,13 +100,15 @@ impl FaceRings {
             SEARCH_BOUND_SLACK * (hi - lo).length().max(lo.abs().max(hi.abs()).max_element())
         });
         // Per chunk of slots: each ring's length, the rings, the half clearances.
-        let chunks: Vec<(Vec<u32>, Vec<u32>, Vec<f64>)> = (0..n)
+        #[allow(clippy::type_complexity)] // one chunk's share of the four arrays
+        let chunks: Vec<(Vec<u32>, Vec<u32>, Vec<f64>, Vec<(DVec3, f64)>)> = (0..n)
             .step_by(CHUNK)
             .collect::<Vec<_>>()
             .into_par_iter()
             .map(|from| {
                 let to = (from + CHUNK).min(n);
                 let (mut lens, mut rings, mut halves) = (Vec::new(), Vec::new(), Vec::new());
+                let mut balls = Vec::new();
                 let mut ring: Vec<u32> = Vec::new();
                 let mut near: Vec<(usize, f64)> = Vec::new();
                 for k in from..to {
@@ -144,26 +150,30 @@ impl FaceRings {
                     lens.push(ring.len() as u32);
                     rings.extend_from_slice(&ring);
                     halves.push(0.5 * (clearance - margin));
+                    balls.push((m, r + margin));
                 }
-                (lens, rings, halves)
+                (lens, rings, halves, balls)
             })
             .collect();
         let mut offsets = Vec::with_capacity(n + 1);
         offsets.push(0u32);
         let mut ring = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
         let mut half_clearance = Vec::with_capacity(n);
-        for (lens, rings, halves) in chunks {
+        let mut all_balls = Vec::with_capacity(n);
+        for (lens, rings, halves, balls) in chunks {
             for l in lens {
                 let last = *offsets.last().unwrap_or(&0);
                 offsets.push(last + l);
             }
             ring.extend(rings);
             half_clearance.extend(halves);
+            all_balls.extend(balls);
         }
         FaceRings {
             offsets,
             ring,
             half_clearance,
+            balls: all_balls,
         }
     }
 
@@ -189,13 +199,22 @@ impl FaceRings {
         };
         let (q, bary) = closest_on_triangle(p, tree.corners_at(at));
         let mut best = (at, q, bary, q.distance_squared(p));
+        // The best distance a hair longer: a face whose ball is farther is farther.
+        let reach = |d2: f64| d2.sqrt() * (1.0 + SEARCH_BOUND_SLACK);
+        let mut best_reach = reach(best.3);
         for _ in 0..MAX_STEPS {
             let ring = &self.ring[self.offsets[at] as usize..self.offsets[at + 1] as usize];
             for &j in ring {
+                let (centre, radius) = self.balls[j as usize];
+                let beyond = best_reach + radius;
+                if p.distance_squared(centre) > beyond * beyond {
+                    continue;
+                }
                 let (q, bary) = closest_on_triangle(p, tree.corners_at(j as usize));
                 let d = q.distance_squared(p);
                 if tree.nearer(d, j as usize, best.3, Some(best.0)) {
                     best = (j as usize, q, bary, d);
+                    best_reach = reach(d);
                 }
             }
             if best.0 != at {
