@@ -11,7 +11,9 @@ use crate::finish::fit::{fit_to_surface, FitStats};
 use crate::finish::optimize::{mend_near, optimize, MendStats, OptimizeParams, OptimizeStats};
 use crate::finish::refine::{refine_faces, RefineCrossingsParams, RefineCrossingsStats};
 use crate::finish::stray_shells::{remove_stray_shells, StrayShells};
-use crate::finish::untangle::{untangle_known, UntangleParams, UntangleStats, Untangled};
+use crate::finish::untangle::{
+    untangle_known, untangle_near, UntangleParams, UntangleStats, Untangled,
+};
 use crate::geometry::crossing_curve::{output_spacing, CrossingCurve};
 use crate::geometry::face_intersection::faces_intersect;
 use crate::geometry::self_intersection::intersecting_pairs;
@@ -232,7 +234,12 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
             // guards (no new crossing, near the surface).
             let pressed = pressed_out_of_bounds(mesh, &before_untangle, &moved, op.angle_bounds());
             let near = around_changed_faces(mesh, &origin, &pressed);
-            let (stats, pairs) = mend_changed(mesh, face_sources, f, op, &fixed, &protected, &near);
+            // The pairs untangle left are those the mending starts from where both take one
+            // `near` (no search of the whole mesh).
+            let same_near = untangle_near(&params, f.sigma_p) == op.near.max(0.0);
+            let known = left.filter(|_| same_near);
+            let (stats, pairs) =
+                mend_changed(mesh, face_sources, f, op, &fixed, &protected, &near, known);
             mend_after_untangle = mend_after_untangle.then(&stats);
             intersecting = Some(pairs);
             later_dropped += mesh.remove_unreferenced_vertices();
@@ -318,7 +325,8 @@ pub(crate) fn finish<S: SurfaceQuery + ?Sized>(
 
 /// The last pass of the optimization again around the vertices flagged in `near` (`V` flags),
 /// the faces' sources carried along: what it did, and the pairs of faces that intersect after
-/// it (or come within its `near`).
+/// it (or come within its `near`). `known`: the pairs within that `near` before it, when known.
+#[allow(clippy::too_many_arguments)] // mend_near's arguments from the finishing stage's
 fn mend_changed<S: SurfaceQuery + ?Sized>(
     mesh: &mut TriMesh,
     face_sources: &mut Vec<FaceSource>,
@@ -327,6 +335,7 @@ fn mend_changed<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     protected: &[[u32; 2]],
     near: &[bool],
+    known: Option<Vec<[u32; 2]>>,
 ) -> (MendStats, Vec<[u32; 2]>) {
     let (stats, mended) = mend_near(
         mesh,
@@ -338,6 +347,7 @@ fn mend_changed<S: SurfaceQuery + ?Sized>(
         f.sigma_p,
         op,
         near,
+        known,
     );
     *face_sources = carried_sources(&mended.origin, face_sources);
     (stats, mended.intersecting)
@@ -459,7 +469,7 @@ fn refine_rounds<S: SurfaceQuery + ?Sized>(
             // the last pass mends their angles under its guards.
             let near = around_changed_faces(mesh, &origin, &split_faces);
             let (stats, mended) =
-                mend_changed(mesh, face_sources, f, op, &fixed, &protected, &near);
+                mend_changed(mesh, face_sources, f, op, &fixed, &protected, &near, None);
             *totals.mend = totals.mend.then(&stats);
             pairs = Some(mended);
         } else if stats.collapses == 0 {

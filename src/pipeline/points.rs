@@ -887,6 +887,7 @@ fn remesh_points_once(
                 sigma_p,
                 op,
                 &near,
+                None,
             );
             sources = crate::pipeline::finish::carried_sources(&mended.origin, &sources);
             mend_after_removals = stats;

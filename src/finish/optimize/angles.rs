@@ -70,7 +70,9 @@ enum Op {
 /// pass's budget ([`MEND_BUDGET_PER_FACE`] per face, at most [`MEND_TRIES_PER_FACE`] failed
 /// attempts a face); and the pairs of faces (slots, the smaller first, sorted) that intersect
 /// or come within `params.near` of it at the end, as [`pairs_within`] over the live faces gives
-/// them. Deterministic.
+/// them. `known`: those pairs as the pass starts, when the caller has them (else searched for
+/// over the whole mesh). Deterministic.
+#[allow(clippy::too_many_arguments)] // where to work, and the pairs when known
 pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     m: &mut Mesh,
     surface: &S,
@@ -79,6 +81,7 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
     fixed: &[bool],
     params: &Limits,
     near: Option<&[bool]>,
+    known: Option<Vec<[u32; 2]>>,
 ) -> (MendStats, Vec<[u32; 2]>) {
     let marked = |t: [u32; 3]| {
         near.is_none_or(|n| {
@@ -117,10 +120,17 @@ pub(super) fn mend_faces<S: SurfaceQuery + ?Sized>(
         out.extend(crossing);
         out
     };
-    // The intersecting pairs (slots, the smaller first, sorted): searched over the whole mesh
-    // once, then after each round only around the faces the round made or moved (the pairs of
-    // faces it left alone stand), through the guard.
-    let mut pairs: Vec<[u32; 2]> = {
+    // The intersecting pairs (slots, the smaller first, sorted): `known`, or searched over the
+    // whole mesh once, then after each round only around the faces the round made or moved
+    // (the pairs of faces it left alone stand), through the guard.
+    let mut pairs: Vec<[u32; 2]> = if let Some(mut known) = known {
+        for p in known.iter_mut() {
+            *p = [p[0].min(p[1]), p[0].max(p[1])];
+        }
+        known.sort_unstable();
+        known.dedup();
+        known
+    } else {
         let (live, slots) = m.live_faces();
         let mut pairs: Vec<[u32; 2]> = pairs_within(m.positions(), &live, params.near)
             .into_iter()

@@ -412,6 +412,7 @@ pub fn optimize<S: SurfaceQuery + ?Sized>(
         &fixed,
         params,
         None,
+        None,
     );
     stats.mends = stats.mend.ops;
     (stats, written(m, mesh, &pairs))
@@ -483,7 +484,9 @@ pub struct Edited {
 /// `near` (`V` flags; the faces a later stage changed, such as untangle's collapses, and their
 /// neighbours) and on every face that crosses another, with the same guards (same arguments
 /// and units as [`optimize`]). Returns what it did, and the faces' origins and intersecting
-/// pairs ([`Edited`]). Deterministic.
+/// pairs ([`Edited`]). `known`: the pairs of faces of `mesh` within `params.near` of each
+/// other (indices into its triangles), when the caller has them (else searched for over the
+/// whole mesh). Deterministic.
 #[allow(clippy::too_many_arguments)] // optimize's arguments, and where to work
 pub fn mend_near<S: SurfaceQuery + ?Sized>(
     mesh: &mut TriMesh,
@@ -495,9 +498,18 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
     sigma_p: f64,
     params: &OptimizeParams,
     near: &[bool],
+    known: Option<Vec<[u32; 2]>>,
 ) -> (MendStats, Edited) {
     let params = &Limits::new(params, sigma_p);
     let (mut m, fixed) = editable(mesh, fixed, protected);
+    // A fresh edit mesh's slots are the faces' indices.
+    let known = known.filter(|_| {
+        m.live_faces()
+            .1
+            .iter()
+            .enumerate()
+            .all(|(k, &f)| f as usize == k)
+    });
     let (stats, pairs) = mend_faces(
         &mut m,
         surface,
@@ -506,6 +518,7 @@ pub fn mend_near<S: SurfaceQuery + ?Sized>(
         &fixed,
         params,
         Some(near),
+        known,
     );
     (stats, written(m, mesh, &pairs))
 }

@@ -86,7 +86,7 @@ fn a_vertex_of_three_faces_near_an_edge_is_collapsed_away() {
     let before = theta_min(&m);
     assert!(before < 20.0, "{before}");
     let fixed = vec![false; m.vertex_count()];
-    let (made, _) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    let (made, _) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None, None);
     assert!(made.ops >= 1);
     assert_eq!(m.degree(v), 0, "the vertex is gone");
     assert!(theta_min(&m) >= 30.0, "{before} -> {}", theta_min(&m));
@@ -110,7 +110,7 @@ fn a_sliver_on_a_short_fixed_boundary_edge_is_mended_and_the_boundary_stays() {
         .filter(|&v| fixed[v])
         .map(|v| m.position(v as u32))
         .collect();
-    mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None, None);
     assert!(theta_min(&m) >= 25.0, "{before} -> {}", theta_min(&m));
     let after: Vec<DVec3> = (0..m.vertex_count())
         .filter(|&v| fixed[v])
@@ -127,7 +127,7 @@ fn a_mesh_without_small_angles_is_left_alone() {
     let mut m: Mesh = EditMesh::from_trimesh(&g, Some, SlotPolicy::Reuse);
     let fixed = vec![false; m.vertex_count()];
     assert_eq!(
-        mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None)
+        mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None, None)
             .0
             .ops,
         0
@@ -220,7 +220,7 @@ fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
     let fixed = vec![false; m.vertex_count()];
     // sigma_p 4: the pass may move the mesh by up to 1 off the surface, more than the poke.
     let wide = Limits::new(&OptimizeParams::default(), 4.0);
-    let (made, left) = mend_faces(&mut m, &surface, None, None, &fixed, &wide, None);
+    let (made, left) = mend_faces(&mut m, &surface, None, None, &fixed, &wide, None, None);
     assert!(made.ops >= 1);
     let out = m.to_trimesh();
     let pairs = intersecting_pairs(&out.positions, &out.triangles);
@@ -237,7 +237,7 @@ fn a_face_through_another_sheet_is_mended_and_nothing_crosses_after() {
     assert_eq!(m.sanity_check(), Ok(()));
     // Without moves that far (sigma_p 1: 0.25), nothing is made that would cross.
     let mut m: Mesh = EditMesh::from_trimesh(&mesh, Some, SlotPolicy::Reuse);
-    let (_, left) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    let (_, left) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None, None);
     assert_eq!(left, slot_pairs(&m));
     let out = m.to_trimesh();
     assert!(
@@ -314,7 +314,7 @@ fn a_reflex_boundary_corner_with_two_faces_gets_its_edge_split() {
     // neighbours on the boundary have two faces each (no collapse): no flip, collapse or move
     // mends the corner's faces, whose angles at it add up to 206°.
     let fixed = vec![true; m.vertex_count()];
-    let (made, _) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    let (made, _) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None, None);
     assert!(made.ops >= 1);
     assert!(m.vertex_count() > 7, "no vertex added");
     assert!(m.degree(v) >= 3, "the corner has {} faces", m.degree(v));
@@ -344,7 +344,7 @@ fn a_boundary_vertex_slides_along_the_boundary_to_mend_its_face() {
     let before = theta_min(&m);
     assert!(before < 10.0, "{before}");
     // Without the boundary's lines, vertex 1 stays and nothing mends the face.
-    mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None);
+    mend_faces(&mut m, &surface, None, None, &fixed, &limits(), None, None);
     assert_eq!(m.position(1), DVec3::new(0.12, 0.0, 0.0));
     let (made, _) = mend_faces(
         &mut m,
@@ -353,6 +353,7 @@ fn a_boundary_vertex_slides_along_the_boundary_to_mend_its_face() {
         None,
         &fixed,
         &limits(),
+        None,
         None,
     );
     assert!(made.ops >= 1);
@@ -447,7 +448,16 @@ fn mending_near_marked_vertices_leaves_the_other_faces_as_they_are() {
     let mut near = vec![false; m.vertex_count()];
     near[a as usize] = true;
     let fixed = vec![false; m.vertex_count()];
-    let (made, _) = mend_faces(&mut m, &surface, None, None, &fixed, &limits(), Some(&near));
+    let (made, _) = mend_faces(
+        &mut m,
+        &surface,
+        None,
+        None,
+        &fixed,
+        &limits(),
+        Some(&near),
+        None,
+    );
     assert!(made.ops >= 1);
     assert!(m.degree(a) == 0 || worst_at(&m, a) >= 30.0);
     assert_eq!(m.position(b), before_b);
@@ -483,6 +493,27 @@ fn mend_near_says_which_faces_of_its_result_intersect() {
     }
     mesh.triangles.extend(split);
     let (n, faces) = (mesh.positions.len(), mesh.triangles.len());
+    // The same pass given the crossing pairs it would search for (any order, either way round)
+    // does the same.
+    let mut given = mesh.clone();
+    let mut known: Vec<[u32; 2]> = intersecting_pairs(&given.positions, &given.triangles)
+        .into_iter()
+        .map(|[f, g]| [g, f])
+        .collect();
+    known.reverse();
+    assert!(!known.is_empty(), "the test case: a crossing to start from");
+    let (_, mended_given) = mend_near(
+        &mut given,
+        &surface,
+        &vec![false; n],
+        &[],
+        None,
+        None,
+        1.0,
+        &OptimizeParams::default(),
+        &vec![true; n],
+        Some(known),
+    );
     let (_, mended) = mend_near(
         &mut mesh,
         &surface,
@@ -493,6 +524,7 @@ fn mend_near_says_which_faces_of_its_result_intersect() {
         1.0,
         &OptimizeParams::default(),
         &vec![true; n],
+        None,
     );
     assert!(mesh.triangles.len() < faces, "the test case: a collapse");
     let mut found: Vec<[u32; 2]> = intersecting_pairs(&mesh.positions, &mesh.triangles)
@@ -503,6 +535,8 @@ fn mend_near_says_which_faces_of_its_result_intersect() {
     assert!(!found.is_empty(), "the test case: a crossing left");
     assert_eq!(mended.intersecting, found);
     assert_eq!(mended.origin.len(), mesh.triangles.len());
+    assert_eq!(given, mesh);
+    assert_eq!(mended_given.intersecting, mended.intersecting);
 }
 
 #[test]
@@ -538,7 +572,7 @@ fn with_a_near_distance_the_pass_brings_no_faces_that_close() {
             },
             4.0,
         );
-        let (made, left) = mend_faces(&mut m, &surface, None, None, &fixed, &params, None);
+        let (made, left) = mend_faces(&mut m, &surface, None, None, &fixed, &params, None, None);
         (m, made, left)
     };
     // The test case: with the exact guard alone, the lift crosses nothing and leaves the tip
