@@ -778,9 +778,11 @@ fn sigma_p_too_small_for_memory_is_a_usage_error_at_once() {
 /// Issue 14, item 11: `--points 5` and `--sigma-p 1000` said "error: : no triangle ..." with an
 /// empty file name (exit 3), and with `--no-distance` wrote an empty mesh (exit 0). Where no
 /// triangle forms (the umbrellas, which insert no sample) it is a usage error naming the flag,
-/// nothing written. Issue 75: the restricted Delaunay triangulation (the default) inserts the
-/// samples the surface's topology needs, so spot at 5 points comes out a closed sphere with a
-/// note saying how many were inserted; with `--strict` that count is refused, nothing written.
+/// nothing written (or, where the count search ends at a density the umbrellas triangulate, a
+/// closed sphere). Issue 75: the restricted Delaunay triangulation (the default) inserts the
+/// samples the surface's topology needs, so spot at 5 points comes out a closed sphere (with a
+/// note saying how many were inserted where any were); with `--strict` a count that needed
+/// them is refused, nothing written (a torus at 5 points).
 #[test]
 fn a_density_too_small_for_the_surface_keeps_its_topology_or_is_refused() {
     let dir = tempfile::tempdir().unwrap();
@@ -792,7 +794,20 @@ fn a_density_too_small_for_the_surface_keeps_its_topology_or_is_refused() {
             args.extend_from_slice(&["--triangulation", "umbrellas"]);
             args.extend_from_slice(extra);
             let o = remesh(&args);
-            assert_error(&o, 2, &[flag, "no triangle"], &out);
+            if flag == "--points" && o.status.success() {
+                // The count search found a density the umbrellas triangulate (a retry with
+                // more samples): then the output keeps the input's topology.
+                std::fs::remove_file(&out).unwrap();
+                let r = assert_remeshed(&input, &out, &args[2..6]);
+                assert_eq!(r["topology_changes"].as_array().unwrap().len(), 0, "{r}");
+                assert_eq!(
+                    (topo(&r, "components"), topo(&r, "euler_characteristic")),
+                    (1, 2)
+                );
+                std::fs::remove_file(&out).unwrap();
+            } else {
+                assert_error(&o, 2, &[flag, "no triangle"], &out);
+            }
         }
     }
     for (flag, value) in [("--points", "5"), ("--sigma-p", "1000")] {
@@ -802,12 +817,20 @@ fn a_density_too_small_for_the_surface_keeps_its_topology_or_is_refused() {
             (topo(&r, "components"), topo(&r, "euler_characteristic")),
             (1, 2)
         );
+        // At sigma_p 1000 (no search) the cells of the few samples are not discs: samples
+        // are inserted. (At --points 5 the search may end at 4 samples whose cells are.)
         let notes = r["notes"].to_string();
-        assert!(notes.contains("samples were inserted"), "{notes}");
+        if flag == "--sigma-p" {
+            assert!(notes.contains("samples were inserted"), "{notes}");
+        }
         std::fs::remove_file(&out).unwrap();
     }
+    // A torus takes 7 vertices at least: at 5 points samples are always inserted, which
+    // `--strict` refuses.
+    let torus = dir.path().join("torus.obj");
+    std::fs::write(&torus, torus_obj(24, 12)).unwrap();
     let o = remesh(&[
-        input.to_str().unwrap(),
+        torus.to_str().unwrap(),
         out.to_str().unwrap(),
         "--points",
         "5",
@@ -819,6 +842,27 @@ fn a_density_too_small_for_the_surface_keeps_its_topology_or_is_refused() {
         &["5 points are too few to keep the input's topology"],
         &out,
     );
+}
+
+/// A torus (radii 3 and 1) as OBJ text, `n` by `m` quads split in two triangles each.
+fn torus_obj(n: usize, m: usize) -> String {
+    use std::f64::consts::TAU;
+    let mut s = String::new();
+    for i in 0..n {
+        for j in 0..m {
+            let (u, v) = (TAU * i as f64 / n as f64, TAU * j as f64 / m as f64);
+            let r = 3.0 + v.cos();
+            s += &format!("v {} {} {}\n", r * u.cos(), r * u.sin(), v.sin());
+        }
+    }
+    let at = |i: usize, j: usize| (i % n) * m + (j % m) + 1;
+    for i in 0..n {
+        for j in 0..m {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            s += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+        }
+    }
+    s
 }
 
 /// Issue 14, item 11: an unsupported output extension was an input error (3), found after the
