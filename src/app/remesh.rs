@@ -82,6 +82,13 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         }
         report_clash(report, &others)?;
     }
+    // A mesh too large for the memory the job may take is refused before anything else is
+    // allocated (the output buffers included: under a tight address-space limit they could not
+    // be).
+    let points = job.as_points || crate::pipeline::points::is_point_set(&job.input)?;
+    if let (false, Some(limit)) = (points, job.max_memory) {
+        memory::check_input_size(&job.input, limit)?;
+    }
     // Every file the job writes is opened (as a temporary beside it) before the work: a path
     // that cannot be written is an error now, not after the run.
     let outputs = Outputs {
@@ -94,7 +101,7 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
         report: job.report.as_deref().map(AtomicFile::create).transpose()?,
     };
     let write = |mesh: &TriMesh| write_output(job, format, mesh, &outputs);
-    let report = if job.as_points || crate::pipeline::points::is_point_set(&job.input)? {
+    let report = if points {
         remesh_points::run(
             job,
             &PointSource::File(job.input.clone()),
@@ -103,9 +110,6 @@ pub fn run_remesh(job: &RemeshJob, on_stage: &(dyn Fn(&str) + Sync)) -> Result<Q
             on_stage,
         )?
     } else {
-        if let Some(limit) = job.max_memory {
-            memory::check_input_size(&job.input, limit)?;
-        }
         on_stage("read");
         let t = Clock::start();
         let (input, stats) = read_mesh(&job.input)?;
