@@ -95,7 +95,11 @@ pub fn remesh(
     on_stage("normalize");
     let (input, as_read) = NormalizedInput::new(input, normalization)?;
     let pool_size = input.pool_size(target, params)?;
-    let index = InputIndex::new(&input.mesh, 2 * pool_size + input.mesh.positions.len())?;
+    let index = InputIndex::new(
+        &input.mesh,
+        2 * pool_size + input.mesh.positions.len(),
+        (pool_size as f64 / params.candidates_per_sample.max(1.0)) as usize,
+    )?;
     timer.lap("normalize");
 
     on_stage("candidates");
