@@ -24,7 +24,7 @@ use crate::finish::untangle::UntangleParams;
 use crate::geometry::crossing_curve::CrossingCurve;
 use crate::mesh::{Normalization, TriMesh};
 use crate::sampling::sizing::SizingField;
-use crate::sampling::spacing::{search_start, sigma_p_for_count};
+use crate::sampling::spacing::sigma_p_for_count;
 use crate::surface::features::Features;
 use crate::timing::StageTimer;
 use crate::triangulate::TriangulationMethod;
@@ -126,10 +126,7 @@ pub fn remesh(
 
     let mut search = Search {
         goal: target.count().unwrap_or(0),
-        start: match target {
-            Target::Points(n) => search_start(input.area, input.boundary_length, n as f64),
-            Target::SigmaP(s) => s,
-        },
+        start: first_sigma_p,
         sigma_ref: first_sigma_p,
         // sigma_p is bounded only where the sizing field holds part of the count.
         max_sigma: params

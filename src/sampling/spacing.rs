@@ -8,14 +8,6 @@
 /// sigma_p search and to size the candidate pool when sigma_p is given.
 pub const SAMPLES_PER_SIGMA2: f64 = 1.0;
 
-/// The samples per unit of sigma_p^-2 area the linear scan leaves where the sigma_p search
-/// first evaluates it: the count there over the target was 0.81-0.875 on eight models
-/// (beetle 0.875, bracket 0.834, cow 0.812, fandisk 0.856, flange 0.834, horse 0.813 at 1,000
-/// and 0.835 at 200,000, stanford-bunny 0.841), below [`SAMPLES_PER_SIGMA2`], which the
-/// pipeline keeps as its unit of spacing. Only the search's first guess takes it
-/// ([`search_start`]): one scan fewer where the second then lands within the tolerance.
-pub const SCAN_SAMPLES_PER_SIGMA2: f64 = 0.84;
-
 /// Spacing of the boundary samples in units of sigma_p: the mean edge length the interior
 /// sampling reaches (measured), so boundary triangles match interior ones.
 pub const BOUNDARY_SPACING_PER_SIGMA: f64 = 1.0;
@@ -50,14 +42,6 @@ pub fn expected_samples(area: f64, boundary_length: f64, sigma_p: f64) -> f64 {
 /// one) it is the area-only guess.
 pub fn sigma_p_for_count(area: f64, boundary_length: f64, count: f64) -> f64 {
     let from_area = (SAMPLES_PER_SIGMA2 * area / count).sqrt();
-    let from_boundary = boundary_length / (BOUNDARY_SPACING_PER_SIGMA * count);
-    from_area.max(from_boundary)
-}
-
-/// The sigma_p the search for `count` samples evaluates first: [`sigma_p_for_count`] with the
-/// area term at the linear scan's own density ([`SCAN_SAMPLES_PER_SIGMA2`]).
-pub fn search_start(area: f64, boundary_length: f64, count: f64) -> f64 {
-    let from_area = (SCAN_SAMPLES_PER_SIGMA2 * area / count).sqrt();
     let from_boundary = boundary_length / (BOUNDARY_SPACING_PER_SIGMA * count);
     from_area.max(from_boundary)
 }
