@@ -502,30 +502,22 @@ fn mend_near_says_which_faces_of_its_result_intersect() {
         .collect();
     known.reverse();
     assert!(!known.is_empty(), "the test case: a crossing to start from");
-    let (_, mended_given) = mend_near(
-        &mut given,
-        &surface,
-        &vec![false; n],
-        &[],
-        None,
-        None,
-        1.0,
-        &OptimizeParams::default(),
-        &vec![true; n],
-        Some(known),
-    );
-    let (_, mended) = mend_near(
-        &mut mesh,
-        &surface,
-        &vec![false; n],
-        &[],
-        None,
-        None,
-        1.0,
-        &OptimizeParams::default(),
-        &vec![true; n],
-        None,
-    );
+    let mend = |mesh: &mut TriMesh, known: Option<Vec<[u32; 2]>>| {
+        mend_near(
+            mesh,
+            &surface,
+            &vec![false; n],
+            &[],
+            None,
+            None,
+            1.0,
+            &OptimizeParams::default(),
+            &vec![true; n],
+            known,
+        )
+    };
+    let (_, mended_given) = mend(&mut given, Some(known));
+    let (_, mended) = mend(&mut mesh, None);
     assert!(mesh.triangles.len() < faces, "the test case: a collapse");
     let mut found: Vec<[u32; 2]> = intersecting_pairs(&mesh.positions, &mesh.triangles)
         .into_iter()
