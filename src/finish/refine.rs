@@ -53,12 +53,14 @@ pub struct RefineCrossingsStats {
     pub pairs_after: usize,
 }
 
-/// Splits each edge of the faces `faces` (indices into `mesh.triangles`) at the surface point
-/// nearest its middle (bbox-100 units). Not split: boundary edges, edges in `protected` (kept
-/// creases, either direction), edges shorter than `min_edge`, and edges whose surface point lies
-/// on a piece of the surface facing away from the mean normal of the edge's two faces (a sheet
-/// across a thin part, not the one the edge follows). Longest edges first, ties by vertex index:
-/// deterministic.
+/// Splits each edge of the faces `faces` (indices into `mesh.triangles`) at the point nearest
+/// its middle of the sheet the edge follows: the surface's pieces facing the way of the mean
+/// normal of the edge's two faces ([`SurfaceQuery::closest_point_facing`]), within half the
+/// edge's length (its ends lie on the surface), so that a nearer sheet facing away (another
+/// part's wall, the far side of a thin plate) is passed over. Not split: boundary edges, edges
+/// in `protected` (kept creases, either direction), edges shorter than `min_edge`, and edges
+/// with no such sheet that close. Longest edges first, ties by vertex index: deterministic.
+/// Positions in bbox-100 units.
 ///
 /// Returns the edges split and refused, and each face's index before (`None` for a face a split
 /// made). The new vertices are appended to `mesh.positions`.
@@ -100,15 +102,14 @@ pub fn refine_faces<S: SurfaceQuery + ?Sized>(
             let [p, q, r] = m.corners(m.face(f).expect("a live face"));
             (q - p).cross(r - p).normalize_or_zero()
         };
+        // The edge's ends lie on the surface, half its length from its middle: the sheet the
+        // edge follows is within that, facing its faces' way.
         let facing = normal(f1) + normal(f2);
-        let Some(sp) = surface.closest_point_to_midpoint(pa, pb) else {
+        let Some(sp) = surface.closest_point_facing(0.5 * (pa + pb), facing, 0.5 * pa.distance(pb))
+        else {
             refused += 1;
             continue;
         };
-        if surface.piece_normal(&sp).dot(facing) <= 0.0 {
-            refused += 1;
-            continue;
-        }
         let v = m.add_vertex(sp.position);
         if m.split_edge(a, b, v, None).is_ok() {
             splits += 1;
@@ -172,6 +173,59 @@ mod tests {
         let (s, _, _) = refine_faces(&mut again, &surface, &[0, 1, 2, 3], &[[0, 4], [4, 3]], 10.0);
         assert_eq!(s, 0);
         assert_eq!(again.triangles, coarse.triangles);
+    }
+
+    /// Two parts' walls a hair apart (box.STL's parts lie 0.001 to 0.005 apart where the
+    /// spacing is 0.32): the edge follows the upper wall, a low ridge facing up, and its chord
+    /// passes under the ridge, nearer the lower wall, which faces down. The split point is on
+    /// the ridge, not on the nearer wall.
+    #[test]
+    fn the_split_point_is_on_the_sheet_the_edge_follows_past_a_nearer_one_facing_away() {
+        let p = vec![
+            // The ridge: z = 0 at x = 0 and 2, 0.05 along x = 1; faces up.
+            DVec3::new(0.0, -1.0, 0.0),
+            DVec3::new(1.0, -1.0, 0.05),
+            DVec3::new(2.0, -1.0, 0.0),
+            DVec3::new(0.0, 3.0, 0.0),
+            DVec3::new(1.0, 3.0, 0.05),
+            DVec3::new(2.0, 3.0, 0.0),
+            // The lower wall at z = -0.01; faces down.
+            DVec3::new(-1.0, -1.0, -0.01),
+            DVec3::new(3.0, -1.0, -0.01),
+            DVec3::new(3.0, 3.0, -0.01),
+            DVec3::new(-1.0, 3.0, -0.01),
+        ];
+        let walls = TriMesh::new(
+            p,
+            vec![
+                [0, 1, 4],
+                [0, 4, 3],
+                [1, 2, 5],
+                [1, 5, 4],
+                [6, 8, 7],
+                [6, 9, 8],
+            ],
+        );
+        let surface = MeshSurface::new(&walls).unwrap();
+        // A coarse square over the ridge, its corners on the ridge's feet, facing up.
+        let mut coarse = TriMesh::new(
+            vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(2.0, 0.0, 0.0),
+                DVec3::new(2.0, 2.0, 0.0),
+                DVec3::new(0.0, 2.0, 0.0),
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        );
+        let mid = 0.5 * (coarse.positions[0] + coarse.positions[2]);
+        let near = surface.closest_point(mid).unwrap();
+        assert!(near.face >= 4, "the lower wall is nearer: {near:?}");
+        let (splits, _, _) = refine_faces(&mut coarse, &surface, &[0], &[], 0.01);
+        assert_eq!(splits, 1);
+        // The foot of (1, 1, 0) on the ridge's plane z = 0.05 x.
+        let q = coarse.positions[4];
+        let foot = DVec3::new(1.0 - 0.0025 / 1.0025, 1.0, 0.05 / 1.0025);
+        assert!((q - foot).length() < 1e-12, "{q}");
     }
 
     #[test]

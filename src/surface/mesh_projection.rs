@@ -233,6 +233,23 @@ impl MeshSurface {
         self.closest_point_hinted(0.5 * (a + b), 0.5 * a.distance(b), f64::MAX)
     }
 
+    /// The closest point to `p` within `max_dist` among the faces whose normal points the way
+    /// of `facing` (a positive dot product): the point on the sheet a mesh piece with that
+    /// normal follows, passing over a sheet of another part, or the far side of a thin wall,
+    /// that lies nearer but faces away. `None` when no such face is that close.
+    pub fn closest_point_facing(
+        &self,
+        p: DVec3,
+        facing: DVec3,
+        max_dist: f64,
+    ) -> Option<SurfacePoint> {
+        let bound = max_dist * max_dist * (1.0 + SEARCH_BOUND_SLACK);
+        let away = |slot: usize| self.face_normals[self.tree.id(slot) as usize].dot(facing) <= 0.0;
+        self.tree
+            .closest_skipping(p, bound, away)
+            .map(surface_point)
+    }
+
     /// Unit normal of face `f` of the source mesh.
     #[inline]
     pub fn face_normal(&self, f: u32) -> DVec3 {
@@ -279,6 +296,29 @@ mod tests {
             ],
             vec![[0, 1, 2], [0, 2, 3]],
         )
+    }
+
+    /// Two parallel squares a hair apart, facing away from each other (the walls of two parts
+    /// that touch): the plain query takes the nearer, the facing one the sheet facing `facing`.
+    #[test]
+    fn the_facing_query_passes_over_a_nearer_sheet_facing_away() {
+        let mut p = unit_square().positions;
+        p.extend(p.clone().iter().map(|q| *q + DVec3::new(0.0, 0.0, -0.01)));
+        // The upper square faces up (+z), the lower one down (-z).
+        let two = TriMesh::new(p, vec![[0, 1, 2], [0, 2, 3], [4, 6, 5], [4, 7, 6]]);
+        let s = MeshSurface::new(&two).unwrap();
+        let q = DVec3::new(0.3, 0.6, -0.02);
+        let near = s.closest_point(q).unwrap();
+        assert!(near.face >= 2 && (near.distance - 0.01).abs() < 1e-12);
+        let up = s.closest_point_facing(q, DVec3::Z, 1.0).unwrap();
+        assert!(up.face < 2, "{up:?}");
+        assert!((up.position - DVec3::new(0.3, 0.6, 0.0)).length() < 1e-12);
+        assert!((up.distance - 0.02).abs() < 1e-12);
+        // Nothing facing up within the bound, and nothing facing sideways at all.
+        assert!(s.closest_point_facing(q, DVec3::Z, 0.015).is_none());
+        assert!(s.closest_point_facing(q, DVec3::X, 10.0).is_none());
+        let down = s.closest_point_facing(q, -DVec3::Z, 1.0).unwrap();
+        assert_eq!(down.face, near.face);
     }
 
     #[test]

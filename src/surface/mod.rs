@@ -87,6 +87,16 @@ pub trait SurfaceQuery: Sync {
         self.smooth_normal(sp)
     }
 
+    /// The closest point to `p` within `max_dist` on a piece of the surface whose normal
+    /// ([`SurfaceQuery::piece_normal`]) points the way of `facing` (a positive dot product):
+    /// the sheet a mesh piece of that orientation follows, where a sheet facing away (another
+    /// part's wall, the far side of a thin plate) lies nearer. On a surface of one smooth sheet,
+    /// the closest point when it faces that way, else `None`.
+    fn closest_point_facing(&self, p: DVec3, facing: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        self.closest_point_within(p, max_dist)
+            .filter(|sp| self.piece_normal(sp).dot(facing) > 0.0)
+    }
+
     /// The closest point of the surface to `p`. `None` only when `p` is not finite.
     fn closest_point(&self, p: DVec3) -> Option<SurfacePoint> {
         self.closest_point_within(p, f64::MAX)
@@ -149,6 +159,10 @@ impl SurfaceQuery for MeshSurface {
 
     fn piece_normal(&self, sp: &SurfacePoint) -> DVec3 {
         self.face_normal(sp.face)
+    }
+
+    fn closest_point_facing(&self, p: DVec3, facing: DVec3, max_dist: f64) -> Option<SurfacePoint> {
+        MeshSurface::closest_point_facing(self, p, facing, max_dist)
     }
 
     fn closest_point(&self, p: DVec3) -> Option<SurfacePoint> {
