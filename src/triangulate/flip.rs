@@ -59,7 +59,7 @@ pub(crate) fn max_min_candidate<L: Copy>(m: &EditMesh<L>, x: u32, y: u32) -> Opt
     })
 }
 
-/// Below this many edges [`max_min_flips`] runs sequentially: the parallel evaluation pays off
+/// Below this many edges [`max_min_flips_after`] runs sequentially: the parallel evaluation pays off
 /// on whole meshes, not on the few edges around a poor triangle.
 const PARALLEL_EDGES: usize = 512;
 
@@ -67,15 +67,38 @@ const PARALLEL_EDGES: usize = 512;
 /// ([`max_min_candidate`]) and `accept` allows (it sees the mesh and the flip before it is
 /// made), with [`EditMesh::flip_edge`]; new faces get `label`. Returns the number of flips.
 /// `accept` decides from the flip's four vertices alone ([`flip_in_order`]).
-pub(crate) fn max_min_flips<L: Copy + Send + Sync>(
+///
+/// As a sweep after another: `last` flags the vertices of the quads the sweep before came to
+/// flip, whose edges are decided again; an edge none of whose four
+/// vertices is flagged was left by that sweep on the same four vertices and is taken as left
+/// without deciding it (unless a flip earlier in this pass touched it). Marks in `touched` (one
+/// flag per vertex) the four vertices of every quad this pass comes to flip, whether the flip
+/// then succeeds or not: `last` of the next sweep. With `last` `None` every edge is decided.
+/// The same flips as deciding every edge.
+pub(crate) fn max_min_flips_after<L: Copy + Send + Sync>(
     m: &mut EditMesh<L>,
     edges: &[(u32, u32)],
     label: L,
+    last: Option<&[bool]>,
+    touched: &mut [bool],
     accept: impl Fn(&EditMesh<L>, &FlipCandidate) -> bool + Sync,
 ) -> usize {
-    flip_in_order(m, edges, label, |m, x, y| {
-        max_min_candidate(m, x, y).is_some_and(|flip| accept(m, &flip))
-    })
+    passes(
+        m,
+        edges,
+        label,
+        |m, x, y| max_min_candidate(m, x, y).is_some_and(|flip| accept(m, &flip)),
+        |m, x, y| {
+            for v in quad(m, x, y).unwrap_or([x, y, x, y]) {
+                if let Some(t) = touched.get_mut(v as usize) {
+                    *t = true;
+                }
+            }
+            true
+        },
+        |_, _| {},
+        last,
+    )
 }
 
 /// Flips, in order, the edges of `edges` for which `decide` says yes on the mesh as it is when
@@ -106,11 +129,33 @@ pub(crate) fn flip_in_order_vetoed<L: Copy + Send + Sync>(
     edges: &[(u32, u32)],
     label: L,
     decide: impl Fn(&EditMesh<L>, u32, u32) -> bool + Sync,
+    veto: impl FnMut(&EditMesh<L>, u32, u32) -> bool,
+    flipped: impl FnMut(&EditMesh<L>, [u32; 4]),
+) -> usize {
+    passes(m, edges, label, decide, veto, flipped, None)
+}
+
+/// [`flip_in_order_vetoed`], where `settled` (when given: one flag per vertex) says which
+/// edges are known to be left at the start of the pass: those none of whose four vertices is
+/// flagged. They are not decided unless a flip earlier in the pass touched them.
+fn passes<L: Copy + Send + Sync>(
+    m: &mut EditMesh<L>,
+    edges: &[(u32, u32)],
+    label: L,
+    decide: impl Fn(&EditMesh<L>, u32, u32) -> bool + Sync,
     mut veto: impl FnMut(&EditMesh<L>, u32, u32) -> bool,
     mut flipped: impl FnMut(&EditMesh<L>, [u32; 4]),
+    settled: Option<&[bool]>,
 ) -> usize {
     use rayon::prelude::*;
     let mut flips = 0;
+    let left = |x: u32, y: u32, apexes: [u32; 2]| {
+        settled.is_some_and(|flag| {
+            [x, y, apexes[0], apexes[1]]
+                .iter()
+                .all(|&v| !flag.get(v as usize).copied().unwrap_or(true))
+        })
+    };
     if edges.len() < PARALLEL_EDGES {
         for &(x, y) in edges {
             if !(decide(m, x, y) && veto(m, x, y)) {
@@ -130,7 +175,7 @@ pub(crate) fn flip_in_order_vetoed<L: Copy + Send + Sync>(
             .par_iter()
             .map(|&(x, y)| {
                 let apexes = quad(m, x, y).map_or([x, y], |[_, _, c, d]| [c, d]);
-                (apexes, decide(m, x, y))
+                (apexes, !left(x, y, apexes) && decide(m, x, y))
             })
             .collect()
     };
@@ -184,11 +229,17 @@ mod tests {
         let flip = max_min_candidate(&m, 0, 1).expect("the long diagonal is a candidate");
         assert_eq!(flip.old, [[0, 1, 2], [1, 0, 3]]);
         assert_eq!(flip.new, [[0, 3, 2], [1, 2, 3]]);
-        assert_eq!(max_min_flips(&mut m, &[(0, 1)], (), |_, _| true), 1);
+        assert_eq!(
+            max_min_flips_after(&mut m, &[(0, 1)], (), None, &mut [], |_, _| true),
+            1
+        );
         assert!(m.has_edge(2, 3) && !m.has_edge(0, 1));
         // Flipping back would lower the smallest angle.
         assert_eq!(max_min_candidate(&m, 2, 3), None);
-        assert_eq!(max_min_flips(&mut m, &[(2, 3)], (), |_, _| true), 0);
+        assert_eq!(
+            max_min_flips_after(&mut m, &[(2, 3)], (), None, &mut [], |_, _| true),
+            0
+        );
         assert_eq!(m.sanity_check(), Ok(()));
     }
 
@@ -206,6 +257,48 @@ mod tests {
         EditMesh::from_trimesh(&mesh, |_| (), SlotPolicy::Reuse)
     }
 
+    /// Sweeps over every edge until none flips, the later ones told which vertices the sweep
+    /// before came to flip at, make the flips of sweeps that decide every edge, sweep by sweep.
+    #[test]
+    fn sweeps_that_skip_the_settled_edges_flip_what_full_sweeps_flip() {
+        for seed in 0..4 {
+            let mut skipping = jittered(30, seed);
+            let mut full = skipping.clone();
+            // A guard that reads the four vertices only, to make some refusals.
+            let accept = |m: &EditMesh<()>, f: &FlipCandidate| {
+                let [c, d] = [f.new[0][2], f.new[0][1]];
+                m.position(c).x + m.position(d).x > 1.5
+            };
+            let edges = |m: &EditMesh<()>| {
+                let mut e: Vec<(u32, u32)> = m.directed_edges().filter(|&(x, y)| x < y).collect();
+                e.sort_unstable();
+                e
+            };
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            let mut last: Option<Vec<bool>> = None;
+            loop {
+                let (ea, eb) = (edges(&skipping), edges(&full));
+                assert_eq!(ea, eb);
+                let mut now = vec![false; skipping.vertex_count()];
+                let fa =
+                    max_min_flips_after(&mut skipping, &ea, (), last.as_deref(), &mut now, accept);
+                let fb = max_min_flips_after(&mut full, &eb, (), None, &mut [], accept);
+                a.push(fa);
+                b.push(fb);
+                if fa == 0 && fb == 0 {
+                    break;
+                }
+                last = Some(now);
+            }
+            assert!(
+                a.len() >= 3 && a[1] > 0,
+                "{a:?}: the case should take sweeps"
+            );
+            assert_eq!(a, b);
+            assert_eq!(skipping.live_faces(), full.live_faces());
+        }
+    }
+
     #[test]
     fn the_parallel_pass_flips_what_the_sequential_pass_flips() {
         for seed in 0..4 {
@@ -221,11 +314,20 @@ mod tests {
                 let [c, d] = [f.new[0][2], f.new[0][1]];
                 m.position(c).x + m.position(d).x > 1.5
             };
-            let a = max_min_flips(&mut parallel, &edges, (), accept);
+            let a = max_min_flips_after(&mut parallel, &edges, (), None, &mut [], accept);
             // One edge at a time: below PARALLEL_EDGES, so the plain sequential pass.
             let b: usize = edges
                 .iter()
-                .map(|e| max_min_flips(&mut sequential, std::slice::from_ref(e), (), accept))
+                .map(|e| {
+                    max_min_flips_after(
+                        &mut sequential,
+                        std::slice::from_ref(e),
+                        (),
+                        None,
+                        &mut [],
+                        accept,
+                    )
+                })
                 .sum();
             assert!(a > 50, "{a} flips: the case should chain flips");
             assert_eq!(a, b);
@@ -240,7 +342,10 @@ mod tests {
         let m = quad(false);
         assert_eq!(max_min_candidate(&m, 0, 1), None);
         let mut m = quad(true);
-        assert_eq!(max_min_flips(&mut m, &[(0, 1)], (), |_, _| false), 0);
+        assert_eq!(
+            max_min_flips_after(&mut m, &[(0, 1)], (), None, &mut [], |_, _| false),
+            0
+        );
         assert!(m.has_edge(0, 1));
         // A boundary edge is never a candidate.
         assert_eq!(max_min_candidate(&m, 6, 0), None);

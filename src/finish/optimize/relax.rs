@@ -6,7 +6,7 @@ use glam::DVec3;
 use super::*;
 use crate::triangulate::flip::{flip_in_order_vetoed, max_min_candidate};
 
-/// Max-min angle flips ([`max_min_flips`]) of the edges of the faces around `poor_vertices`
+/// Max-min angle flips ([`max_min_candidate`]) of the edges of the faces around `poor_vertices`
 /// (the poor triangles' vertices, [`PoorFaces::vertices`]), where the new faces face the way
 /// the old ones did, stay within `max_offset` of the surface and cross no face (`guard`).
 /// Returns the number of flips.
