@@ -26,6 +26,13 @@ pub struct RefineCrossingsParams {
     pub max_rounds: usize,
     /// Edges shorter than this are not split (σ_p units). Default 1/16.
     pub min_edge_sigma_p: f64,
+    /// The splits of all rounds together at most this share of the mesh's vertices when the
+    /// rounds begin (rounded up): a bound on the work where the rounds do not separate the
+    /// sheets, since each round can double the faces that cross (a folded sliver box at 161
+    /// points, `tests/fuzz/remesh-coincident-seam-curves.obj`: 7,844 splits in 8 rounds and
+    /// 60 s, all taken back). Default 1/4; the corpus at 3000 needs at most 200 (cycloidal.ply,
+    /// chair_model.obj 115, box.STL 21).
+    pub max_splits_per_vertex: f64,
 }
 
 impl Default for RefineCrossingsParams {
@@ -33,6 +40,7 @@ impl Default for RefineCrossingsParams {
         RefineCrossingsParams {
             max_rounds: 8,
             min_edge_sigma_p: 1.0 / 16.0,
+            max_splits_per_vertex: 0.25,
         }
     }
 }
@@ -62,6 +70,8 @@ pub struct RefineCrossingsStats {
 /// with no such sheet that close. Longest edges first, ties by vertex index: deterministic.
 /// Positions in bbox-100 units.
 ///
+/// At most `max_splits` splits: the longest edges past them are left (not counted as refused).
+///
 /// Returns the edges split and refused, and each face's index before (`None` for a face a split
 /// made). The new vertices are appended to `mesh.positions`.
 pub fn refine_faces<S: SurfaceQuery + ?Sized>(
@@ -70,6 +80,7 @@ pub fn refine_faces<S: SurfaceQuery + ?Sized>(
     faces: &[u32],
     protected: &[[u32; 2]],
     min_edge: f64,
+    max_splits: usize,
 ) -> (usize, usize, Vec<Option<u32>>) {
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
     let protected: rustc_hash::FxHashSet<(u32, u32)> =
@@ -89,6 +100,9 @@ pub fn refine_faces<S: SurfaceQuery + ?Sized>(
     let mut m: EditMesh<Option<u32>> = EditMesh::from_trimesh(mesh, Some, SlotPolicy::Reuse);
     let (mut splits, mut refused) = (0, 0);
     for (a, b) in edges {
+        if splits >= max_splits {
+            break;
+        }
         let (pa, pb) = (m.position(a), m.position(b));
         if protected.contains(&(a, b)) || pa.distance(pb) < min_edge {
             refused += 1;
@@ -157,7 +171,8 @@ mod tests {
             ],
             vec![[0, 1, 3], [0, 3, 2]],
         );
-        let (splits, refused, origin) = refine_faces(&mut coarse, &surface, &[0], &[], 0.01);
+        let (splits, refused, origin) =
+            refine_faces(&mut coarse, &surface, &[0], &[], 0.01, usize::MAX);
         // Of face 0's edges only the diagonal 0-3 is interior.
         assert_eq!((splits, refused), (1, 2));
         assert_eq!(coarse.positions.len(), 5);
@@ -168,9 +183,31 @@ mod tests {
         let q = coarse.positions[4];
         assert!(surface.closest_point(q).unwrap().distance < 1e-12);
         assert!((q - DVec3::new(1.25, 0.5, 0.25)).length() < 1e-12, "{q}");
+        // No split past the bound on splits.
+        let mut bounded = coarse.clone();
+        let mut unbounded = coarse.clone();
+        let (all, _, _) = refine_faces(
+            &mut unbounded,
+            &surface,
+            &[0, 1, 2, 3],
+            &[],
+            0.01,
+            usize::MAX,
+        );
+        assert!(all > 2, "{all}");
+        let (s, _, _) = refine_faces(&mut bounded, &surface, &[0, 1, 2, 3], &[], 0.01, 2);
+        assert_eq!(s, 2);
+        assert_eq!(bounded.positions.len(), coarse.positions.len() + 2);
         // A protected edge, or one shorter than the bound, is left.
         let mut again = coarse.clone();
-        let (s, _, _) = refine_faces(&mut again, &surface, &[0, 1, 2, 3], &[[0, 4], [4, 3]], 10.0);
+        let (s, _, _) = refine_faces(
+            &mut again,
+            &surface,
+            &[0, 1, 2, 3],
+            &[[0, 4], [4, 3]],
+            10.0,
+            usize::MAX,
+        );
         assert_eq!(s, 0);
         assert_eq!(again.triangles, coarse.triangles);
     }
@@ -220,7 +257,7 @@ mod tests {
         let mid = 0.5 * (coarse.positions[0] + coarse.positions[2]);
         let near = surface.closest_point(mid).unwrap();
         assert!(near.face >= 4, "the lower wall is nearer: {near:?}");
-        let (splits, _, _) = refine_faces(&mut coarse, &surface, &[0], &[], 0.01);
+        let (splits, _, _) = refine_faces(&mut coarse, &surface, &[0], &[], 0.01, usize::MAX);
         assert_eq!(splits, 1);
         // The foot of (1, 1, 0) on the ridge's plane z = 0.05 x.
         let q = coarse.positions[4];
@@ -250,12 +287,12 @@ mod tests {
             ],
             vec![[0, 1, 3], [0, 3, 2]],
         );
-        let (splits, refused, _) = refine_faces(&mut up, &surface, &[0, 1], &[], 0.01);
+        let (splits, refused, _) = refine_faces(&mut up, &surface, &[0, 1], &[], 0.01, usize::MAX);
         assert_eq!((splits, refused), (0, 5));
         // Facing up, the same sheet is taken.
         let above = TriMesh::new(below.positions.clone(), vec![[0, 3, 2], [0, 1, 3]]);
         let surface = MeshSurface::new(&above).unwrap();
-        let (splits, _, _) = refine_faces(&mut up, &surface, &[0, 1], &[], 0.01);
+        let (splits, _, _) = refine_faces(&mut up, &surface, &[0, 1], &[], 0.01, usize::MAX);
         assert_eq!(splits, 1);
     }
 }

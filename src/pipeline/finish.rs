@@ -406,7 +406,8 @@ fn refine_rounds<S: SurfaceQuery + ?Sized>(
     refine.pairs_before = own.len();
     // The fewest own pairs yet, and the mesh that had them once a later round changed it.
     let mut best: (usize, Option<Kept>) = (own.len(), None);
-    while refine.rounds < f.refine.max_rounds && !own.is_empty() {
+    let budget = (f.refine.max_splits_per_vertex * mesh.positions.len() as f64).ceil() as usize;
+    while refine.rounds < f.refine.max_rounds && !own.is_empty() && refine.splits < budget {
         refine.rounds += 1;
         if best.1.is_none() {
             best.1 = Some(Kept {
@@ -425,6 +426,7 @@ fn refine_rounds<S: SurfaceQuery + ?Sized>(
             &faces,
             &protected,
             f.refine.min_edge_sigma_p * f.sigma_p,
+            budget - refine.splits,
         );
         refine.splits += splits;
         refine.refused += refused;
